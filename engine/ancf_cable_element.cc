@@ -1,0 +1,200 @@
+#include "engine/ancf_cable_element.h"
+
+namespace cablesim {
+namespace {
+
+// Cubic Hermite functions (eq. 3) and their x-derivatives (eq. 25, 26).
+void Shape(double xi, double l, double s[4]) {
+  const double xi2 = xi * xi, xi3 = xi2 * xi;
+  s[0] = 1 - 3 * xi2 + 2 * xi3;
+  s[1] = l * (xi - 2 * xi2 + xi3);
+  s[2] = 3 * xi2 - 2 * xi3;
+  s[3] = l * (xi3 - xi2);
+}
+void ShapeD1(double xi, double l, double s[4]) {
+  s[0] = (-6 * xi + 6 * xi * xi) / l;
+  s[1] = 1 - 4 * xi + 3 * xi * xi;
+  s[2] = (6 * xi - 6 * xi * xi) / l;
+  s[3] = 3 * xi * xi - 2 * xi;
+}
+void ShapeD2(double xi, double l, double s[4]) {
+  s[0] = (-6 + 12 * xi) / (l * l);
+  s[1] = (-4 + 6 * xi) / l;
+  s[2] = (6 - 12 * xi) / (l * l);
+  s[3] = (6 * xi - 2) / l;
+}
+
+}  // namespace
+
+template <int D>
+AncfCableElement<D>::AncfCableElement(double length_m, double ea_n, double ei_n_m2,
+                                      BendingModel bending, int gauss_points)
+    : length_(length_m), ea_(ea_n), ei_(ei_n_m2), bending_(bending),
+      rule_(MakeGaussRule(gauss_points)) {
+  for (int g = 0; g < rule_.n; ++g) {
+    ShapeD1(rule_.xi[g], length_, d1_[g]);
+    ShapeD2(rule_.xi[g], length_, d2_[g]);
+  }
+}
+
+template <int D>
+typename AncfCableElement<D>::Matrix AncfCableElement<D>::MassMatrix(
+    double mass_per_length_kg_m) const {
+  const double l = length_;
+  const double m = mass_per_length_kg_m * l;
+  Eigen::Matrix4d c;
+  c << 156, 22 * l, 54, -13 * l,
+       22 * l, 4 * l * l, 13 * l, -3 * l * l,
+       54, 13 * l, 156, -22 * l,
+       -13 * l, -3 * l * l, -22 * l, 4 * l * l;
+  c *= m / 420;
+  Matrix mass = Matrix::Zero();
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j)
+      for (int d = 0; d < D; ++d) mass(i * D + d, j * D + d) = c(i, j);
+  return mass;
+}
+
+template <int D>
+typename AncfCableElement<D>::Coords AncfCableElement<D>::GravityForce(
+    double mass_per_length_kg_m, const Point& g) const {
+  const double l = length_;
+  const double m = mass_per_length_kg_m * l;
+  Coords q;
+  q.template segment<D>(0) = m * g / 2;
+  q.template segment<D>(D) = m * l * g / 12;
+  q.template segment<D>(2 * D) = m * g / 2;
+  q.template segment<D>(3 * D) = -m * l * g / 12;
+  return q;
+}
+
+template <int D>
+typename AncfCableElement<D>::Point AncfCableElement<D>::Position(const Coords& e,
+                                                                  double xi) const {
+  double s[4];
+  Shape(xi, length_, s);
+  Point r = Point::Zero();
+  for (int k = 0; k < 4; ++k) r += s[k] * e.template segment<D>(k * D);
+  return r;
+}
+
+template <int D>
+typename AncfCableElement<D>::Point AncfCableElement<D>::Slope(const Coords& e,
+                                                               double xi) const {
+  double s[4];
+  ShapeD1(xi, length_, s);
+  Point r = Point::Zero();
+  for (int k = 0; k < 4; ++k) r += s[k] * e.template segment<D>(k * D);
+  return r;
+}
+
+template <int D>
+typename AncfCableElement<D>::BMatrix AncfCableElement<D>::B(int g) const {
+  BMatrix b = BMatrix::Zero();
+  for (int k = 0; k < 4; ++k)
+    for (int d = 0; d < D; ++d) {
+      b(d, k * D + d) = d1_[g][k];
+      b(D + d, k * D + d) = d2_[g][k];
+    }
+  return b;
+}
+
+template <int D>
+typename AncfCableElement<D>::Energy AncfCableElement<D>::StrainEnergy(const Coords& e) const {
+  Energy energy;
+  for (int g = 0; g < rule_.n; ++g) {
+    Point u = Point::Zero(), w = Point::Zero();
+    for (int k = 0; k < 4; ++k) {
+      u += d1_[g][k] * e.template segment<D>(k * D);
+      w += d2_[g][k] * e.template segment<D>(k * D);
+    }
+    const double a = u.squaredNorm(), b = u.dot(w), c = w.squaredNorm();
+    const double eps = (a - 1) / 2;
+    const double wl = rule_.weight[g] * length_;
+    energy.axial += wl * 0.5 * ea_ * eps * eps;
+    double kappa2 = 0;
+    if (bending_ == BendingModel::kExact) {
+      kappa2 = (a * c - b * b) / (a * a * a);
+    } else if (bending_ == BendingModel::kLinear) {
+      kappa2 = c;
+    }
+    energy.bending += wl * 0.5 * ei_ * kappa2;
+  }
+  return energy;
+}
+
+template <int D>
+void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* tangent) const {
+  using Id = Eigen::Matrix<double, D, D>;
+  using Block = Eigen::Matrix<double, D, D>;
+  for (int g = 0; g < rule_.n; ++g) {
+    const double* s1 = d1_[g];
+    const double* s2 = d2_[g];
+    Point u = Point::Zero(), w = Point::Zero();
+    for (int k = 0; k < 4; ++k) {
+      u += s1[k] * e.template segment<D>(k * D);
+      w += s2[k] * e.template segment<D>(k * D);
+    }
+    const double a = u.squaredNorm(), b = u.dot(w), c = w.squaredNorm();
+    const double wl = rule_.weight[g] * length_;
+
+    // Gradient (gu, gw) and Hessian blocks of psi with respect to (u, w).
+    const double eps = (a - 1) / 2;
+    Point gu = ea_ * eps * u, gw = Point::Zero();
+    Block huu, huw = Block::Zero(), hww = Block::Zero();
+    if (tangent) huu = ea_ * (eps * Id::Identity() + u * u.transpose());
+    if (bending_ == BendingModel::kLinear) {
+      gw += ei_ * w;
+      if (tangent) hww += ei_ * Id::Identity();
+    } else if (bending_ == BendingModel::kExact) {
+      // psi_b = EI/2 f(a, b, c), f = c / a^2 - b^2 / a^3, with
+      // da/du = 2u, db/du = w, db/dw = u, dc/dw = 2w.
+      const double ia = 1 / a, ia2 = ia * ia, ia3 = ia2 * ia, ia4 = ia2 * ia2;
+      const double k = 0.5 * ei_;
+      const double fa = k * (-2 * c * ia3 + 3 * b * b * ia4);
+      const double fb = k * (-2 * b * ia3);
+      const double fc = k * ia2;
+      gu += 2 * fa * u + fb * w;
+      gw += fb * u + 2 * fc * w;
+      if (tangent) {
+        const double faa = k * (6 * c * ia4 - 12 * b * b * ia4 * ia);
+        const double fab = k * (6 * b * ia4);
+        const double fac = k * (-2 * ia3);
+        const double fbb = k * (-2 * ia3);
+        // Second derivatives of f through a, b, c, plus f_a, f_b, f_c times
+        // the Hessians of a, b, c.
+        huu += 4 * faa * u * u.transpose() + 2 * fab * (u * w.transpose() + w * u.transpose()) +
+               fbb * w * w.transpose() + 2 * fa * Id::Identity();
+        huw += 2 * fab * u * u.transpose() + 4 * fac * u * w.transpose() +
+               fbb * w * u.transpose() + fb * Id::Identity();
+        hww += fbb * u * u.transpose() + 2 * fc * Id::Identity();
+      }
+    }
+    for (int k = 0; k < 4; ++k)
+      force->template segment<D>(k * D) += wl * (s1[k] * gu + s2[k] * gw);
+    if (tangent) {
+      // K += wl B^T H B, block by block: B's node block k is
+      // [s_k' I; s_k'' I], so block (k, m) is
+      // s_k' s_m' H_uu + s_k' s_m'' H_uw + s_k'' s_m' H_wu + s_k'' s_m'' H_ww.
+      for (int k = 0; k < 4; ++k) {
+        const double p1 = wl * s1[k], p2 = wl * s2[k];
+        for (int m = k; m < 4; ++m) {
+          const double q1 = s1[m], q2 = s2[m];
+          tangent->template block<D, D>(k * D, m * D) +=
+              (p1 * q1) * huu + (p1 * q2) * huw + (p2 * q1) * huw.transpose() + (p2 * q2) * hww;
+        }
+      }
+    }
+  }
+  if (tangent) {
+    for (int k = 0; k < 4; ++k)
+      for (int m = k + 1; m < 4; ++m)
+        tangent->template block<D, D>(m * D, k * D) =
+            tangent->template block<D, D>(k * D, m * D).transpose();
+  }
+}
+
+template class AncfCableElement<2>;
+template class AncfCableElement<3>;
+
+}  // namespace cablesim

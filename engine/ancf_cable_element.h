@@ -1,0 +1,101 @@
+#ifndef CABLESIM_ENGINE_ANCF_CABLE_ELEMENT_H_
+#define CABLESIM_ENGINE_ANCF_CABLE_ELEMENT_H_
+
+// The gradient-deficient ANCF cable element (MODEL.md sections 1-3), planar
+// (D = 2, 8 coordinates) or spatial (D = 3, 12 coordinates).
+//
+// Coordinates e = [r_O, r_O,x, r_A, r_A,x] (paper eq. 4, 6, 7 with its typo
+// fixed); r(x) = S(x) e with the cubic Hermite functions of eq. 3.
+// With u = r' = S' e and w = r'' = S'' e (eq. 25, 26), the strain energy per
+// unit undeformed length is
+//
+//   psi = EA/2 eps^2 + EI/2 kappa^2,   eps = (u.u - 1) / 2   (Green-Lagrange)
+//
+// and, writing a = u.u, b = u.w, c = w.w,
+//
+//   EXACT:  kappa^2 = |u x w|^2 / |u|^6 = (a c - b^2) / a^3     (eq. 17)
+//   LINEAR: kappa^2 = c                                          (eq. 21-22)
+//   NONE:   kappa^2 = 0.
+//
+// The identity |u x w|^2 = a c - b^2 holds in the plane and in space, so
+// one formula serves both dimensions and is smooth (no absolute value).
+// U = int_0^l psi dx by Gauss quadrature; the force Q_k = dU/de and the
+// tangent K = d^2U/de^2 are analytic (no finite differences).
+//
+// Units: SI. Forces in N (or N for position coordinates and N m for slope
+// coordinates), stiffness in N/m accordingly, energy in J.
+
+#include <Eigen/Core>
+
+#include "engine/gauss_quadrature.h"
+#include "engine/scene.h"
+
+namespace cablesim {
+
+template <int D>
+class AncfCableElement {
+ public:
+  static constexpr int kCoords = 4 * D;
+  using Coords = Eigen::Matrix<double, kCoords, 1>;
+  using Matrix = Eigen::Matrix<double, kCoords, kCoords>;
+  using Point = Eigen::Matrix<double, D, 1>;
+
+  struct Energy {
+    double axial = 0;
+    double bending = 0;
+  };
+
+  // Default quadrature: 5 points integrate the axial term (degree 8 in xi)
+  // exactly; tests/ancf_cable_element_test.cc measures that the rational
+  // exact-curvature term is converged to better than 1e-6 relative at
+  // 5 points for strongly bent and stretched elements.
+  static constexpr int kDefaultGaussPoints = 5;
+
+  AncfCableElement() = default;
+  AncfCableElement(double length_m, double ea_n, double ei_n_m2, BendingModel bending,
+                   int gauss_points = kDefaultGaussPoints);
+
+  double length() const { return length_; }
+
+  // Consistent mass matrix (eq. 8-10, MODEL.md section 2) for mass per unit
+  // length rho A [kg/m].
+  Matrix MassMatrix(double mass_per_length_kg_m) const;
+
+  // Generalized gravity force m [g/2, l g/12, g/2, -l g/12] per component;
+  // the element's gravitational potential is exactly -Q_g . e.
+  Coords GravityForce(double mass_per_length_kg_m, const Point& g) const;
+
+  // Position r(xi l) and slope r'(xi l) for xi in [0, 1].
+  Point Position(const Coords& e, double xi) const;
+  Point Slope(const Coords& e, double xi) const;
+
+  Energy StrainEnergy(const Coords& e) const;
+
+  // Adds the elastic force Q_k = dU/de to `force` and, when `tangent` is not
+  // null, the tangent K_T = dQ_k/de to `tangent` (which must be symmetric on
+  // entry, usually zero). Allocates nothing.
+  void ElasticForce(const Coords& e, Coords* force, Matrix* tangent) const;
+
+ private:
+  // B maps e to (u, w) at Gauss point g: rows 0..D-1 are S', rows D..2D-1
+  // are S''.
+  using BMatrix = Eigen::Matrix<double, 2 * D, kCoords>;
+  BMatrix B(int g) const;
+
+  double length_ = 0;
+  double ea_ = 0;
+  double ei_ = 0;
+  BendingModel bending_ = BendingModel::kExact;
+  GaussRule rule_;
+  // Shape-function derivatives at the Gauss points: d1_[g][k] = s_k'(x),
+  // d2_[g][k] = s_k''(x), derivatives in x.
+  double d1_[GaussRule::kMaxPoints][4] = {};
+  double d2_[GaussRule::kMaxPoints][4] = {};
+};
+
+extern template class AncfCableElement<2>;
+extern template class AncfCableElement<3>;
+
+}  // namespace cablesim
+
+#endif  // CABLESIM_ENGINE_ANCF_CABLE_ELEMENT_H_

@@ -1,0 +1,148 @@
+#include "engine/implicit_euler_stepper.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "absl/strings/str_format.h"
+
+namespace cablesim {
+
+ImplicitEulerStepper::ImplicitEulerStepper(PlanarModel* model, const SolverSettings& settings)
+    : model_(model), settings_(settings) {
+  n_ = model->dofs();
+  m_ = model->multipliers();
+  solver_.Resize(model->envelope(), model->jacobian_pattern());
+  z_ = model->initial_z();
+  v_ = model->initial_v();
+  a_.setZero(n_);
+  lambda_.setZero(m_);
+  z1_.setZero(n_);
+  v1_.setZero(n_);
+  lambda1_.setZero(m_);
+  q_.setZero(model->coordinates());
+  f_.setZero(n_);
+  phi_.setZero(m_);
+  mdv_.setZero(n_);
+  rhs_.setZero(n_ + m_);
+  dx_.setZero(n_ + m_);
+  bt_mu_.setZero(n_);
+}
+
+bool ImplicitEulerStepper::Initialize(std::string* reason) {
+  model_->ToFull(z_, &q_);
+  model_->NetForce(q_, 1.0, &f_);
+  model_->Constraints(q_, &phi_, &solver_.b());
+  Eigen::VectorXd qdot(model_->coordinates()), gamma(m_);
+  model_->RateToFull(v_, &qdot);
+  model_->ConstraintGamma(q_, qdot, &gamma);
+  std::copy(model_->mass().values(), model_->mass().values() + model_->mass().stored(),
+            solver_.a().values());
+  if (!solver_.Prepare()) {
+    *reason = "the mass matrix could not be factorized";
+    return false;
+  }
+  rhs_.head(n_) = f_;
+  if (m_ > 0) rhs_.tail(m_) = gamma;
+  const auto stats = solver_.Solve(settings_.linear_solver, rhs_, 1e-12,
+                                   std::max(settings_.max_linear_iterations, 1000), &dx_);
+  if (!(stats.relative_residual <= 1e-8)) {
+    *reason = absl::StrFormat(
+        "the initial acceleration solve did not converge (relative residual %.3g)",
+        stats.relative_residual);
+    return false;
+  }
+  a_ = dx_.head(n_);
+  lambda_ = dx_.tail(m_);
+  return true;
+}
+
+ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
+  StepStats st;
+  const double tol = settings_.newton_tolerance;
+  v1_ = v_ + h * a_;
+  lambda1_ = lambda_;
+  double last_increment = 0;
+  SkylineLdlt& a = solver_.a();
+  for (int it = 0; it <= settings_.max_newton_iterations; ++it) {
+    z1_ = z_ + h * v1_;
+    model_->ToFull(z1_, &q_);
+    // Newton matrix M + h^2 (K_T + H_lambda), assembled with the forces
+    // unless this evaluation is expected to be the converged one.
+    const bool checking = it > 0 && last_increment <= tol * (1 + z1_.lpNorm<Eigen::Infinity>());
+    bool assembled = !checking;
+    if (assembled) {
+      std::copy(model_->mass().values(), model_->mass().values() + model_->mass().stored(),
+                a.values());
+    }
+    const double force_size = model_->NetForce(q_, 1.0, &f_, assembled ? &a : nullptr, h * h);
+    model_->Constraints(q_, &phi_, &solver_.b());
+    // R_v = M (v1 - v0) - h f + Phi_z^T (h lambda).
+    mdv_ = v1_ - v_;
+    model_->mass().Multiply(mdv_.data(), rhs_.data());
+    auto rv = rhs_.head(n_);
+    bt_mu_.setZero();
+    solver_.b().AddTransposeMultiply(lambda1_.data(), bt_mu_.data());
+    bt_mu_ *= h;
+    const double scale = std::max({rv.lpNorm<Eigen::Infinity>(), h * force_size,
+                                   bt_mu_.lpNorm<Eigen::Infinity>(), 1e-300});
+    rv += bt_mu_ - h * f_;
+    if (m_ > 0) rhs_.tail(m_) = phi_ / h;
+    const double zscale = 1 + z1_.lpNorm<Eigen::Infinity>();
+    const double res = rv.lpNorm<Eigen::Infinity>() / scale;
+    const double viol = m_ > 0 ? phi_.lpNorm<Eigen::Infinity>() : 0.0;
+    if (!std::isfinite(res) || !std::isfinite(viol)) {
+      st.reason = "the residual is not finite (the step diverged)";
+      return st;
+    }
+    if (checking && res <= tol && viol <= tol * zscale) {
+      st.converged = true;
+      st.residual = res;
+      break;
+    }
+    if (it == settings_.max_newton_iterations) {
+      st.reason = absl::StrFormat(
+          "Newton did not converge in %d iterations (position increment %.3g m, relative "
+          "residual %.3g, constraint violation %.3g)",
+          it, last_increment, res, viol);
+      return st;
+    }
+    if (!assembled) {
+      std::copy(model_->mass().values(), model_->mass().values() + model_->mass().stored(),
+                a.values());
+      model_->NetForce(q_, 1.0, &f_, &a, h * h);
+    }
+    if (m_ > 0) model_->AddConstraintHessian(q_, lambda1_, h * h, &a);
+    if (!solver_.Prepare()) {
+      st.reason = "the Newton matrix has a non-finite pivot";
+      return st;
+    }
+    rhs_ = -rhs_;
+    const auto ls = solver_.Solve(settings_.linear_solver, rhs_, settings_.linear_tolerance,
+                                  settings_.max_linear_iterations, &dx_);
+    ++st.newton_iterations;
+    st.linear_iterations += ls.iterations;
+    st.max_linear_residual = std::max(st.max_linear_residual, ls.relative_residual);
+    // An inexact solve still gives a descent direction; a bad one does not.
+    if (!(ls.relative_residual <= 1e-6)) {
+      st.reason = absl::StrFormat(
+          "the %s solve did not converge (true relative residual %.3g after %d iterations)",
+          settings_.linear_solver == LinearSolverKind::kGmres ? "GMRES" : "MINRES",
+          ls.relative_residual, ls.iterations);
+      return st;
+    }
+    v1_ += dx_.head(n_);
+    if (m_ > 0) lambda1_ += dx_.tail(m_) / h;
+    last_increment = h * dx_.head(n_).lpNorm<Eigen::Infinity>();
+    if (!std::isfinite(last_increment) || last_increment > 1e6 * zscale) {
+      st.reason = "Newton diverged";
+      return st;
+    }
+  }
+  a_ = (v1_ - v_) / h;
+  v_ = v1_;
+  z_ = z1_;
+  lambda_ = lambda1_;
+  return st;
+}
+
+}  // namespace cablesim

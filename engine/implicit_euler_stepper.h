@@ -1,0 +1,76 @@
+#ifndef CABLESIM_ENGINE_IMPLICIT_EULER_STEPPER_H_
+#define CABLESIM_ENGINE_IMPLICIT_EULER_STEPPER_H_
+
+// The paper's stepper (MODEL.md section 5): backward Euler on the index-3
+// equations of motion,
+//
+//   v1 = v0 + h a1,   z1 = z0 + h v1,
+//   M (v1 - v0) + h (Q_k(z1) - Q_a(z1)) + Phi_z(z1)^T mu = 0,   mu = h lambda
+//   Phi(z1) / h = 0,
+//
+// solved by Newton on (v1, mu) from the predictor v1 = v0 + h a0. Each Newton
+// step solves the symmetric saddle-point system
+//
+//   [ M + h^2 (K_T + H_lambda)   Phi_z^T ] [dv ]     [ R_v ]
+//   [ Phi_z                      0       ] [dmu] = - [ R_c ]
+//
+// with MINRES (or GMRES) under SaddlePointSolver's preconditioner. Newton
+// stops when the position increment h |dv|_inf is below
+// tol (1 + |z|_inf), the momentum residual below tol times its largest term
+// and |Phi|_inf below tol (1 + |z|_inf); otherwise the step is reported as
+// not converged and the caller retries with a smaller step. Nothing is
+// accepted silently.
+//
+// Backward Euler is first order and removes energy at high frequencies;
+// simulation.cc reports how much.
+//
+// Step() allocates nothing.
+
+#include <string>
+
+#include <Eigen/Core>
+
+#include "engine/planar_model.h"
+#include "engine/saddle_point_solver.h"
+#include "engine/scene.h"
+
+namespace cablesim {
+
+class ImplicitEulerStepper {
+ public:
+  struct StepStats {
+    bool converged = false;
+    int newton_iterations = 0;
+    int linear_iterations = 0;
+    double residual = 0;               // relative momentum residual accepted
+    double max_linear_residual = 0;    // largest true relative residual
+    std::string reason;                // why it did not converge
+  };
+
+  ImplicitEulerStepper(PlanarModel* model, const SolverSettings& settings);
+
+  // Consistent initial acceleration from M a + Phi_z^T lambda = f,
+  // Phi_z a = gamma. Returns false (with `reason`) if the solve fails.
+  bool Initialize(std::string* reason);
+
+  // Advances by h, or leaves the state unchanged and returns !converged.
+  StepStats Step(double h);
+
+  const Eigen::VectorXd& z() const { return z_; }
+  const Eigen::VectorXd& v() const { return v_; }
+  const Eigen::VectorXd& a() const { return a_; }
+  const Eigen::VectorXd& lambda() const { return lambda_; }
+
+ private:
+  PlanarModel* model_;
+  SolverSettings settings_;
+  SaddlePointSolver solver_;
+  int n_ = 0, m_ = 0;
+  Eigen::VectorXd z_, v_, a_, lambda_;
+  // Newton work vectors.
+  Eigen::VectorXd z1_, v1_, lambda1_, q_, f_, phi_, mdv_, rhs_, dx_, bt_mu_;
+};
+
+}  // namespace cablesim
+
+#endif  // CABLESIM_ENGINE_IMPLICIT_EULER_STEPPER_H_

@@ -1,0 +1,81 @@
+#ifndef CABLESIM_ENGINE_SADDLE_POINT_SOLVER_H_
+#define CABLESIM_ENGINE_SADDLE_POINT_SOLVER_H_
+
+// Solves the symmetric saddle-point (KKT) systems of the steppers and of
+// statics,
+//
+//   [ A   B^T ] [x1]   [r1]
+//   [ B   0   ] [x2] = [r2],
+//
+// A = M + h^2 (K_T + H_lambda) (dynamics) or K_T + H_lambda (statics) on the
+// unknowns, B = Phi_q (MODEL.md section 5), with MINRES or GMRES under the
+// block-diagonal preconditioner
+//
+//   P = diag( L|D|L^T , B (L|D|L^T)^{-1} B^T ),
+//
+// where A = L D L^T is A's skyline factorization. P is symmetric positive
+// definite, as MINRES requires; when A is positive definite the
+// preconditioned matrix has only three distinct eigenvalues (Murphy, Golub
+// and Wathen, SIAM J. Sci. Comput. 21, 2000), so MINRES converges in a few
+// iterations whatever the step and the stiffness. After every solve the
+// true residual is computed and returned, never only the estimate.
+//
+// Nothing here allocates after Resize().
+
+#include <vector>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+#include "engine/krylov.h"
+#include "engine/scene.h"
+#include "engine/skyline_ldlt.h"
+#include "engine/sparse_rows.h"
+
+namespace cablesim {
+
+class SaddlePointSolver {
+ public:
+  struct Stats {
+    int iterations = 0;
+    double relative_residual = 0;  // true: |r - K x| / |r|
+    bool converged = false;
+  };
+
+  void Resize(const std::vector<int>& envelope, const SparseRows& jacobian_pattern);
+
+  int n() const { return a_.size(); }
+  int m() const { return b_.rows(); }
+  SkylineLdlt& a() { return a_; }
+  SparseRows& b() { return b_; }
+
+  // Factors A and forms the Schur-complement preconditioner. False when a
+  // pivot is not finite.
+  bool Prepare();
+
+  // Solves K x = rhs (sizes n + m). `tolerance` is relative.
+  Stats Solve(LinearSolverKind kind, const Eigen::VectorXd& rhs, double tolerance,
+              int max_iterations, Eigen::VectorXd* x);
+
+  // y = K x.
+  void Multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
+
+ private:
+  void Precondition(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
+
+  SkylineLdlt a_;
+  SparseRows b_;
+  Eigen::MatrixXd y_;      // (L|D|L^T)^{-1} B^T, n x m
+  Eigen::MatrixXd schur_;  // m x m
+  Eigen::LLT<Eigen::MatrixXd> schur_llt_;
+  bool schur_dense_ = true;
+  Eigen::VectorXd schur_diag_;
+  mutable Eigen::VectorXd col_, tmp_;
+  Eigen::VectorXd residual_, correction_;
+  Minres minres_;
+  Gmres gmres_;
+};
+
+}  // namespace cablesim
+
+#endif  // CABLESIM_ENGINE_SADDLE_POINT_SOLVER_H_

@@ -1,0 +1,109 @@
+#ifndef CABLESIM_ENGINE_SCENE_H_
+#define CABLESIM_ENGINE_SCENE_H_
+
+// The engine's description of a scene: plain structs, free of protobuf.
+// convert/ builds one from a cablesim.v1.Scene after validating it; the
+// vectors here keep the indices of the scene file, so the engine can name a
+// field (`joints[1]`) in its own errors.
+//
+// Units are SI: m, kg, s, N, Pa, rad.
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace cablesim {
+
+enum class BendingModel { kExact, kLinear, kNone };
+enum class JointType { kPin, kFixed };
+enum class Analysis { kDynamic, kStatic };
+enum class Integrator { kImplicitEuler };
+enum class LinearSolverKind { kMinres, kGmres };
+
+struct CableSpec {
+  std::string name;
+  // Polyline the undeformed-length cable is laid along at t = 0 (>= 2
+  // points). A straight cable has two.
+  std::vector<Eigen::Vector3d> points;
+  double length_m = 0;  // undeformed length
+  int elements = 10;    // before extra nodes are inserted
+  double density_kg_m3 = 0;
+  double youngs_modulus_pa = 0;
+  double area_m2 = 0;
+  double second_moment_m4 = 0;
+  BendingModel bending = BendingModel::kExact;
+};
+
+struct BodySpec {
+  std::string name;
+  double mass_kg = 0;
+  // Principal moments of inertia about the centre of mass, body axes.
+  Eigen::Vector3d inertia_kg_m2 = Eigen::Vector3d::Zero();
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();  // centre of mass
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitX();       // local x, unit
+};
+
+// A place on a cable (cable >= 0), on a body (body >= 0), or the ground
+// (both -1).
+struct Attachment {
+  int cable = -1;
+  double s_m = 0;  // arc length in the undeformed cable
+  int body = -1;
+  Eigen::Vector3d point_body_m = Eigen::Vector3d::Zero();
+  bool IsGround() const { return cable < 0 && body < 0; }
+};
+
+struct JointSpec {
+  JointType type = JointType::kPin;
+  Attachment a;  // never ground
+  Attachment b;
+};
+
+struct LoadSpec {
+  Attachment at;
+  Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
+  Eigen::Vector3d torque_nm = Eigen::Vector3d::Zero();  // bodies only
+};
+
+struct ProbeSpec {
+  std::string name;
+  Attachment at;
+};
+
+struct InitialVelocitySpec {
+  Eigen::Vector3d linear_m_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_rad_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d origin_m = Eigen::Vector3d::Zero();
+};
+
+struct SolverSettings {
+  Analysis analysis = Analysis::kDynamic;
+  double duration_s = 0;
+  double step_s = 1e-3;
+  double output_interval_s = 0;  // 0: every step
+  Integrator integrator = Integrator::kImplicitEuler;
+  LinearSolverKind linear_solver = LinearSolverKind::kMinres;
+  int load_steps = 10;
+  double newton_tolerance = 1e-8;
+  int max_newton_iterations = 25;
+  int max_step_halvings = 12;
+  double linear_tolerance = 1e-10;
+  int max_linear_iterations = 200;
+};
+
+struct Scene {
+  std::string name;
+  Eigen::Vector3d gravity_m_s2 = Eigen::Vector3d::Zero();
+  std::vector<CableSpec> cables;
+  std::vector<BodySpec> bodies;
+  std::vector<JointSpec> joints;
+  std::vector<LoadSpec> loads;
+  std::vector<ProbeSpec> probes;
+  InitialVelocitySpec initial_velocity;
+  SolverSettings solver;
+};
+
+}  // namespace cablesim
+
+#endif  // CABLESIM_ENGINE_SCENE_H_

@@ -1,0 +1,102 @@
+#ifndef CABLESIM_ENGINE_SIMULATION_H_
+#define CABLESIM_ENGINE_SIMULATION_H_
+
+// Runs a scene's analysis (DYNAMIC or STATIC) and reports it frame by frame
+// to a FrameSink, then returns the run's summary: what it cost (steps,
+// iterations, wall time) and how far it can be trusted (energy balance,
+// constraint violation, Newton and linear residuals).
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "engine/scene.h"
+
+namespace cablesim {
+
+// What the engine built for a scene.
+struct ModelInfo {
+  std::string model;       // "planar" (later also "spatial")
+  int coordinates = 0;     // all nodal and body coordinates
+  int dofs = 0;            // unknowns after removing ground-fixed ones
+  int multipliers = 0;     // Lagrange multipliers (constraint equations)
+  int elements = 0;        // cable elements, inserted nodes included
+  int nodes = 0;
+  std::vector<std::string> probe_names;
+};
+
+struct ProbeSample {
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d acceleration_m_s2 = Eigen::Vector3d::Zero();
+};
+
+// Energy [J]. `potential` is that of gravity and of the constant applied
+// loads (both conservative), so `total` is conserved by the exact solution.
+struct EnergySample {
+  double kinetic = 0;
+  double potential = 0;
+  double axial = 0;
+  double bending = 0;
+  double total = 0;
+};
+
+struct Frame {
+  // Time [s] for DYNAMIC; the load factor in (0, 1] for STATIC.
+  double t = 0;
+  std::vector<ProbeSample> probes;  // in scene order
+  EnergySample energy;
+  // Largest absolute constraint residual (m for positions, dimensionless
+  // for tangent cross products).
+  double constraint_violation = 0;
+};
+
+class FrameSink {
+ public:
+  virtual ~FrameSink() = default;
+  virtual absl::Status OnStart(const ModelInfo& info) { return absl::OkStatus(); }
+  // A non-OK status stops the run (the summary says "cancelled").
+  virtual absl::Status OnFrame(const Frame& frame) = 0;
+};
+
+struct RunSummary {
+  std::string status = "ok";  // "ok", "failed" or "cancelled"
+  std::string error;          // why, when not ok (with the time)
+  double failure_time_s = 0;  // time of the step that failed
+  std::string analysis;       // "DYNAMIC" or "STATIC"
+  std::string integrator;
+  std::string linear_solver;
+  ModelInfo info;
+  int64_t frames = 0;
+  int64_t steps = 0;            // accepted steps (load increments for STATIC)
+  int64_t rejected_steps = 0;   // steps retried with half the step
+  int64_t newton_iterations = 0;
+  int64_t linear_iterations = 0;
+  double min_step_s = 0;        // smallest step taken
+  double wall_seconds = 0;
+  double end_time_s = 0;        // last converged time (or load factor)
+  double energy_initial = 0;
+  double energy_final = 0;
+  // Energy the stepper removed: initial minus final total energy for a
+  // scene without external work (gravity and constant loads included);
+  // backward Euler's numerical damping.
+  double energy_dissipated = 0;
+  double energy_max_increase = 0;  // largest rise of the total above its start
+  double max_constraint_violation = 0;
+  double max_newton_residual = 0;  // largest accepted Newton residual norm
+  double max_linear_residual = 0;  // largest true relative residual of a solve
+};
+
+// Builds the model for `scene` and runs it. Returns InvalidArgument (naming
+// the scene field) when the scene cannot be modelled; a numerical failure is
+// not an error status: the summary's status is "failed" with the reason, and
+// every frame up to the last converged one has been delivered.
+absl::StatusOr<RunSummary> RunScene(const Scene& scene, FrameSink* sink);
+
+}  // namespace cablesim
+
+#endif  // CABLESIM_ENGINE_SIMULATION_H_
