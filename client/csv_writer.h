@@ -1,0 +1,82 @@
+#ifndef CABLESIM_CLIENT_CSV_WRITER_H_
+#define CABLESIM_CLIENT_CSV_WRITER_H_
+
+// Writes a run's trajectory as CSV, one row per frame:
+//
+//   t, then for each probe NAME.x NAME.y NAME.z NAME.vx NAME.vy NAME.vz
+//   NAME.ax NAME.ay NAME.az, then energy.kinetic energy.potential
+//   energy.axial energy.bending energy.total constraint.violation
+//
+// t is the time [s] (DYNAMIC) or the load factor (STATIC); positions [m],
+// velocities [m/s], accelerations [m/s^2], energies [J]. Numbers are written
+// with 17 significant digits, so they read back exactly.
+
+#include <cstdint>
+#include <fstream>
+#include <memory>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "engine/simulation.h"
+
+namespace cablesim {
+
+class CsvWriter : public FrameSink {
+ public:
+  // Rows written between flushes of the output.
+  static constexpr int64_t kRowsPerFlush = 100;
+
+  // Creates (or truncates) the file at `path`. Returns a non-OK status
+  // naming the file when it cannot be opened.
+  static absl::StatusOr<std::unique_ptr<CsvWriter>> Create(const std::string& path);
+
+  // Writes to `out`, which must outlive the writer. `name` is used in error
+  // messages.
+  CsvWriter(std::ostream* out, std::string name);
+
+  CsvWriter(const CsvWriter&) = delete;
+  CsvWriter& operator=(const CsvWriter&) = delete;
+
+  // Flushes what is still buffered.
+  ~CsvWriter() override;
+
+  // Writes the header line. Returns the write error, if any.
+  absl::Status OnStart(const ModelInfo& info) override;
+  // Writes one row (every frame must have one sample per probe of OnStart).
+  // Flushes every kRowsPerFlush rows. Returns the write error, if any.
+  absl::Status OnFrame(const Frame& frame) override;
+
+  // Flushes and, for a file made by Create, closes it. Returns the first
+  // error of the whole writer, so a run's CSV is known complete when this
+  // returns OK. Later frames are refused.
+  absl::Status Finish();
+
+  // The first error so far (OK if none).
+  const absl::Status& status() const { return status_; }
+  int64_t rows() const { return rows_; }
+
+  // The header line for `probe_names`, without the newline.
+  static std::string Header(const std::vector<std::string>& probe_names);
+
+ private:
+  CsvWriter(std::unique_ptr<std::ofstream> file, std::string name);
+
+  // Records a failure of `out_` (with `what` it was doing) in status_.
+  absl::Status CheckStream(const char* what);
+
+  std::unique_ptr<std::ofstream> file_;  // set when the writer owns the file
+  std::ostream* out_;
+  std::string name_;
+  absl::Status status_;
+  size_t probe_count_ = 0;
+  bool started_ = false;
+  bool finished_ = false;
+  int64_t rows_ = 0;
+};
+
+}  // namespace cablesim
+
+#endif  // CABLESIM_CLIENT_CSV_WRITER_H_

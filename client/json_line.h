@@ -1,0 +1,44 @@
+#ifndef CABLESIM_CLIENT_JSON_LINE_H_
+#define CABLESIM_CLIENT_JSON_LINE_H_
+
+// Builds one JSON object on one line, key by key, in insertion order. Used
+// for the machine-readable output of the command line.
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+namespace cablesim {
+
+class JsonLine {
+ public:
+  JsonLine() = default;
+
+  // Adds `"key":value`. Keys are not checked for duplicates.
+  JsonLine& Add(std::string_view key, std::string_view value);
+  JsonLine& Add(std::string_view key, const char* value);
+  JsonLine& Add(std::string_view key, int64_t value);
+  JsonLine& Add(std::string_view key, int value);
+  // Written in the shortest form that reads back to the same double; a
+  // non-finite value is written as null.
+  JsonLine& Add(std::string_view key, double value);
+  JsonLine& Add(std::string_view key, bool value);
+
+  // The object, e.g. `{"status":"ok","steps":10}`, without a newline.
+  std::string ToString() const { return body_ + "}"; }
+
+  // `value` as a JSON string literal, quotes included. Control characters
+  // are escaped; invalid UTF-8 is passed through unchanged.
+  static std::string Quote(std::string_view value);
+  // `value` as a JSON number, or `null` when it is not finite.
+  static std::string Number(double value);
+
+ private:
+  void AddRaw(std::string_view key, std::string_view json_value);
+
+  std::string body_ = "{";
+};
+
+}  // namespace cablesim
+
+#endif  // CABLESIM_CLIENT_JSON_LINE_H_

@@ -1,0 +1,39 @@
+#include "client/summary_json.h"
+
+#include "client/json_line.h"
+
+namespace cablesim {
+
+std::string SummaryToJson(const RunSummary& summary) {
+  JsonLine json;
+  json.Add("status", summary.status);
+  if (!summary.error.empty()) json.Add("error", summary.error);
+  if (summary.status == "failed") json.Add("failure_time_s", summary.failure_time_s);
+  json.Add("model", summary.info.model)
+      .Add("analysis", summary.analysis)
+      .Add("integrator", summary.integrator)
+      .Add("linear_solver", summary.linear_solver)
+      .Add("coordinates", summary.info.coordinates)
+      .Add("dofs", summary.info.dofs)
+      .Add("multipliers", summary.info.multipliers)
+      .Add("elements", summary.info.elements)
+      .Add("nodes", summary.info.nodes)
+      .Add("frames", summary.frames)
+      .Add("steps", summary.steps)
+      .Add("rejected_steps", summary.rejected_steps)
+      .Add("newton_iterations", summary.newton_iterations)
+      .Add("linear_iterations", summary.linear_iterations)
+      .Add("min_step_s", summary.min_step_s)
+      .Add("end_time_s", summary.end_time_s)
+      .Add("wall_seconds", summary.wall_seconds)
+      .Add("energy_initial", summary.energy_initial)
+      .Add("energy_final", summary.energy_final)
+      .Add("energy_dissipated", summary.energy_dissipated)
+      .Add("energy_max_increase", summary.energy_max_increase)
+      .Add("max_constraint_violation", summary.max_constraint_violation)
+      .Add("max_newton_residual", summary.max_newton_residual)
+      .Add("max_linear_residual", summary.max_linear_residual);
+  return json.ToString();
+}
+
+}  // namespace cablesim

@@ -1,0 +1,653 @@
+#include "convert/scene_from_proto.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <string>
+#include <utility>
+
+#include "absl/status/status.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "absl/strings/string_view.h"
+
+// Local helpers for early return on error.
+#define CABLESIM_RETURN_IF_ERROR(expr)   \
+  do {                                   \
+    const absl::Status _status = (expr); \
+    if (!_status.ok()) return _status;   \
+  } while (false)
+#define CABLESIM_CONCAT_INNER(a, b) a##b
+#define CABLESIM_CONCAT(a, b) CABLESIM_CONCAT_INNER(a, b)
+#define CABLESIM_ASSIGN_OR_RETURN(lhs, expr) \
+  CABLESIM_ASSIGN_OR_RETURN_IMPL(CABLESIM_CONCAT(_status_or_, __LINE__), lhs, expr)
+#define CABLESIM_ASSIGN_OR_RETURN_IMPL(tmp, lhs, expr) \
+  auto tmp = (expr);                                   \
+  if (!tmp.ok()) return tmp.status();                  \
+  lhs = std::move(*tmp)
+
+namespace cablesim {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// Relative tolerance of the arc-length range check, so that `s` may be given
+// as the cable's length even when that length is a sum of segments.
+constexpr double kArcLengthTolerance = 1e-9;
+// Relative tolerance of the comparisons between solver times.
+constexpr double kTimeTolerance = 1e-9;
+
+constexpr int kDefaultElements = 10;
+constexpr int kMaxElements = 100000;
+constexpr double kDefaultStep = 1e-3;
+constexpr double kMaxFrames = 1e7;
+constexpr int kDefaultLoadSteps = 10;
+constexpr int kMaxLoadSteps = 100000;
+constexpr double kDefaultNewtonTolerance = 1e-8;
+constexpr double kMaxTolerance = 1e-2;
+constexpr int kDefaultMaxNewtonIterations = 25;
+constexpr int kMaxNewtonIterations = 1000;
+constexpr int kDefaultMaxStepHalvings = 12;
+constexpr int kMaxStepHalvings = 40;
+constexpr double kDefaultLinearTolerance = 1e-10;
+constexpr int kDefaultMaxLinearIterations = 200;
+constexpr int kMaxLinearIterations = 100000;
+
+constexpr char kSpatialNotSupported[] =
+    "spatial scenes are not supported yet (the planar model needs z = 0)";
+
+absl::Status Invalid(absl::string_view path, absl::string_view rule) {
+  return absl::InvalidArgumentError(absl::StrCat(path, ": ", rule));
+}
+
+std::string Sub(absl::string_view parent, absl::string_view field) {
+  return absl::StrCat(parent, ".", field);
+}
+
+std::string Indexed(absl::string_view parent, absl::string_view field, int index) {
+  return absl::StrCat(parent, parent.empty() ? "" : ".", field, "[", index, "]");
+}
+
+std::string Num(double value) { return absl::StrFormat("%.10g", value); }
+
+absl::Status CheckFinite(absl::string_view path, double value) {
+  if (!std::isfinite(value))
+    return Invalid(path, absl::StrCat("must be finite (got ", Num(value), ")"));
+  return absl::OkStatus();
+}
+
+absl::Status CheckPositive(absl::string_view path, double value) {
+  CABLESIM_RETURN_IF_ERROR(CheckFinite(path, value));
+  if (!(value > 0)) return Invalid(path, absl::StrCat("must be > 0 (got ", Num(value), ")"));
+  return absl::OkStatus();
+}
+
+absl::Status CheckNonNegative(absl::string_view path, double value) {
+  CABLESIM_RETURN_IF_ERROR(CheckFinite(path, value));
+  if (!(value >= 0)) return Invalid(path, absl::StrCat("must be >= 0 (got ", Num(value), ")"));
+  return absl::OkStatus();
+}
+
+absl::Status CheckIntRange(absl::string_view path, int value, int lo, int hi) {
+  if (value < lo || value > hi) {
+    return Invalid(path, absl::StrCat("must be in [", lo, ", ", hi, "] (got ", value, ")"));
+  }
+  return absl::OkStatus();
+}
+
+// A tolerance in (0, kMaxTolerance].
+absl::Status CheckTolerance(absl::string_view path, double value) {
+  CABLESIM_RETURN_IF_ERROR(CheckFinite(path, value));
+  if (!(value > 0 && value <= kMaxTolerance)) {
+    return Invalid(path,
+                   absl::StrCat("must be in (0, ", Num(kMaxTolerance), "] (got ", Num(value), ")"));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<Eigen::Vector3d> FiniteVector(absl::string_view path, const v1::Vec3& v) {
+  CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(path, "x"), v.x()));
+  CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(path, "y"), v.y()));
+  CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(path, "z"), v.z()));
+  return Eigen::Vector3d(v.x(), v.y(), v.z());
+}
+
+// Positions, directions, forces and linear velocities of a planar scene lie
+// in the x-y plane.
+absl::Status CheckInPlane(absl::string_view path, const Eigen::Vector3d& v) {
+  if (v.z() != 0) return Invalid(Sub(path, "z"), kSpatialNotSupported);
+  return absl::OkStatus();
+}
+
+// Torques and angular velocities of a planar scene are about z.
+absl::Status CheckAboutZ(absl::string_view path, const Eigen::Vector3d& v) {
+  if (v.x() != 0) return Invalid(Sub(path, "x"), kSpatialNotSupported);
+  if (v.y() != 0) return Invalid(Sub(path, "y"), kSpatialNotSupported);
+  return absl::OkStatus();
+}
+
+absl::StatusOr<Eigen::Vector3d> PlanarVector(absl::string_view path, const v1::Vec3& v) {
+  CABLESIM_ASSIGN_OR_RETURN(const Eigen::Vector3d result, FiniteVector(path, v));
+  CABLESIM_RETURN_IF_ERROR(CheckInPlane(path, result));
+  return result;
+}
+
+// A direction in the x-y plane, normalised.
+absl::StatusOr<Eigen::Vector3d> PlanarDirection(absl::string_view path, const v1::Vec3& v) {
+  CABLESIM_ASSIGN_OR_RETURN(const Eigen::Vector3d result, PlanarVector(path, v));
+  const double norm = result.norm();
+  if (!(norm > 0) || !std::isfinite(norm)) return Invalid(path, "must be non-zero");
+  return Eigen::Vector3d(result / norm);
+}
+
+bool IsProbeNameChar(char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+         c == '-' || c == '.';
+}
+
+// Validates a scene and builds the engine's scene from it, stopping at the
+// first invalid field.
+class SceneConverter {
+ public:
+  explicit SceneConverter(const v1::Scene& proto) : proto_(proto) {}
+
+  absl::StatusOr<Scene> Convert() {
+    scene_.name = proto_.name();
+    CABLESIM_ASSIGN_OR_RETURN(scene_.gravity_m_s2, PlanarVector("gravity", proto_.gravity()));
+    if (proto_.cables_size() == 0 && proto_.bodies_size() == 0) {
+      return Invalid("cables", "a scene needs at least one cable or body");
+    }
+    scene_.cables.resize(proto_.cables_size());
+    for (int i = 0; i < proto_.cables_size(); ++i) {
+      CABLESIM_RETURN_IF_ERROR(ConvertCable(i, &scene_.cables[i]));
+    }
+    scene_.bodies.resize(proto_.bodies_size());
+    for (int i = 0; i < proto_.bodies_size(); ++i) {
+      CABLESIM_RETURN_IF_ERROR(ConvertBody(i, &scene_.bodies[i]));
+    }
+    scene_.joints.resize(proto_.joints_size());
+    for (int i = 0; i < proto_.joints_size(); ++i) {
+      CABLESIM_RETURN_IF_ERROR(ConvertJoint(i, &scene_.joints[i]));
+    }
+    scene_.loads.resize(proto_.loads_size());
+    for (int i = 0; i < proto_.loads_size(); ++i) {
+      CABLESIM_RETURN_IF_ERROR(ConvertLoad(i, &scene_.loads[i]));
+    }
+    scene_.probes.resize(proto_.probes_size());
+    for (int i = 0; i < proto_.probes_size(); ++i) {
+      CABLESIM_RETURN_IF_ERROR(ConvertProbe(i, &scene_.probes[i]));
+    }
+    CABLESIM_RETURN_IF_ERROR(ConvertInitialVelocity());
+    CABLESIM_RETURN_IF_ERROR(ConvertSolver());
+    return std::move(scene_);
+  }
+
+ private:
+  // Registers `name` of item `index` in `names`; `path` is the name field.
+  static absl::Status RegisterName(absl::string_view path, absl::string_view kind,
+                                   const std::string& name, int index,
+                                   std::map<std::string, int, std::less<>>* names) {
+    if (name.empty()) return Invalid(path, "required");
+    const auto [it, inserted] = names->emplace(name, index);
+    if (!inserted) {
+      return Invalid(
+          path, absl::StrCat("duplicate name \"", name, "\" (also ", kind, "[", it->second, "])"));
+    }
+    return absl::OkStatus();
+  }
+
+  absl::Status ConvertCable(int i, CableSpec* cable) {
+    const v1::Cable& c = proto_.cables(i);
+    const std::string path = Indexed("", "cables", i);
+    CABLESIM_RETURN_IF_ERROR(RegisterName(Sub(path, "name"), "cables", c.name(), i, &cable_index_));
+    cable->name = c.name();
+
+    cable->elements = c.has_elements() ? c.elements() : kDefaultElements;
+    CABLESIM_RETURN_IF_ERROR(
+        CheckIntRange(Sub(path, "elements"), cable->elements, 1, kMaxElements));
+
+    // Geometry: a polyline, or start + direction * length.
+    if (c.points_size() > 0) {
+      if (c.has_start())
+        return Invalid(Sub(path, "start"), "give either start/direction or points");
+      if (c.has_direction()) {
+        return Invalid(Sub(path, "direction"), "give either start/direction or points");
+      }
+      if (c.points_size() < 2) {
+        return Invalid(Sub(path, "points"),
+                       absl::StrCat("needs at least 2 points (got ", c.points_size(), ")"));
+      }
+      double polyline_length = 0;
+      for (int j = 0; j < c.points_size(); ++j) {
+        const std::string point_path = Indexed(path, "points", j);
+        CABLESIM_ASSIGN_OR_RETURN(const Eigen::Vector3d p, PlanarVector(point_path, c.points(j)));
+        if (j > 0) {
+          const Eigen::Vector3d& previous = cable->points.back();
+          const double segment = (p - previous).norm();
+          const double scale = std::max(p.norm(), previous.norm());
+          if (!(segment > 1e-12 * scale) || segment == 0) {
+            return Invalid(point_path, absl::StrCat("same as points[", j - 1,
+                                                    "] (consecutive points must differ)"));
+          }
+          polyline_length += segment;
+        }
+        cable->points.push_back(p);
+      }
+      if (!std::isfinite(polyline_length)) {
+        return Invalid(Sub(path, "points"), "polyline length overflows");
+      }
+      if (c.has_length()) {
+        CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(path, "length"), c.length()));
+        cable->length_m = c.length();
+      } else {
+        cable->length_m = polyline_length;
+      }
+    } else {
+      CABLESIM_ASSIGN_OR_RETURN(const Eigen::Vector3d start,
+                                PlanarVector(Sub(path, "start"), c.start()));
+      Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
+      if (c.has_direction()) {
+        CABLESIM_ASSIGN_OR_RETURN(direction,
+                                  PlanarDirection(Sub(path, "direction"), c.direction()));
+      }
+      if (!c.has_length()) return Invalid(Sub(path, "length"), "required (or give points)");
+      CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(path, "length"), c.length()));
+      cable->length_m = c.length();
+      const Eigen::Vector3d end = start + direction * cable->length_m;
+      if (!end.allFinite()) return Invalid(Sub(path, "length"), "end point overflows");
+      cable->points = {start, end};
+    }
+
+    CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(path, "density"), c.density()));
+    cable->density_kg_m3 = c.density();
+    CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(path, "youngs_modulus"), c.youngs_modulus()));
+    cable->youngs_modulus_pa = c.youngs_modulus();
+
+    if (c.has_diameter()) {
+      CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(path, "diameter"), c.diameter()));
+    }
+    const double d = c.diameter();
+    if (c.has_area()) {
+      CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(path, "area"), c.area()));
+      cable->area_m2 = c.area();
+    } else if (c.has_diameter()) {
+      cable->area_m2 = kPi * d * d / 4;
+    } else {
+      return Invalid(Sub(path, "area"), "required (give area or diameter)");
+    }
+
+    CABLESIM_ASSIGN_OR_RETURN(cable->bending, BendingFromProto(c.bending(), Sub(path, "bending")));
+    const bool no_bending = cable->bending == BendingModel::kNone;
+    if (c.has_second_moment()) {
+      const std::string moment_path = Sub(path, "second_moment");
+      CABLESIM_RETURN_IF_ERROR(no_bending ? CheckNonNegative(moment_path, c.second_moment())
+                                          : CheckPositive(moment_path, c.second_moment()));
+      cable->second_moment_m4 = c.second_moment();
+    } else if (c.has_diameter()) {
+      cable->second_moment_m4 = kPi * d * d * d * d / 64;
+    } else if (no_bending) {
+      cable->second_moment_m4 = 0;
+    } else {
+      return Invalid(Sub(path, "second_moment"),
+                     "required unless bending is NONE (give second_moment or diameter)");
+    }
+    if (!std::isfinite(cable->area_m2) || !(cable->area_m2 > 0) ||
+        !std::isfinite(cable->second_moment_m4)) {
+      return Invalid(Sub(path, "diameter"), "section properties out of range");
+    }
+    return absl::OkStatus();
+  }
+
+  absl::Status ConvertBody(int i, BodySpec* body) {
+    const v1::Body& b = proto_.bodies(i);
+    const std::string path = Indexed("", "bodies", i);
+    CABLESIM_RETURN_IF_ERROR(RegisterName(Sub(path, "name"), "bodies", b.name(), i, &body_index_));
+    body->name = b.name();
+
+    if (b.has_cylinder()) {
+      if (b.has_mass()) {
+        return Invalid(Sub(path, "mass"),
+                       "give either cylinder + density or mass + inertia, not both");
+      }
+      if (b.has_inertia()) {
+        return Invalid(Sub(path, "inertia"),
+                       "follows from the cylinder; give inertia only with mass");
+      }
+      const std::string cylinder_path = Sub(path, "cylinder");
+      const double d = b.cylinder().diameter();
+      const double h = b.cylinder().height();
+      CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(cylinder_path, "diameter"), d));
+      CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(cylinder_path, "height"), h));
+      if (!b.has_density()) return Invalid(Sub(path, "density"), "required with cylinder");
+      CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(path, "density"), b.density()));
+      const double m = b.density() * kPi * d * d / 4 * h;
+      const double r = d / 2;
+      const double transverse = m * (3 * r * r + h * h) / 12;
+      body->mass_kg = m;
+      body->inertia_kg_m2 = Eigen::Vector3d(m * d * d / 8, transverse, transverse);
+      if (!std::isfinite(m) || !(m > 0) || !body->inertia_kg_m2.allFinite() ||
+          !(body->inertia_kg_m2.minCoeff() > 0)) {
+        return Invalid(cylinder_path, "mass or inertia out of range");
+      }
+    } else if (b.has_mass()) {
+      if (b.has_density()) {
+        return Invalid(Sub(path, "density"),
+                       "only with cylinder (give either cylinder + density or mass + inertia)");
+      }
+      CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(path, "mass"), b.mass()));
+      body->mass_kg = b.mass();
+      const std::string inertia_path = Sub(path, "inertia");
+      CABLESIM_ASSIGN_OR_RETURN(body->inertia_kg_m2, FiniteVector(inertia_path, b.inertia()));
+      CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(inertia_path, "x"), b.inertia().x()));
+      CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(inertia_path, "y"), b.inertia().y()));
+      CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(inertia_path, "z"), b.inertia().z()));
+    } else if (b.has_density()) {
+      return Invalid(Sub(path, "cylinder"), "required with density");
+    } else {
+      return Invalid(Sub(path, "mass"), "required (give cylinder + density, or mass + inertia)");
+    }
+
+    CABLESIM_ASSIGN_OR_RETURN(body->position_m, PlanarVector(Sub(path, "position"), b.position()));
+    body->axis = Eigen::Vector3d::UnitX();
+    if (b.has_axis()) {
+      CABLESIM_ASSIGN_OR_RETURN(body->axis, PlanarDirection(Sub(path, "axis"), b.axis()));
+    }
+    return absl::OkStatus();
+  }
+
+  // A cable point, a body point or (when `allow_ground`) the ground.
+  absl::StatusOr<Attachment> ConvertAttachment(absl::string_view path, const v1::Attachment& a,
+                                               bool allow_ground) const {
+    Attachment result;
+    const bool on_cable = !a.cable().empty();
+    const bool on_body = !a.body().empty();
+    if (on_cable && on_body) return Invalid(path, "names both a cable and a body");
+    if (on_cable) {
+      const auto it = cable_index_.find(a.cable());
+      if (it == cable_index_.end()) {
+        return Invalid(Sub(path, "cable"), absl::StrCat("no cable named \"", a.cable(), "\""));
+      }
+      if (a.has_point()) return Invalid(Sub(path, "point"), "only with body");
+      result.cable = it->second;
+      const double length = scene_.cables[it->second].length_m;
+      const std::string s_path = Sub(path, "s");
+      CABLESIM_RETURN_IF_ERROR(CheckFinite(s_path, a.s()));
+      const double tolerance = kArcLengthTolerance * length;
+      if (a.s() < -tolerance || a.s() > length + tolerance) {
+        return Invalid(s_path,
+                       absl::StrCat("must be in [0, ", Num(length), "] (got ", Num(a.s()), ")"));
+      }
+      result.s_m = std::clamp(a.s(), 0.0, length);
+      return result;
+    }
+    if (on_body) {
+      const auto it = body_index_.find(a.body());
+      if (it == body_index_.end()) {
+        return Invalid(Sub(path, "body"), absl::StrCat("no body named \"", a.body(), "\""));
+      }
+      if (a.s() != 0) return Invalid(Sub(path, "s"), "only with cable");
+      result.body = it->second;
+      CABLESIM_ASSIGN_OR_RETURN(result.point_body_m, PlanarVector(Sub(path, "point"), a.point()));
+      return result;
+    }
+    if (!allow_ground) return Invalid(path, "must name a cable or a body");
+    if (a.s() != 0) return Invalid(Sub(path, "s"), "only with cable");
+    if (a.has_point()) return Invalid(Sub(path, "point"), "only with body");
+    return result;  // ground
+  }
+
+  absl::Status ConvertJoint(int i, JointSpec* joint) const {
+    const v1::Joint& j = proto_.joints(i);
+    const std::string path = Indexed("", "joints", i);
+    CABLESIM_ASSIGN_OR_RETURN(joint->type, JointTypeFromProto(j.type(), Sub(path, "type")));
+    CABLESIM_ASSIGN_OR_RETURN(joint->a, ConvertAttachment(Sub(path, "a"), j.a(), false));
+    CABLESIM_ASSIGN_OR_RETURN(joint->b, ConvertAttachment(Sub(path, "b"), j.b(), true));
+    const Attachment& a = joint->a;
+    const Attachment& b = joint->b;
+    if (a.cable >= 0 && a.cable == b.cable) {
+      const double length = scene_.cables[a.cable].length_m;
+      if (std::abs(a.s_m - b.s_m) <= kArcLengthTolerance * length) {
+        return Invalid(Sub(path, "b"),
+                       absl::StrCat("same place as side a (cable \"", scene_.cables[a.cable].name,
+                                    "\" at s = ", Num(a.s_m), ")"));
+      }
+    }
+    if (a.body >= 0 && a.body == b.body) {
+      return Invalid(Sub(path, "b"),
+                     absl::StrCat("joins body \"", scene_.bodies[a.body].name, "\" to itself"));
+    }
+    return absl::OkStatus();
+  }
+
+  absl::Status ConvertLoad(int i, LoadSpec* load) const {
+    const v1::Load& l = proto_.loads(i);
+    const std::string path = Indexed("", "loads", i);
+    CABLESIM_ASSIGN_OR_RETURN(load->at, ConvertAttachment(Sub(path, "at"), l.at(), false));
+    CABLESIM_ASSIGN_OR_RETURN(load->force_n, PlanarVector(Sub(path, "force"), l.force()));
+    const std::string torque_path = Sub(path, "torque");
+    CABLESIM_ASSIGN_OR_RETURN(load->torque_nm, FiniteVector(torque_path, l.torque()));
+    if (load->at.cable >= 0) {
+      if (!load->torque_nm.isZero(0)) return Invalid(torque_path, "allowed on bodies only");
+    } else {
+      CABLESIM_RETURN_IF_ERROR(CheckAboutZ(torque_path, load->torque_nm));
+    }
+    return absl::OkStatus();
+  }
+
+  absl::Status ConvertProbe(int i, ProbeSpec* probe) {
+    const v1::Probe& p = proto_.probes(i);
+    const std::string path = Indexed("", "probes", i);
+    const std::string name_path = Sub(path, "name");
+    if (!p.name().empty() && !std::all_of(p.name().begin(), p.name().end(), IsProbeNameChar)) {
+      return Invalid(name_path, absl::StrCat("\"", p.name(),
+                                             "\" may contain only letters, digits, '_', '-' "
+                                             "and '.'"));
+    }
+    CABLESIM_RETURN_IF_ERROR(RegisterName(name_path, "probes", p.name(), i, &probe_index_));
+    probe->name = p.name();
+    v1::Attachment at;
+    at.set_cable(p.cable());
+    at.set_s(p.s());
+    at.set_body(p.body());
+    if (p.has_point()) *at.mutable_point() = p.point();
+    CABLESIM_ASSIGN_OR_RETURN(probe->at, ConvertAttachment(path, at, false));
+    return absl::OkStatus();
+  }
+
+  absl::Status ConvertInitialVelocity() {
+    const v1::InitialVelocity& v = proto_.initial_velocity();
+    InitialVelocitySpec& spec = scene_.initial_velocity;
+    CABLESIM_ASSIGN_OR_RETURN(spec.linear_m_s, PlanarVector("initial_velocity.linear", v.linear()));
+    CABLESIM_ASSIGN_OR_RETURN(spec.angular_rad_s,
+                              FiniteVector("initial_velocity.angular", v.angular()));
+    CABLESIM_RETURN_IF_ERROR(CheckAboutZ("initial_velocity.angular", spec.angular_rad_s));
+    CABLESIM_ASSIGN_OR_RETURN(spec.origin_m, FiniteVector("initial_velocity.origin", v.origin()));
+    return absl::OkStatus();
+  }
+
+  absl::Status ConvertSolver() {
+    const v1::Solver& s = proto_.solver();
+    SolverSettings& out = scene_.solver;
+    CABLESIM_ASSIGN_OR_RETURN(out.analysis, AnalysisFromProto(s.analysis(), "solver.analysis"));
+    CABLESIM_ASSIGN_OR_RETURN(out.integrator,
+                              IntegratorFromProto(s.integrator(), "solver.integrator"));
+    CABLESIM_ASSIGN_OR_RETURN(out.linear_solver,
+                              LinearSolverFromProto(s.linear_solver(), "solver.linear_solver"));
+
+    CABLESIM_RETURN_IF_ERROR(CheckFinite("solver.duration", s.duration()));
+    CABLESIM_RETURN_IF_ERROR(CheckFinite("solver.step", s.step()));
+    CABLESIM_RETURN_IF_ERROR(CheckFinite("solver.output_interval", s.output_interval()));
+    out.step_s = s.has_step() ? s.step() : kDefaultStep;
+    CABLESIM_RETURN_IF_ERROR(CheckPositive("solver.step", out.step_s));
+    out.output_interval_s = s.has_output_interval() ? s.output_interval() : out.step_s;
+    CABLESIM_RETURN_IF_ERROR(CheckPositive("solver.output_interval", out.output_interval_s));
+    if (out.output_interval_s < out.step_s * (1 - kTimeTolerance)) {
+      return Invalid("solver.output_interval",
+                     absl::StrCat("must be >= solver.step (", Num(out.step_s), "; got ",
+                                  Num(out.output_interval_s), ")"));
+    }
+    out.duration_s = s.duration();
+    if (out.analysis == Analysis::kDynamic) {
+      if (!(s.duration() > 0)) {
+        return Invalid("solver.duration", absl::StrCat("must be > 0 for DYNAMIC analysis (got ",
+                                                       Num(s.duration()), ")"));
+      }
+      if (out.step_s > out.duration_s * (1 + kTimeTolerance)) {
+        return Invalid("solver.step",
+                       absl::StrCat("must be <= solver.duration (", Num(out.duration_s), "; got ",
+                                    Num(out.step_s), ")"));
+      }
+      if (out.output_interval_s > out.duration_s * (1 + kTimeTolerance)) {
+        return Invalid("solver.output_interval",
+                       absl::StrCat("must be <= solver.duration (", Num(out.duration_s), "; got ",
+                                    Num(out.output_interval_s), ")"));
+      }
+      if (out.duration_s / out.output_interval_s > kMaxFrames) {
+        return Invalid(
+            "solver.output_interval",
+            absl::StrCat("too many frames (duration / output_interval > ", Num(kMaxFrames), ")"));
+      }
+    } else {
+      CABLESIM_RETURN_IF_ERROR(CheckNonNegative("solver.duration", s.duration()));
+    }
+
+    out.load_steps = s.has_load_steps() ? s.load_steps() : kDefaultLoadSteps;
+    CABLESIM_RETURN_IF_ERROR(CheckIntRange("solver.load_steps", out.load_steps, 1, kMaxLoadSteps));
+    out.newton_tolerance =
+        s.has_newton_tolerance() ? s.newton_tolerance() : kDefaultNewtonTolerance;
+    CABLESIM_RETURN_IF_ERROR(CheckTolerance("solver.newton_tolerance", out.newton_tolerance));
+    out.max_newton_iterations =
+        s.has_max_newton_iterations() ? s.max_newton_iterations() : kDefaultMaxNewtonIterations;
+    CABLESIM_RETURN_IF_ERROR(CheckIntRange("solver.max_newton_iterations",
+                                           out.max_newton_iterations, 1, kMaxNewtonIterations));
+    out.max_step_halvings =
+        s.has_max_step_halvings() ? s.max_step_halvings() : kDefaultMaxStepHalvings;
+    CABLESIM_RETURN_IF_ERROR(
+        CheckIntRange("solver.max_step_halvings", out.max_step_halvings, 0, kMaxStepHalvings));
+    out.linear_tolerance =
+        s.has_linear_tolerance() ? s.linear_tolerance() : kDefaultLinearTolerance;
+    CABLESIM_RETURN_IF_ERROR(CheckTolerance("solver.linear_tolerance", out.linear_tolerance));
+    out.max_linear_iterations =
+        s.has_max_linear_iterations() ? s.max_linear_iterations() : kDefaultMaxLinearIterations;
+    CABLESIM_RETURN_IF_ERROR(CheckIntRange("solver.max_linear_iterations",
+                                           out.max_linear_iterations, 1, kMaxLinearIterations));
+    return absl::OkStatus();
+  }
+
+  const v1::Scene& proto_;
+  Scene scene_;
+  std::map<std::string, int, std::less<>> cable_index_;
+  std::map<std::string, int, std::less<>> body_index_;
+  std::map<std::string, int, std::less<>> probe_index_;
+};
+
+absl::Status UnknownEnumValue(absl::string_view path, int value, absl::string_view allowed) {
+  return Invalid(path, absl::StrCat("unknown value ", value, " (must be ", allowed, ")"));
+}
+
+}  // namespace
+
+absl::StatusOr<Scene> SceneFromProto(const v1::Scene& proto) {
+  return SceneConverter(proto).Convert();
+}
+
+absl::StatusOr<BendingModel> BendingFromProto(v1::Bending bending, std::string_view path_std) {
+  const absl::string_view path(path_std.data(), path_std.size());
+  switch (bending) {
+    case v1::BENDING_UNSPECIFIED:
+    case v1::EXACT:
+      return BendingModel::kExact;
+    case v1::LINEAR:
+      return BendingModel::kLinear;
+    case v1::NONE:
+      return BendingModel::kNone;
+    default:
+      return UnknownEnumValue(path, bending, "EXACT, LINEAR or NONE");
+  }
+}
+
+absl::StatusOr<JointType> JointTypeFromProto(v1::JointType type, std::string_view path_std) {
+  const absl::string_view path(path_std.data(), path_std.size());
+  switch (type) {
+    case v1::PIN:
+      return JointType::kPin;
+    case v1::FIXED:
+      return JointType::kFixed;
+    default:
+      return Invalid(path, "must be PIN or FIXED");
+  }
+}
+
+absl::StatusOr<Analysis> AnalysisFromProto(v1::Analysis analysis, std::string_view path_std) {
+  const absl::string_view path(path_std.data(), path_std.size());
+  switch (analysis) {
+    case v1::ANALYSIS_UNSPECIFIED:
+    case v1::DYNAMIC:
+      return Analysis::kDynamic;
+    case v1::STATIC:
+      return Analysis::kStatic;
+    default:
+      return UnknownEnumValue(path, analysis, "DYNAMIC or STATIC");
+  }
+}
+
+absl::StatusOr<Integrator> IntegratorFromProto(v1::Integrator integrator,
+                                               std::string_view path_std) {
+  const absl::string_view path(path_std.data(), path_std.size());
+  switch (integrator) {
+    case v1::INTEGRATOR_UNSPECIFIED:
+    case v1::IMPLICIT_EULER:
+      return Integrator::kImplicitEuler;
+    default:
+      return UnknownEnumValue(path, integrator, "IMPLICIT_EULER");
+  }
+}
+
+absl::StatusOr<LinearSolverKind> LinearSolverFromProto(v1::LinearSolver solver,
+                                                       std::string_view path_std) {
+  const absl::string_view path(path_std.data(), path_std.size());
+  switch (solver) {
+    case v1::LINEAR_SOLVER_UNSPECIFIED:
+    case v1::MINRES:
+      return LinearSolverKind::kMinres;
+    case v1::GMRES:
+      return LinearSolverKind::kGmres;
+    default:
+      return UnknownEnumValue(path, solver, "MINRES or GMRES");
+  }
+}
+
+std::string_view AnalysisName(Analysis analysis) {
+  switch (analysis) {
+    case Analysis::kDynamic:
+      return "DYNAMIC";
+    case Analysis::kStatic:
+      return "STATIC";
+  }
+  return "UNKNOWN";
+}
+
+std::string_view IntegratorName(Integrator integrator) {
+  switch (integrator) {
+    case Integrator::kImplicitEuler:
+      return "IMPLICIT_EULER";
+  }
+  return "UNKNOWN";
+}
+
+std::string_view LinearSolverName(LinearSolverKind solver) {
+  switch (solver) {
+    case LinearSolverKind::kMinres:
+      return "MINRES";
+    case LinearSolverKind::kGmres:
+      return "GMRES";
+  }
+  return "UNKNOWN";
+}
+
+}  // namespace cablesim
+
+#undef CABLESIM_ASSIGN_OR_RETURN_IMPL
+#undef CABLESIM_ASSIGN_OR_RETURN
+#undef CABLESIM_CONCAT
+#undef CABLESIM_CONCAT_INNER
+#undef CABLESIM_RETURN_IF_ERROR

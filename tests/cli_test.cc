@@ -1,0 +1,253 @@
+// The command line, run in-process through RunCli.
+
+#include "client/cli.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
+#include "client/csv_writer.h"
+
+namespace cablesim {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+struct CliResult {
+  int code = -1;
+  std::string out;
+  std::string err;
+};
+
+CliResult Cli(const std::vector<std::string>& args) {
+  std::ostringstream out, err;
+  CliResult result;
+  result.code = RunCli(args, out, err);
+  result.out = out.str();
+  result.err = err.str();
+  return result;
+}
+
+std::string SampleScene(const char* name) {
+  return absl::StrCat(CABLESIM_SOURCE_DIR, "/scenes/", name);
+}
+
+std::string WriteTempFile(const std::string& name, const std::string& contents) {
+  const std::string path = absl::StrCat(::testing::TempDir(), "/cli_test_", name);
+  std::ofstream(path) << contents;
+  return path;
+}
+
+std::vector<std::string> ReadLines(const std::string& path) {
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+// A tiny dynamic scene: 2 elements, 4 steps, 3 frames (t = 0, 0.01, 0.02).
+constexpr char kTinyScene[] = R"({
+  "name": "tiny",
+  "gravity": {"y": -9.81},
+  "cables": [{"name": "c", "length": 0.5, "elements": 2, "density": 1000,
+              "youngs_modulus": 1e7, "diameter": 0.01}],
+  "joints": [{"type": "PIN", "a": {"cable": "c", "s": 0}}],
+  "probes": [{"name": "end", "cable": "c", "s": 0.5}],
+  "solver": {"duration": 0.02, "step": 0.005, "output_interval": 0.01}
+})";
+
+TEST(CliTest, NoArgumentsIsAUsageError) {
+  const CliResult r = Cli({});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("Usage:"));
+  EXPECT_EQ(r.out, "");
+}
+
+TEST(CliTest, UnknownCommandIsAUsageError) {
+  const CliResult r = Cli({"frobnicate", "x.json"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("cablesim: unknown command \"frobnicate\""));
+  EXPECT_THAT(r.err, HasSubstr("Usage:"));
+}
+
+TEST(CliTest, UnknownOptionIsAUsageError) {
+  const CliResult r = Cli({"run", SampleScene("falling-pendulum.json"), "--outt=x.csv"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("unknown option --outt=x.csv"));
+}
+
+TEST(CliTest, MissingSceneArgument) {
+  EXPECT_EQ(Cli({"run"}).code, 2);
+  EXPECT_EQ(Cli({"validate"}).code, 2);
+  EXPECT_EQ(Cli({"run", "--out"}).code, 2);
+  EXPECT_EQ(Cli({"validate", "a.json", "b.json"}).code, 2);
+}
+
+TEST(CliTest, Help) {
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"--help"}, {"help"}, {"run", "--help"}}) {
+    const CliResult r = Cli(args);
+    EXPECT_EQ(r.code, 0);
+    EXPECT_THAT(r.out, HasSubstr("cablesim run SCENE [--out FILE.csv]"));
+    EXPECT_EQ(r.err, "");
+  }
+}
+
+TEST(CliTest, MissingFileIsBadInput) {
+  for (const char* command : {"run", "validate"}) {
+    const CliResult r = Cli({command, "/nonexistent/scene.json"});
+    EXPECT_EQ(r.code, 2) << command;
+    EXPECT_THAT(r.err, StartsWith("cablesim: /nonexistent/scene.json: ")) << command;
+  }
+}
+
+TEST(CliTest, InvalidSceneIsBadInputWithTheFieldPath) {
+  const std::string path = WriteTempFile("invalid.json", R"({
+    "cables": [{"name": "c", "length": -1, "density": 1000, "youngs_modulus": 1e7,
+                "diameter": 0.01}],
+    "solver": {"duration": 1}})");
+  for (const char* command : {"run", "validate"}) {
+    const CliResult r = Cli({command, path});
+    EXPECT_EQ(r.code, 2) << command;
+    EXPECT_EQ(r.err, absl::StrCat("cablesim: ", path, ": cables[0].length: must be > 0 (got -1)\n"))
+        << command;
+  }
+  // validate also answers in JSON.
+  const CliResult r = Cli({"validate", path});
+  EXPECT_THAT(r.out, StartsWith(R"({"status":"invalid",)"));
+  EXPECT_THAT(r.out, HasSubstr(R"j("error":"cables[0].length: must be > 0 (got -1)")j"));
+  std::remove(path.c_str());
+}
+
+TEST(CliTest, UnparsableSceneIsBadInputWithTheFieldName) {
+  const std::string path =
+      WriteTempFile("unknown_field.json", R"({"cables": [{"name": "c", "lenght": 1}]})");
+  const CliResult r = Cli({"run", path});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith(absl::StrCat("cablesim: ", path, ": ")));
+  EXPECT_THAT(r.err, HasSubstr("lenght"));
+  std::remove(path.c_str());
+}
+
+TEST(CliTest, TextFormatScene) {
+  const std::string path = WriteTempFile("scene.txtpb", R"pb(
+    name: "text"
+    cables { name: "c" length: 1 density: 1000 youngs_modulus: 1e7 diameter: 0.01 }
+    solver { duration: 1 }
+  )pb");
+  const CliResult r = Cli({"validate", path});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr(R"("name":"text")"));
+  std::remove(path.c_str());
+}
+
+TEST(CliTest, ValidateSampleScenes) {
+  const CliResult pendulum = Cli({"validate", SampleScene("falling-pendulum.json")});
+  EXPECT_EQ(pendulum.code, 0) << pendulum.err;
+  EXPECT_EQ(pendulum.err, "");
+  EXPECT_THAT(pendulum.out, StartsWith(R"({"status":"ok",)"));
+  EXPECT_THAT(pendulum.out,
+              HasSubstr(R"("name":"falling-pendulum","cables":1,"bodies":0,"joints":1,)"
+                        R"("loads":0,"probes":1,"analysis":"DYNAMIC")"));
+  EXPECT_EQ(pendulum.out.back(), '\n');
+  EXPECT_EQ(pendulum.out.find('\n'), pendulum.out.size() - 1);  // one line
+
+  const CliResult cylinder = Cli({"validate", SampleScene("cable-with-end-cylinder.json")});
+  EXPECT_EQ(cylinder.code, 0) << cylinder.err;
+  EXPECT_THAT(cylinder.out, HasSubstr(R"("bodies":1,"joints":2,)"));
+
+  const CliResult cantilever = Cli({"validate", SampleScene("cantilever-large-deflection.json")});
+  EXPECT_EQ(cantilever.code, 0) << cantilever.err;
+  EXPECT_THAT(cantilever.out, HasSubstr(R"("analysis":"STATIC")"));
+  EXPECT_THAT(cantilever.out, HasSubstr(R"("load_steps":20)"));
+}
+
+TEST(CliTest, ValidateTakesNoOut) {
+  const CliResult r = Cli({"validate", SampleScene("falling-pendulum.json"), "--out", "x.csv"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("--out is only for run"));
+}
+
+TEST(CliTest, RunWritesSummaryAndCsv) {
+  const std::string scene = WriteTempFile("tiny.json", kTinyScene);
+  const std::string csv = absl::StrCat(::testing::TempDir(), "/cli_test_tiny.csv");
+  // Twice, with both spellings of --out: RunCli keeps no state.
+  for (const std::string& out_flag : {std::string("--out=") + csv, std::string("--out")}) {
+    std::vector<std::string> args = {"run", scene, out_flag};
+    if (out_flag == "--out") args.push_back(csv);
+    const CliResult r = Cli(args);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(r.err, "");
+    EXPECT_THAT(r.out, StartsWith(R"({"status":"ok",)"));
+    EXPECT_THAT(r.out, HasSubstr(R"("model":"planar")"));
+    const std::vector<std::string> lines = ReadLines(csv);
+    ASSERT_EQ(lines.size(), 4);  // header and t = 0, 0.01, 0.02
+    EXPECT_EQ(lines[0], CsvWriter::Header({"end"}));
+    EXPECT_THAT(lines[1], StartsWith("0,"));
+    const std::vector<std::string> last = absl::StrSplit(lines[3], ',');
+    EXPECT_NEAR(std::stod(last[0]), 0.02, 1e-12);
+  }
+  std::remove(csv.c_str());
+  std::remove(scene.c_str());
+}
+
+TEST(CliTest, RunWithoutOut) {
+  const std::string scene = WriteTempFile("tiny_no_out.json", kTinyScene);
+  const CliResult r = Cli({"run", scene});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, StartsWith(R"({"status":"ok",)"));
+  EXPECT_THAT(r.out, HasSubstr(R"("frames":3,)"));
+  std::remove(scene.c_str());
+}
+
+TEST(CliTest, UnwritableOutIsAnIoError) {
+  const std::string scene = WriteTempFile("tiny_bad_out.json", kTinyScene);
+  const CliResult r = Cli({"run", scene, "--out", "/nonexistent-dir/out.csv"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_THAT(r.err, StartsWith("cablesim: /nonexistent-dir/out.csv: "));
+  std::remove(scene.c_str());
+}
+
+TEST(CliTest, FullDiskIsAnIoError) {
+  if (!std::ifstream("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  const std::string scene = WriteTempFile("tiny_full.json", kTinyScene);
+  const CliResult r = Cli({"run", scene, "--out", "/dev/full"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_THAT(r.err, StartsWith("cablesim: /dev/full: "));
+  std::remove(scene.c_str());
+}
+
+TEST(CliTest, NumericalFailureExitsWith3AndKeepsTheCsv) {
+  // One Newton iteration and no step halving cannot carry a stiff cable
+  // through a 0.5 s step.
+  const std::string scene = WriteTempFile("failing.json", R"({
+    "gravity": {"y": -9.81},
+    "cables": [{"name": "c", "length": 1, "elements": 4, "density": 1000,
+                "youngs_modulus": 1e9, "diameter": 0.01}],
+    "joints": [{"type": "PIN", "a": {"cable": "c", "s": 0}}],
+    "solver": {"duration": 1, "step": 0.5, "max_newton_iterations": 1,
+               "max_step_halvings": 0}})");
+  const std::string csv = absl::StrCat(::testing::TempDir(), "/cli_test_failing.csv");
+  const CliResult r = Cli({"run", scene, "--out", csv});
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_THAT(r.out, StartsWith(R"({"status":"failed","error":")"));
+  EXPECT_THAT(r.out, HasSubstr(R"("failure_time_s":)"));
+  EXPECT_THAT(r.err, StartsWith("cablesim: numerical failure at t = "));
+  const std::vector<std::string> lines = ReadLines(csv);
+  ASSERT_GE(lines.size(), 2);  // the header and the frame at t = 0
+  EXPECT_EQ(lines[0], CsvWriter::Header({}));
+  EXPECT_THAT(lines[1], StartsWith("0,"));
+  std::remove(csv.c_str());
+  std::remove(scene.c_str());
+}
+
+}  // namespace
+}  // namespace cablesim

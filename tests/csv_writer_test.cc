@@ -1,0 +1,146 @@
+// The trajectory CSV: header, row format, write errors.
+
+#include "client/csv_writer.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "absl/strings/str_split.h"
+
+namespace cablesim {
+namespace {
+
+using ::testing::HasSubstr;
+
+ModelInfo InfoWithProbes(std::vector<std::string> names) {
+  ModelInfo info;
+  info.model = "planar";
+  info.probe_names = std::move(names);
+  return info;
+}
+
+Frame FrameWithProbes(double t, int probes) {
+  Frame frame;
+  frame.t = t;
+  for (int i = 0; i < probes; ++i) {
+    ProbeSample sample;
+    sample.position_m = Eigen::Vector3d(1 + i, 2, 3);
+    sample.velocity_m_s = Eigen::Vector3d(4, 5, 6);
+    sample.acceleration_m_s2 = Eigen::Vector3d(7, 8, 9);
+    frame.probes.push_back(sample);
+  }
+  frame.energy = {0.1, -0.2, 0.3, 0.4, 0.6};
+  frame.constraint_violation = 1e-12;
+  return frame;
+}
+
+TEST(CsvWriterTest, Header) {
+  EXPECT_EQ(CsvWriter::Header({}),
+            "t,energy.kinetic,energy.potential,energy.axial,energy.bending,energy.total,"
+            "constraint.violation");
+  EXPECT_EQ(CsvWriter::Header({"tip"}),
+            "t,tip.x,tip.y,tip.z,tip.vx,tip.vy,tip.vz,tip.ax,tip.ay,tip.az,"
+            "energy.kinetic,energy.potential,energy.axial,energy.bending,energy.total,"
+            "constraint.violation");
+}
+
+TEST(CsvWriterTest, RowsRoundTrip) {
+  std::ostringstream out;
+  {
+    CsvWriter writer(&out, "memory");
+    ASSERT_TRUE(writer.OnStart(InfoWithProbes({"a", "b"})).ok());
+    ASSERT_TRUE(writer.OnFrame(FrameWithProbes(0, 2)).ok());
+    ASSERT_TRUE(writer.OnFrame(FrameWithProbes(0.1, 2)).ok());
+    EXPECT_TRUE(writer.Finish().ok());
+    EXPECT_EQ(writer.rows(), 2);
+  }
+  const std::vector<std::string> lines = absl::StrSplit(out.str(), '\n');
+  ASSERT_EQ(lines.size(), 4);  // header, 2 rows, empty after the last newline
+  EXPECT_EQ(lines[0], CsvWriter::Header({"a", "b"}));
+  EXPECT_EQ(lines[1],
+            "0,1,2,3,4,5,6,7,8,9,2,2,3,4,5,6,7,8,9,0.10000000000000001,"
+            "-0.20000000000000001,0.29999999999999999,0.40000000000000002,"
+            "0.59999999999999998,9.9999999999999998e-13");
+  const std::vector<std::string> cells = absl::StrSplit(lines[2], ',');
+  ASSERT_EQ(cells.size(), 1 + 2 * 9 + 6);
+  EXPECT_EQ(std::stod(cells[0]), 0.1);  // 17 digits read back exactly
+  EXPECT_EQ(lines[3], "");
+}
+
+TEST(CsvWriterTest, NonFiniteValuesAreWritten) {
+  std::ostringstream out;
+  CsvWriter writer(&out, "memory");
+  ASSERT_TRUE(writer.OnStart(InfoWithProbes({})).ok());
+  Frame frame = FrameWithProbes(1, 0);
+  frame.energy.total = std::numeric_limits<double>::infinity();
+  ASSERT_TRUE(writer.OnFrame(frame).ok());
+  EXPECT_THAT(out.str(), HasSubstr(",inf,"));
+}
+
+TEST(CsvWriterTest, WrongProbeCountIsAnError) {
+  std::ostringstream out;
+  CsvWriter writer(&out, "memory");
+  ASSERT_TRUE(writer.OnStart(InfoWithProbes({"a"})).ok());
+  const absl::Status status = writer.OnFrame(FrameWithProbes(0, 2));
+  EXPECT_FALSE(status.ok());
+  EXPECT_FALSE(writer.status().ok());
+  EXPECT_FALSE(writer.Finish().ok());
+}
+
+TEST(CsvWriterTest, FileIsCompleteAfterFinish) {
+  const std::string path = ::testing::TempDir() + "/csv_writer_test.csv";
+  auto writer = CsvWriter::Create(path);
+  ASSERT_TRUE(writer.ok()) << writer.status();
+  ASSERT_TRUE((*writer)->OnStart(InfoWithProbes({"p"})).ok());
+  for (int i = 0; i < 250; ++i) ASSERT_TRUE((*writer)->OnFrame(FrameWithProbes(i, 1)).ok());
+  ASSERT_TRUE((*writer)->Finish().ok());
+  std::ifstream in(path);
+  std::string line;
+  int lines = 0;
+  while (std::getline(in, line)) ++lines;
+  EXPECT_EQ(lines, 251);
+  std::remove(path.c_str());
+}
+
+TEST(CsvWriterTest, FileIsFlushedOnDestruction) {
+  const std::string path = ::testing::TempDir() + "/csv_writer_test_destroyed.csv";
+  {
+    auto writer = CsvWriter::Create(path);
+    ASSERT_TRUE(writer.ok()) << writer.status();
+    ASSERT_TRUE((*writer)->OnStart(InfoWithProbes({})).ok());
+    ASSERT_TRUE((*writer)->OnFrame(FrameWithProbes(0, 0)).ok());
+  }
+  std::ifstream in(path);
+  std::string header, row;
+  ASSERT_TRUE(std::getline(in, header));
+  ASSERT_TRUE(std::getline(in, row));
+  EXPECT_EQ(row.substr(0, 2), "0,");
+  std::remove(path.c_str());
+}
+
+TEST(CsvWriterTest, UnopenableFile) {
+  auto writer = CsvWriter::Create("/nonexistent-dir/out.csv");
+  ASSERT_FALSE(writer.ok());
+  EXPECT_THAT(std::string(writer.status().message()), HasSubstr("/nonexistent-dir/out.csv"));
+}
+
+TEST(CsvWriterTest, WriteFailureIsReported) {
+  std::ifstream probe("/dev/full");
+  if (!probe) GTEST_SKIP() << "no /dev/full";
+  auto writer = CsvWriter::Create("/dev/full");
+  ASSERT_TRUE(writer.ok()) << writer.status();
+  // The header is flushed at once, so /dev/full refuses it.
+  EXPECT_FALSE((*writer)->OnStart(InfoWithProbes({"p"})).ok());
+  EXPECT_FALSE((*writer)->Finish().ok());
+}
+
+}  // namespace
+}  // namespace cablesim

@@ -1,0 +1,572 @@
+// Scene validation and conversion: invalid scenes are rejected with the
+// offending field's path; valid ones convert with the documented defaults.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/strings/str_cat.h"
+#include "convert/scene_file.h"
+#include "convert/scene_from_proto.h"
+#include "engine/scene.h"
+
+namespace cablesim {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+constexpr double kPi = 3.14159265358979323846;
+
+absl::StatusOr<Scene> ConvertJson(const std::string& json) {
+  absl::StatusOr<v1::Scene> proto = ParseSceneJson(json);
+  if (!proto.ok()) return proto.status();
+  return SceneFromProto(*proto);
+}
+
+// A valid cable "c" of length 1.
+constexpr char kCable[] =
+    R"({"name": "c", "length": 1, "density": 1000, "youngs_modulus": 1e7, "diameter": 0.01})";
+// A valid solver section.
+constexpr char kSolver[] = R"("solver": {"duration": 1, "step": 0.01})";
+
+std::string Scene1(const std::string& extra) {
+  return absl::StrCat("{\"cables\": [", kCable, "], ", extra, kSolver, "}");
+}
+
+struct InvalidCase {
+  const char* name;
+  std::string json;
+  // The error message must start with this (the field path and ": ").
+  const char* prefix;
+  // And contain this.
+  const char* detail;
+};
+
+std::vector<InvalidCase> InvalidCases() {
+  return {
+      {"NegativeLength",
+       R"({"cables": [{"name": "c", "length": -1, "density": 1000, "youngs_modulus": 1e7,
+                       "diameter": 0.01}], "solver": {"duration": 1}})",
+       "cables[0].length: ", "must be > 0"},
+      {"NanLength",
+       R"({"cables": [{"name": "c", "length": "NaN", "density": 1000, "youngs_modulus": 1e7,
+                       "diameter": 0.01}], "solver": {"duration": 1}})",
+       "cables[0].length: ", "must be finite"},
+      {"InfiniteGravity",
+       R"({"gravity": {"y": "-Infinity"}, "cables": [)" + std::string(kCable) + "], " + kSolver +
+           "}",
+       "gravity.y: ", "must be finite"},
+      {"MissingLength",
+       R"({"cables": [{"name": "c", "density": 1000, "youngs_modulus": 1e7, "diameter": 0.01}],
+           "solver": {"duration": 1}})",
+       "cables[0].length: ", "required"},
+      {"NegativeElements",
+       R"({"cables": [{"name": "c", "length": 1, "elements": -3, "density": 1000,
+                       "youngs_modulus": 1e7, "diameter": 0.01}], "solver": {"duration": 1}})",
+       "cables[0].elements: ", "must be in [1, 100000]"},
+      {"ZeroElements",
+       R"({"cables": [{"name": "c", "length": 1, "elements": 0, "density": 1000,
+                       "youngs_modulus": 1e7, "diameter": 0.01}], "solver": {"duration": 1}})",
+       "cables[0].elements: ", "must be in [1, 100000]"},
+      {"ZeroStep",
+       absl::StrCat(R"({"cables": [)", kCable, R"(], "solver": {"duration": 1, "step": 0}})"),
+       "solver.step: ", "must be > 0"},
+      {"ZeroLoadStepsStatic",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"analysis": "STATIC", "load_steps": 0}})"),
+       "solver.load_steps: ", "must be in [1, 100000]"},
+      {"TooManyElements",
+       R"({"cables": [{"name": "c", "length": 1, "elements": 100001, "density": 1000,
+                       "youngs_modulus": 1e7, "diameter": 0.01}], "solver": {"duration": 1}})",
+       "cables[0].elements: ", "must be in [1, 100000]"},
+      {"MissingDensity",
+       R"({"cables": [{"name": "c", "length": 1, "youngs_modulus": 1e7, "diameter": 0.01}],
+           "solver": {"duration": 1}})",
+       "cables[0].density: ", "must be > 0"},
+      {"NegativeYoungsModulus",
+       R"({"cables": [{"name": "c", "length": 1, "density": 1000, "youngs_modulus": -1e7,
+                       "diameter": 0.01}], "solver": {"duration": 1}})",
+       "cables[0].youngs_modulus: ", "must be > 0"},
+      {"MissingArea",
+       R"({"cables": [{"name": "c", "length": 1, "density": 1000, "youngs_modulus": 1e7,
+                       "second_moment": 1e-9}], "solver": {"duration": 1}})",
+       "cables[0].area: ", "required (give area or diameter)"},
+      {"MissingSecondMomentExactBending",
+       R"({"cables": [{"name": "c", "length": 1, "density": 1000, "youngs_modulus": 1e7,
+                       "area": 1e-4, "bending": "EXACT"}], "solver": {"duration": 1}})",
+       "cables[0].second_moment: ", "required unless bending is NONE"},
+      {"ZeroDiameter",
+       R"({"cables": [{"name": "c", "length": 1, "density": 1000, "youngs_modulus": 1e7,
+                       "diameter": 0}], "solver": {"duration": 1}})",
+       "cables[0].diameter: ", "must be > 0"},
+      {"UnknownBendingValue",
+       R"({"cables": [{"name": "c", "length": 1, "density": 1000, "youngs_modulus": 1e7,
+                       "diameter": 0.01, "bending": 7}], "solver": {"duration": 1}})",
+       "cables[0].bending: ", "unknown value 7"},
+      {"EmptyCableName",
+       R"({"cables": [{"length": 1, "density": 1000, "youngs_modulus": 1e7, "diameter": 0.01}],
+           "solver": {"duration": 1}})",
+       "cables[0].name: ", "required"},
+      {"DuplicateCableName",
+       absl::StrCat(R"({"cables": [)", kCable, ", ", kCable, "], ", kSolver, "}"),
+       "cables[1].name: ", "duplicate name \"c\" (also cables[0])"},
+      {"ZeroDirection",
+       R"({"cables": [{"name": "c", "length": 1, "direction": {"x": 0}, "density": 1000,
+                       "youngs_modulus": 1e7, "diameter": 0.01}], "solver": {"duration": 1}})",
+       "cables[0].direction: ", "must be non-zero"},
+      {"PolylineWithOnePoint",
+       R"({"cables": [{"name": "c", "points": [{"x": 1}], "density": 1000,
+                       "youngs_modulus": 1e7, "diameter": 0.01}], "solver": {"duration": 1}})",
+       "cables[0].points: ", "at least 2 points"},
+      {"PolylineRepeatedPoint",
+       R"({"cables": [{"name": "c", "points": [{"x": 0}, {"x": 1}, {"x": 1}], "density": 1000,
+                       "youngs_modulus": 1e7, "diameter": 0.01}], "solver": {"duration": 1}})",
+       "cables[0].points[2]: ", "same as points[1]"},
+      {"PolylineAndStart",
+       R"({"cables": [{"name": "c", "start": {"x": 1}, "points": [{"x": 0}, {"x": 1}],
+                       "density": 1000, "youngs_modulus": 1e7, "diameter": 0.01}],
+           "solver": {"duration": 1}})",
+       "cables[0].start: ", "either"},
+      {"NoCableOrBody", R"({"solver": {"duration": 1}})", "cables: ", "at least one"},
+      {"DuplicateBodyName", Scene1(R"("bodies": [{"name": "b", "mass": 1, "inertia": {"z": 1}},
+                            {"name": "b", "mass": 1, "inertia": {"z": 1}}], )"),
+       "bodies[1].name: ", "duplicate name"},
+      {"BodyCylinderAndMass",
+       Scene1(R"("bodies": [{"name": "b", "cylinder": {"diameter": 0.04, "height": 0.1},
+                             "density": 1000, "mass": 2}], )"),
+       "bodies[0].mass: ", "not both"},
+      {"BodyZeroCylinderDiameter",
+       Scene1(R"("bodies": [{"name": "b", "cylinder": {"height": 0.1}, "density": 1000}], )"),
+       "bodies[0].cylinder.diameter: ", "must be > 0"},
+      {"BodyCylinderWithoutDensity",
+       Scene1(R"("bodies": [{"name": "b", "cylinder": {"diameter": 0.04, "height": 0.1}}], )"),
+       "bodies[0].density: ", "required with cylinder"},
+      {"BodyMassWithoutInertia", Scene1(R"("bodies": [{"name": "b", "mass": 2}], )"),
+       "bodies[0].inertia.z: ", "must be > 0"},
+      {"BodyNegativeInertiaX",
+       Scene1(R"("bodies": [{"name": "b", "mass": 2, "inertia": {"x": -1, "z": 1}}], )"),
+       "bodies[0].inertia.x: ", "must be >= 0"},
+      {"BodyWithoutMass", Scene1(R"("bodies": [{"name": "b"}], )"), "bodies[0].mass: ", "required"},
+      {"BodyZeroAxis",
+       Scene1(R"("bodies": [{"name": "b", "mass": 2, "inertia": {"z": 1}, "axis": {"x": 0}}], )"),
+       "bodies[0].axis: ", "must be non-zero"},
+      {"UnknownCableInJoint", Scene1(R"("joints": [{"type": "PIN", "a": {"cable": "bem"}}], )"),
+       "joints[0].a.cable: ", "no cable named \"bem\""},
+      {"UnknownBodyInJoint",
+       Scene1(R"("joints": [{"type": "PIN", "a": {"cable": "c"}, "b": {"body": "x"}}], )"),
+       "joints[0].b.body: ", "no body named \"x\""},
+      {"JointSOutOfRange",
+       Scene1(R"("joints": [{"type": "PIN", "a": {"cable": "c", "s": 1.5}}], )"),
+       "joints[0].a.s: ", "must be in [0, 1]"},
+      {"JointNegativeS", Scene1(R"("joints": [{"type": "PIN", "a": {"cable": "c", "s": -0.1}}], )"),
+       "joints[0].a.s: ", "must be in [0, 1]"},
+      {"JointTypeMissing", Scene1(R"("joints": [{"a": {"cable": "c"}}], )"),
+       "joints[0].type: ", "must be PIN or FIXED"},
+      {"JointSideAGround", Scene1(R"("joints": [{"type": "PIN", "b": {"cable": "c"}}], )"),
+       "joints[0].a: ", "must name a cable or a body"},
+      {"JointSideCableAndBody", Scene1(R"("bodies": [{"name": "b", "mass": 2, "inertia": {"z": 1}}],
+                 "joints": [{"type": "PIN", "a": {"cable": "c", "body": "b"}}], )"),
+       "joints[0].a: ", "names both a cable and a body"},
+      {"JointSamePlace", Scene1(R"("joints": [{"type": "FIXED", "a": {"cable": "c", "s": 0.5},
+                             "b": {"cable": "c", "s": 0.5}}], )"),
+       "joints[0].b: ", "same place as side a"},
+      {"JointBodyToItself", Scene1(R"("bodies": [{"name": "b", "mass": 2, "inertia": {"z": 1}}],
+                 "joints": [{"type": "PIN", "a": {"body": "b"},
+                             "b": {"body": "b", "point": {"x": 1}}}], )"),
+       "joints[0].b: ", "to itself"},
+      {"JointBodyPointZ", Scene1(R"("bodies": [{"name": "b", "mass": 2, "inertia": {"z": 1}}],
+                 "joints": [{"type": "PIN", "a": {"cable": "c", "s": 1},
+                             "b": {"body": "b", "point": {"z": 0.1}}}], )"),
+       "joints[0].b.point.z: ", "spatial scenes are not supported yet"},
+      {"TorqueOnCableLoad",
+       Scene1(R"("loads": [{"at": {"cable": "c", "s": 1}, "torque": {"z": 1}}], )"),
+       "loads[0].torque: ", "allowed on bodies only"},
+      {"LoadOnGround", Scene1(R"("loads": [{"force": {"y": 1}}], )"),
+       "loads[0].at: ", "must name a cable or a body"},
+      {"LoadForceZ", Scene1(R"("loads": [{"at": {"cable": "c", "s": 1}, "force": {"z": 1}}], )"),
+       "loads[0].force.z: ", "spatial scenes are not supported yet"},
+      {"BodyTorqueX", Scene1(R"("bodies": [{"name": "b", "mass": 2, "inertia": {"z": 1}}],
+                 "loads": [{"at": {"body": "b"}, "torque": {"x": 1}}], )"),
+       "loads[0].torque.x: ", "spatial scenes are not supported yet"},
+      {"GravityZ",
+       R"({"gravity": {"z": -9.81}, "cables": [)" + std::string(kCable) + "], " + kSolver + "}",
+       "gravity.z: ", "spatial scenes are not supported yet (the planar model needs z = 0)"},
+      {"CableDirectionZ",
+       R"({"cables": [{"name": "c", "length": 1, "direction": {"x": 1, "z": 1}, "density": 1000,
+                       "youngs_modulus": 1e7, "diameter": 0.01}], "solver": {"duration": 1}})",
+       "cables[0].direction.z: ", "spatial scenes are not supported yet"},
+      {"InitialAngularVelocityY", Scene1(R"("initial_velocity": {"angular": {"y": 4}}, )"),
+       "initial_velocity.angular.y: ", "spatial scenes are not supported yet"},
+      {"InitialLinearVelocityZ", Scene1(R"("initial_velocity": {"linear": {"z": 4}}, )"),
+       "initial_velocity.linear.z: ", "spatial scenes are not supported yet"},
+      {"BadProbeName", Scene1(R"("probes": [{"name": "tip 1", "cable": "c", "s": 1}], )"),
+       "probes[0].name: ", "may contain only"},
+      {"EmptyProbeName", Scene1(R"("probes": [{"cable": "c", "s": 1}], )"),
+       "probes[0].name: ", "required"},
+      {"DuplicateProbeName", Scene1(R"("probes": [{"name": "tip", "cable": "c", "s": 1},
+                            {"name": "tip", "cable": "c", "s": 0.5}], )"),
+       "probes[1].name: ", "duplicate name \"tip\" (also probes[0])"},
+      {"ProbeOnNothing", Scene1(R"("probes": [{"name": "p"}], )"),
+       "probes[0]: ", "must name a cable or a body"},
+      {"ProbeSOutOfRange", Scene1(R"("probes": [{"name": "p", "cable": "c", "s": 2}], )"),
+       "probes[0].s: ", "must be in [0, 1]"},
+      {"NegativeStep",
+       absl::StrCat(R"({"cables": [)", kCable, R"(], "solver": {"duration": 1, "step": -0.01}})"),
+       "solver.step: ", "must be > 0"},
+      {"StepLongerThanDuration",
+       absl::StrCat(R"({"cables": [)", kCable, R"(], "solver": {"duration": 1, "step": 2}})"),
+       "solver.step: ", "must be <= solver.duration"},
+      {"ZeroDurationDynamic",
+       absl::StrCat(R"({"cables": [)", kCable, R"(], "solver": {"analysis": "DYNAMIC"}})"),
+       "solver.duration: ", "must be > 0"},
+      {"OutputIntervalBelowStep",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"duration": 1, "step": 0.01, "output_interval": 0.001}})"),
+       "solver.output_interval: ", "must be >= solver.step"},
+      {"TooManyFrames",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"duration": 1e8, "step": 1, "output_interval": 1}})"),
+       "solver.output_interval: ", "too many frames"},
+      {"NegativeLoadStepsStatic",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"analysis": "STATIC", "load_steps": -1}})"),
+       "solver.load_steps: ", "must be in [1, 100000]"},
+      {"NewtonToleranceTooLarge",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"duration": 1, "newton_tolerance": 0.1}})"),
+       "solver.newton_tolerance: ", "must be in (0, 0.01]"},
+      {"ZeroLinearTolerance",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"duration": 1, "linear_tolerance": 0}})"),
+       "solver.linear_tolerance: ", "must be in (0, 0.01]"},
+      {"TooManyNewtonIterations",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"duration": 1, "max_newton_iterations": 1001}})"),
+       "solver.max_newton_iterations: ", "must be in [1, 1000]"},
+      {"TooManyStepHalvings",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"duration": 1, "max_step_halvings": 41}})"),
+       "solver.max_step_halvings: ", "must be in [0, 40]"},
+      {"NegativeMaxLinearIterations",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"duration": 1, "max_linear_iterations": -5}})"),
+       "solver.max_linear_iterations: ", "must be in [1, 100000]"},
+  };
+}
+
+class InvalidSceneTest : public ::testing::TestWithParam<InvalidCase> {};
+
+TEST_P(InvalidSceneTest, NamesTheField) {
+  const InvalidCase& c = GetParam();
+  const absl::StatusOr<Scene> scene = ConvertJson(c.json);
+  ASSERT_FALSE(scene.ok()) << c.json;
+  EXPECT_EQ(scene.status().code(), absl::StatusCode::kInvalidArgument);
+  const std::string message(scene.status().message());
+  EXPECT_THAT(message, StartsWith(c.prefix));
+  EXPECT_THAT(message, HasSubstr(c.detail));
+}
+
+INSTANTIATE_TEST_SUITE_P(All, InvalidSceneTest, ::testing::ValuesIn(InvalidCases()),
+                         [](const ::testing::TestParamInfo<InvalidCase>& info) {
+                           return std::string(info.param.name);
+                         });
+
+TEST(SceneParseTest, UnknownJsonFieldIsNamed) {
+  const absl::StatusOr<v1::Scene> scene =
+      ParseSceneJson(R"({"cables": [{"name": "c", "lenght": 1}]})");
+  ASSERT_FALSE(scene.ok());
+  EXPECT_EQ(scene.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(scene.status().message()), HasSubstr("lenght"));
+  EXPECT_THAT(std::string(scene.status().message()), HasSubstr("cables[0]"));
+}
+
+TEST(SceneParseTest, UnknownEnumNameIsNamed) {
+  const absl::StatusOr<v1::Scene> scene = ParseSceneJson(R"({"joints": [{"type": "HINGE"}]})");
+  ASSERT_FALSE(scene.ok());
+  EXPECT_THAT(std::string(scene.status().message()), HasSubstr("joints[0].type"));
+  EXPECT_THAT(std::string(scene.status().message()), HasSubstr("HINGE"));
+}
+
+TEST(SceneParseTest, MalformedJsonIsOneLine) {
+  const absl::StatusOr<v1::Scene> scene = ParseSceneJson("{\"cables\": [");
+  ASSERT_FALSE(scene.ok());
+  EXPECT_EQ(scene.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(scene.status().message()), ::testing::Not(HasSubstr("\n")));
+}
+
+TEST(SceneParseTest, TextFormat) {
+  const absl::StatusOr<v1::Scene> scene = ParseSceneTextFormat(R"pb(
+    name: "t"
+    cables { name: "c" length: 2 density: 1000 youngs_modulus: 1e7 diameter: 0.01 }
+    solver { duration: 1 }
+  )pb");
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  EXPECT_EQ(scene->cables(0).length(), 2);
+  const absl::StatusOr<v1::Scene> bad = ParseSceneTextFormat("cables { lenght: 1 }");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(bad.status().message()), HasSubstr("lenght"));
+}
+
+TEST(SceneFileTest, FormatFromExtension) {
+  EXPECT_TRUE(IsTextFormatScenePath("a/b.txtpb"));
+  EXPECT_TRUE(IsTextFormatScenePath("b.textproto"));
+  EXPECT_TRUE(IsTextFormatScenePath("b.pbtxt"));
+  EXPECT_FALSE(IsTextFormatScenePath("b.json"));
+  EXPECT_FALSE(IsTextFormatScenePath("scene"));
+}
+
+TEST(SceneFileTest, MissingFile) {
+  const absl::StatusOr<v1::Scene> scene = ReadSceneFile("/nonexistent/scene.json");
+  ASSERT_FALSE(scene.ok());
+  EXPECT_EQ(scene.status().code(), absl::StatusCode::kNotFound);
+  EXPECT_THAT(std::string(scene.status().message()), StartsWith("/nonexistent/scene.json: "));
+}
+
+TEST(SceneFileTest, ParseErrorNamesFileAndField) {
+  const std::string path = ::testing::TempDir() + "/scene_validation_test_bad.json";
+  {
+    FILE* f = std::fopen(path.c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fputs(R"({"cables": [{"name": "c", "colour": "red"}]})", f);
+    std::fclose(f);
+  }
+  const absl::StatusOr<v1::Scene> scene = ReadSceneFile(path);
+  ASSERT_FALSE(scene.ok());
+  EXPECT_EQ(scene.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(scene.status().message()), StartsWith(path + ": "));
+  EXPECT_THAT(std::string(scene.status().message()), HasSubstr("colour"));
+  std::remove(path.c_str());
+}
+
+std::string SceneFile(const char* name) {
+  return absl::StrCat(CABLESIM_SOURCE_DIR, "/scenes/", name);
+}
+
+TEST(SampleSceneTest, FallingPendulum) {
+  const absl::StatusOr<v1::Scene> proto = ReadSceneFile(SceneFile("falling-pendulum.json"));
+  ASSERT_TRUE(proto.ok()) << proto.status();
+  const absl::StatusOr<Scene> scene = SceneFromProto(*proto);
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  EXPECT_EQ(scene->name, "falling-pendulum");
+  EXPECT_EQ(scene->gravity_m_s2, Eigen::Vector3d(0, -9.81, 0));
+  ASSERT_EQ(scene->cables.size(), 1);
+  const CableSpec& cable = scene->cables[0];
+  EXPECT_EQ(cable.name, "beam");
+  ASSERT_EQ(cable.points.size(), 2);
+  EXPECT_EQ(cable.points[0], Eigen::Vector3d(0, 0, 0));
+  EXPECT_EQ(cable.points[1], Eigen::Vector3d(1.2, 0, 0));
+  EXPECT_EQ(cable.length_m, 1.2);
+  EXPECT_EQ(cable.elements, 12);
+  EXPECT_EQ(cable.density_kg_m3, 5540);
+  EXPECT_EQ(cable.youngs_modulus_pa, 0.7e6);
+  EXPECT_EQ(cable.area_m2, 0.0018);
+  EXPECT_EQ(cable.second_moment_m4, 1.215e-8);
+  EXPECT_EQ(cable.bending, BendingModel::kExact);
+  EXPECT_TRUE(scene->bodies.empty());
+  ASSERT_EQ(scene->joints.size(), 1);
+  EXPECT_EQ(scene->joints[0].type, JointType::kPin);
+  EXPECT_EQ(scene->joints[0].a.cable, 0);
+  EXPECT_EQ(scene->joints[0].a.s_m, 0);
+  EXPECT_TRUE(scene->joints[0].b.IsGround());
+  ASSERT_EQ(scene->probes.size(), 1);
+  EXPECT_EQ(scene->probes[0].name, "tip");
+  EXPECT_EQ(scene->probes[0].at.cable, 0);
+  EXPECT_EQ(scene->probes[0].at.s_m, 1.2);
+  const SolverSettings& solver = scene->solver;
+  EXPECT_EQ(solver.analysis, Analysis::kDynamic);
+  EXPECT_EQ(solver.duration_s, 1.0);
+  EXPECT_EQ(solver.step_s, 1e-4);
+  EXPECT_EQ(solver.output_interval_s, 0.001);
+  EXPECT_EQ(solver.integrator, Integrator::kImplicitEuler);
+  EXPECT_EQ(solver.linear_solver, LinearSolverKind::kMinres);
+  // Defaults.
+  EXPECT_EQ(solver.load_steps, 10);
+  EXPECT_EQ(solver.newton_tolerance, 1e-8);
+  EXPECT_EQ(solver.max_newton_iterations, 25);
+  EXPECT_EQ(solver.max_step_halvings, 12);
+  EXPECT_EQ(solver.linear_tolerance, 1e-10);
+  EXPECT_EQ(solver.max_linear_iterations, 200);
+}
+
+TEST(SampleSceneTest, CableWithEndCylinder) {
+  const absl::StatusOr<v1::Scene> proto = ReadSceneFile(SceneFile("cable-with-end-cylinder.json"));
+  ASSERT_TRUE(proto.ok()) << proto.status();
+  const absl::StatusOr<Scene> scene = SceneFromProto(*proto);
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  const CableSpec& cable = scene->cables[0];
+  EXPECT_EQ(cable.points[0], Eigen::Vector3d(0, 0, 0));
+  EXPECT_EQ(cable.points[1], Eigen::Vector3d(0.5, 0, 0));
+  EXPECT_EQ(cable.elements, 20);
+  // MODEL.md Table 1: A = 7.85e-5 m^2, I = 4.91e-10 m^4.
+  EXPECT_DOUBLE_EQ(cable.area_m2, kPi * 0.01 * 0.01 / 4);
+  EXPECT_NEAR(cable.area_m2, 7.85e-5, 1e-7);
+  EXPECT_DOUBLE_EQ(cable.second_moment_m4, kPi * std::pow(0.01, 4) / 64);
+  EXPECT_NEAR(cable.second_moment_m4, 4.91e-10, 1e-12);
+  EXPECT_EQ(cable.bending, BendingModel::kExact);
+
+  ASSERT_EQ(scene->bodies.size(), 1);
+  const BodySpec& body = scene->bodies[0];
+  const double m = 1000 * kPi * 0.04 * 0.04 / 4 * 0.1;
+  EXPECT_DOUBLE_EQ(body.mass_kg, m);
+  EXPECT_DOUBLE_EQ(body.inertia_kg_m2.x(), m * 0.04 * 0.04 / 8);
+  EXPECT_DOUBLE_EQ(body.inertia_kg_m2.y(), m * (3 * 0.02 * 0.02 + 0.1 * 0.1) / 12);
+  EXPECT_DOUBLE_EQ(body.inertia_kg_m2.z(), m * (3 * 0.02 * 0.02 + 0.1 * 0.1) / 12);
+  EXPECT_EQ(body.position_m, Eigen::Vector3d(0.55, 0, 0));
+  EXPECT_EQ(body.axis, Eigen::Vector3d(1, 0, 0));
+
+  ASSERT_EQ(scene->joints.size(), 2);
+  EXPECT_EQ(scene->joints[0].type, JointType::kPin);
+  EXPECT_TRUE(scene->joints[0].b.IsGround());
+  const JointSpec& weld = scene->joints[1];
+  EXPECT_EQ(weld.type, JointType::kFixed);
+  EXPECT_EQ(weld.a.cable, 0);
+  EXPECT_EQ(weld.a.s_m, 0.5);
+  EXPECT_EQ(weld.b.body, 0);
+  EXPECT_EQ(weld.b.cable, -1);
+  EXPECT_EQ(weld.b.point_body_m, Eigen::Vector3d(-0.05, 0, 0));
+  ASSERT_EQ(scene->probes.size(), 1);
+  EXPECT_EQ(scene->probes[0].at.body, 0);
+  EXPECT_EQ(scene->probes[0].at.point_body_m, Eigen::Vector3d::Zero());
+
+  EXPECT_EQ(scene->solver.analysis, Analysis::kDynamic);  // from UNSPECIFIED
+  EXPECT_EQ(scene->solver.duration_s, 20);
+  EXPECT_EQ(scene->solver.step_s, 0.005);
+  EXPECT_EQ(scene->solver.output_interval_s, 0.01);
+  EXPECT_EQ(scene->solver.integrator, Integrator::kImplicitEuler);
+  EXPECT_EQ(scene->solver.linear_solver, LinearSolverKind::kMinres);
+}
+
+TEST(SampleSceneTest, CantileverLargeDeflection) {
+  const absl::StatusOr<v1::Scene> proto =
+      ReadSceneFile(SceneFile("cantilever-large-deflection.json"));
+  ASSERT_TRUE(proto.ok()) << proto.status();
+  const absl::StatusOr<Scene> scene = SceneFromProto(*proto);
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  EXPECT_EQ(scene->name, "large-deflection-cantilever");
+  EXPECT_EQ(scene->gravity_m_s2, Eigen::Vector3d::Zero());
+  EXPECT_EQ(scene->cables[0].points[1], Eigen::Vector3d(1, 0, 0));
+  EXPECT_EQ(scene->cables[0].elements, 16);
+  ASSERT_EQ(scene->joints.size(), 1);
+  EXPECT_EQ(scene->joints[0].type, JointType::kFixed);
+  EXPECT_TRUE(scene->joints[0].b.IsGround());
+  ASSERT_EQ(scene->loads.size(), 1);
+  EXPECT_EQ(scene->loads[0].at.cable, 0);
+  EXPECT_EQ(scene->loads[0].at.s_m, 1.0);
+  EXPECT_EQ(scene->loads[0].force_n, Eigen::Vector3d(0, -196.3495, 0));
+  EXPECT_EQ(scene->loads[0].torque_nm, Eigen::Vector3d::Zero());
+  EXPECT_EQ(scene->probes[0].at.s_m, 1.0);
+  EXPECT_EQ(scene->solver.analysis, Analysis::kStatic);
+  EXPECT_EQ(scene->solver.load_steps, 20);
+  EXPECT_EQ(scene->solver.step_s, 1e-3);             // default
+  EXPECT_EQ(scene->solver.output_interval_s, 1e-3);  // default: the step
+}
+
+TEST(SceneConversionTest, DefaultsForAMinimalCable) {
+  const absl::StatusOr<Scene> scene =
+      ConvertJson(R"({"cables": [{"name": "c", "length": 2, "density": 1, "youngs_modulus": 1,
+                                  "area": 1e-4, "bending": "NONE"}],
+                      "solver": {"duration": 1}})");
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  const CableSpec& cable = scene->cables[0];
+  EXPECT_EQ(cable.elements, 10);
+  EXPECT_EQ(cable.points[0], Eigen::Vector3d::Zero());
+  EXPECT_EQ(cable.points[1], Eigen::Vector3d(2, 0, 0));
+  EXPECT_EQ(cable.bending, BendingModel::kNone);
+  EXPECT_EQ(cable.second_moment_m4, 0);  // not needed without bending
+  EXPECT_EQ(scene->solver.step_s, 1e-3);
+  EXPECT_EQ(scene->solver.output_interval_s, 1e-3);
+}
+
+TEST(SceneConversionTest, StartAndNormalisedDirection) {
+  const absl::StatusOr<Scene> scene = ConvertJson(
+      R"({"cables": [{"name": "c", "length": 10, "start": {"x": 1, "y": 2},
+                      "direction": {"x": 3, "y": -4}, "density": 1, "youngs_modulus": 1,
+                      "diameter": 0.01, "bending": "LINEAR"}],
+          "solver": {"duration": 1}})");
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  const CableSpec& cable = scene->cables[0];
+  EXPECT_EQ(cable.points[0], Eigen::Vector3d(1, 2, 0));
+  EXPECT_TRUE(cable.points[1].isApprox(Eigen::Vector3d(7, -6, 0)));
+  EXPECT_EQ(cable.bending, BendingModel::kLinear);
+}
+
+TEST(SceneConversionTest, PolylineLengthAndExplicitSectionWins) {
+  const absl::StatusOr<Scene> scene = ConvertJson(
+      R"({"cables": [{"name": "c", "points": [{"x": 0}, {"x": 3}, {"x": 3, "y": 4}],
+                      "density": 1, "youngs_modulus": 1, "diameter": 0.01, "area": 2e-4,
+                      "second_moment": 3e-9}],
+          "probes": [{"name": "end", "cable": "c", "s": 7}],
+          "solver": {"duration": 1}})");
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  const CableSpec& cable = scene->cables[0];
+  ASSERT_EQ(cable.points.size(), 3);
+  EXPECT_EQ(cable.points[2], Eigen::Vector3d(3, 4, 0));
+  EXPECT_EQ(cable.length_m, 7);
+  EXPECT_EQ(cable.area_m2, 2e-4);
+  EXPECT_EQ(cable.second_moment_m4, 3e-9);
+}
+
+TEST(SceneConversionTest, ArcLengthAtTheEndToleratesRounding) {
+  // 0.1 + 0.2 is slightly above 0.3.
+  const absl::StatusOr<Scene> scene = ConvertJson(absl::StrCat(
+      R"({"cables": [{"name": "c", "length": 0.3, "density": 1, "youngs_modulus": 1,
+                      "diameter": 0.01}],
+          "probes": [{"name": "end", "cable": "c", "s": )",
+      0.1 + 0.2, R"(}], "solver": {"duration": 1}})"));
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  EXPECT_EQ(scene->probes[0].at.s_m, 0.3);  // clamped into [0, length]
+}
+
+TEST(SceneConversionTest, BodyWithMassAndInertia) {
+  const absl::StatusOr<Scene> scene = ConvertJson(
+      R"({"bodies": [{"name": "b", "mass": 2, "inertia": {"z": 0.5},
+                      "position": {"x": 1, "y": -1}, "axis": {"x": 0, "y": 2}}],
+          "loads": [{"at": {"body": "b", "point": {"x": 0.1}}, "force": {"x": 1},
+                     "torque": {"z": 3}}],
+          "probes": [{"name": "b.com", "body": "b"}],
+          "initial_velocity": {"linear": {"x": 1}, "angular": {"z": 2},
+                               "origin": {"x": 1, "z": 5}},
+          "solver": {"analysis": "STATIC", "linear_solver": "GMRES"}})");
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  ASSERT_TRUE(scene->cables.empty());
+  const BodySpec& body = scene->bodies[0];
+  EXPECT_EQ(body.mass_kg, 2);
+  EXPECT_EQ(body.inertia_kg_m2, Eigen::Vector3d(0, 0, 0.5));
+  EXPECT_EQ(body.position_m, Eigen::Vector3d(1, -1, 0));
+  EXPECT_EQ(body.axis, Eigen::Vector3d(0, 1, 0));  // normalised
+  EXPECT_EQ(scene->loads[0].at.body, 0);
+  EXPECT_EQ(scene->loads[0].at.point_body_m, Eigen::Vector3d(0.1, 0, 0));
+  EXPECT_EQ(scene->loads[0].torque_nm, Eigen::Vector3d(0, 0, 3));
+  EXPECT_EQ(scene->initial_velocity.angular_rad_s, Eigen::Vector3d(0, 0, 2));
+  EXPECT_EQ(scene->initial_velocity.origin_m, Eigen::Vector3d(1, 0, 5));
+  EXPECT_EQ(scene->solver.analysis, Analysis::kStatic);
+  EXPECT_EQ(scene->solver.linear_solver, LinearSolverKind::kGmres);
+}
+
+TEST(SceneConversionTest, JointBetweenTwoPointsOfOneCable) {
+  const absl::StatusOr<Scene> scene =
+      ConvertJson(Scene1(R"("joints": [{"type": "PIN", "a": {"cable": "c", "s": 0},
+                                        "b": {"cable": "c", "s": 1}}], )"));
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  EXPECT_EQ(scene->joints[0].b.cable, 0);
+  EXPECT_EQ(scene->joints[0].b.s_m, 1);
+}
+
+TEST(EnumConversionTest, Names) {
+  EXPECT_EQ(AnalysisName(Analysis::kStatic), "STATIC");
+  EXPECT_EQ(IntegratorName(Integrator::kImplicitEuler), "IMPLICIT_EULER");
+  EXPECT_EQ(LinearSolverName(LinearSolverKind::kGmres), "GMRES");
+  const absl::StatusOr<JointType> none = JointTypeFromProto(v1::JOINT_TYPE_UNSPECIFIED, "j.type");
+  ASSERT_FALSE(none.ok());
+  EXPECT_THAT(std::string(none.status().message()), StartsWith("j.type: "));
+}
+
+}  // namespace
+}  // namespace cablesim
