@@ -1,0 +1,156 @@
+// The skyline LDL^T and the preallocated Krylov solvers against Eigen's
+// dense LU and Eigen's own (allocating) MINRES, on random systems of the
+// shapes the steppers produce.
+
+#include <random>
+
+#include <Eigen/Dense>
+#include <gtest/gtest.h>
+#include <unsupported/Eigen/IterativeSolvers>
+
+#include "engine/krylov.h"
+#include "engine/saddle_point_solver.h"
+#include "engine/skyline_ldlt.h"
+
+namespace cablesim {
+namespace {
+
+// A random symmetric matrix with a variable band: row i couples to
+// max(0, i - band_i)..i. Diagonally dominant when `definite`.
+Eigen::MatrixXd RandomBanded(int n, std::vector<int>* first, bool definite, std::mt19937* rng) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::uniform_int_distribution<int> band(0, 6);
+  first->resize(n);
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
+  for (int i = 0; i < n; ++i) {
+    (*first)[i] = std::max(0, i - band(*rng));
+    for (int j = (*first)[i]; j < i; ++j) a(i, j) = a(j, i) = u(*rng);
+  }
+  for (int i = 0; i < n; ++i) a(i, i) = (definite ? 8.0 : 3.0 * u(*rng)) + (definite ? 0 : 0.5);
+  return a;
+}
+
+void Load(const Eigen::MatrixXd& a, SkylineLdlt* s) {
+  s->SetZero();
+  for (int i = 0; i < a.rows(); ++i)
+    for (int j = 0; j <= i; ++j)
+      if (s->Slot(i, j) >= 0) s->values()[s->Slot(i, j)] = a(i, j);
+}
+
+TEST(SkylineLdltTest, SolvesIndefiniteBandedSystemsLikeDenseLu) {
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 10; ++trial) {
+    std::vector<int> first;
+    const Eigen::MatrixXd a = RandomBanded(60, &first, false, &rng);
+    SkylineLdlt s;
+    s.SetPattern(first);
+    Load(a, &s);
+    Eigen::VectorXd x = Eigen::VectorXd::Random(60), y(60);
+    s.Multiply(x.data(), y.data());
+    EXPECT_LT((y - a * x).norm(), 1e-12 * (a * x).norm());
+    ASSERT_TRUE(s.Factor());
+    const Eigen::VectorXd b = Eigen::VectorXd::Random(60);
+    Eigen::VectorXd sol = b;
+    s.Solve(sol.data());
+    const Eigen::VectorXd ref = a.partialPivLu().solve(b);
+    EXPECT_LT((sol - ref).norm(), 1e-8 * ref.norm());
+  }
+}
+
+TEST(SkylineLdltTest, AbsoluteSolveIsPositiveDefinite) {
+  std::mt19937 rng(4);
+  std::vector<int> first;
+  const Eigen::MatrixXd a = RandomBanded(40, &first, false, &rng);
+  SkylineLdlt s;
+  s.SetPattern(first);
+  Load(a, &s);
+  ASSERT_TRUE(s.Factor());
+  EXPECT_GT(s.negative_pivots(), 0);  // the test matrix is indefinite
+  Eigen::MatrixXd p(40, 40);
+  for (int c = 0; c < 40; ++c) {
+    Eigen::VectorXd e = Eigen::VectorXd::Unit(40, c);
+    s.SolveAbs(e.data());
+    p.col(c) = e;
+  }
+  EXPECT_LT((p - p.transpose()).norm(), 1e-10 * p.norm());
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(p).eigenvalues().minCoeff(), 0);
+}
+
+TEST(KrylovTest, MinresMatchesEigenMinresOnSymmetricIndefiniteSystems) {
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 5; ++trial) {
+    std::vector<int> first;
+    const Eigen::MatrixXd a = RandomBanded(50, &first, false, &rng);
+    const Eigen::VectorXd b = Eigen::VectorXd::Random(50);
+    Minres minres;
+    Eigen::VectorXd x(50);
+    auto op = [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) { out = a * in; };
+    auto ident = [](const Eigen::VectorXd& in, Eigen::VectorXd& out) { out = in; };
+    const KrylovResult r = minres.Solve(op, ident, b, 1e-12, 2000, x);
+    EXPECT_TRUE(r.converged);
+    Eigen::MINRES<Eigen::MatrixXd, Eigen::Lower | Eigen::Upper, Eigen::IdentityPreconditioner> ref;
+    ref.setTolerance(1e-12);
+    ref.setMaxIterations(2000);
+    ref.compute(a);
+    const Eigen::VectorXd xr = ref.solve(b);
+    EXPECT_LT((x - xr).norm(), 1e-7 * xr.norm());
+    EXPECT_LT((a * x - b).norm(), 1e-8 * b.norm());
+  }
+}
+
+TEST(KrylovTest, GmresSolvesNonsymmetricSystemsWithRestarts) {
+  std::mt19937 rng(6);
+  Eigen::MatrixXd a = Eigen::MatrixXd::Random(80, 80) + 12 * Eigen::MatrixXd::Identity(80, 80);
+  const Eigen::VectorXd b = Eigen::VectorXd::Random(80);
+  Gmres gmres(10);  // forces restarts
+  Eigen::VectorXd x(80);
+  auto op = [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) { out = a * in; };
+  auto ident = [](const Eigen::VectorXd& in, Eigen::VectorXd& out) { out = in; };
+  const KrylovResult r = gmres.Solve(op, ident, b, 1e-12, 500, x);
+  EXPECT_TRUE(r.converged);
+  EXPECT_LT((a * x - b).norm(), 1e-10 * b.norm());
+}
+
+TEST(SaddlePointSolverTest, BlockPreconditionedMinresNeedsFewIterations) {
+  // A positive definite A and a full-rank B: with the exact Schur
+  // complement MINRES needs at most 3 iterations in exact arithmetic
+  // (Murphy, Golub and Wathen 2000); allow 6 for rounding.
+  std::mt19937 rng(7);
+  std::vector<int> first;
+  const int n = 40, m = 5;
+  const Eigen::MatrixXd a = RandomBanded(n, &first, true, &rng);
+  SparseRows pattern;
+  pattern.cols = n;
+  std::uniform_int_distribution<int> col(0, n - 1);
+  Eigen::MatrixXd bd = Eigen::MatrixXd::Zero(m, n);
+  for (int r = 0; r < m; ++r) {
+    for (int k = 0; k < 4; ++k) {
+      const int c = col(rng);
+      const double v = 1 + k;
+      pattern.col.push_back(c);
+      pattern.value.push_back(v);
+      bd(r, c) += v;
+    }
+    pattern.row_start.push_back(static_cast<int>(pattern.col.size()));
+  }
+  for (LinearSolverKind kind : {LinearSolverKind::kMinres, LinearSolverKind::kGmres}) {
+    SaddlePointSolver solver;
+    solver.Resize(first, pattern);
+    Load(a, &solver.a());
+    ASSERT_TRUE(solver.Prepare());
+    const Eigen::VectorXd rhs = Eigen::VectorXd::Random(n + m);
+    Eigen::VectorXd x(n + m);
+    const auto stats = solver.Solve(kind, rhs, 1e-12, 200, &x);
+    Eigen::MatrixXd k = Eigen::MatrixXd::Zero(n + m, n + m);
+    k.topLeftCorner(n, n) = a;
+    k.topRightCorner(n, m) = bd.transpose();
+    k.bottomLeftCorner(m, n) = bd;
+    const Eigen::VectorXd ref = k.partialPivLu().solve(rhs);
+    EXPECT_LT((x - ref).norm(), 1e-8 * ref.norm());
+    EXPECT_LE(stats.iterations, 6);
+    EXPECT_LT(stats.relative_residual, 1e-10);
+  }
+}
+
+}  // namespace
+}  // namespace cablesim
