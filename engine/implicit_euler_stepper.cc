@@ -94,7 +94,10 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
       st.reason = "the residual is not finite (the step diverged)";
       return st;
     }
-    if (checking && res <= tol && viol <= tol * zscale) {
+    // Converged: the last increment was small, and the residual is below
+    // the tolerance or at the rounding floor of the elastic forces.
+    const double floor = h * model_->force_roundoff() / scale;
+    if (checking && res <= tol + floor && viol <= tol * zscale) {
       st.converged = true;
       st.residual = res;
       break;

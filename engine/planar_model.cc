@@ -284,6 +284,8 @@ absl::StatusOr<PlanarModel> PlanarModel::Build(const Scene& scene) {
       const double l = node_s[c][local + 1] - node_s[c][local];
       ElementData e;
       e.element = Element(l, ea, ei, cable.bending);
+      m.force_roundoff_ = std::max(
+          m.force_roundoff_, 100 * std::numeric_limits<double>::epsilon() * std::max(ea, ei / (l * l)));
       e.first_coord = 4 * k;
       e.mass_per_length = mpl;
       e.gravity = e.element.GravityForce(mpl, Xy(scene.gravity_m_s2));

@@ -78,6 +78,11 @@ class PlanarModel {
   double NetForce(const Eigen::VectorXd& q, double load_factor, Eigen::VectorXd* f,
                   SkylineLdlt* stiffness = nullptr, double stiffness_scale = 0);
 
+  // The level below which force residuals are rounding error: 100 machine
+  // epsilons of the stiffest element's EA or EI / l^2 [N]. Newton cannot
+  // drive a residual below it, so it is added to the convergence threshold.
+  double force_roundoff() const { return force_roundoff_; }
+
   // Constraint values Phi(q) [multipliers()] and Jacobian dPhi/dz.
   void Constraints(const Eigen::VectorXd& q, Eigen::VectorXd* phi, SparseRows* jac) const;
   // An empty Jacobian with the constraint pattern (values to be filled).
@@ -175,6 +180,7 @@ class PlanarModel {
   std::vector<std::string> probe_names_;
   Eigen::VectorXd constant_force_;  // full: gravity and node loads
   Eigen::Vector2d gravity_ = Eigen::Vector2d::Zero();
+  double force_roundoff_ = 0;
 
   std::vector<int> envelope_;
   SkylineLdlt mass_;

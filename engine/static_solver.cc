@@ -53,7 +53,8 @@ StaticSolver::IncrementStats StaticSolver::Solve(double alpha) {
       st.reason = "the residual is not finite";
       return st;
     }
-    if (it > 0 && last_increment <= tol * zscale && res <= tol &&
+    const double floor = model_->force_roundoff() / scale;  // rounding level
+    if (it > 0 && last_increment <= tol * zscale && res <= tol + floor &&
         viol <= tol * zscale) {
       st.converged = true;
       st.residual = res;

@@ -1,0 +1,390 @@
+// Proves that ImplicitEulerStepper::Step allocates nothing once warmed up.
+//
+// This file replaces the global operator new/delete family (forwarding to
+// malloc/free, aligned_alloc for the aligned forms). On glibc it also
+// interposes malloc, calloc, realloc and the aligned C allocators
+// (forwarding to glibc's __libc_* entry points), because Eigen's dynamic
+// matrices and vectors are allocated with std::malloc, never through
+// operator new: counting new alone would miss them. While the counting flag
+// is on, every allocation call is counted.
+//
+// To find an allocation's origin, run with CABLESIM_ALLOC_BACKTRACE=1: each
+// counted allocation then prints a backtrace to stderr; resolve its
+// `binary(+0xOFFSET)` frames with `addr2line -f -C -e binary 0xOFFSET`
+// (build with -g, e.g. RelWithDebInfo, for file and line), or in gdb break
+// on PrintBacktrace / CountMalloc while the counting window is open.
+
+#include <execinfo.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cstddef>
+#include <cstdlib>
+#include <fstream>
+#include <new>
+#include <sstream>
+#include <string>
+
+#include <Eigen/Core>
+#include <gtest/gtest.h>
+
+#include "engine/implicit_euler_stepper.h"
+#include "engine/planar_model.h"
+#include "engine/scene.h"
+#include "tests/test_util.h"
+
+namespace {
+
+std::atomic<bool> g_counting{false};
+std::atomic<long> g_new_calls{0};     // operator new / new[] (all forms)
+std::atomic<long> g_malloc_calls{0};  // malloc family (operator new included)
+bool g_backtrace = false;             // set from CABLESIM_ALLOC_BACKTRACE
+thread_local bool t_in_hook = false;  // no counting inside the backtrace
+
+[[gnu::noinline]] void PrintBacktrace(const char* what) {
+  if (!g_backtrace || t_in_hook) return;
+  t_in_hook = true;
+  void* frames[64];
+  const int n = backtrace(frames, 64);
+  static const char kHeader[] = "---- counted allocation: ";
+  (void)!write(2, kHeader, sizeof(kHeader) - 1);
+  (void)!write(2, what, __builtin_strlen(what));
+  (void)!write(2, "\n", 1);
+  backtrace_symbols_fd(frames, n, 2);
+  t_in_hook = false;
+}
+
+[[gnu::noinline]] void CountNew() {
+  if (g_counting.load(std::memory_order_relaxed) && !t_in_hook) {
+    g_new_calls.fetch_add(1, std::memory_order_relaxed);
+    PrintBacktrace("operator new");
+  }
+}
+
+[[gnu::noinline]] void CountMalloc(const char* what) {
+  if (g_counting.load(std::memory_order_relaxed) && !t_in_hook) {
+    g_malloc_calls.fetch_add(1, std::memory_order_relaxed);
+    PrintBacktrace(what);
+  }
+}
+
+void* NewOrThrow(std::size_t size) {
+  CountNew();
+  if (size == 0) size = 1;
+  void* p = std::malloc(size);
+  if (!p) throw std::bad_alloc();
+  return p;
+}
+
+void* AlignedNewOrNull(std::size_t size, std::align_val_t align) {
+  CountNew();
+  const std::size_t a = std::max(static_cast<std::size_t>(align), sizeof(void*));
+  // aligned_alloc wants the size to be a multiple of the alignment.
+  std::size_t rounded = (std::max<std::size_t>(size, 1) + a - 1) / a * a;
+  return std::aligned_alloc(a, rounded);
+}
+
+void* AlignedNewOrThrow(std::size_t size, std::align_val_t align) {
+  void* p = AlignedNewOrNull(size, align);
+  if (!p) throw std::bad_alloc();
+  return p;
+}
+
+// A window in which allocations are counted.
+struct Counts {
+  long news = 0;
+  long mallocs = 0;
+};
+
+class CountingWindow {
+ public:
+  CountingWindow() {
+    new_start_ = g_new_calls.load();
+    malloc_start_ = g_malloc_calls.load();
+    g_counting.store(true);
+  }
+  Counts Stop() {
+    g_counting.store(false);
+    return {g_new_calls.load() - new_start_, g_malloc_calls.load() - malloc_start_};
+  }
+  ~CountingWindow() { g_counting.store(false); }
+
+ private:
+  long new_start_ = 0, malloc_start_ = 0;
+};
+
+}  // namespace
+
+// ---- the C allocator (glibc only) ----------------------------------------
+
+#if defined(__GLIBC__)
+#define CABLESIM_COUNTS_MALLOC 1
+extern "C" {
+void* __libc_malloc(std::size_t);
+void* __libc_calloc(std::size_t, std::size_t);
+void* __libc_realloc(void*, std::size_t);
+void* __libc_memalign(std::size_t, std::size_t);
+void __libc_free(void*);
+
+void* malloc(std::size_t size) {
+  CountMalloc("malloc");
+  return __libc_malloc(size);
+}
+void* calloc(std::size_t n, std::size_t size) {
+  CountMalloc("calloc");
+  return __libc_calloc(n, size);
+}
+void* realloc(void* p, std::size_t size) {
+  CountMalloc("realloc");
+  return __libc_realloc(p, size);
+}
+void* memalign(std::size_t align, std::size_t size) {
+  CountMalloc("memalign");
+  return __libc_memalign(align, size);
+}
+void* aligned_alloc(std::size_t align, std::size_t size) {
+  CountMalloc("aligned_alloc");
+  return __libc_memalign(align, size);
+}
+int posix_memalign(void** out, std::size_t align, std::size_t size) {
+  CountMalloc("posix_memalign");
+  if (align < sizeof(void*) || (align & (align - 1)) != 0) return EINVAL;
+  void* p = __libc_memalign(align, size);
+  if (!p) return ENOMEM;
+  *out = p;
+  return 0;
+}
+void free(void* p) { __libc_free(p); }
+}  // extern "C"
+#else
+#define CABLESIM_COUNTS_MALLOC 0
+#endif
+
+// ---- the global operator new / delete family ------------------------------
+
+void* operator new(std::size_t size) { return NewOrThrow(size); }
+void* operator new[](std::size_t size) { return NewOrThrow(size); }
+void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
+  CountNew();
+  return std::malloc(size ? size : 1);
+}
+void* operator new[](std::size_t size, const std::nothrow_t&) noexcept {
+  CountNew();
+  return std::malloc(size ? size : 1);
+}
+void* operator new(std::size_t size, std::align_val_t align) {
+  return AlignedNewOrThrow(size, align);
+}
+void* operator new[](std::size_t size, std::align_val_t align) {
+  return AlignedNewOrThrow(size, align);
+}
+void* operator new(std::size_t size, std::align_val_t align, const std::nothrow_t&) noexcept {
+  return AlignedNewOrNull(size, align);
+}
+void* operator new[](std::size_t size, std::align_val_t align, const std::nothrow_t&) noexcept {
+  return AlignedNewOrNull(size, align);
+}
+
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept {
+  std::free(p);
+}
+
+namespace cablesim {
+namespace {
+
+class StepperAllocationTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const char* env = std::getenv("CABLESIM_ALLOC_BACKTRACE");
+    g_backtrace = env != nullptr && *env != '\0' && *env != '0';
+    if (g_backtrace) {
+      // The first backtrace() loads libgcc_s (and allocates): do it now.
+      void* frames[4];
+      backtrace(frames, 4);
+    }
+  }
+};
+
+// ---- the counter itself counts -------------------------------------------
+
+TEST_F(StepperAllocationTest, CounterSeesOperatorNew) {
+  CountingWindow window;
+  int* volatile p = new int(7);
+  const Counts counts = window.Stop();
+  delete p;
+  EXPECT_EQ(counts.news, 1);
+}
+
+TEST_F(StepperAllocationTest, CounterSeesAlignedAndArrayNew) {
+  struct alignas(64) Wide {
+    double x[8];
+  };
+  CountingWindow window;
+  Wide* volatile w = new Wide();
+  double* volatile a = new double[5];
+  const Counts counts = window.Stop();
+  delete w;
+  delete[] a;
+  EXPECT_EQ(counts.news, 2);
+}
+
+TEST_F(StepperAllocationTest, CounterSeesEigenHeapVectors) {
+  if (!CABLESIM_COUNTS_MALLOC) GTEST_SKIP() << "malloc is counted on glibc only";
+  CountingWindow window;
+  Eigen::VectorXd v(100);
+  double* volatile data = v.data();
+  const Counts counts = window.Stop();
+  (void)data;
+  // Eigen allocates with malloc, not operator new.
+  EXPECT_GE(counts.mallocs, 1);
+}
+
+// The counter sees allocations made inside the engine library too (building
+// a model fills std::vectors and Eigen vectors).
+TEST_F(StepperAllocationTest, CounterSeesEngineAllocations) {
+  Scene scene;
+  CableSpec cable;
+  cable.points = {Eigen::Vector3d::Zero(), Eigen::Vector3d(1, 0, 0)};
+  cable.length_m = 1;
+  cable.elements = 4;
+  cable.density_kg_m3 = 1000;
+  cable.youngs_modulus_pa = 1e7;
+  cable.area_m2 = 1e-4;
+  cable.second_moment_m4 = 1e-9;
+  scene.cables.push_back(cable);
+  CountingWindow window;
+  absl::StatusOr<PlanarModel> model = PlanarModel::Build(scene);
+  const Counts counts = window.Stop();
+  ASSERT_TRUE(model.ok()) << model.status();
+  EXPECT_GE(counts.news + counts.mallocs, 1);
+  if (CABLESIM_COUNTS_MALLOC) {
+    EXPECT_GE(counts.mallocs, 1);
+  }
+}
+
+// ---- the stepper ----------------------------------------------------------
+
+// Builds the model, warms the stepper up with 5 steps, then counts
+// allocations over `steps` steps of size h; all must converge.
+void ExpectStepsDoNotAllocate(const Scene& scene, double h, int steps) {
+  absl::StatusOr<PlanarModel> model = PlanarModel::Build(scene);
+  ASSERT_TRUE(model.ok()) << model.status();
+  ImplicitEulerStepper stepper(&*model, scene.solver);
+  std::string reason;
+  ASSERT_TRUE(stepper.Initialize(&reason)) << reason;
+  for (int i = 0; i < 5; ++i) {
+    const ImplicitEulerStepper::StepStats st = stepper.Step(h);
+    ASSERT_TRUE(st.converged) << "warm-up step " << i << ": " << st.reason;
+  }
+
+  int not_converged = 0, first_failure = -1;
+  long newton = 0;
+  CountingWindow window;
+  for (int i = 0; i < steps; ++i) {
+    const ImplicitEulerStepper::StepStats st = stepper.Step(h);
+    newton += st.newton_iterations;
+    if (!st.converged) {
+      if (first_failure < 0) first_failure = i;
+      ++not_converged;
+    }
+  }
+  const Counts counts = window.Stop();
+
+  EXPECT_EQ(not_converged, 0) << "first failure at counted step " << first_failure;
+  EXPECT_GT(newton, 0);
+  EXPECT_EQ(counts.news, 0) << "operator new calls in " << steps << " steps "
+                            << "(rerun with CABLESIM_ALLOC_BACKTRACE=1 to see where)";
+  EXPECT_EQ(counts.mallocs, 0) << "malloc-family calls in " << steps << " steps "
+                               << "(rerun with CABLESIM_ALLOC_BACKTRACE=1 to see where)";
+  EXPECT_TRUE(stepper.z().allFinite());
+}
+
+// scenes/falling-pendulum.json, built in C++ (12 elements, no multipliers:
+// the pin removes the node's position).
+Scene FallingPendulum() {
+  Scene scene;
+  scene.name = "falling-pendulum";
+  scene.gravity_m_s2 = Eigen::Vector3d(0, -9.81, 0);
+  CableSpec cable;
+  cable.name = "beam";
+  cable.points = {Eigen::Vector3d::Zero(), Eigen::Vector3d(1.2, 0, 0)};
+  cable.length_m = 1.2;
+  cable.elements = 12;
+  cable.density_kg_m3 = 5540;
+  cable.youngs_modulus_pa = 0.7e6;
+  cable.area_m2 = 0.0018;
+  cable.second_moment_m4 = 1.215e-8;
+  cable.bending = BendingModel::kExact;
+  scene.cables.push_back(cable);
+  JointSpec pin;
+  pin.type = JointType::kPin;
+  pin.a.cable = 0;
+  pin.a.s_m = 0;
+  scene.joints.push_back(pin);
+  ProbeSpec tip;
+  tip.name = "tip";
+  tip.at.cable = 0;
+  tip.at.s_m = 1.2;
+  scene.probes.push_back(tip);
+  scene.solver.analysis = Analysis::kDynamic;
+  scene.solver.duration_s = 1.0;
+  scene.solver.step_s = 1e-4;
+  scene.solver.output_interval_s = 1e-3;
+  scene.solver.linear_solver = LinearSolverKind::kMinres;
+  return scene;
+}
+
+Scene CableWithEndCylinder(LinearSolverKind linear_solver) {
+  const std::string path = std::string(CABLESIM_SOURCE_DIR) + "/scenes/cable-with-end-cylinder.json";
+  std::ifstream in(path);
+  EXPECT_TRUE(in.good()) << "cannot read " << path;
+  std::stringstream json;
+  json << in.rdbuf();
+  Scene scene = testing::SceneFromJson(json.str());
+  scene.solver.linear_solver = linear_solver;
+  return scene;
+}
+
+TEST_F(StepperAllocationTest, FallingPendulumStepsDoNotAllocate) {
+  const Scene scene = FallingPendulum();
+  ExpectStepsDoNotAllocate(scene, 1e-4, 200);
+}
+
+TEST_F(StepperAllocationTest, FallingPendulumGmresStepsDoNotAllocate) {
+  Scene scene = FallingPendulum();
+  scene.solver.linear_solver = LinearSolverKind::kGmres;
+  ExpectStepsDoNotAllocate(scene, 1e-4, 200);
+}
+
+TEST_F(StepperAllocationTest, CableWithEndCylinderStepsDoNotAllocate) {
+  const Scene scene = CableWithEndCylinder(LinearSolverKind::kMinres);
+  ASSERT_FALSE(scene.cables.empty());
+  {
+    auto model = PlanarModel::Build(scene);
+    ASSERT_TRUE(model.ok()) << model.status();
+    ASSERT_GT(model->multipliers(), 0) << "the FIXED cable-body joint should need multipliers";
+  }
+  ExpectStepsDoNotAllocate(scene, 0.005, 200);
+}
+
+TEST_F(StepperAllocationTest, CableWithEndCylinderGmresStepsDoNotAllocate) {
+  const Scene scene = CableWithEndCylinder(LinearSolverKind::kGmres);
+  ASSERT_FALSE(scene.cables.empty());
+  ExpectStepsDoNotAllocate(scene, 0.005, 200);
+}
+
+}  // namespace
+}  // namespace cablesim
