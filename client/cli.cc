@@ -98,6 +98,20 @@ int Validate(const std::string& path, std::ostream& out, std::ostream& err) {
     out.flush();
     return kExitBadInput;
   }
+  // The engine's own checks (joint sides that do not meet at t = 0, ...)
+  // and what it would build.
+  const absl::StatusOr<ModelInfo> info = DescribeModel(*scene);
+  if (!info.ok()) {
+    err << "cablesim: " << path << ": " << info.status().message() << "\n";
+    out << JsonLine()
+               .Add("status", "invalid")
+               .Add("file", path)
+               .Add("error", std::string(info.status().message()))
+               .ToString()
+        << "\n";
+    out.flush();
+    return kExitBadInput;
+  }
   const SolverSettings& solver = scene->solver;
   JsonLine json;
   json.Add("status", "ok")
@@ -110,7 +124,13 @@ int Validate(const std::string& path, std::ostream& out, std::ostream& err) {
       .Add("probes", static_cast<int64_t>(scene->probes.size()))
       .Add("analysis", AnalysisName(solver.analysis))
       .Add("integrator", IntegratorName(solver.integrator))
-      .Add("linear_solver", LinearSolverName(solver.linear_solver));
+      .Add("linear_solver", LinearSolverName(solver.linear_solver))
+      .Add("model", info->model)
+      .Add("coordinates", static_cast<int64_t>(info->coordinates))
+      .Add("dofs", static_cast<int64_t>(info->dofs))
+      .Add("multipliers", static_cast<int64_t>(info->multipliers))
+      .Add("elements", static_cast<int64_t>(info->elements))
+      .Add("nodes", static_cast<int64_t>(info->nodes));
   if (solver.analysis == Analysis::kDynamic) {
     json.Add("duration_s", solver.duration_s)
         .Add("step_s", solver.step_s)

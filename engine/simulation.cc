@@ -166,6 +166,12 @@ void RunStatic(PlanarModel* model, const SolverSettings& settings, FrameRecorder
 
 }  // namespace
 
+absl::StatusOr<ModelInfo> DescribeModel(const Scene& scene) {
+  absl::StatusOr<PlanarModel> built = PlanarModel::Build(scene);
+  if (!built.ok()) return built.status();
+  return built->Info();
+}
+
 absl::StatusOr<RunSummary> RunScene(const Scene& scene, FrameSink* sink) {
   const auto start = Clock::now();
   absl::StatusOr<PlanarModel> built = PlanarModel::Build(scene);

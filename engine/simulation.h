@@ -91,6 +91,10 @@ struct RunSummary {
   double max_linear_residual = 0;  // largest true relative residual of a solve
 };
 
+// Builds the model for `scene` without running it: what the engine would
+// build, or InvalidArgument naming the field that prevents it.
+absl::StatusOr<ModelInfo> DescribeModel(const Scene& scene);
+
 // Builds the model for `scene` and runs it. Returns InvalidArgument (naming
 // the scene field) when the scene cannot be modelled; a numerical failure is
 // not an error status: the summary's status is "failed" with the reason, and

@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Installs every package cablesim builds and tests with: Debian 12 packages
+# only, nothing downloaded at build time. Runs apt-get as root (directly, or
+# through sudo when not root).
+set -euo pipefail
+packages=(
+  cmake g++ make pkg-config
+  libeigen3-dev libabsl-dev
+  libprotobuf-dev protobuf-compiler
+  libgrpc++-dev protobuf-compiler-grpc
+  libgtest-dev libgmock-dev libbenchmark-dev
+  libsqlite3-dev
+  python3
+)
+as_root=()
+if [ "$(id -u)" -ne 0 ]; then as_root=(sudo); fi
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages already installed"
+  exit 0
+fi
+export DEBIAN_FRONTEND=noninteractive
+"${as_root[@]}" apt-get update -q
+"${as_root[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
