@@ -344,6 +344,16 @@ absl::StatusOr<PlanarModel> PlanarModel::Build(const Scene& scene) {
           row.joint, ev.value));
     }
   }
+  // A row that no unknown can change (both sides held by ground, say a
+  // pinned node and a body pinned at its centre of mass) is satisfied by
+  // construction, as far as the check above allows, and could never be
+  // corrected: it would only make the system singular.
+  std::erase_if(m.rows_, [&](const Row& row) {
+    const RowEval ev = m.EvalRow(row, q0);
+    for (int k = 0; k < ev.n; ++k)
+      if (m.j_[ev.idx[k]] >= 0 && m.s_(ev.idx[k]) != 0 && ev.grad(k) != 0) return false;
+    return true;
+  });
 
   // ---- Envelope of the Newton matrix on z. ----
   m.envelope_.resize(m.dofs_);

@@ -18,16 +18,52 @@ void SaddlePointSolver::Resize(const std::vector<int>& envelope,
   if (schur_dense_) {
     y_.setZero(n, m);
     schur_.setZero(m, m);
-    schur_llt_ = Eigen::LLT<Eigen::MatrixXd>(m);
+    schur_l_.setZero(m, m);
   }
   schur_diag_.setZero(m);
   col_.setZero(n);
   tmp_.setZero(n + m);
   residual_.setZero(n + m);
   correction_.setZero(n + m);
+  augmented_rhs_.setZero(n + m);
   minres_.Resize(n + m);
   gmres_.Resize(n + m);
 }
+
+void SaddlePointSolver::Augment(double gamma) {
+  gamma_ = gamma;
+  double* values = a_.values();
+  for (int r = 0; r < b_.rows(); ++r) {
+    for (int x = b_.row_start[r]; x < b_.row_start[r + 1]; ++x) {
+      for (int y = b_.row_start[r]; y < b_.row_start[r + 1]; ++y) {
+        const int cx = b_.col[x], cy = b_.col[y];
+        // Lower triangle; a diagonal entry takes both orders of x != y.
+        if (cy > cx) continue;
+        values[a_.Slot(cx, cy)] += gamma * b_.value[x] * b_.value[y];
+      }
+    }
+  }
+}
+
+namespace {
+// In-place Cholesky of the lower triangle; false unless positive definite.
+bool CholeskyInPlace(Eigen::MatrixXd& s) {
+  const int m = static_cast<int>(s.rows());
+  for (int j = 0; j < m; ++j) {
+    double d = s(j, j);
+    for (int k = 0; k < j; ++k) d -= s(j, k) * s(j, k);
+    if (!(d > 0)) return false;
+    d = std::sqrt(d);
+    s(j, j) = d;
+    for (int i = j + 1; i < m; ++i) {
+      double v = s(i, j);
+      for (int k = 0; k < j; ++k) v -= s(i, k) * s(j, k);
+      s(i, j) = v / d;
+    }
+  }
+  return true;
+}
+}  // namespace
 
 bool SaddlePointSolver::Prepare() {
   if (!a_.Factor()) return false;
@@ -51,8 +87,8 @@ bool SaddlePointSolver::Prepare() {
     // preconditioner positive definite without changing the system solved.
     const double shift = 1e-12 * schur_.diagonal().cwiseAbs().maxCoeff() + 1e-300;
     schur_.diagonal().array() += shift;
-    schur_llt_.compute(schur_);
-    if (schur_llt_.info() != Eigen::Success) return false;
+    schur_l_ = schur_;
+    if (!CholeskyInPlace(schur_l_)) return false;
   } else {
     // diag(B diag(|A|)^{-1} B^T) as a cheap positive approximation.
     for (int r = 0; r < m; ++r) {
@@ -83,16 +119,34 @@ void SaddlePointSolver::Precondition(const Eigen::VectorXd& r, Eigen::VectorXd& 
   if (m == 0) return;
   auto z2 = z.segment(n, m);
   if (schur_dense_) {
-    schur_llt_.matrixL().solveInPlace(z2);
-    schur_llt_.matrixU().solveInPlace(z2);
+    for (int i = 0; i < m; ++i) {  // L y = r2
+      double v = z2(i);
+      for (int k = 0; k < i; ++k) v -= schur_l_(i, k) * z2(k);
+      z2(i) = v / schur_l_(i, i);
+    }
+    for (int i = m - 1; i >= 0; --i) {  // L^T z2 = y
+      double v = z2(i);
+      for (int k = i + 1; k < m; ++k) v -= schur_l_(k, i) * z2(k);
+      z2(i) = v / schur_l_(i, i);
+    }
   } else {
     z2.array() /= schur_diag_.array();
   }
 }
 
 SaddlePointSolver::Stats SaddlePointSolver::Solve(LinearSolverKind kind,
-                                                  const Eigen::VectorXd& rhs, double tolerance,
+                                                  const Eigen::VectorXd& rhs_in, double tolerance,
                                                   int max_iterations, Eigen::VectorXd* x) {
+  const Eigen::VectorXd* rhs_ptr = &rhs_in;
+  if (gamma_ != 0 && b_.rows() > 0) {
+    // [A + gamma B^T B, B^T; B, 0] x = [r1 + gamma B^T r2; r2] has the
+    // solution of the original system.
+    augmented_rhs_ = rhs_in;
+    tmp_.head(b_.rows()) = gamma_ * rhs_in.tail(b_.rows());
+    b_.AddTransposeMultiply(tmp_.data(), augmented_rhs_.data());
+    rhs_ptr = &augmented_rhs_;
+  }
+  const Eigen::VectorXd& rhs = *rhs_ptr;
   auto op = [this](const Eigen::VectorXd& in, Eigen::VectorXd& out) { Multiply(in, out); };
   auto prec = [this](const Eigen::VectorXd& in, Eigen::VectorXd& out) { Precondition(in, out); };
   auto krylov = [&](const Eigen::VectorXd& b, Eigen::VectorXd& out) {

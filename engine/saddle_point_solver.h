@@ -24,7 +24,6 @@
 
 #include <vector>
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
 
 #include "engine/krylov.h"
@@ -49,6 +48,12 @@ class SaddlePointSolver {
   SkylineLdlt& a() { return a_; }
   SparseRows& b() { return b_; }
 
+  // Adds gamma B^T B to the assembled A (call after assembling A and B,
+  // before Prepare). Solve() then adds gamma B^T r2 to r1, so the solution
+  // is unchanged: an augmented Lagrangian that makes A definite where only
+  // the constraints hold the unknowns (a body in statics has no stiffness).
+  void Augment(double gamma);
+
   // Factors A and forms the Schur-complement preconditioner. False when a
   // pivot is not finite.
   bool Prepare();
@@ -67,7 +72,11 @@ class SaddlePointSolver {
   SparseRows b_;
   Eigen::MatrixXd y_;      // (L|D|L^T)^{-1} B^T, n x m
   Eigen::MatrixXd schur_;  // m x m
-  Eigen::LLT<Eigen::MatrixXd> schur_llt_;
+  // Cholesky factor of the Schur complement, in place (lower triangle):
+  // Eigen's LLT allocates a workspace for large matrices.
+  Eigen::MatrixXd schur_l_;
+  double gamma_ = 0;
+  Eigen::VectorXd augmented_rhs_;
   bool schur_dense_ = true;
   Eigen::VectorXd schur_diag_;
   mutable Eigen::VectorXd col_, tmp_;

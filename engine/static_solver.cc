@@ -66,7 +66,15 @@ StaticSolver::IncrementStats StaticSolver::Solve(double alpha) {
           it, last_increment, res);
       return st;
     }
-    if (m_ > 0) model_->AddConstraintHessian(q_, lambda1_, 1.0, &a);
+    if (m_ > 0) {
+      model_->AddConstraintHessian(q_, lambda1_, 1.0, &a);
+      // Bodies have no stiffness: only the constraints hold them, so A alone
+      // is singular. The augmented Lagrangian gamma B^T B, with gamma the
+      // size of A's diagonal, makes it definite without changing the answer.
+      double diag = 0;
+      for (int j = 0; j < n_; ++j) diag = std::max(diag, std::abs(a.values()[a.Slot(j, j)]));
+      solver_.Augment(diag > 0 ? diag : 1.0);
+    }
     if (!solver_.Prepare()) {
       st.reason = "the tangent stiffness has a non-finite pivot";
       return st;

@@ -68,5 +68,26 @@ TEST(ModelBuildTest, RejectsAFixedJointWhoseTangentsAreNotParallel) {
       << info.status();
 }
 
+TEST(ModelBuildTest, DropsAJointBetweenTwoGroundedPointsAndStillRuns) {
+  // The cable's first node is pinned to ground and so is the body's centre
+  // of mass: a PIN between the two has no unknowns left, within 1e-7 m it is
+  // satisfied, and it must not make the Newton system singular.
+  const Scene scene = SceneFromJson(std::string("{") + kCable + R"(,
+    "gravity": {"y": -9.81},
+    "bodies": [{"name": "b", "mass": 1, "inertia": {"x": 1, "y": 1, "z": 1},
+                "position": {"x": 1e-7}}],
+    "joints": [{"type": "PIN", "a": {"cable": "c", "s": 0}},
+               {"type": "PIN", "a": {"body": "b"}},
+               {"type": "PIN", "a": {"cable": "c", "s": 0}, "b": {"body": "b"}}],
+    "solver": {"duration": 0.01, "step": 1e-3}})");
+  const auto info = DescribeModel(scene);
+  ASSERT_TRUE(info.ok()) << info.status();
+  EXPECT_EQ(info->multipliers, 0);
+  testing::CollectingSink sink;
+  const auto summary = RunScene(scene, &sink);
+  ASSERT_TRUE(summary.ok());
+  EXPECT_EQ(summary->status, "ok") << summary->error;
+}
+
 }  // namespace
 }  // namespace cablesim

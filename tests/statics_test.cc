@@ -52,5 +52,31 @@ TEST(StaticsTest, LargeDeflectionCantileverMatchesMattiassonElastica) {
   EXPECT_DOUBLE_EQ(sink.frames().back().t, 1.0);
 }
 
+TEST(StaticsTest, CantileverCarryingABodyAtItsTip) {
+  // A nearly weightless rod clamped at one end carries a body FIXED at its
+  // tip; the body's weight m g = 1e-3 E I / L^2 gives P L^3 / (3 E I).
+  // Bodies have no stiffness, so this exercises the augmented Lagrangian.
+  const double ei = 2e11 * std::numbers::pi * std::pow(0.01, 4) / 64;
+  const double p = 1e-3 * ei, g = 9.81;
+  const std::string json = absl::StrFormat(R"({
+    "gravity": {"y": -9.81},
+    "cables": [{"name": "rod", "length": 1.0, "elements": 4, "direction": {"x": 1},
+                "density": 1e-6, "youngs_modulus": 2e11, "diameter": 0.01}],
+    "bodies": [{"name": "tip", "mass": %.17g, "inertia": {"x": 1e-6, "y": 1e-6, "z": 1e-6},
+                "position": {"x": 1.0}}],
+    "joints": [{"type": "FIXED", "a": {"cable": "rod", "s": 0}},
+               {"type": "FIXED", "a": {"cable": "rod", "s": 1.0}, "b": {"body": "tip"}}],
+    "probes": [{"name": "tip", "body": "tip"}],
+    "solver": {"analysis": "STATIC", "load_steps": 2}})",
+                                           p / g);
+  CollectingSink sink;
+  const RunSummary s = RunOk(SceneFromJson(json), &sink);
+  EXPECT_EQ(s.info.multipliers, 3);
+  ASSERT_FALSE(sink.frames().empty());
+  const double deflection = -sink.frames().back().probes[0].position_m.y();
+  const double ref = p / (3 * ei);
+  EXPECT_NEAR(deflection, ref, 0.005 * ref);
+}
+
 }  // namespace
 }  // namespace cablesim

@@ -388,3 +388,55 @@ TEST_F(StepperAllocationTest, CableWithEndCylinderGmresStepsDoNotAllocate) {
 
 }  // namespace
 }  // namespace cablesim
+
+namespace cablesim {
+namespace {
+
+// Three coincident 100-element cables pinned together at every node: 404
+// constraint rows, enough for Eigen's blocked LLT to want a workspace (it
+// allocated here before the Schur complement got its own in-place Cholesky).
+TEST_F(StepperAllocationTest, ManyConstraintRowsDoNotAllocate) {
+  Scene scene;
+  scene.gravity_m_s2 = Eigen::Vector3d(0, -9.81, 0);
+  for (int c = 0; c < 3; ++c) {
+    CableSpec cable;
+    cable.name = "c" + std::to_string(c);
+    cable.points = {Eigen::Vector3d::Zero(), Eigen::Vector3d(1, 0, 0)};
+    cable.length_m = 1;
+    cable.elements = 100;
+    cable.density_kg_m3 = 1000;
+    cable.youngs_modulus_pa = 1e7;
+    cable.area_m2 = 1e-4;
+    cable.second_moment_m4 = 1e-9;
+    scene.cables.push_back(cable);
+  }
+  JointSpec ground;
+  ground.a.cable = 0;
+  scene.joints.push_back(ground);
+  for (int k = 1; k <= 100; ++k) {
+    for (int c = 0; c < 2; ++c) {
+      JointSpec pin;
+      pin.a.cable = c;
+      pin.a.s_m = k / 100.0;
+      pin.b.cable = c + 1;
+      pin.b.s_m = k / 100.0;
+      scene.joints.push_back(pin);
+    }
+  }
+  // 400 rows from the pins along the cables, plus two cables' first nodes
+  // pinned to the grounded one's (which has no unknowns there: those rows
+  // keep only the free side).
+  JointSpec first01, first12;
+  first01.a.cable = 0, first01.b.cable = 1;
+  first12.a.cable = 1, first12.b.cable = 2;
+  scene.joints.push_back(first01);
+  scene.joints.push_back(first12);
+  scene.solver.step_s = 1e-3;
+  absl::StatusOr<PlanarModel> model = PlanarModel::Build(scene);
+  ASSERT_TRUE(model.ok()) << model.status();
+  ASSERT_GE(model->multipliers(), 400);
+  ExpectStepsDoNotAllocate(scene, 1e-3, 3);
+}
+
+}  // namespace
+}  // namespace cablesim
