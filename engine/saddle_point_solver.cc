@@ -67,7 +67,7 @@ bool CholeskyInPlace(Eigen::MatrixXd& s) {
 
 bool SaddlePointSolver::Prepare() {
   if (!a_.Factor()) return false;
-  const int n = a_.size(), m = b_.rows();
+  const int m = b_.rows();
   if (m == 0) return true;
   if (schur_dense_) {
     y_.setZero();
@@ -100,7 +100,6 @@ bool SaddlePointSolver::Prepare() {
       schur_diag_(r) = acc > 0 ? acc : 1;
     }
   }
-  (void)n;
   return true;
 }
 
