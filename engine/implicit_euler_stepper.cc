@@ -35,8 +35,7 @@ bool ImplicitEulerStepper::Initialize(std::string* reason) {
   Eigen::VectorXd qdot(model_->coordinates()), gamma(m_);
   model_->RateToFull(v_, &qdot);
   model_->ConstraintGamma(q_, qdot, &gamma);
-  std::copy(model_->mass().values(), model_->mass().values() + model_->mass().stored(),
-            solver_.a().values());
+  LoadMass();
   if (!solver_.Prepare()) {
     *reason = "the mass matrix could not be factorized";
     return false;
@@ -56,6 +55,16 @@ bool ImplicitEulerStepper::Initialize(std::string* reason) {
   return true;
 }
 
+void ImplicitEulerStepper::LoadMass() {
+  const SkylineLdlt& mass = model_->mass();
+  std::copy(mass.values(), mass.values() + mass.stored(), solver_.a().values());
+}
+
+double ImplicitEulerStepper::AssembleForces(double h) {
+  LoadMass();
+  return model_->NetForce(q_, 1.0, &f_, &solver_.a(), h * h);
+}
+
 ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
   StepStats st;
   const double tol = settings_.newton_tolerance;
@@ -69,12 +78,7 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
     // Newton matrix M + h^2 (K_T + H_lambda), assembled with the forces
     // unless this evaluation is expected to be the converged one.
     const bool checking = it > 0 && last_increment <= tol * (1 + z1_.lpNorm<Eigen::Infinity>());
-    bool assembled = !checking;
-    if (assembled) {
-      std::copy(model_->mass().values(), model_->mass().values() + model_->mass().stored(),
-                a.values());
-    }
-    const double force_size = model_->NetForce(q_, 1.0, &f_, assembled ? &a : nullptr, h * h);
+    const double force_size = checking ? model_->NetForce(q_, 1.0, &f_) : AssembleForces(h);
     model_->Constraints(q_, &phi_, &solver_.b());
     // R_v = M (v1 - v0) - h f + Phi_z^T (h lambda).
     mdv_ = v1_ - v_;
@@ -109,11 +113,7 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
           it, last_increment, res, viol);
       return st;
     }
-    if (!assembled) {
-      std::copy(model_->mass().values(), model_->mass().values() + model_->mass().stored(),
-                a.values());
-      model_->NetForce(q_, 1.0, &f_, &a, h * h);
-    }
+    if (checking) AssembleForces(h);
     if (m_ > 0) model_->AddConstraintHessian(q_, lambda1_, h * h, &a);
     if (!solver_.Prepare()) {
       st.reason = "the Newton matrix has a non-finite pivot";

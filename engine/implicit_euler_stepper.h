@@ -62,6 +62,11 @@ class ImplicitEulerStepper {
   const Eigen::VectorXd& lambda() const { return lambda_; }
 
  private:
+  // Newton matrix block a = M.
+  void LoadMass();
+  // a = M + h^2 K_T(q_) and f_ = f(q_) in one pass; returns the force size.
+  double AssembleForces(double h);
+
   PlanarModel* model_;
   SolverSettings settings_;
   SaddlePointSolver solver_;

@@ -252,19 +252,25 @@ TEST_F(StepperAllocationTest, CounterSeesEigenHeapVectors) {
   EXPECT_GE(counts.mallocs, 1);
 }
 
-// The counter sees allocations made inside the engine library too (building
-// a model fills std::vectors and Eigen vectors).
-TEST_F(StepperAllocationTest, CounterSeesEngineAllocations) {
-  Scene scene;
+// A straight 1 m cable along +x from the origin (E 1e7 Pa, A 1e-4 m^2).
+CableSpec UnitCable(std::string name, int elements) {
   CableSpec cable;
+  cable.name = std::move(name);
   cable.points = {Eigen::Vector3d::Zero(), Eigen::Vector3d(1, 0, 0)};
   cable.length_m = 1;
-  cable.elements = 4;
+  cable.elements = elements;
   cable.density_kg_m3 = 1000;
   cable.youngs_modulus_pa = 1e7;
   cable.area_m2 = 1e-4;
   cable.second_moment_m4 = 1e-9;
-  scene.cables.push_back(cable);
+  return cable;
+}
+
+// The counter sees allocations made inside the engine library too (building
+// a model fills std::vectors and Eigen vectors).
+TEST_F(StepperAllocationTest, CounterSeesEngineAllocations) {
+  Scene scene;
+  scene.cables.push_back(UnitCable("c", 4));
   CountingWindow window;
   absl::StatusOr<PlanarModel> model = PlanarModel::Build(scene);
   const Counts counts = window.Stop();
@@ -398,18 +404,7 @@ namespace {
 TEST_F(StepperAllocationTest, ManyConstraintRowsDoNotAllocate) {
   Scene scene;
   scene.gravity_m_s2 = Eigen::Vector3d(0, -9.81, 0);
-  for (int c = 0; c < 3; ++c) {
-    CableSpec cable;
-    cable.name = "c" + std::to_string(c);
-    cable.points = {Eigen::Vector3d::Zero(), Eigen::Vector3d(1, 0, 0)};
-    cable.length_m = 1;
-    cable.elements = 100;
-    cable.density_kg_m3 = 1000;
-    cable.youngs_modulus_pa = 1e7;
-    cable.area_m2 = 1e-4;
-    cable.second_moment_m4 = 1e-9;
-    scene.cables.push_back(cable);
-  }
+  for (int c = 0; c < 3; ++c) scene.cables.push_back(UnitCable("c" + std::to_string(c), 100));
   JointSpec ground;
   ground.a.cable = 0;
   scene.joints.push_back(ground);
