@@ -7,7 +7,7 @@
 
 namespace cablesim {
 
-ImplicitEulerStepper::ImplicitEulerStepper(PlanarModel* model, const SolverSettings& settings)
+ImplicitEulerStepper::ImplicitEulerStepper(MultibodyModel* model, const SolverSettings& settings)
     : model_(model), settings_(settings) {
   n_ = model->dofs();
   m_ = model->multipliers();

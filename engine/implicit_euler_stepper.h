@@ -30,7 +30,7 @@
 
 #include <Eigen/Core>
 
-#include "engine/planar_model.h"
+#include "engine/multibody_model.h"
 #include "engine/saddle_point_solver.h"
 #include "engine/scene.h"
 
@@ -47,7 +47,7 @@ class ImplicitEulerStepper {
     std::string reason;                // why it did not converge
   };
 
-  ImplicitEulerStepper(PlanarModel* model, const SolverSettings& settings);
+  ImplicitEulerStepper(MultibodyModel* model, const SolverSettings& settings);
 
   // Consistent initial acceleration from M a + Phi_z^T lambda = f,
   // Phi_z a = gamma. Returns false (with `reason`) if the solve fails.
@@ -67,7 +67,7 @@ class ImplicitEulerStepper {
   // a = M + h^2 K_T(q_) and f_ = f(q_) in one pass; returns the force size.
   double AssembleForces(double h);
 
-  PlanarModel* model_;
+  MultibodyModel* model_;
   SolverSettings settings_;
   SaddlePointSolver solver_;
   int n_ = 0, m_ = 0;

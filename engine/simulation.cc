@@ -6,7 +6,7 @@
 
 #include "absl/strings/str_format.h"
 #include "engine/implicit_euler_stepper.h"
-#include "engine/planar_model.h"
+#include "engine/multibody_model.h"
 #include "engine/static_solver.h"
 
 namespace cablesim {
@@ -17,7 +17,7 @@ using Clock = std::chrono::steady_clock;
 // Tracks the frame-level quantities of the summary.
 class FrameRecorder {
  public:
-  FrameRecorder(PlanarModel* model, FrameSink* sink, RunSummary* summary)
+  FrameRecorder(MultibodyModel* model, FrameSink* sink, RunSummary* summary)
       : model_(model), sink_(sink), summary_(summary) {
     q_.setZero(model->coordinates());
     qd_.setZero(model->coordinates());
@@ -46,7 +46,7 @@ class FrameRecorder {
   }
 
  private:
-  PlanarModel* model_;
+  MultibodyModel* model_;
   FrameSink* sink_;
   RunSummary* summary_;
   Frame frame_;
@@ -59,8 +59,24 @@ void Fail(RunSummary* s, double t, const std::string& reason) {
   s->error = reason;
 }
 
-void RunDynamic(PlanarModel* model, const SolverSettings& settings, FrameRecorder* rec,
-                RunSummary* summary) {
+// Checks the caller's stop request and step limit before a step attempt;
+// false (with the summary filled in) means stop now.
+bool MayStep(const RunControl& control, double t, RunSummary* s) {
+  if (control.should_stop && control.should_stop()) {
+    s->status = "cancelled";
+    s->error = absl::StrFormat("stopped by the caller at t = %.9g", t);
+    return false;
+  }
+  if (control.max_steps > 0 && s->steps + s->rejected_steps >= control.max_steps) {
+    Fail(s, t, absl::StrFormat("step limit of %d step attempts reached at t = %.9g",
+                               control.max_steps, t));
+    return false;
+  }
+  return true;
+}
+
+void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const RunControl& control,
+                FrameRecorder* rec, RunSummary* summary) {
   ImplicitEulerStepper stepper(model, settings);
   std::string reason;
   if (!stepper.Initialize(&reason)) {
@@ -85,6 +101,7 @@ void RunDynamic(PlanarModel* model, const SolverSettings& settings, FrameRecorde
   for (long k = 1; k <= frames; ++k) {
     const double t_frame = std::min(duration, k * interval);
     while (t_frame - t > 1e-12 * std::max(1.0, t_frame)) {
+      if (!MayStep(control, t, summary)) return;
       const double remaining = t_frame - t;
       const double substeps = std::ceil(remaining / h - 1e-9);
       const double h_try = remaining / substeps;
@@ -124,8 +141,8 @@ void RunDynamic(PlanarModel* model, const SolverSettings& settings, FrameRecorde
   }
 }
 
-void RunStatic(PlanarModel* model, const SolverSettings& settings, FrameRecorder* rec,
-               RunSummary* summary) {
+void RunStatic(MultibodyModel* model, const SolverSettings& settings, const RunControl& control,
+               FrameRecorder* rec, RunSummary* summary) {
   StaticSolver solver(model, settings);
   const int n = settings.load_steps;
   const double min_increment = std::ldexp(1.0 / n, -settings.max_step_halvings);
@@ -134,6 +151,7 @@ void RunStatic(PlanarModel* model, const SolverSettings& settings, FrameRecorder
     const double target = static_cast<double>(k) / n;
     double d = target - alpha;
     while (target - alpha > 1e-12) {
+      if (!MayStep(control, alpha, summary)) return;
       d = std::min(d, target - alpha);
       const auto st = solver.Solve(alpha + d);
       summary->newton_iterations += st.newton_iterations;
@@ -167,16 +185,17 @@ void RunStatic(PlanarModel* model, const SolverSettings& settings, FrameRecorder
 }  // namespace
 
 absl::StatusOr<ModelInfo> DescribeModel(const Scene& scene) {
-  absl::StatusOr<PlanarModel> built = PlanarModel::Build(scene);
+  absl::StatusOr<MultibodyModel> built = MultibodyModel::Build(scene);
   if (!built.ok()) return built.status();
   return built->Info();
 }
 
-absl::StatusOr<RunSummary> RunScene(const Scene& scene, FrameSink* sink) {
+absl::StatusOr<RunSummary> RunScene(const Scene& scene, FrameSink* sink,
+                                    const RunControl& control) {
   const auto start = Clock::now();
-  absl::StatusOr<PlanarModel> built = PlanarModel::Build(scene);
+  absl::StatusOr<MultibodyModel> built = MultibodyModel::Build(scene);
   if (!built.ok()) return built.status();
-  PlanarModel& model = *built;
+  MultibodyModel& model = *built;
   RunSummary summary;
   summary.info = model.Info();
   const SolverSettings& settings = scene.solver;
@@ -186,9 +205,9 @@ absl::StatusOr<RunSummary> RunScene(const Scene& scene, FrameSink* sink) {
   if (absl::Status s = sink->OnStart(summary.info); !s.ok()) return s;
   FrameRecorder recorder(&model, sink, &summary);
   if (settings.analysis == Analysis::kStatic) {
-    RunStatic(&model, settings, &recorder, &summary);
+    RunStatic(&model, settings, control, &recorder, &summary);
   } else {
-    RunDynamic(&model, settings, &recorder, &summary);
+    RunDynamic(&model, settings, control, &recorder, &summary);
   }
   if (settings.analysis == Analysis::kDynamic)
     summary.energy_dissipated = summary.energy_initial - summary.energy_final;

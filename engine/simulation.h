@@ -7,6 +7,7 @@
 // constraint violation, Newton and linear residuals).
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -91,6 +92,17 @@ struct RunSummary {
   double max_linear_residual = 0;  // largest true relative residual of a solve
 };
 
+// How a caller bounds and stops a run (a server's limits, deadlines and
+// cancellation). Both are checked before every step (or load increment).
+struct RunControl {
+  // Returns true to stop: the summary's status becomes "cancelled" and every
+  // frame up to the last converged step has been delivered.
+  std::function<bool()> should_stop;
+  // Largest number of step attempts, accepted and rejected (0: no limit);
+  // beyond it the run stops with status "failed" and says so.
+  int64_t max_steps = 0;
+};
+
 // Builds the model for `scene` without running it: what the engine would
 // build, or InvalidArgument naming the field that prevents it.
 absl::StatusOr<ModelInfo> DescribeModel(const Scene& scene);
@@ -99,7 +111,8 @@ absl::StatusOr<ModelInfo> DescribeModel(const Scene& scene);
 // the scene field) when the scene cannot be modelled; a numerical failure is
 // not an error status: the summary's status is "failed" with the reason, and
 // every frame up to the last converged one has been delivered.
-absl::StatusOr<RunSummary> RunScene(const Scene& scene, FrameSink* sink);
+absl::StatusOr<RunSummary> RunScene(const Scene& scene, FrameSink* sink,
+                                    const RunControl& control = {});
 
 }  // namespace cablesim
 

@@ -7,7 +7,7 @@
 
 namespace cablesim {
 
-StaticSolver::StaticSolver(PlanarModel* model, const SolverSettings& settings)
+StaticSolver::StaticSolver(MultibodyModel* model, const SolverSettings& settings)
     : model_(model), settings_(settings) {
   n_ = model->dofs();
   m_ = model->multipliers();

@@ -16,7 +16,7 @@
 
 #include <Eigen/Core>
 
-#include "engine/planar_model.h"
+#include "engine/multibody_model.h"
 #include "engine/saddle_point_solver.h"
 #include "engine/scene.h"
 
@@ -33,7 +33,7 @@ class StaticSolver {
     std::string reason;
   };
 
-  StaticSolver(PlanarModel* model, const SolverSettings& settings);
+  StaticSolver(MultibodyModel* model, const SolverSettings& settings);
 
   // Moves the equilibrium to load factor `alpha`, or leaves it unchanged and
   // returns !converged.
@@ -42,7 +42,7 @@ class StaticSolver {
   const Eigen::VectorXd& z() const { return z_; }
 
  private:
-  PlanarModel* model_;
+  MultibodyModel* model_;
   SolverSettings settings_;
   SaddlePointSolver solver_;
   int n_ = 0, m_ = 0;

@@ -166,5 +166,31 @@ TEST(DynamicsTest, NumericalFailureIsReportedWithTimeAndKeepsConvergedFrames) {
   for (const Frame& f : sink.frames()) EXPECT_TRUE(std::isfinite(f.energy.total));
 }
 
+TEST(RunControlTest, StopRequestCancelsAtTheNextStepAndKeepsEarlierFrames) {
+  // 1 s at h = 1e-3 with a frame per millisecond: stop after 100 checks.
+  int checks = 0;
+  RunControl control;
+  control.should_stop = [&checks] { return ++checks > 100; };
+  CollectingSink sink;
+  auto summary = RunScene(SceneFromJson(FallingPendulum(4, 1e-3, 1.0)), &sink, control);
+  ASSERT_TRUE(summary.ok()) << summary.status();
+  EXPECT_EQ(summary->status, "cancelled");
+  EXPECT_EQ(summary->steps, 100);
+  // The frame at t = 0 and one per accepted step, nothing after the stop.
+  EXPECT_EQ(sink.frames().size(), 101u);
+  EXPECT_NEAR(sink.frames().back().t, 0.1, 1e-12);
+}
+
+TEST(RunControlTest, StepLimitFailsTheRunAndSaysWhy) {
+  RunControl control;
+  control.max_steps = 50;
+  CollectingSink sink;
+  auto summary = RunScene(SceneFromJson(FallingPendulum(4, 1e-3, 1.0)), &sink, control);
+  ASSERT_TRUE(summary.ok()) << summary.status();
+  EXPECT_EQ(summary->status, "failed");
+  EXPECT_NE(summary->error.find("step limit"), std::string::npos) << summary->error;
+  EXPECT_EQ(summary->steps + summary->rejected_steps, 50);
+}
+
 }  // namespace
 }  // namespace cablesim

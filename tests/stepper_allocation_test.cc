@@ -31,7 +31,7 @@
 #include <gtest/gtest.h>
 
 #include "engine/implicit_euler_stepper.h"
-#include "engine/planar_model.h"
+#include "engine/multibody_model.h"
 #include "engine/scene.h"
 #include "tests/test_util.h"
 
@@ -272,7 +272,7 @@ TEST_F(StepperAllocationTest, CounterSeesEngineAllocations) {
   Scene scene;
   scene.cables.push_back(UnitCable("c", 4));
   CountingWindow window;
-  absl::StatusOr<PlanarModel> model = PlanarModel::Build(scene);
+  absl::StatusOr<MultibodyModel> model = MultibodyModel::Build(scene);
   const Counts counts = window.Stop();
   ASSERT_TRUE(model.ok()) << model.status();
   EXPECT_GE(counts.news + counts.mallocs, 1);
@@ -286,7 +286,7 @@ TEST_F(StepperAllocationTest, CounterSeesEngineAllocations) {
 // Builds the model, warms the stepper up with 5 steps, then counts
 // allocations over `steps` steps of size h; all must converge.
 void ExpectStepsDoNotAllocate(const Scene& scene, double h, int steps) {
-  absl::StatusOr<PlanarModel> model = PlanarModel::Build(scene);
+  absl::StatusOr<MultibodyModel> model = MultibodyModel::Build(scene);
   ASSERT_TRUE(model.ok()) << model.status();
   ImplicitEulerStepper stepper(&*model, scene.solver);
   std::string reason;
@@ -379,7 +379,7 @@ TEST_F(StepperAllocationTest, CableWithEndCylinderStepsDoNotAllocate) {
   const Scene scene = CableWithEndCylinder(LinearSolverKind::kMinres);
   ASSERT_FALSE(scene.cables.empty());
   {
-    auto model = PlanarModel::Build(scene);
+    auto model = MultibodyModel::Build(scene);
     ASSERT_TRUE(model.ok()) << model.status();
     ASSERT_GT(model->multipliers(), 0) << "the FIXED cable-body joint should need multipliers";
   }
@@ -427,7 +427,7 @@ TEST_F(StepperAllocationTest, ManyConstraintRowsDoNotAllocate) {
   scene.joints.push_back(first01);
   scene.joints.push_back(first12);
   scene.solver.step_s = 1e-3;
-  absl::StatusOr<PlanarModel> model = PlanarModel::Build(scene);
+  absl::StatusOr<MultibodyModel> model = MultibodyModel::Build(scene);
   ASSERT_TRUE(model.ok()) << model.status();
   ASSERT_GE(model->multipliers(), 400);
   ExpectStepsDoNotAllocate(scene, 1e-3, 3);

@@ -1,4 +1,4 @@
-#include "engine/planar_model.h"
+#include "engine/multibody_model.h"
 
 #include <algorithm>
 #include <cmath>
@@ -66,8 +66,8 @@ std::string SideName(int joint, bool a) { return absl::StrCat("joints[", joint, 
 
 }  // namespace
 
-absl::StatusOr<PlanarModel> PlanarModel::Build(const Scene& scene) {
-  PlanarModel m;
+absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
+  MultibodyModel m;
   const int num_cables = static_cast<int>(scene.cables.size());
   const int num_bodies = static_cast<int>(scene.bodies.size());
 
@@ -425,7 +425,7 @@ absl::StatusOr<PlanarModel> PlanarModel::Build(const Scene& scene) {
   return m;
 }
 
-ModelInfo PlanarModel::Info() const {
+ModelInfo MultibodyModel::Info() const {
   ModelInfo info;
   info.model = "planar";
   info.coordinates = coordinates();
@@ -437,17 +437,17 @@ ModelInfo PlanarModel::Info() const {
   return info;
 }
 
-void PlanarModel::ToFull(const VectorXd& z, VectorXd* q) const {
+void MultibodyModel::ToFull(const VectorXd& z, VectorXd* q) const {
   const int n = coordinates();
   for (int i = 0; i < n; ++i) (*q)(i) = j_[i] >= 0 ? c_(i) + s_(i) * z(j_[i]) : c_(i);
 }
 
-void PlanarModel::RateToFull(const VectorXd& zdot, VectorXd* qdot) const {
+void MultibodyModel::RateToFull(const VectorXd& zdot, VectorXd* qdot) const {
   const int n = coordinates();
   for (int i = 0; i < n; ++i) (*qdot)(i) = j_[i] >= 0 ? s_(i) * zdot(j_[i]) : 0.0;
 }
 
-double PlanarModel::NetForce(const VectorXd& q, double load_factor, VectorXd* f,
+double MultibodyModel::NetForce(const VectorXd& q, double load_factor, VectorXd* f,
                              SkylineLdlt* stiffness, double stiffness_scale) {
   VectorXd& full = scratch_full_;
   full = load_factor * constant_force_;
@@ -490,7 +490,7 @@ double PlanarModel::NetForce(const VectorXd& q, double load_factor, VectorXd* f,
   return size;
 }
 
-PlanarModel::SideEval PlanarModel::EvalPoint(const Side& s, const VectorXd& q) const {
+MultibodyModel::SideEval MultibodyModel::EvalPoint(const Side& s, const VectorXd& q) const {
   SideEval ev;
   if (s.kind == Side::kGround) {
     ev.value = s.ground;
@@ -513,7 +513,7 @@ PlanarModel::SideEval PlanarModel::EvalPoint(const Side& s, const VectorXd& q) c
   return ev;
 }
 
-PlanarModel::SideEval PlanarModel::EvalDirection(const Side& s, const VectorXd& q) const {
+MultibodyModel::SideEval MultibodyModel::EvalDirection(const Side& s, const VectorXd& q) const {
   SideEval ev;
   if (s.kind == Side::kGround) {
     ev.value = s.ground;
@@ -535,7 +535,7 @@ PlanarModel::SideEval PlanarModel::EvalDirection(const Side& s, const VectorXd& 
   return ev;
 }
 
-PlanarModel::RowEval PlanarModel::EvalRow(const Row& row, const VectorXd& q) const {
+MultibodyModel::RowEval MultibodyModel::EvalRow(const Row& row, const VectorXd& q) const {
   RowEval r;
   const bool parallel = row.kind == Row::kParallel;
   const SideEval a = parallel ? EvalDirection(row.a, q) : EvalPoint(row.a, q);
@@ -570,7 +570,7 @@ PlanarModel::RowEval PlanarModel::EvalRow(const Row& row, const VectorXd& q) con
   return r;
 }
 
-void PlanarModel::Constraints(const VectorXd& q, VectorXd* phi, SparseRows* jac) const {
+void MultibodyModel::Constraints(const VectorXd& q, VectorXd* phi, SparseRows* jac) const {
   int slot = 0;
   for (size_t i = 0; i < rows_.size(); ++i) {
     const RowEval ev = EvalRow(rows_[i], q);
@@ -583,7 +583,7 @@ void PlanarModel::Constraints(const VectorXd& q, VectorXd* phi, SparseRows* jac)
   }
 }
 
-void PlanarModel::AddConstraintHessian(const VectorXd& q, const VectorXd& lambda, double scale,
+void MultibodyModel::AddConstraintHessian(const VectorXd& q, const VectorXd& lambda, double scale,
                                        SkylineLdlt* a) const {
   double* values = a->values();
   for (size_t i = 0; i < rows_.size(); ++i) {
@@ -603,7 +603,7 @@ void PlanarModel::AddConstraintHessian(const VectorXd& q, const VectorXd& lambda
   }
 }
 
-void PlanarModel::ConstraintGamma(const VectorXd& q, const VectorXd& qdot,
+void MultibodyModel::ConstraintGamma(const VectorXd& q, const VectorXd& qdot,
                                   VectorXd* gamma) const {
   for (size_t i = 0; i < rows_.size(); ++i) {
     const RowEval ev = EvalRow(rows_[i], q);
@@ -614,7 +614,7 @@ void PlanarModel::ConstraintGamma(const VectorXd& q, const VectorXd& qdot,
   }
 }
 
-EnergySample PlanarModel::Energy(const VectorXd& q, const VectorXd& qdot,
+EnergySample MultibodyModel::Energy(const VectorXd& q, const VectorXd& qdot,
                                  double load_factor) const {
   EnergySample en;
   for (const ElementData& e : elements_) {
@@ -641,7 +641,7 @@ EnergySample PlanarModel::Energy(const VectorXd& q, const VectorXd& qdot,
   return en;
 }
 
-void PlanarModel::Probes(const VectorXd& q, const VectorXd& qdot, const VectorXd& qddot,
+void MultibodyModel::Probes(const VectorXd& q, const VectorXd& qdot, const VectorXd& qddot,
                          std::vector<ProbeSample>* out) const {
   out->resize(probes_.size());
   for (size_t k = 0; k < probes_.size(); ++k) {

@@ -1,5 +1,5 @@
-#ifndef CABLESIM_ENGINE_PLANAR_MODEL_H_
-#define CABLESIM_ENGINE_PLANAR_MODEL_H_
+#ifndef CABLESIM_ENGINE_MULTIBODY_MODEL_H_
+#define CABLESIM_ENGINE_MULTIBODY_MODEL_H_
 
 // The planar multibody model of a scene: ANCF cable elements (8 coordinates
 // each, MODEL.md sections 1-3), rigid bodies (x, y, theta) (section 6),
@@ -35,7 +35,7 @@
 
 namespace cablesim {
 
-class PlanarModel {
+class MultibodyModel {
  public:
   using Element = AncfCableElement<2>;
 
@@ -43,7 +43,7 @@ class PlanarModel {
   // coordinate map, and the constraint pattern. InvalidArgument names the
   // scene field when the scene cannot be assembled (for example joint sides
   // that do not coincide at t = 0).
-  static absl::StatusOr<PlanarModel> Build(const Scene& scene);
+  static absl::StatusOr<MultibodyModel> Build(const Scene& scene);
 
   int coordinates() const { return static_cast<int>(c_.size()); }
   int dofs() const { return dofs_; }
@@ -194,4 +194,4 @@ class PlanarModel {
 
 }  // namespace cablesim
 
-#endif  // CABLESIM_ENGINE_PLANAR_MODEL_H_
+#endif  // CABLESIM_ENGINE_MULTIBODY_MODEL_H_
