@@ -52,9 +52,6 @@ constexpr double kDefaultLinearTolerance = 1e-10;
 constexpr int kDefaultMaxLinearIterations = 200;
 constexpr int kMaxLinearIterations = 100000;
 
-constexpr char kSpatialNotSupported[] =
-    "spatial scenes are not supported yet (the planar model needs z = 0)";
-
 absl::Status Invalid(absl::string_view path, absl::string_view rule) {
   return absl::InvalidArgumentError(absl::StrCat(path, ": ", rule));
 }
@@ -111,29 +108,9 @@ absl::StatusOr<Eigen::Vector3d> FiniteVector(absl::string_view path, const v1::V
   return Eigen::Vector3d(v.x(), v.y(), v.z());
 }
 
-// Positions, directions, forces and linear velocities of a planar scene lie
-// in the x-y plane.
-absl::Status CheckInPlane(absl::string_view path, const Eigen::Vector3d& v) {
-  if (v.z() != 0) return Invalid(Sub(path, "z"), kSpatialNotSupported);
-  return absl::OkStatus();
-}
-
-// Torques and angular velocities of a planar scene are about z.
-absl::Status CheckAboutZ(absl::string_view path, const Eigen::Vector3d& v) {
-  if (v.x() != 0) return Invalid(Sub(path, "x"), kSpatialNotSupported);
-  if (v.y() != 0) return Invalid(Sub(path, "y"), kSpatialNotSupported);
-  return absl::OkStatus();
-}
-
-absl::StatusOr<Eigen::Vector3d> PlanarVector(absl::string_view path, const v1::Vec3& v) {
+// A non-zero direction, normalised.
+absl::StatusOr<Eigen::Vector3d> Direction(absl::string_view path, const v1::Vec3& v) {
   CABLESIM_ASSIGN_OR_RETURN(const Eigen::Vector3d result, FiniteVector(path, v));
-  CABLESIM_RETURN_IF_ERROR(CheckInPlane(path, result));
-  return result;
-}
-
-// A direction in the x-y plane, normalised.
-absl::StatusOr<Eigen::Vector3d> PlanarDirection(absl::string_view path, const v1::Vec3& v) {
-  CABLESIM_ASSIGN_OR_RETURN(const Eigen::Vector3d result, PlanarVector(path, v));
   const double norm = result.norm();
   if (!(norm > 0) || !std::isfinite(norm)) return Invalid(path, "must be non-zero");
   return Eigen::Vector3d(result / norm);
@@ -152,7 +129,22 @@ class SceneConverter {
 
   absl::StatusOr<Scene> Convert() {
     scene_.name = proto_.name();
-    CABLESIM_ASSIGN_OR_RETURN(scene_.gravity_m_s2, PlanarVector("gravity", proto_.gravity()));
+    switch (proto_.model()) {
+      case v1::Scene::MODEL_UNSPECIFIED:
+      case v1::Scene::AUTO:
+        scene_.model = ModelChoice::kAuto;
+        break;
+      case v1::Scene::PLANAR:
+        scene_.model = ModelChoice::kPlanar;
+        break;
+      case v1::Scene::SPATIAL:
+        scene_.model = ModelChoice::kSpatial;
+        break;
+      default:
+        return Invalid("model", absl::StrCat("unknown value ", static_cast<int>(proto_.model()),
+                                             " (expected AUTO, PLANAR or SPATIAL)"));
+    }
+    CABLESIM_ASSIGN_OR_RETURN(scene_.gravity_m_s2, FiniteVector("gravity", proto_.gravity()));
     if (proto_.cables_size() == 0 && proto_.bodies_size() == 0) {
       return Invalid("cables", "a scene needs at least one cable or body");
     }
@@ -219,7 +211,7 @@ class SceneConverter {
       double polyline_length = 0;
       for (int j = 0; j < c.points_size(); ++j) {
         const std::string point_path = Indexed(path, "points", j);
-        CABLESIM_ASSIGN_OR_RETURN(const Eigen::Vector3d p, PlanarVector(point_path, c.points(j)));
+        CABLESIM_ASSIGN_OR_RETURN(const Eigen::Vector3d p, FiniteVector(point_path, c.points(j)));
         if (j > 0) {
           const Eigen::Vector3d& previous = cable->points.back();
           const double segment = (p - previous).norm();
@@ -243,11 +235,11 @@ class SceneConverter {
       }
     } else {
       CABLESIM_ASSIGN_OR_RETURN(const Eigen::Vector3d start,
-                                PlanarVector(Sub(path, "start"), c.start()));
+                                FiniteVector(Sub(path, "start"), c.start()));
       Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
       if (c.has_direction()) {
         CABLESIM_ASSIGN_OR_RETURN(direction,
-                                  PlanarDirection(Sub(path, "direction"), c.direction()));
+                                  Direction(Sub(path, "direction"), c.direction()));
       }
       if (!c.has_length()) return Invalid(Sub(path, "length"), "required (or give points)");
       CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(path, "length"), c.length()));
@@ -346,10 +338,10 @@ class SceneConverter {
       return Invalid(Sub(path, "mass"), "required (give cylinder + density, or mass + inertia)");
     }
 
-    CABLESIM_ASSIGN_OR_RETURN(body->position_m, PlanarVector(Sub(path, "position"), b.position()));
+    CABLESIM_ASSIGN_OR_RETURN(body->position_m, FiniteVector(Sub(path, "position"), b.position()));
     body->axis = Eigen::Vector3d::UnitX();
     if (b.has_axis()) {
-      CABLESIM_ASSIGN_OR_RETURN(body->axis, PlanarDirection(Sub(path, "axis"), b.axis()));
+      CABLESIM_ASSIGN_OR_RETURN(body->axis, Direction(Sub(path, "axis"), b.axis()));
     }
     return absl::OkStatus();
   }
@@ -386,7 +378,7 @@ class SceneConverter {
       }
       if (a.s() != 0) return Invalid(Sub(path, "s"), "only with cable");
       result.body = it->second;
-      CABLESIM_ASSIGN_OR_RETURN(result.point_body_m, PlanarVector(Sub(path, "point"), a.point()));
+      CABLESIM_ASSIGN_OR_RETURN(result.point_body_m, FiniteVector(Sub(path, "point"), a.point()));
       return result;
     }
     if (!allow_ground) return Invalid(path, "must name a cable or a body");
@@ -422,13 +414,12 @@ class SceneConverter {
     const v1::Load& l = proto_.loads(i);
     const std::string path = Indexed("", "loads", i);
     CABLESIM_ASSIGN_OR_RETURN(load->at, ConvertAttachment(Sub(path, "at"), l.at(), false));
-    CABLESIM_ASSIGN_OR_RETURN(load->force_n, PlanarVector(Sub(path, "force"), l.force()));
+    CABLESIM_ASSIGN_OR_RETURN(load->force_n, FiniteVector(Sub(path, "force"), l.force()));
     const std::string torque_path = Sub(path, "torque");
     CABLESIM_ASSIGN_OR_RETURN(load->torque_nm, FiniteVector(torque_path, l.torque()));
     if (load->at.cable >= 0) {
       if (!load->torque_nm.isZero(0)) return Invalid(torque_path, "allowed on bodies only");
     } else {
-      CABLESIM_RETURN_IF_ERROR(CheckAboutZ(torque_path, load->torque_nm));
     }
     return absl::OkStatus();
   }
@@ -456,10 +447,9 @@ class SceneConverter {
   absl::Status ConvertInitialVelocity() {
     const v1::InitialVelocity& v = proto_.initial_velocity();
     InitialVelocitySpec& spec = scene_.initial_velocity;
-    CABLESIM_ASSIGN_OR_RETURN(spec.linear_m_s, PlanarVector("initial_velocity.linear", v.linear()));
+    CABLESIM_ASSIGN_OR_RETURN(spec.linear_m_s, FiniteVector("initial_velocity.linear", v.linear()));
     CABLESIM_ASSIGN_OR_RETURN(spec.angular_rad_s,
                               FiniteVector("initial_velocity.angular", v.angular()));
-    CABLESIM_RETURN_IF_ERROR(CheckAboutZ("initial_velocity.angular", spec.angular_rad_s));
     CABLESIM_ASSIGN_OR_RETURN(spec.origin_m, FiniteVector("initial_velocity.origin", v.origin()));
     return absl::OkStatus();
   }

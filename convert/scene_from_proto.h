@@ -20,10 +20,7 @@ namespace cablesim {
 // The result keeps the scene's indices; derived values are filled in (area
 // and second moment from a diameter, a cylinder's mass and inertia, a
 // straight cable's two points, normalised body axes, solver defaults).
-//
-// Only planar scenes are accepted for now: every z component of a position,
-// direction, force, gravity and linear velocity, and the x and y components
-// of torques and angular velocities, must be 0.
+// Whether the scene is planar is the engine's decision (model_choice.h).
 absl::StatusOr<Scene> SceneFromProto(const v1::Scene& proto);
 
 // Proto enum to engine enum. An UNSPECIFIED value maps to the documented

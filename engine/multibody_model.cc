@@ -1,32 +1,24 @@
 #include "engine/multibody_model.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
+#include <type_traits>
+#include <utility>
+
+#include <Eigen/Geometry>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "engine/model_choice.h"
 
 namespace cablesim {
 namespace {
 
-using Eigen::Vector2d;
+using Eigen::Vector3d;
 using Eigen::VectorXd;
-
-Vector2d Xy(const Eigen::Vector3d& v) { return v.head<2>(); }
-
-Eigen::Matrix2d Rotation(double theta) {
-  const double c = std::cos(theta), s = std::sin(theta);
-  Eigen::Matrix2d r;
-  r << c, -s, s, c;
-  return r;
-}
-
-// J v: v rotated by +90 degrees (the planar "omega x").
-Vector2d Perp(const Vector2d& v) { return Vector2d(-v.y(), v.x()); }
-
-double Cross(const Vector2d& a, const Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 // Relative tolerance for matching arc lengths to nodes.
 constexpr double kSnap = 1e-9;
@@ -34,40 +26,137 @@ constexpr double kSnap = 1e-9;
 // Arc-length position along a polyline: point and unit tangent at `frac`
 // of its total length. At an interior vertex the tangent is the average of
 // the two segments' directions.
-void PolylineAt(const std::vector<Eigen::Vector3d>& pts, double frac, Vector2d* point,
-                Vector2d* tangent) {
+void PolylineAt(const std::vector<Vector3d>& pts, double frac, Vector3d* point,
+                Vector3d* tangent) {
   std::vector<double> cum(pts.size(), 0.0);
   for (size_t i = 1; i < pts.size(); ++i) cum[i] = cum[i - 1] + (pts[i] - pts[i - 1]).norm();
   const double total = cum.back();
   const double s = std::clamp(frac, 0.0, 1.0) * total;
   size_t seg = 1;
   while (seg + 1 < pts.size() && cum[seg] < s) ++seg;
-  const Vector2d a = Xy(pts[seg - 1]), b = Xy(pts[seg]);
+  const Vector3d a = pts[seg - 1], b = pts[seg];
   const double len = cum[seg] - cum[seg - 1];
   const double t = len > 0 ? (s - cum[seg - 1]) / len : 0;
   *point = a + t * (b - a);
-  Vector2d dir = (b - a).normalized();
+  Vector3d dir = (b - a).normalized();
   const double tol = kSnap * total;
   if (std::abs(s - cum[seg]) <= tol && seg + 1 < pts.size()) {
-    dir = (dir + (Xy(pts[seg + 1]) - b).normalized()).normalized();
+    dir = (dir + (pts[seg + 1] - b).normalized()).normalized();
   } else if (std::abs(s - cum[seg - 1]) <= tol && seg >= 2) {
-    dir = (dir + (a - Xy(pts[seg - 2])).normalized()).normalized();
+    dir = (dir + (a - pts[seg - 2]).normalized()).normalized();
   }
   *tangent = dir;
 }
 
-double PolylineLength(const std::vector<Eigen::Vector3d>& pts) {
+double PolylineLength(const std::vector<Vector3d>& pts) {
   double total = 0;
   for (size_t i = 1; i < pts.size(); ++i) total += (pts[i] - pts[i - 1]).norm();
   return total;
 }
 
-std::string SideName(int joint, bool a) { return absl::StrCat("joints[", joint, "].", a ? "a" : "b"); }
+// The body frame at t = 0 from its x axis (scene.h): columns x, y, z.
+Eigen::Matrix3d BodyFrame(const Vector3d& axis) {
+  const Vector3d x = axis.normalized();
+  Vector3d y = Vector3d::UnitZ().cross(x);
+  if (y.norm() < 1e-12) y = Vector3d::UnitX().cross(x);
+  y.normalize();
+  Eigen::Matrix3d r;
+  r.col(0) = x;
+  r.col(1) = y;
+  r.col(2) = x.cross(y);
+  return r;
+}
+
+LinearVector Constant(const Vector3d& v) {
+  return {LinearForm::Constant(v.x()), LinearForm::Constant(v.y()), LinearForm::Constant(v.z())};
+}
+
+LinearVector Combination(const std::vector<std::pair<double, LinearVector>>& terms) {
+  LinearVector r;
+  for (const auto& [s, v] : terms) r = Add(r, v, s);
+  return r;
+}
+
+// A unit vector perpendicular to `t`, nearest to e_z (e_x if t is along z).
+Vector3d PerpendicularTowardsZ(const Vector3d& t) {
+  Vector3d m = Vector3d::UnitZ() - Vector3d::UnitZ().dot(t) * t;
+  if (m.norm() < 1e-9) m = Vector3d::UnitX() - Vector3d::UnitX().dot(t) * t;
+  return m.normalized();
+}
 
 }  // namespace
 
+void MultibodyModel::AddRow(const QuadraticForm& f, Row::Kind kind, int joint, int body) {
+  Row row;
+  row.kind = kind;
+  row.joint = joint;
+  row.body = body;
+  row.c = f.c;
+  std::vector<int> coords;
+  for (const auto& [i, v] : f.linear)
+    if (v != 0) coords.push_back(i);
+  for (const auto& [ij, v] : f.quadratic) {
+    if (v == 0) continue;
+    coords.push_back(ij.first);
+    coords.push_back(ij.second);
+  }
+  std::sort(coords.begin(), coords.end());
+  coords.erase(std::unique(coords.begin(), coords.end()), coords.end());
+  // The widest row, two welded spatial bodies, touches 24 coordinates.
+  assert(static_cast<int>(coords.size()) <= kMaxRowCoords);
+  auto local = [&](int i) {
+    return static_cast<int>(std::lower_bound(coords.begin(), coords.end(), i) - coords.begin());
+  };
+  row.coord_begin = static_cast<int>(row_coord_.size());
+  row_coord_.insert(row_coord_.end(), coords.begin(), coords.end());
+  row.coord_end = static_cast<int>(row_coord_.size());
+  row.lin_begin = static_cast<int>(lin_local_.size());
+  for (const auto& [i, v] : f.linear) {
+    if (v == 0) continue;
+    lin_local_.push_back(local(i));
+    lin_value_.push_back(v);
+  }
+  row.lin_end = static_cast<int>(lin_local_.size());
+  row.mono_begin = static_cast<int>(mono_a_.size());
+  for (const auto& [ij, v] : f.quadratic) {
+    if (v == 0) continue;
+    mono_a_.push_back(local(ij.first));
+    mono_b_.push_back(local(ij.second));
+    mono_w_.push_back(v);
+  }
+  row.mono_end = static_cast<int>(mono_a_.size());
+  rows_.push_back(row);
+}
+
+double MultibodyModel::RowValue(const Row& row, const VectorXd& q) const {
+  const int* coord = &row_coord_[row.coord_begin];
+  double acc = row.c;
+  for (int k = row.lin_begin; k < row.lin_end; ++k) acc += lin_value_[k] * q(coord[lin_local_[k]]);
+  for (int k = row.mono_begin; k < row.mono_end; ++k)
+    acc += mono_w_[k] * q(coord[mono_a_[k]]) * q(coord[mono_b_[k]]);
+  return acc;
+}
+
+void MultibodyModel::RowGradient(const Row& row, const VectorXd& q, double* grad) const {
+  const int* coord = &row_coord_[row.coord_begin];
+  const int n = row.coord_end - row.coord_begin;
+  for (int k = 0; k < n; ++k) grad[k] = 0;
+  for (int k = row.lin_begin; k < row.lin_end; ++k) grad[lin_local_[k]] += lin_value_[k];
+  for (int k = row.mono_begin; k < row.mono_end; ++k) {
+    grad[mono_a_[k]] += mono_w_[k] * q(coord[mono_b_[k]]);
+    grad[mono_b_[k]] += mono_w_[k] * q(coord[mono_a_[k]]);
+  }
+}
+
 absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
   MultibodyModel m;
+  absl::StatusOr<int> dim = ChooseDimension(scene);
+  if (!dim.ok()) return dim.status();
+  const int D = *dim;
+  m.dim_ = D;
+  m.node_stride_ = 2 * D;
+  m.body_stride_ = D == 2 ? 4 : 12;
+  const int ns = m.node_stride_, bs = m.body_stride_;
   const int num_cables = static_cast<int>(scene.cables.size());
   const int num_bodies = static_cast<int>(scene.bodies.size());
 
@@ -106,101 +195,223 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
   };
 
   // ---- Full coordinates and their initial values and rates. ----
-  const int ncoord = 4 * m.num_nodes_ + 3 * num_bodies;
-  const int body0 = 4 * m.num_nodes_;
+  const int ncoord = ns * m.num_nodes_ + bs * num_bodies;
+  const int body0 = ns * m.num_nodes_;
   VectorXd q0 = VectorXd::Zero(ncoord), qd0 = VectorXd::Zero(ncoord);
   const InitialVelocitySpec& iv = scene.initial_velocity;
-  const double omega = iv.angular_rad_s.z();
-  auto rigid_velocity = [&](const Vector2d& r) {
-    return Vector2d(Xy(iv.linear_m_s) + omega * Perp(r - Xy(iv.origin_m)));
+  const Vector3d omega = iv.angular_rad_s;
+  auto rigid_velocity = [&](const Vector3d& r) -> Vector3d {
+    return iv.linear_m_s + omega.cross(r - iv.origin_m);
   };
   for (int c = 0; c < num_cables; ++c) {
     const CableSpec& cable = scene.cables[c];
     const double stretch = PolylineLength(cable.points) / cable.length_m;
     for (size_t k = 0; k < node_s[c].size(); ++k) {
-      Vector2d p, t;
+      Vector3d p, t;
       PolylineAt(cable.points, node_s[c][k] / cable.length_m, &p, &t);
-      const int i = 4 * (first_node[c] + static_cast<int>(k));
-      q0.segment<2>(i) = p;
-      q0.segment<2>(i + 2) = stretch * t;
-      qd0.segment<2>(i) = rigid_velocity(p);
-      qd0.segment<2>(i + 2) = omega * Perp(stretch * t);
+      const int i = ns * (first_node[c] + static_cast<int>(k));
+      // Slopes move with the rigid rotation too: d(r_x)/dt = omega x r_x.
+      const Vector3d slope = stretch * t;
+      q0.segment(i, D) = p.head(D);
+      q0.segment(i + D, D) = slope.head(D);
+      qd0.segment(i, D) = rigid_velocity(p).head(D);
+      qd0.segment(i + D, D) = omega.cross(slope).head(D);
     }
   }
+  std::vector<Eigen::Matrix3d> frame0(num_bodies);
   for (int b = 0; b < num_bodies; ++b) {
     const BodySpec& body = scene.bodies[b];
-    const int i = body0 + 3 * b;
-    q0.segment<2>(i) = Xy(body.position_m);
-    q0(i + 2) = std::atan2(body.axis.y(), body.axis.x());
-    qd0.segment<2>(i) = rigid_velocity(Xy(body.position_m));
-    qd0(i + 2) = omega;
-    m.bodies_.push_back({i, body.mass_kg, body.inertia_kg_m2.z()});
+    const int i = body0 + bs * b;
+    frame0[b] = BodyFrame(body.axis);
+    q0.segment(i, D) = body.position_m.head(D);
+    qd0.segment(i, D) = rigid_velocity(body.position_m).head(D);
+    BodyData data;
+    data.coord = i;
+    data.mass = body.mass_kg;
+    const Vector3d& inertia = body.inertia_kg_m2;
+    if (D == 2) {
+      q0.segment<2>(i + 2) = frame0[b].col(0).head<2>();
+      qd0.segment<2>(i + 2) = omega.cross(frame0[b].col(0)).head<2>();
+      data.jbar = Vector3d(inertia.z(), 0, 0);
+    } else {
+      for (int k = 0; k < 3; ++k) {
+        q0.segment<3>(i + 3 + 3 * k) = frame0[b].col(k);
+        qd0.segment<3>(i + 3 + 3 * k) = omega.cross(frame0[b].col(k));
+      }
+      data.jbar = Vector3d::Constant(inertia.sum() / 2) - inertia;
+      if (!(data.jbar.minCoeff() > 0)) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "bodies[%d].inertia: the spatial model needs each principal moment to be less than "
+            "the sum of the other two (a real body's mass lies off every axis); got "
+            "(%.6g, %.6g, %.6g) kg m^2",
+            b, inertia.x(), inertia.y(), inertia.z()));
+      }
+    }
+    m.bodies_.push_back(data);
   }
+
+  // ---- Points and directions as linear forms of q. ----
+  auto node_position = [&](int node) {
+    LinearVector v;
+    for (int d = 0; d < D; ++d) v[d] = LinearForm::Coordinate(ns * node + d);
+    return v;
+  };
+  auto node_slope = [&](int node) {
+    LinearVector v;
+    for (int d = 0; d < D; ++d) v[d] = LinearForm::Coordinate(ns * node + D + d);
+    return v;
+  };
+  auto body_axis = [&](int b, int k) {
+    const int i = body0 + bs * b;
+    LinearVector v;
+    if (D == 3) {
+      for (int d = 0; d < 3; ++d) v[d] = LinearForm::Coordinate(i + 3 + 3 * k + d);
+    } else if (k == 0) {
+      v[0] = LinearForm::Coordinate(i + 2);
+      v[1] = LinearForm::Coordinate(i + 3);
+    } else if (k == 1) {  // perp(u) = (-u_y, u_x)
+      v[0] = LinearForm::Coordinate(i + 3, -1);
+      v[1] = LinearForm::Coordinate(i + 2);
+    } else {
+      v = Constant(Vector3d::UnitZ());
+    }
+    return v;
+  };
+  auto body_point = [&](int b, const Vector3d& p) {
+    const int i = body0 + bs * b;
+    LinearVector v;
+    for (int d = 0; d < D; ++d) v[d] = LinearForm::Coordinate(i + d);
+    for (int k = 0; k < D; ++k)
+      if (p(k) != 0) v = Add(v, body_axis(b, k), p(k));
+    return v;
+  };
+  auto point_form = [&](const Attachment& at) {
+    if (at.cable >= 0) return node_position(node_of(at));
+    return body_point(at.body, at.point_body_m);
+  };
+  auto eval = [&](const LinearVector& v) {
+    return Vector3d(v[0].Evaluate(q0), v[1].Evaluate(q0), v[2].Evaluate(q0));
+  };
+  auto body_frame_forms = [&](int b) {
+    return std::array<LinearVector, 3>{body_axis(b, 0), body_axis(b, 1), body_axis(b, 2)};
+  };
 
   // ---- Joints: eliminate ground-fixed coordinates, the rest as rows. ----
   // Per full coordinate: -1 free, -2 fixed; slope coordinates of a clamped
   // node share one unknown along `clamp_dir`.
   std::vector<int> state(ncoord, -1);
-  std::vector<Vector2d> clamp_dir(m.num_nodes_, Vector2d::Zero());
+  std::vector<Vector3d> clamp_dir(m.num_nodes_, Vector3d::Zero());
   std::vector<bool> clamped(m.num_nodes_, false);
-  auto make_side = [&](const Attachment& at) {
-    Side s;
-    if (at.cable >= 0) {
-      s.kind = Side::kNode;
-      s.coord = 4 * node_of(at);
-    } else if (at.body >= 0) {
-      s.kind = Side::kBody;
-      s.coord = body0 + 3 * at.body;
-      s.local = Xy(at.point_body_m);
-    }
-    return s;
+  struct PendingRow {
+    QuadraticForm f;
+    Row::Kind kind;
+    int joint;
+    int body;
   };
-  auto point_of = [&](const Side& s) -> Vector2d {
-    if (s.kind == Side::kNode) return q0.segment<2>(s.coord);
-    if (s.kind == Side::kBody)
-      return q0.segment<2>(s.coord) + Rotation(q0(s.coord + 2)) * s.local;
-    return s.ground;
-  };
-  auto direction_of = [&](const Side& s) -> Vector2d {
-    if (s.kind == Side::kNode) return q0.segment<2>(s.coord + 2).normalized();
-    if (s.kind == Side::kBody) return Rotation(q0(s.coord + 2)).col(0);
-    return s.ground;
-  };
+  std::vector<PendingRow> pending;
+  auto side_name = [](int joint, bool a) { return absl::StrCat("joints[", joint, "].", a ? "a" : "b"); };
   for (int ji = 0; ji < static_cast<int>(scene.joints.size()); ++ji) {
     const JointSpec& joint = scene.joints[ji];
-    Side a = make_side(joint.a), b = make_side(joint.b);
-    if (a.kind == Side::kGround) std::swap(a, b);
-    if (a.kind == Side::kGround) {
+    Attachment a = joint.a, b = joint.b;
+    if (a.IsGround()) std::swap(a, b);
+    if (a.IsGround()) {
       return absl::InvalidArgumentError(
-          absl::StrCat(SideName(ji, true), ": a joint needs a cable or a body on one side"));
+          absl::StrCat(side_name(ji, true), ": a joint needs a cable or a body on one side"));
     }
     const bool fixed = joint.type == JointType::kFixed;
-    if (b.kind == Side::kGround) {
-      if (a.kind == Side::kNode) {
-        state[a.coord] = state[a.coord + 1] = -2;
+    if (b.IsGround()) {
+      if (a.cable >= 0) {
+        const int node = node_of(a);
+        for (int d = 0; d < D; ++d) state[ns * node + d] = -2;
         if (fixed) {
-          const int node = a.coord / 4;
           clamped[node] = true;
-          clamp_dir[node] = direction_of(a);
+          clamp_dir[node] = eval(node_slope(node)).normalized();
         }
         continue;
       }
+      const int i = body0 + bs * a.body;
       if (fixed) {
-        state[a.coord] = state[a.coord + 1] = state[a.coord + 2] = -2;
+        for (int k = 0; k < bs; ++k) state[i + k] = -2;
         continue;
       }
-      if (a.local.norm() == 0) {
-        state[a.coord] = state[a.coord + 1] = -2;
+      if (a.point_body_m.norm() == 0) {
+        for (int d = 0; d < D; ++d) state[i + d] = -2;
         continue;
       }
-      b.ground = point_of(a);
-      m.rows_.push_back({Row::kPositionX, ji, a, b});
-      m.rows_.push_back({Row::kPositionY, ji, a, b});
-      continue;
     }
-    m.rows_.push_back({Row::kPositionX, ji, a, b});
-    m.rows_.push_back({Row::kPositionY, ji, a, b});
-    if (fixed) m.rows_.push_back({Row::kParallel, ji, a, b});
+    // Points coincide: D rows.
+    const LinearVector pa = point_form(a);
+    const LinearVector pb = b.IsGround() ? Constant(eval(pa)) : point_form(b);
+    for (int d = 0; d < D; ++d) {
+      LinearForm diff = pa[d];
+      diff += pb[d].Scaled(-1);
+      pending.push_back({QuadraticForm::FromLinear(diff), Row::kPosition, ji, -1});
+    }
+    if (!fixed || b.IsGround()) continue;
+    if (a.cable < 0 && b.cable >= 0) std::swap(a, b);  // a node first
+    if (a.cable >= 0 && b.cable >= 0) {
+      // Two cable tangents parallel: (t_a x t_b) . m = 0 for the one (planar)
+      // or two (spatial) directions m normal to the initial tangent.
+      const LinearVector ta = node_slope(node_of(a)), tb = node_slope(node_of(b));
+      const Vector3d t0 = eval(ta).normalized();
+      const Vector3d m1 = D == 2 ? Vector3d::UnitZ() : PerpendicularTowardsZ(t0);
+      pending.push_back({CrossDot(ta, tb, m1), Row::kDirection, ji, -1});
+      if (D == 3) pending.push_back({CrossDot(ta, tb, t0.cross(m1)), Row::kDirection, ji, -1});
+    } else if (a.cable >= 0) {
+      // A cable tangent along the body's x axis: t . e2 = 0 (and t . e3 = 0).
+      const LinearVector t = node_slope(node_of(a));
+      pending.push_back({Dot(t, body_axis(b.body, 1), D), Row::kDirection, ji, -1});
+      if (D == 3) pending.push_back({Dot(t, body_axis(b.body, 2), D), Row::kDirection, ji, -1});
+    } else {
+      // Two bodies welded: with B0 = A0 R0 at t = 0, b's axes must stay
+      // A R0: e2_b . u_hat = 0, e3_b . u_hat = 0, e3_b . v_hat = 0 where
+      // u_hat, v_hat are A R0 e_x, A R0 e_y (planar: the first only).
+      const Eigen::Matrix3d r0 = frame0[a.body].transpose() * frame0[b.body];
+      const auto ea = body_frame_forms(a.body);
+      const LinearVector u_hat =
+          Combination({{r0(0, 0), ea[0]}, {r0(1, 0), ea[1]}, {r0(2, 0), ea[2]}});
+      const LinearVector v_hat =
+          Combination({{r0(0, 1), ea[0]}, {r0(1, 1), ea[1]}, {r0(2, 1), ea[2]}});
+      pending.push_back({Dot(body_axis(b.body, 1), u_hat, D), Row::kDirection, ji, -1});
+      if (D == 3) {
+        pending.push_back({Dot(body_axis(b.body, 2), u_hat, D), Row::kDirection, ji, -1});
+        pending.push_back({Dot(body_axis(b.body, 2), v_hat, D), Row::kDirection, ji, -1});
+      }
+    }
+  }
+  // Each body's axes stay unit and orthogonal.
+  for (int b = 0; b < num_bodies; ++b) {
+    const auto e = body_frame_forms(b);
+    const int axes = D == 2 ? 1 : 3;
+    for (int k = 0; k < axes; ++k) {
+      QuadraticForm f = Dot(e[k], e[k], D);
+      f.c -= 1;
+      pending.push_back({f, Row::kAxes, -1, b});
+    }
+    for (int k = 0; k < axes; ++k)
+      for (int l = k + 1; l < axes; ++l) pending.push_back({Dot(e[k], e[l], D), Row::kAxes, -1, b});
+  }
+
+  // ---- Initial consistency of the joints kept as constraints. ----
+  {
+    std::vector<double> gap2(scene.joints.size(), 0.0);
+    for (const PendingRow& r : pending) {
+      const double v = r.f.Evaluate(q0);
+      if (r.kind == Row::kPosition) gap2[r.joint] += v * v;
+      if (r.kind == Row::kDirection && std::abs(v) > 1e-6) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "joints[%d]: FIXED needs the cable tangent parallel to the other side's axis at "
+            "t = 0 (sine of the angle between them: %.6g)",
+            r.joint, v));
+      }
+    }
+    for (size_t j = 0; j < gap2.size(); ++j) {
+      if (std::sqrt(gap2[j]) > 1e-6) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "joints[%d]: its two points are %.6g m apart at t = 0 (they must coincide)",
+            static_cast<int>(j), std::sqrt(gap2[j])));
+      }
+    }
   }
 
   // ---- Unknowns, ordered along the cables; bodies after their first joined node.
@@ -212,8 +423,8 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
   auto place_body = [&](int b) {
     if (body_placed[b]) return;
     body_placed[b] = true;
-    const int i = body0 + 3 * b;
-    for (int k = 0; k < 3; ++k) {
+    const int i = body0 + bs * b;
+    for (int k = 0; k < bs; ++k) {
       if (state[i + k] == -2) {
         m.c_(i + k) = q0(i + k);
       } else {
@@ -228,8 +439,8 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
     if (joint.b.cable >= 0 && joint.a.body >= 0) bodies_at_node[node_of(joint.b)].push_back(joint.a.body);
   }
   for (int node = 0; node < m.num_nodes_; ++node) {
-    const int i = 4 * node;
-    for (int k = 0; k < 2; ++k) {
+    const int i = ns * node;
+    for (int k = 0; k < D; ++k) {
       if (state[i + k] == -2) {
         m.c_(i + k) = q0(i + k);
       } else {
@@ -239,12 +450,12 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
     }
     if (clamped[node]) {
       const int alpha = next++;
-      for (int k = 0; k < 2; ++k) {
-        m.j_[i + 2 + k] = alpha;
-        m.s_(i + 2 + k) = clamp_dir[node](k);
+      for (int k = 0; k < D; ++k) {
+        m.j_[i + D + k] = alpha;
+        m.s_(i + D + k) = clamp_dir[node](k);
       }
     } else {
-      for (int k = 2; k < 4; ++k) {
+      for (int k = D; k < 2 * D; ++k) {
         m.j_[i + k] = next++;
         m.s_(i + k) = 1;
       }
@@ -273,87 +484,82 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
     }
   }
 
-  // ---- Elements. ----
-  for (int c = 0; c < num_cables; ++c) {
-    const CableSpec& cable = scene.cables[c];
-    const double ea = cable.youngs_modulus_pa * cable.area_m2;
-    const double ei = cable.youngs_modulus_pa * cable.second_moment_m4;
-    const double mpl = cable.density_kg_m3 * cable.area_m2;
-    for (int k = first_node[c]; k + 1 < first_node[c + 1]; ++k) {
-      const int local = k - first_node[c];
-      const double l = node_s[c][local + 1] - node_s[c][local];
-      ElementData e;
-      e.element = Element(l, ea, ei, cable.bending);
-      m.force_roundoff_ = std::max(
-          m.force_roundoff_, 100 * std::numeric_limits<double>::epsilon() * std::max(ea, ei / (l * l)));
-      e.first_coord = 4 * k;
-      e.mass_per_length = mpl;
-      e.gravity = e.element.GravityForce(mpl, Xy(scene.gravity_m_s2));
-      m.elements_.push_back(e);
+  // A row that no unknown can change (both sides held by ground, say a
+  // pinned node and a body pinned at its centre of mass, or the axes of a
+  // welded body) is satisfied by construction, as far as the check above
+  // allows, and could never be corrected: it would only make the system
+  // singular.
+  for (const PendingRow& r : pending) {
+    bool movable = false;
+    for (const auto& [i, v] : r.f.linear) movable |= v != 0 && m.j_[i] >= 0 && m.s_(i) != 0;
+    for (const auto& [ij, v] : r.f.quadratic) {
+      movable |= v != 0 && ((m.j_[ij.first] >= 0 && m.s_(ij.first) != 0) ||
+                            (m.j_[ij.second] >= 0 && m.s_(ij.second) != 0));
     }
+    if (movable) m.AddRow(r.f, r.kind, r.joint, r.body);
   }
-  m.gravity_ = Xy(scene.gravity_m_s2);
 
-  // ---- Constant forces: gravity and loads at nodes; body loads kept. ----
+  // ---- Elements. ----
+  auto build_elements = [&](auto& elements, auto dim_tag) {
+    constexpr int kD = decltype(dim_tag)::value;
+    const Eigen::Matrix<double, kD, 1> g = scene.gravity_m_s2.head<kD>();
+    for (int c = 0; c < num_cables; ++c) {
+      const CableSpec& cable = scene.cables[c];
+      const double ea = cable.youngs_modulus_pa * cable.area_m2;
+      const double ei = cable.youngs_modulus_pa * cable.second_moment_m4;
+      const double mpl = cable.density_kg_m3 * cable.area_m2;
+      for (int k = first_node[c]; k + 1 < first_node[c + 1]; ++k) {
+        const int local = k - first_node[c];
+        const double l = node_s[c][local + 1] - node_s[c][local];
+        ElementData<kD> e;
+        e.element = AncfCableElement<kD>(l, ea, ei, cable.bending);
+        m.force_roundoff_ =
+            std::max(m.force_roundoff_,
+                     100 * std::numeric_limits<double>::epsilon() * std::max(ea, ei / (l * l)));
+        e.first_coord = ns * k;
+        e.mass_per_length = mpl;
+        e.gravity = e.element.GravityForce(mpl, g);
+        elements.push_back(e);
+      }
+    }
+  };
+  if (D == 2) {
+    build_elements(m.elements2_, std::integral_constant<int, 2>());
+  } else {
+    build_elements(m.elements3_, std::integral_constant<int, 3>());
+  }
+
+  // ---- Constant forces: gravity and loads at points; torques kept. ----
   m.constant_force_ = VectorXd::Zero(ncoord);
-  for (const ElementData& e : m.elements_) m.constant_force_.segment<8>(e.first_coord) += e.gravity;
-  for (const BodyData& b : m.bodies_) m.constant_force_.segment<2>(b.coord) += b.mass * m.gravity_;
+  for (const auto& e : m.elements2_) m.constant_force_.segment<8>(e.first_coord) += e.gravity;
+  for (const auto& e : m.elements3_) m.constant_force_.segment<12>(e.first_coord) += e.gravity;
+  for (const BodyData& b : m.bodies_)
+    m.constant_force_.segment(b.coord, D) += b.mass * scene.gravity_m_s2.head(D);
+  // A force F at a point r = sum_i a_i q_i + c does the work F . dr, so its
+  // generalized force is sum_d F_d a_{d,i} on q_i (constant: the point is
+  // linear in q).
+  auto add_point_force = [&](const LinearVector& point, const Vector3d& force) {
+    for (int d = 0; d < D; ++d)
+      for (const auto& [i, v] : point[d].terms) m.constant_force_(i) += v * force(d);
+  };
   for (const LoadSpec& load : scene.loads) {
-    if (load.at.cable >= 0) {
-      m.constant_force_.segment<2>(4 * node_of(load.at)) += Xy(load.force_n);
-    } else {
-      BodyLoad bl;
-      bl.body = load.at.body;
-      bl.local = Xy(load.at.point_body_m);
-      bl.force = Xy(load.force_n);
-      bl.torque = load.torque_nm.z();
-      m.body_loads_.push_back(bl);
+    add_point_force(point_form(load.at), load.force_n);
+    if (load.at.body >= 0 && load.torque_nm.norm() > 0) {
+      m.torques_.push_back({load.at.body, load.torque_nm});
     }
   }
 
   // ---- Probes. ----
+  m.probe_term_begin_.push_back(0);
   for (const ProbeSpec& p : scene.probes) {
-    ProbeData d;
-    if (p.at.cable >= 0) {
-      d.coord = 4 * node_of(p.at);
-    } else {
-      d.body = true;
-      d.coord = body0 + 3 * p.at.body;
-      d.local = Xy(p.at.point_body_m);
+    const LinearVector point = point_form(p.at);
+    for (int d = 0; d < 3; ++d) {
+      for (const auto& [i, v] : point[d].terms) m.probe_terms_.push_back({i, v});
+      m.probe_term_begin_.push_back(static_cast<int>(m.probe_terms_.size()));
+      m.probe_const_.push_back(point[d].c);
     }
-    m.probes_.push_back(d);
     m.probe_names_.push_back(p.name);
   }
-
-  // ---- Initial consistency of the joints kept as constraints. ----
-  for (const Row& row : m.rows_) {
-    const RowEval ev = m.EvalRow(row, q0);
-    if (row.kind != Row::kParallel) {
-      const double gap = (point_of(row.a) - (row.b.kind == Side::kGround ? row.b.ground
-                                                                          : point_of(row.b)))
-                             .norm();
-      if (gap > 1e-6) {
-        return absl::InvalidArgumentError(absl::StrFormat(
-            "joints[%d]: its two points are %.6g m apart at t = 0 (they must coincide)",
-            row.joint, gap));
-      }
-    } else if (std::abs(ev.value) > 1e-6) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "joints[%d]: FIXED needs the cable tangent parallel to the other side's axis at "
-          "t = 0 (sine of the angle between them: %.6g)",
-          row.joint, ev.value));
-    }
-  }
-  // A row that no unknown can change (both sides held by ground, say a
-  // pinned node and a body pinned at its centre of mass) is satisfied by
-  // construction, as far as the check above allows, and could never be
-  // corrected: it would only make the system singular.
-  std::erase_if(m.rows_, [&](const Row& row) {
-    const RowEval ev = m.EvalRow(row, q0);
-    for (int k = 0; k < ev.n; ++k)
-      if (m.j_[ev.idx[k]] >= 0 && m.s_(ev.idx[k]) != 0 && ev.grad(k) != 0) return false;
-    return true;
-  });
 
   // ---- Envelope of the Newton matrix on z. ----
   m.envelope_.resize(m.dofs_);
@@ -365,69 +571,102 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
     for (int k = 0; k < n; ++k)
       if (m.j_[idx[k]] >= 0) m.envelope_[m.j_[idx[k]]] = std::min(m.envelope_[m.j_[idx[k]]], lo);
   };
-  for (const ElementData& e : m.elements_) {
-    int idx[8];
-    for (int k = 0; k < 8; ++k) idx[k] = e.first_coord + k;
-    couple(idx, 8);
+  {
+    std::vector<int> idx(4 * D);
+    for (const auto& e : m.elements2_) {
+      for (int k = 0; k < 8; ++k) idx[k] = e.first_coord + k;
+      couple(idx.data(), 8);
+    }
+    for (const auto& e : m.elements3_) {
+      for (int k = 0; k < 12; ++k) idx[k] = e.first_coord + k;
+      couple(idx.data(), 12);
+    }
   }
   for (const BodyData& b : m.bodies_) {
-    int idx[3] = {b.coord, b.coord + 1, b.coord + 2};
-    couple(idx, 3);
+    std::vector<int> idx(bs);
+    for (int k = 0; k < bs; ++k) idx[k] = b.coord + k;
+    couple(idx.data(), bs);
   }
   for (const Row& row : m.rows_) {
-    const RowEval ev = m.EvalRow(row, q0);
-    couple(ev.idx, ev.n);
+    couple(&m.row_coord_[row.coord_begin], row.coord_end - row.coord_begin);
   }
 
   // ---- Reduced mass matrix and element scatter tables. ----
   m.mass_.SetPattern(m.envelope_);
-  m.element_slots_.resize(64 * m.elements_.size());
-  m.element_factors_.resize(64 * m.elements_.size());
-  for (size_t k = 0; k < m.elements_.size(); ++k) {
-    const ElementData& e = m.elements_[k];
-    for (int a = 0; a < 8; ++a) {
-      for (int b = 0; b < 8; ++b) {
-        const int ia = e.first_coord + a, ib = e.first_coord + b;
-        const int ja = m.j_[ia], jb = m.j_[ib];
-        // A(ja, jb) with ja > jb is stored once; the diagonal takes every
-        // (a, b) with ja == jb (both orders of a != b), as the sum requires.
-        const int slot = (ja >= 0 && jb >= 0 && ja >= jb) ? m.mass_.Slot(ja, jb) : -1;
-        m.element_slots_[64 * k + 8 * a + b] = slot;
-        m.element_factors_[64 * k + 8 * a + b] = slot < 0 ? 0 : m.s_(ia) * m.s_(ib);
-      }
-    }
-    const auto me = e.element.MassMatrix(e.mass_per_length);
-    for (int t = 0; t < 64; ++t) {
-      const int slot = m.element_slots_[64 * k + t];
-      if (slot >= 0) m.mass_.values()[slot] += m.element_factors_[64 * k + t] * me(t / 8, t % 8);
-    }
+  if (D == 2) {
+    m.SetupElementSlots(m.elements2_);
+  } else {
+    m.SetupElementSlots(m.elements3_);
   }
   for (const BodyData& b : m.bodies_) {
-    const double diag[3] = {b.mass, b.mass, b.inertia};
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < bs; ++k) {
       const int j = m.j_[b.coord + k];
-      if (j >= 0) m.mass_.values()[m.mass_.Slot(j, j)] += diag[k];
+      if (j < 0) continue;
+      const double diag = k < D ? b.mass : b.jbar((k - D) / D);
+      m.mass_.values()[m.mass_.Slot(j, j)] += m.s_(b.coord + k) * m.s_(b.coord + k) * diag;
     }
   }
 
-  // ---- Constraint Jacobian pattern. ----
+  // ---- Constraint Jacobian pattern and Hessian factors. ----
   m.jac_pattern_.cols = m.dofs_;
   for (const Row& row : m.rows_) {
-    const RowEval ev = m.EvalRow(row, q0);
-    for (int k = 0; k < ev.n; ++k) {
-      if (m.j_[ev.idx[k]] < 0) continue;
-      m.jac_pattern_.col.push_back(m.j_[ev.idx[k]]);
+    for (int k = row.coord_begin; k < row.coord_end; ++k) {
+      if (m.j_[m.row_coord_[k]] < 0) continue;
+      m.jac_pattern_.col.push_back(m.j_[m.row_coord_[k]]);
       m.jac_pattern_.value.push_back(0);
     }
     m.jac_pattern_.row_start.push_back(static_cast<int>(m.jac_pattern_.col.size()));
   }
+  m.mono_slot_.assign(m.mono_a_.size(), -1);
+  m.mono_factor_.assign(m.mono_a_.size(), 0.0);
+  for (const Row& row : m.rows_) {
+    const int* coord = &m.row_coord_[row.coord_begin];
+    for (int k = row.mono_begin; k < row.mono_end; ++k) {
+      const int a = coord[m.mono_a_[k]], b = coord[m.mono_b_[k]];
+      const int ja = m.j_[a], jb = m.j_[b];
+      if (ja < 0 || jb < 0) continue;
+      // w q_a q_b has Hessian entries (a, b) and (b, a) equal to w; on z
+      // they land on (ja, jb) and (jb, ja): stored once off the diagonal,
+      // twice (2 w) on it.
+      m.mono_slot_[k] = m.mass_.Slot(std::max(ja, jb), std::min(ja, jb));
+      m.mono_factor_[k] = m.mono_w_[k] * m.s_(a) * m.s_(b) * (ja == jb ? 2 : 1);
+    }
+  }
+  m.torque_axes_.resize(m.torques_.size());
+  for (size_t k = 0; k < m.torques_.size(); ++k) m.torque_axes_[k] = frame0[m.torques_[k].body];
   m.scratch_full_ = VectorXd::Zero(ncoord);
   return m;
 }
 
+template <int D>
+void MultibodyModel::SetupElementSlots(const std::vector<ElementData<D>>& elements) {
+  constexpr int kN = 4 * D, kN2 = kN * kN;
+  element_slots_.resize(kN2 * elements.size());
+  element_factors_.resize(kN2 * elements.size());
+  for (size_t k = 0; k < elements.size(); ++k) {
+    const ElementData<D>& e = elements[k];
+    for (int a = 0; a < kN; ++a) {
+      for (int b = 0; b < kN; ++b) {
+        const int ia = e.first_coord + a, ib = e.first_coord + b;
+        const int ja = j_[ia], jb = j_[ib];
+        // A(ja, jb) with ja > jb is stored once; the diagonal takes every
+        // (a, b) with ja == jb (both orders of a != b), as the sum requires.
+        const int slot = (ja >= 0 && jb >= 0 && ja >= jb) ? mass_.Slot(ja, jb) : -1;
+        element_slots_[kN2 * k + kN * a + b] = slot;
+        element_factors_[kN2 * k + kN * a + b] = slot < 0 ? 0 : s_(ia) * s_(ib);
+      }
+    }
+    const auto me = e.element.MassMatrix(e.mass_per_length);
+    for (int t = 0; t < kN2; ++t) {
+      const int slot = element_slots_[kN2 * k + t];
+      if (slot >= 0) mass_.values()[slot] += element_factors_[kN2 * k + t] * me(t / kN, t % kN);
+    }
+  }
+}
+
 ModelInfo MultibodyModel::Info() const {
   ModelInfo info;
-  info.model = "planar";
+  info.model = dim_ == 2 ? "planar" : "spatial";
   info.coordinates = coordinates();
   info.dofs = dofs();
   info.multipliers = multipliers();
@@ -447,42 +686,59 @@ void MultibodyModel::RateToFull(const VectorXd& zdot, VectorXd* qdot) const {
   for (int i = 0; i < n; ++i) (*qdot)(i) = j_[i] >= 0 ? s_(i) * zdot(j_[i]) : 0.0;
 }
 
-double MultibodyModel::NetForce(const VectorXd& q, double load_factor, VectorXd* f,
-                             SkylineLdlt* stiffness, double stiffness_scale) {
-  VectorXd& full = scratch_full_;
-  full = load_factor * constant_force_;
-  for (const BodyLoad& bl : body_loads_) {
-    const int c = bodies_[bl.body].coord;
-    const Vector2d rp = Rotation(q(c + 2)) * bl.local;
-    full.segment<2>(c) += load_factor * bl.force;
-    full(c + 2) += load_factor * (bl.force.dot(Perp(rp)) + bl.torque);
-    // Q_theta = F . (R' p) has derivative -F . (R p); the stiffness is its
-    // negative.
-    const int j = j_[c + 2];
-    if (stiffness && j >= 0) {
-      stiffness->values()[stiffness->Slot(j, j)] +=
-          stiffness_scale * load_factor * bl.force.dot(rp);
-    }
-  }
-  double size = full.lpNorm<Eigen::Infinity>();
-  Element::Coords fe;
-  Element::Matrix ke;
+template <int D>
+double MultibodyModel::ElementForces(const VectorXd& q, VectorXd* full, SkylineLdlt* stiffness,
+                                     double stiffness_scale) const {
+  constexpr int kN = 4 * D, kN2 = kN * kN;
+  const auto& elements = Elements<D>();
+  typename AncfCableElement<D>::Coords fe;
+  typename AncfCableElement<D>::Matrix ke;
+  double size = 0;
   double* values = stiffness ? stiffness->values() : nullptr;
-  for (size_t k = 0; k < elements_.size(); ++k) {
-    const ElementData& e = elements_[k];
+  for (size_t k = 0; k < elements.size(); ++k) {
+    const ElementData<D>& e = elements[k];
     fe.setZero();
     if (stiffness) ke.setZero();
-    e.element.ElasticForce(q.segment<8>(e.first_coord), &fe, stiffness ? &ke : nullptr);
-    full.segment<8>(e.first_coord) -= fe;
-    size = std::max(size, fe.lpNorm<Eigen::Infinity>());
+    e.element.ElasticForce(q.segment<kN>(e.first_coord), &fe, stiffness ? &ke : nullptr);
+    full->segment<kN>(e.first_coord) -= fe;
+    size = std::max(size, fe.template lpNorm<Eigen::Infinity>());
     if (!stiffness) continue;
-    const int* slots = &element_slots_[64 * k];
-    const double* factors = &element_factors_[64 * k];
+    const int* slots = &element_slots_[kN2 * k];
+    const double* factors = &element_factors_[kN2 * k];
     const double* kv = ke.data();  // symmetric, so layout order does not matter
-    for (int t = 0; t < 64; ++t) {
+    for (int t = 0; t < kN2; ++t) {
       if (slots[t] >= 0) values[slots[t]] += stiffness_scale * factors[t] * kv[t];
     }
   }
+  return size;
+}
+
+double MultibodyModel::NetForce(const VectorXd& q, double load_factor, VectorXd* f,
+                                SkylineLdlt* stiffness, double stiffness_scale) {
+  VectorXd& full = scratch_full_;
+  full = load_factor * constant_force_;
+  // A torque T on a body: its virtual work T . dphi, with de_k = dphi x e_k,
+  // is done by the generalized forces (1/2) T x e_k on the axes (spatial),
+  // and T_z perp(u) on u (planar), on the unit, orthogonal axes the
+  // constraints keep. Their derivative is skew-symmetric, so the symmetric
+  // Newton matrix leaves it out (Newton then converges linearly, at a rate
+  // of order h^2 |T| / J, instead of quadratically).
+  for (const TorqueLoad& t : torques_) {
+    const int c = bodies_[t.body].coord;
+    if (dim_ == 2) {
+      const double tz = load_factor * t.torque.z();
+      full(c + 2) -= tz * q(c + 3);
+      full(c + 3) += tz * q(c + 2);
+    } else {
+      for (int k = 0; k < 3; ++k) {
+        const Vector3d e = q.segment<3>(c + 3 + 3 * k);
+        full.segment<3>(c + 3 + 3 * k) += 0.5 * load_factor * t.torque.cross(e);
+      }
+    }
+  }
+  double size = full.lpNorm<Eigen::Infinity>();
+  size = std::max(size, dim_ == 2 ? ElementForces<2>(q, &full, stiffness, stiffness_scale)
+                                  : ElementForces<3>(q, &full, stiffness, stiffness_scale));
   f->setZero();
   const int n = coordinates();
   for (int i = 0; i < n; ++i)
@@ -490,178 +746,121 @@ double MultibodyModel::NetForce(const VectorXd& q, double load_factor, VectorXd*
   return size;
 }
 
-MultibodyModel::SideEval MultibodyModel::EvalPoint(const Side& s, const VectorXd& q) const {
-  SideEval ev;
-  if (s.kind == Side::kGround) {
-    ev.value = s.ground;
-  } else if (s.kind == Side::kNode) {
-    ev.n = 2;
-    ev.idx[0] = s.coord;
-    ev.idx[1] = s.coord + 1;
-    ev.value = q.segment<2>(s.coord);
-    ev.jac(0, 0) = ev.jac(1, 1) = 1;
-  } else {
-    ev.n = 3;
-    for (int k = 0; k < 3; ++k) ev.idx[k] = s.coord + k;
-    const Vector2d rp = Rotation(q(s.coord + 2)) * s.local;
-    ev.value = q.segment<2>(s.coord) + rp;
-    ev.jac(0, 0) = ev.jac(1, 1) = 1;
-    ev.jac.col(2) = Perp(rp);
-    ev.theta = 2;
-    ev.second = -rp;
-  }
-  return ev;
-}
-
-MultibodyModel::SideEval MultibodyModel::EvalDirection(const Side& s, const VectorXd& q) const {
-  SideEval ev;
-  if (s.kind == Side::kGround) {
-    ev.value = s.ground;
-  } else if (s.kind == Side::kNode) {
-    ev.n = 2;
-    ev.idx[0] = s.coord + 2;
-    ev.idx[1] = s.coord + 3;
-    ev.value = q.segment<2>(s.coord + 2);
-    ev.jac(0, 0) = ev.jac(1, 1) = 1;
-  } else {
-    ev.n = 1;
-    ev.idx[0] = s.coord + 2;
-    const double th = q(s.coord + 2);
-    ev.value = Vector2d(std::cos(th), std::sin(th));
-    ev.jac.col(0) = Perp(ev.value);
-    ev.theta = 0;
-    ev.second = -ev.value;
-  }
-  return ev;
-}
-
-MultibodyModel::RowEval MultibodyModel::EvalRow(const Row& row, const VectorXd& q) const {
-  RowEval r;
-  const bool parallel = row.kind == Row::kParallel;
-  const SideEval a = parallel ? EvalDirection(row.a, q) : EvalPoint(row.a, q);
-  const SideEval b = parallel ? EvalDirection(row.b, q) : EvalPoint(row.b, q);
-  r.n = a.n + b.n;
-  for (int k = 0; k < a.n; ++k) r.idx[k] = a.idx[k];
-  for (int k = 0; k < b.n; ++k) r.idx[a.n + k] = b.idx[k];
-  if (!parallel) {
-    const int d = row.kind == Row::kPositionX ? 0 : 1;
-    r.value = a.value(d) - b.value(d);
-    for (int k = 0; k < a.n; ++k) r.grad(k) = a.jac(d, k);
-    for (int k = 0; k < b.n; ++k) r.grad(a.n + k) = -b.jac(d, k);
-    if (a.theta >= 0) r.hess(a.theta, a.theta) = a.second(d);
-    if (b.theta >= 0) r.hess(a.n + b.theta, a.n + b.theta) = -b.second(d);
-    return r;
-  }
-  // Phi = t_a x t_b.
-  r.value = Cross(a.value, b.value);
-  const Vector2d ga(b.value.y(), -b.value.x()), gb(-a.value.y(), a.value.x());
-  for (int k = 0; k < a.n; ++k) r.grad(k) = ga.dot(a.jac.col(k));
-  for (int k = 0; k < b.n; ++k) r.grad(a.n + k) = gb.dot(b.jac.col(k));
-  Eigen::Matrix2d cmat;  // d^2 (t_a x t_b) / dt_a dt_b
-  cmat << 0, 1, -1, 0;
-  for (int i = 0; i < a.n; ++i)
-    for (int k = 0; k < b.n; ++k) {
-      const double h = a.jac.col(i).dot(cmat * b.jac.col(k));
-      r.hess(i, a.n + k) = h;
-      r.hess(a.n + k, i) = h;
-    }
-  if (a.theta >= 0) r.hess(a.theta, a.theta) += ga.dot(a.second);
-  if (b.theta >= 0) r.hess(a.n + b.theta, a.n + b.theta) += gb.dot(b.second);
-  return r;
-}
-
 void MultibodyModel::Constraints(const VectorXd& q, VectorXd* phi, SparseRows* jac) const {
   int slot = 0;
+  double grad[kMaxRowCoords];
   for (size_t i = 0; i < rows_.size(); ++i) {
-    const RowEval ev = EvalRow(rows_[i], q);
-    (*phi)(i) = ev.value;
+    const Row& row = rows_[i];
+    (*phi)(i) = RowValue(row, q);
     if (!jac) continue;
-    for (int k = 0; k < ev.n; ++k) {
-      if (j_[ev.idx[k]] < 0) continue;
-      jac->value[slot++] = ev.grad(k) * s_(ev.idx[k]);
+    RowGradient(row, q, grad);
+    for (int k = row.coord_begin; k < row.coord_end; ++k) {
+      const int coord = row_coord_[k];
+      if (j_[coord] < 0) continue;
+      jac->value[slot++] = grad[k - row.coord_begin] * s_(coord);
     }
   }
 }
 
 void MultibodyModel::AddConstraintHessian(const VectorXd& q, const VectorXd& lambda, double scale,
-                                       SkylineLdlt* a) const {
+                                          SkylineLdlt* a) const {
+  // The Hessians are constant; `q` is kept for the interface.
+  (void)q;
   double* values = a->values();
   for (size_t i = 0; i < rows_.size(); ++i) {
-    const RowEval ev = EvalRow(rows_[i], q);
+    const Row& row = rows_[i];
     const double f = scale * lambda(i);
-    for (int x = 0; x < ev.n; ++x) {
-      const int jx = j_[ev.idx[x]];
-      if (jx < 0) continue;
-      for (int y = 0; y < ev.n; ++y) {
-        const int jy = j_[ev.idx[y]];
-        if (jy < 0 || jy > jx || ev.hess(x, y) == 0) continue;
-        // Pairs with jx == jy from x != y appear twice (x, y) and (y, x):
-        // both add, as the quadratic form requires.
-        values[a->Slot(jx, jy)] += f * ev.hess(x, y) * s_(ev.idx[x]) * s_(ev.idx[y]);
-      }
-    }
+    for (int k = row.mono_begin; k < row.mono_end; ++k)
+      if (mono_slot_[k] >= 0) values[mono_slot_[k]] += f * mono_factor_[k];
   }
 }
 
 void MultibodyModel::ConstraintGamma(const VectorXd& q, const VectorXd& qdot,
-                                  VectorXd* gamma) const {
+                                     VectorXd* gamma) const {
+  (void)q;
   for (size_t i = 0; i < rows_.size(); ++i) {
-    const RowEval ev = EvalRow(rows_[i], q);
+    const Row& row = rows_[i];
+    const int* coord = &row_coord_[row.coord_begin];
     double acc = 0;
-    for (int x = 0; x < ev.n; ++x)
-      for (int y = 0; y < ev.n; ++y) acc += qdot(ev.idx[x]) * ev.hess(x, y) * qdot(ev.idx[y]);
-    (*gamma)(i) = -acc;
+    for (int k = row.mono_begin; k < row.mono_end; ++k)
+      acc += mono_w_[k] * qdot(coord[mono_a_[k]]) * qdot(coord[mono_b_[k]]);
+    (*gamma)(i) = -2 * acc;
+  }
+}
+
+template <int D>
+void MultibodyModel::ElementEnergy(const VectorXd& q, const VectorXd& qdot,
+                                   EnergySample* en) const {
+  constexpr int kN = 4 * D;
+  const auto& elements = Elements<D>();
+  for (const ElementData<D>& e : elements) {
+    const auto qe = q.segment<kN>(e.first_coord);
+    const auto ve = qdot.segment<kN>(e.first_coord);
+    en->kinetic += 0.5 * ve.dot(e.element.MassMatrix(e.mass_per_length) * ve);
+    const auto se = e.element.StrainEnergy(qe);
+    en->axial += se.axial;
+    en->bending += se.bending;
   }
 }
 
 EnergySample MultibodyModel::Energy(const VectorXd& q, const VectorXd& qdot,
-                                 double load_factor) const {
+                                    double load_factor) const {
   EnergySample en;
-  for (const ElementData& e : elements_) {
-    const auto qe = q.segment<8>(e.first_coord);
-    const auto ve = qdot.segment<8>(e.first_coord);
-    en.kinetic += 0.5 * ve.dot(e.element.MassMatrix(e.mass_per_length) * ve);
-    const Element::Energy se = e.element.StrainEnergy(qe);
-    en.axial += se.axial;
-    en.bending += se.bending;
+  if (dim_ == 2) {
+    ElementEnergy<2>(q, qdot, &en);
+  } else {
+    ElementEnergy<3>(q, qdot, &en);
   }
+  const int D = dim_;
   for (const BodyData& b : bodies_) {
-    en.kinetic += 0.5 * (b.mass * qdot.segment<2>(b.coord).squaredNorm() +
-                         b.inertia * qdot(b.coord + 2) * qdot(b.coord + 2));
+    en.kinetic += 0.5 * b.mass * qdot.segment(b.coord, D).squaredNorm();
+    const int axes = D == 2 ? 1 : 3;
+    for (int k = 0; k < axes; ++k)
+      en.kinetic += 0.5 * b.jbar(k) * qdot.segment(b.coord + D + D * k, D).squaredNorm();
   }
-  // Gravity and node loads are constant forces: V = -F . q. Element gravity
-  // is exactly -Q_g . e (MODEL.md section 2).
+  // Gravity and point loads are constant forces on q: V = -F . q. Element
+  // gravity is exactly -Q_g . e (MODEL.md section 2).
   en.potential = -load_factor * constant_force_.dot(q);
-  for (const BodyLoad& bl : body_loads_) {
-    const int c = bodies_[bl.body].coord;
-    const Vector2d p = q.segment<2>(c) + Rotation(q(c + 2)) * bl.local;
-    en.potential -= load_factor * (bl.force.dot(p) + bl.torque * q(c + 2));
+  // Torques: the work T . dphi of each body rotation since the last call.
+  for (size_t k = 0; k < torques_.size(); ++k) {
+    const int c = bodies_[torques_[k].body].coord;
+    Eigen::Matrix3d& last = torque_axes_[k];
+    if (D == 2) {
+      const Eigen::Vector2d u0 = last.col(0).head<2>(), u1 = q.segment<2>(c + 2);
+      const double dphi = std::atan2(u0.x() * u1.y() - u0.y() * u1.x(), u0.dot(u1));
+      torque_work_ += load_factor * torques_[k].torque.z() * dphi;
+      last.col(0).head<2>() = u1;
+    } else {
+      Eigen::Matrix3d now;
+      for (int a = 0; a < 3; ++a) now.col(a) = q.segment<3>(c + 3 + 3 * a);
+      const Eigen::AngleAxisd delta(Eigen::Matrix3d(now * last.transpose()));
+      torque_work_ += load_factor * torques_[k].torque.dot(delta.angle() * delta.axis());
+      last = now;
+    }
   }
+  en.potential -= torque_work_;
   en.total = en.kinetic + en.potential + en.axial + en.bending;
   return en;
 }
 
 void MultibodyModel::Probes(const VectorXd& q, const VectorXd& qdot, const VectorXd& qddot,
-                         std::vector<ProbeSample>* out) const {
-  out->resize(probes_.size());
-  for (size_t k = 0; k < probes_.size(); ++k) {
-    const ProbeData& p = probes_[k];
-    ProbeSample& s = (*out)[k];
-    Vector2d x, v, a;
-    if (!p.body) {
-      x = q.segment<2>(p.coord);
-      v = qdot.segment<2>(p.coord);
-      a = qddot.segment<2>(p.coord);
-    } else {
-      const Vector2d rp = Rotation(q(p.coord + 2)) * p.local;
-      const double w = qdot(p.coord + 2), al = qddot(p.coord + 2);
-      x = q.segment<2>(p.coord) + rp;
-      v = qdot.segment<2>(p.coord) + w * Perp(rp);
-      a = qddot.segment<2>(p.coord) + al * Perp(rp) - w * w * rp;
+                            std::vector<ProbeSample>* out) const {
+  out->resize(probe_names_.size());
+  for (size_t p = 0; p < probe_names_.size(); ++p) {
+    ProbeSample& s = (*out)[p];
+    for (int d = 0; d < 3; ++d) {
+      const int r = 3 * static_cast<int>(p) + d;
+      double x = probe_const_[r], v = 0, a = 0;
+      for (int k = probe_term_begin_[r]; k < probe_term_begin_[r + 1]; ++k) {
+        const ProbeTerm& t = probe_terms_[k];
+        x += t.coeff * q(t.coord);
+        v += t.coeff * qdot(t.coord);
+        a += t.coeff * qddot(t.coord);
+      }
+      s.position_m(d) = x;
+      s.velocity_m_s(d) = v;
+      s.acceleration_m_s2(d) = a;
     }
-    s.position_m << x, 0;
-    s.velocity_m_s << v, 0;
-    s.acceleration_m_s2 << a, 0;
   }
 }
 

@@ -1,19 +1,36 @@
 #ifndef CABLESIM_ENGINE_MULTIBODY_MODEL_H_
 #define CABLESIM_ENGINE_MULTIBODY_MODEL_H_
 
-// The planar multibody model of a scene: ANCF cable elements (8 coordinates
-// each, MODEL.md sections 1-3), rigid bodies (x, y, theta) (section 6),
-// joints, gravity and constant loads (section 4).
+// The multibody model of a scene, planar (D = 2) or spatial (D = 3): ANCF
+// cable elements (4 D coordinates each, MODEL.md sections 1-3), rigid bodies
+// (section 6), joints, gravity and constant loads (section 4).
 //
 // Coordinates. The full coordinate vector q holds, cable by cable and node
-// by node, [x, y, x', y'] (position [m] and slope [-]), then [x, y, theta]
-// ([m], [m], [rad]) per body. Coordinates that a joint to ground fixes are
-// removed: q = c + S z, where z are the unknowns (dofs) and each full
-// coordinate is either a constant or a multiple of one unknown. A pinned node
-// loses its position; a clamped (FIXED to ground) node also keeps its slope
-// along its initial direction d0, r_x = alpha d0 with alpha unknown (the
-// cable may still stretch there); a body welded to ground loses all three.
-// Every other joint is a constraint Phi(q) = 0 with a Lagrange multiplier.
+// by node, [r, r_x] (position [m] and slope [-], D each), then per body its
+// natural coordinates [m], [-]:
+//   planar:  [r_c, u]           (4)   body axes e1 = u, e2 = perp(u)
+//   spatial: [r_c, u, v, w]     (12)  body axes e1 = u, e2 = v, e3 = w
+// where r_c is the centre of mass and u, v, w the body's x, y, z axes in the
+// world. A body point p (body frame) is at r_c + p_x e1 + p_y e2 (+ p_z e3):
+// linear in q. The kinetic energy is then (1/2) qdot^T M qdot with a constant
+// mass matrix diag(m I, Jb_x I, Jb_y I, Jb_z I), Jb_k = int rho p_k^2 dV =
+// (I_1 + I_2 + I_3) / 2 - I_k from the principal moments (planar: only u,
+// with Jb = I_z), so the body has no velocity-dependent (gyroscopic) forces
+// in these coordinates: rotation is carried by the axes and the unit and
+// orthogonality constraints of the axes (1 row planar, 6 spatial). Why
+// natural coordinates: the mass matrix stays constant as for the cable, so
+// every stepper treats bodies and cables alike, and every joint row is at
+// most quadratic in q (QuadraticForm). A planar scene run in the spatial
+// model follows the same discrete trajectory (w stays e_z, v = perp(u)).
+//
+// Coordinates that a joint to ground fixes are removed: q = c + S z, where
+// z are the unknowns (dofs) and each full coordinate is either a constant or
+// a multiple of one unknown. A pinned node loses its position; a clamped
+// (FIXED to ground) node also keeps its slope along its initial direction
+// d0, r_x = alpha d0 with alpha unknown (the cable may still stretch there);
+// a body welded to ground loses all its coordinates, a body pinned to ground
+// at its centre of mass loses r_c. Every other joint is a constraint
+// Phi(q) = 0 with a Lagrange multiplier.
 //
 // The unknowns are ordered along each cable, and a body's right after the
 // first cable node it is joined to, so the Newton matrix on z is banded
@@ -28,6 +45,7 @@
 
 #include "absl/status/statusor.h"
 #include "engine/ancf_cable_element.h"
+#include "engine/quadratic_form.h"
 #include "engine/scene.h"
 #include "engine/simulation.h"
 #include "engine/skyline_ldlt.h"
@@ -37,18 +55,18 @@ namespace cablesim {
 
 class MultibodyModel {
  public:
-  using Element = AncfCableElement<2>;
-
   // Builds the mesh (a node wherever a joint, load or probe sits), the
   // coordinate map, and the constraint pattern. InvalidArgument names the
   // scene field when the scene cannot be assembled (for example joint sides
   // that do not coincide at t = 0).
   static absl::StatusOr<MultibodyModel> Build(const Scene& scene);
 
+  // 2 (planar) or 3 (spatial), chosen by ChooseDimension (model_choice.h).
+  int dimension() const { return dim_; }
   int coordinates() const { return static_cast<int>(c_.size()); }
   int dofs() const { return dofs_; }
   int multipliers() const { return static_cast<int>(rows_.size()); }
-  int elements() const { return static_cast<int>(elements_.size()); }
+  int elements() const { return static_cast<int>(elements2_.size() + elements3_.size()); }
   int nodes() const { return num_nodes_; }
   ModelInfo Info() const;
 
@@ -97,7 +115,11 @@ class MultibodyModel {
   void ConstraintGamma(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
                        Eigen::VectorXd* gamma) const;
 
-  // Energy of a full state; potential includes the constant loads.
+  // Energy of a full state; potential includes the constant loads. A torque
+  // on a body is not a constant force in these coordinates: its work is
+  // accumulated from the body's rotation between successive calls (exact
+  // for planar rotations of less than half a turn between calls), so call
+  // this along the trajectory in time order.
   EnergySample Energy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
                       double load_factor) const;
 
@@ -105,65 +127,65 @@ class MultibodyModel {
   void Probes(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
               const Eigen::VectorXd& qddot, std::vector<ProbeSample>* out) const;
 
-  // Which joint a constraint row belongs to (for messages).
+  // Which joint a constraint row belongs to (for messages), or -1 for a
+  // body's own axis constraints.
   int RowJoint(int row) const { return rows_[row].joint; }
 
  private:
+  template <int D>
   struct ElementData {
-    Element element;
-    int first_coord = 0;     // full index of its first node's x
+    AncfCableElement<D> element;
+    int first_coord = 0;  // full index of its first node's position
     double mass_per_length = 0;
-    Eigen::Matrix<double, 8, 1> gravity;
+    Eigen::Matrix<double, 4 * D, 1> gravity;
   };
   struct BodyData {
-    int coord = 0;  // full index of x
+    int coord = 0;  // full index of r_c
     double mass = 0;
-    double inertia = 0;
+    Eigen::Vector3d jbar = Eigen::Vector3d::Zero();  // per axis [kg m^2]
   };
-  // A point or a direction on one side of a joint.
-  struct Side {
-    enum Kind { kGround, kNode, kBody } kind = kGround;
-    int coord = 0;                              // node's x or body's x (full)
-    Eigen::Vector2d local = Eigen::Vector2d::Zero();  // body point (body frame)
-    Eigen::Vector2d ground = Eigen::Vector2d::Zero(); // ground point or direction
-  };
-  struct Row {
-    enum Kind { kPositionX, kPositionY, kParallel } kind = kPositionX;
-    int joint = 0;
-    Side a, b;
-  };
-  // Evaluation of one side: value, derivatives with respect to up to three
-  // full coordinates, and the second derivative along theta (bodies).
-  struct SideEval {
-    int n = 0;
-    int idx[3] = {0, 0, 0};
-    Eigen::Vector2d value = Eigen::Vector2d::Zero();
-    Eigen::Matrix<double, 2, 3> jac = Eigen::Matrix<double, 2, 3>::Zero();
-    int theta = -1;  // local index of theta, or -1
-    Eigen::Vector2d second = Eigen::Vector2d::Zero();
-  };
-  struct RowEval {
-    int n = 0;
-    int idx[6] = {};
-    double value = 0;
-    Eigen::Matrix<double, 6, 1> grad = Eigen::Matrix<double, 6, 1>::Zero();
-    Eigen::Matrix<double, 6, 6> hess = Eigen::Matrix<double, 6, 6>::Zero();
-  };
-  struct BodyLoad {
+  // A torque load on a body [N m] and the rotation seen so far.
+  struct TorqueLoad {
     int body = 0;
-    Eigen::Vector2d local = Eigen::Vector2d::Zero();
-    Eigen::Vector2d force = Eigen::Vector2d::Zero();
-    double torque = 0;
+    Eigen::Vector3d torque = Eigen::Vector3d::Zero();
   };
-  struct ProbeData {
-    bool body = false;
-    int coord = 0;
-    Eigen::Vector2d local = Eigen::Vector2d::Zero();
+  // Constraint rows as flat quadratic forms over local coordinate lists:
+  // phi = c + sum lin_val * q[coord[lin_local]] + sum w q[coord[a]] q[coord[b]].
+  struct Row {
+    int joint = -1;  // scene joint, or -1 for a body's own axis constraint
+    int body = -1;   // the body of an axis constraint
+    enum Kind { kPosition, kDirection, kAxes } kind = kPosition;
+    double c = 0;
+    int coord_begin = 0, coord_end = 0;  // into row_coord_
+    int lin_begin = 0, lin_end = 0;      // into lin_local_, lin_value_
+    int mono_begin = 0, mono_end = 0;    // into mono_a_, mono_b_, mono_w_
   };
+  static constexpr int kMaxRowCoords = 48;
 
-  SideEval EvalPoint(const Side& s, const Eigen::VectorXd& q) const;
-  SideEval EvalDirection(const Side& s, const Eigen::VectorXd& q) const;
-  RowEval EvalRow(const Row& row, const Eigen::VectorXd& q) const;
+  template <int D>
+  double ElementForces(const Eigen::VectorXd& q, Eigen::VectorXd* full, SkylineLdlt* stiffness,
+                       double stiffness_scale) const;
+  template <int D>
+  void ElementEnergy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
+                     EnergySample* en) const;
+  template <int D>
+  void SetupElementSlots(const std::vector<ElementData<D>>& elements);
+  double RowValue(const Row& row, const Eigen::VectorXd& q) const;
+  // Local gradient of a row: grad[k] for coordinate row_coord_[begin + k].
+  void RowGradient(const Row& row, const Eigen::VectorXd& q, double* grad) const;
+  void AddRow(const QuadraticForm& f, Row::Kind kind, int joint, int body);
+  template <int D>
+  const std::vector<ElementData<D>>& Elements() const {
+    if constexpr (D == 2) {
+      return elements2_;
+    } else {
+      return elements3_;
+    }
+  }
+
+  int dim_ = 2;
+  int node_stride_ = 4;  // 2 D
+  int body_stride_ = 4;  // 4 planar, 12 spatial
 
   // Coordinate map: q_i = c_i + s_i z_{j_i} (j_i = -1: constant).
   Eigen::VectorXd c_, s_;
@@ -172,24 +194,46 @@ class MultibodyModel {
   int num_nodes_ = 0;
   Eigen::VectorXd z0_, v0_;
 
-  std::vector<ElementData> elements_;
+  std::vector<ElementData<2>> elements2_;
+  std::vector<ElementData<3>> elements3_;
   std::vector<BodyData> bodies_;
-  std::vector<Row> rows_;
-  std::vector<BodyLoad> body_loads_;
-  std::vector<ProbeData> probes_;
-  std::vector<std::string> probe_names_;
-  Eigen::VectorXd constant_force_;  // full: gravity and node loads
-  Eigen::Vector2d gravity_ = Eigen::Vector2d::Zero();
+  std::vector<TorqueLoad> torques_;
+  Eigen::VectorXd constant_force_;  // full: gravity and point loads
   double force_roundoff_ = 0;
+
+  std::vector<Row> rows_;
+  std::vector<int> row_coord_;
+  std::vector<int> lin_local_;
+  std::vector<double> lin_value_;
+  std::vector<int> mono_a_, mono_b_;
+  std::vector<double> mono_w_;
+  // Per monomial: skyline slot of its Hessian entry (or -1) and factor.
+  std::vector<int> mono_slot_;
+  std::vector<double> mono_factor_;
+
+  // Probes: per probe and component d < 3, a linear form over q (as flat
+  // term lists); velocity and acceleration use the same coefficients.
+  struct ProbeTerm {
+    int coord = 0;
+    double coeff = 0;
+  };
+  std::vector<int> probe_term_begin_;  // size 3 * probes + 1
+  std::vector<ProbeTerm> probe_terms_;
+  std::vector<double> probe_const_;    // 3 per probe
+  std::vector<std::string> probe_names_;
 
   std::vector<int> envelope_;
   SkylineLdlt mass_;
-  // Per element, the 64 skyline slots (or -1) and factors s_a s_b.
+  // Per element, the (4D)^2 skyline slots (or -1) and factors s_a s_b.
   std::vector<int> element_slots_;
   std::vector<double> element_factors_;
   SparseRows jac_pattern_;
   // Scratch (full size) for NetForce.
   Eigen::VectorXd scratch_full_;
+  // Torque work bookkeeping for Energy(): the last axes seen per torque
+  // load, and the work done so far [J].
+  mutable std::vector<Eigen::Matrix3d> torque_axes_;
+  mutable double torque_work_ = 0;
 };
 
 }  // namespace cablesim

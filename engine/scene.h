@@ -15,6 +15,8 @@
 
 namespace cablesim {
 
+// AUTO: planar when the whole scene lies in the x-y plane (model_choice.h).
+enum class ModelChoice { kAuto, kPlanar, kSpatial };
 enum class BendingModel { kExact, kLinear, kNone };
 enum class JointType { kPin, kFixed };
 enum class Analysis { kDynamic, kStatic };
@@ -41,7 +43,10 @@ struct BodySpec {
   // Principal moments of inertia about the centre of mass, body axes.
   Eigen::Vector3d inertia_kg_m2 = Eigen::Vector3d::Zero();
   Eigen::Vector3d position_m = Eigen::Vector3d::Zero();  // centre of mass
-  Eigen::Vector3d axis = Eigen::Vector3d::UnitX();       // local x, unit
+  // Local x axis in the world at t = 0, unit. The local y axis is
+  // normalize(e_z x axis) (normalize(e_x x axis) when the axis is along z),
+  // and z = x x y; the principal moments refer to these axes.
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitX();
 };
 
 // A place on a cable (cable >= 0), on a body (body >= 0), or the ground
@@ -94,6 +99,7 @@ struct SolverSettings {
 
 struct Scene {
   std::string name;
+  ModelChoice model = ModelChoice::kAuto;
   Eigen::Vector3d gravity_m_s2 = Eigen::Vector3d::Zero();
   std::vector<CableSpec> cables;
   std::vector<BodySpec> bodies;

@@ -14,6 +14,7 @@
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
 #include "engine/scene.h"
+#include "engine/simulation.h"
 
 namespace cablesim {
 namespace {
@@ -27,6 +28,16 @@ absl::StatusOr<Scene> ConvertJson(const std::string& json) {
   absl::StatusOr<v1::Scene> proto = ParseSceneJson(json);
   if (!proto.ok()) return proto.status();
   return SceneFromProto(*proto);
+}
+
+// Parses, converts and builds the model, as `cablesim validate` does: some
+// rules (PLANAR on a scene that leaves the plane, a spatial body's inertia)
+// need the model the scene gets.
+absl::StatusOr<Scene> ValidateJson(const std::string& json) {
+  absl::StatusOr<Scene> scene = ConvertJson(json);
+  if (!scene.ok()) return scene.status();
+  if (absl::StatusOr<ModelInfo> info = DescribeModel(*scene); !info.ok()) return info.status();
+  return scene;
 }
 
 // A valid cable "c" of length 1.
@@ -180,31 +191,44 @@ std::vector<InvalidCase> InvalidCases() {
                  "joints": [{"type": "PIN", "a": {"body": "b"},
                              "b": {"body": "b", "point": {"x": 1}}}], )"),
        "joints[0].b: ", "to itself"},
-      {"JointBodyPointZ", Scene1(R"("bodies": [{"name": "b", "mass": 2, "inertia": {"z": 1}}],
+      {"PlanarJointBodyPointZ",
+       Scene1(R"("model": "PLANAR", "bodies": [{"name": "b", "mass": 2, "inertia": {"z": 1}}],
                  "joints": [{"type": "PIN", "a": {"cable": "c", "s": 1},
                              "b": {"body": "b", "point": {"z": 0.1}}}], )"),
-       "joints[0].b.point.z: ", "spatial scenes are not supported yet"},
+       "model: ", "PLANAR, but joints[0].b.point.z leaves the x-y plane"},
       {"TorqueOnCableLoad",
        Scene1(R"("loads": [{"at": {"cable": "c", "s": 1}, "torque": {"z": 1}}], )"),
        "loads[0].torque: ", "allowed on bodies only"},
       {"LoadOnGround", Scene1(R"("loads": [{"force": {"y": 1}}], )"),
        "loads[0].at: ", "must name a cable or a body"},
-      {"LoadForceZ", Scene1(R"("loads": [{"at": {"cable": "c", "s": 1}, "force": {"z": 1}}], )"),
-       "loads[0].force.z: ", "spatial scenes are not supported yet"},
-      {"BodyTorqueX", Scene1(R"("bodies": [{"name": "b", "mass": 2, "inertia": {"z": 1}}],
+      {"PlanarLoadForceZ",
+       Scene1(R"("model": "PLANAR", "loads": [{"at": {"cable": "c", "s": 1}, "force": {"z": 1}}], )"),
+       "model: ", "loads[0].force.z leaves the x-y plane"},
+      {"PlanarBodyTorqueX",
+       Scene1(R"("model": "PLANAR", "bodies": [{"name": "b", "mass": 2, "inertia": {"z": 1}}],
                  "loads": [{"at": {"body": "b"}, "torque": {"x": 1}}], )"),
-       "loads[0].torque.x: ", "spatial scenes are not supported yet"},
-      {"GravityZ",
-       R"({"gravity": {"z": -9.81}, "cables": [)" + std::string(kCable) + "], " + kSolver + "}",
-       "gravity.z: ", "spatial scenes are not supported yet (the planar model needs z = 0)"},
-      {"CableDirectionZ",
-       R"({"cables": [{"name": "c", "length": 1, "direction": {"x": 1, "z": 1}, "density": 1000,
-                       "youngs_modulus": 1e7, "diameter": 0.01}], "solver": {"duration": 1}})",
-       "cables[0].direction.z: ", "spatial scenes are not supported yet"},
-      {"InitialAngularVelocityY", Scene1(R"("initial_velocity": {"angular": {"y": 4}}, )"),
-       "initial_velocity.angular.y: ", "spatial scenes are not supported yet"},
-      {"InitialLinearVelocityZ", Scene1(R"("initial_velocity": {"linear": {"z": 4}}, )"),
-       "initial_velocity.linear.z: ", "spatial scenes are not supported yet"},
+       "model: ", "loads[0].torque.x leaves the x-y plane"},
+      {"PlanarGravityZ",
+       R"({"model": "PLANAR", "gravity": {"z": -9.81}, "cables": [)" + std::string(kCable) +
+           "], " + kSolver + "}",
+       "model: ", "gravity.z leaves the x-y plane"},
+      {"PlanarCableDirectionZ",
+       R"({"model": "PLANAR", "cables": [{"name": "c", "length": 1, "direction": {"x": 1, "z": 1},
+           "density": 1000, "youngs_modulus": 1e7, "diameter": 0.01}], "solver": {"duration": 1}})",
+       "model: ", "cables[0] (point 1 has z != 0) leaves the x-y plane"},
+      {"PlanarInitialAngularVelocityY",
+       Scene1(R"("model": "PLANAR", "initial_velocity": {"angular": {"y": 4}}, )"),
+       "model: ", "initial_velocity.angular.y leaves the x-y plane"},
+      {"PlanarInitialLinearVelocityZ",
+       Scene1(R"("model": "PLANAR", "initial_velocity": {"linear": {"z": 4}}, )"),
+       "model: ", "initial_velocity.linear.z leaves the x-y plane"},
+      {"SpatialBodyInertiaNotTriangle",
+       Scene1(R"("model": "SPATIAL", "bodies": [{"name": "b", "mass": 2, "inertia": {"z": 1}}], )"),
+       "bodies[0].inertia: ", "less than the sum of the other two"},
+      {"SpatialBodyInertiaFromPlanarHabit",
+       Scene1(R"("gravity": {"z": -9.81}, "bodies": [{"name": "b", "mass": 2,
+                 "inertia": {"x": 1, "y": 1, "z": 3}}], )"),
+       "bodies[0].inertia: ", "(1, 1, 3) kg m^2"},
       {"BadProbeName", Scene1(R"("probes": [{"name": "tip 1", "cable": "c", "s": 1}], )"),
        "probes[0].name: ", "may contain only"},
       {"EmptyProbeName", Scene1(R"("probes": [{"cable": "c", "s": 1}], )"),
@@ -264,7 +288,7 @@ class InvalidSceneTest : public ::testing::TestWithParam<InvalidCase> {};
 
 TEST_P(InvalidSceneTest, NamesTheField) {
   const InvalidCase& c = GetParam();
-  const absl::StatusOr<Scene> scene = ConvertJson(c.json);
+  const absl::StatusOr<Scene> scene = ValidateJson(c.json);
   ASSERT_FALSE(scene.ok()) << c.json;
   EXPECT_EQ(scene.status().code(), absl::StatusCode::kInvalidArgument);
   const std::string message(scene.status().message());
