@@ -519,6 +519,9 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
         e.first_coord = ns * k;
         e.mass_per_length = mpl;
         e.gravity = e.element.GravityForce(mpl, g);
+        const auto me = e.element.MassMatrix(mpl);
+        for (int a = 0; a < 4; ++a)
+          for (int b = 0; b < 4; ++b) e.mbar(a, b) = me(kD * a, kD * b);
         elements.push_back(e);
       }
     }
@@ -841,6 +844,45 @@ EnergySample MultibodyModel::Energy(const VectorXd& q, const VectorXd& qdot,
   en.potential -= torque_work_;
   en.total = en.kinetic + en.potential + en.axial + en.bending;
   return en;
+}
+
+template <int D>
+Eigen::Vector3d MultibodyModel::ElementAngularMomentum(const VectorXd& q,
+                                                      const VectorXd& qdot) const {
+  Vector3d l = Vector3d::Zero();
+  for (const ElementData<D>& e : Elements<D>()) {
+    for (int a = 0; a < 4; ++a) {
+      Vector3d ra = Vector3d::Zero();
+      ra.head<D>() = q.segment<D>(e.first_coord + D * a);
+      for (int b = 0; b < 4; ++b) {
+        Vector3d vb = Vector3d::Zero();
+        vb.head<D>() = qdot.segment<D>(e.first_coord + D * b);
+        l += e.mbar(a, b) * ra.cross(vb);
+      }
+    }
+  }
+  return l;
+}
+
+Eigen::Vector3d MultibodyModel::AngularMomentum(const VectorXd& q, const VectorXd& qdot) const {
+  Vector3d l = dim_ == 2 ? ElementAngularMomentum<2>(q, qdot) : ElementAngularMomentum<3>(q, qdot);
+  const int D = dim_;
+  auto vec = [D](const VectorXd& x, int i) {
+    Vector3d v = Vector3d::Zero();
+    v.head(D) = x.segment(i, D);
+    return v;
+  };
+  for (const BodyData& b : bodies_) {
+    l += b.mass * vec(q, b.coord).cross(vec(qdot, b.coord));
+    if (D == 2) {
+      // Both axes u and perp(u) carry Jb_x + Jb_y = I_z: I_z u x udot.
+      l += b.jbar(0) * vec(q, b.coord + 2).cross(vec(qdot, b.coord + 2));
+    } else {
+      for (int k = 0; k < 3; ++k)
+        l += b.jbar(k) * vec(q, b.coord + 3 + 3 * k).cross(vec(qdot, b.coord + 3 + 3 * k));
+    }
+  }
+  return l;
 }
 
 void MultibodyModel::Probes(const VectorXd& q, const VectorXd& qdot, const VectorXd& qddot,

@@ -123,6 +123,12 @@ class MultibodyModel {
   EnergySample Energy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
                       double load_factor) const;
 
+  // Angular momentum about the world origin [kg m^2/s], exact for the
+  // discretised mass: sum over elements of mbar_ab r_a x rdot_b (r_a the
+  // element's nodal vectors, mbar its scalar mass matrix), plus per body
+  // m r_c x rdot_c + sum_k Jb_k e_k x edot_k. Planar models return (0, 0, L_z).
+  Eigen::Vector3d AngularMomentum(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot) const;
+
   // Probes from full position, velocity and acceleration.
   void Probes(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
               const Eigen::VectorXd& qddot, std::vector<ProbeSample>* out) const;
@@ -138,6 +144,7 @@ class MultibodyModel {
     int first_coord = 0;  // full index of its first node's position
     double mass_per_length = 0;
     Eigen::Matrix<double, 4 * D, 1> gravity;
+    Eigen::Matrix4d mbar;  // scalar mass matrix: M = mbar (x) I_D
   };
   struct BodyData {
     int coord = 0;  // full index of r_c
@@ -168,6 +175,9 @@ class MultibodyModel {
   template <int D>
   void ElementEnergy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
                      EnergySample* en) const;
+  template <int D>
+  Eigen::Vector3d ElementAngularMomentum(const Eigen::VectorXd& q,
+                                         const Eigen::VectorXd& qdot) const;
   template <int D>
   void SetupElementSlots(const std::vector<ElementData<D>>& elements);
   double RowValue(const Row& row, const Eigen::VectorXd& q) const;

@@ -33,6 +33,7 @@ class FrameRecorder {
     frame_.t = t;
     model_->Probes(q_, qd_, qdd_, &frame_.probes);
     frame_.energy = model_->Energy(q_, qd_, load_factor);
+    frame_.angular_momentum = model_->AngularMomentum(q_, qd_);
     model_->Constraints(q_, &phi_, nullptr);
     frame_.constraint_violation = phi_.size() ? phi_.lpNorm<Eigen::Infinity>() : 0.0;
     if (summary_->frames == 0) summary_->energy_initial = frame_.energy.total;

@@ -51,6 +51,10 @@ struct Frame {
   double t = 0;
   std::vector<ProbeSample> probes;  // in scene order
   EnergySample energy;
+  // Angular momentum about the world origin [kg m^2/s] (z only for a
+  // planar model); conserved about any axis along which the applied loads
+  // and joints to ground exert no moment.
+  Eigen::Vector3d angular_momentum = Eigen::Vector3d::Zero();
   // Largest absolute constraint residual (m for positions, dimensionless
   // for tangent cross products).
   double constraint_violation = 0;

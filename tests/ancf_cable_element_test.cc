@@ -8,6 +8,7 @@
 #include <cmath>
 #include <random>
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 namespace cablesim {
@@ -196,6 +197,61 @@ TEST(AncfCableElementTest, EnergyIsInvariantUnderRigidRotationOfAnyConfiguration
       for (int k = 0; k < 4; ++k) er.segment<2>(2 * k) = r * e.segment<2>(2 * k);
       er.segment<2>(0) += Eigen::Vector2d(5, -3);  // translate the position nodes
       er.segment<2>(4) += Eigen::Vector2d(5, -3);
+      const auto a = element.StrainEnergy(e), b = element.StrainEnergy(er);
+      EXPECT_NEAR(a.axial, b.axial, 1e-12 * (a.axial + 1e-30));
+      EXPECT_NEAR(a.bending, b.bending, 1e-12 * (a.bending + 1e-30));
+    }
+  }
+}
+
+TEST(AncfCableElementTest, SpatialForceIsGradientOfEnergyLinearBending) {
+  CheckForceAgainstEnergyDifferences<3>(BendingModel::kLinear, 12);
+}
+TEST(AncfCableElementTest, SpatialForceIsGradientOfEnergyNoBending) {
+  CheckForceAgainstEnergyDifferences<3>(BendingModel::kNone, 13);
+}
+TEST(AncfCableElementTest, SpatialTangentIsJacobianOfForceLinearBending) {
+  CheckTangentAgainstForceDifferences<3>(BendingModel::kLinear, 14);
+}
+TEST(AncfCableElementTest, SpatialTangentIsJacobianOfForceNoBending) {
+  CheckTangentAgainstForceDifferences<3>(BendingModel::kNone, 15);
+}
+
+TEST(AncfCableElementTest, SpatialRigidMotionOfStraightElementHasNoEnergyOrForce) {
+  std::mt19937 rng(21);
+  std::normal_distribution<double> n(0, 1);
+  for (BendingModel bending : {BendingModel::kExact, BendingModel::kLinear}) {
+    const AncfCableElement<3> element(kLength, kEA, kEI, bending);
+    for (int trial = 0; trial < 10; ++trial) {
+      const Eigen::Vector3d dir = Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized();
+      const auto e = Straight<3>(Eigen::Vector3d(n(rng), n(rng), n(rng)), dir, 1.0);
+      AncfCableElement<3>::Coords f = AncfCableElement<3>::Coords::Zero();
+      element.ElasticForce(e, &f, nullptr);
+      const auto energy = element.StrainEnergy(e);
+      EXPECT_NEAR(energy.axial + energy.bending, 0, 1e-20);
+      // Roundoff: EA times machine epsilon.
+      EXPECT_LT(f.cwiseAbs().maxCoeff(), 1e-10 * kEA);
+    }
+  }
+}
+
+TEST(AncfCableElementTest, SpatialEnergyIsInvariantUnderArbitraryRotationInSpace) {
+  // A bent, stretched element rotated by a random rotation about a random
+  // axis and translated keeps its strain energy (to rounding, 1e-12).
+  std::mt19937 rng(22);
+  std::normal_distribution<double> n(0, 1);
+  for (BendingModel bending : {BendingModel::kExact, BendingModel::kLinear}) {
+    const AncfCableElement<3> element(kLength, kEA, kEI, bending);
+    for (int trial = 0; trial < 10; ++trial) {
+      const AncfCableElement<3>::Coords e = RandomLargeDeformation<3>(&rng);
+      const Eigen::Matrix3d r =
+          Eigen::AngleAxisd(0.4 + trial, Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized())
+              .toRotationMatrix();
+      const Eigen::Vector3d shift(n(rng), n(rng), n(rng));
+      AncfCableElement<3>::Coords er;
+      for (int k = 0; k < 4; ++k) er.segment<3>(3 * k) = r * e.segment<3>(3 * k);
+      er.segment<3>(0) += shift;
+      er.segment<3>(6) += shift;
       const auto a = element.StrainEnergy(e), b = element.StrainEnergy(er);
       EXPECT_NEAR(a.axial, b.axial, 1e-12 * (a.axial + 1e-30));
       EXPECT_NEAR(a.bending, b.bending, 1e-12 * (a.bending + 1e-30));
