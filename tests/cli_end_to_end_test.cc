@@ -127,5 +127,19 @@ TEST(CliEndToEndTest, CantileverLargeDeflection) {
   EXPECT_LT(csv.rows.back()[2], 0.0);
 }
 
+TEST(CliEndToEndTest, SpatialPendulum) {
+  const Csv csv = RunSample("spatial-pendulum.json");
+  EXPECT_EQ(csv.header,
+            absl::StrCat("t,", ProbeColumns("tip"), ",", ProbeColumns("middle"), ",", kEnergyColumns));
+  ExpectTimes(csv, 1 + 2000, 0.0, 2.0);  // 2 s every 0.001 s
+  // Spun at 4 rad/s about +y from along +x: the tip starts at (1, 0, 0)
+  // moving at w x r = (0, 0, -4) m/s, and the z columns carry the motion.
+  EXPECT_NEAR(csv.rows.front()[1], 1.0, 1e-12);
+  EXPECT_NEAR(csv.rows.front()[6], -4.0, 1e-12);
+  double zmax = 0;
+  for (const auto& row : csv.rows) zmax = std::max(zmax, std::abs(row[3]));
+  EXPECT_GT(zmax, 0.5);
+}
+
 }  // namespace
 }  // namespace cablesim

@@ -165,25 +165,22 @@ TEST(SpatialModelTest, SceneRotatedOutOfThePlaneFollowsTheRotatedPlanarTrajector
   // tolerance (1e-12 here; compared at 1e-9 relative).
   const Eigen::Matrix3d r =
       Eigen::AngleAxisd(0.9, Eigen::Vector3d(1, 2, -0.5).normalized()).toRotationMatrix();
-  {
+  // The cylinder is axisymmetric, so the body frame's y axis convention
+  // (which does not rotate with the scene) must not matter either.
+  using Maker = std::string (*)(const Eigen::Matrix3d&, const std::string&);
+  const std::pair<const char*, Maker> scenes[] = {
+      {"falling pendulum", [](const Eigen::Matrix3d& m, const std::string& model) {
+         return FallingPendulum(m, model);
+       }},
+      {"cable with cylinder", &CableWithCylinder}};
+  for (const auto& [name, make] : scenes) {
     CollectingSink planar, rotated;
-    RunOk(SceneFromJson(FallingPendulum(Eigen::Matrix3d::Identity(), "AUTO")), &planar);
-    const RunSummary s = RunOk(SceneFromJson(FallingPendulum(r, "AUTO")), &rotated);
-    EXPECT_EQ(s.info.model, "spatial");
+    RunOk(SceneFromJson(make(Eigen::Matrix3d::Identity(), "AUTO")), &planar);
+    const RunSummary s = RunOk(SceneFromJson(make(r, "AUTO")), &rotated);
+    EXPECT_EQ(s.info.model, "spatial") << name;
     const double rel = MaxRelativeDifference(planar, rotated, r);
-    std::printf("rotated falling pendulum: max relative probe difference %.3g\n", rel);
-    EXPECT_LT(rel, 1e-9);
-  }
-  {
-    // The cylinder is axisymmetric, so the body frame's y axis convention
-    // (which does not rotate with the scene) must not matter either.
-    CollectingSink planar, rotated;
-    RunOk(SceneFromJson(CableWithCylinder(Eigen::Matrix3d::Identity(), "AUTO")), &planar);
-    const RunSummary s = RunOk(SceneFromJson(CableWithCylinder(r, "AUTO")), &rotated);
-    EXPECT_EQ(s.info.model, "spatial");
-    const double rel = MaxRelativeDifference(planar, rotated, r);
-    std::printf("rotated cable with cylinder: max relative probe difference %.3g\n", rel);
-    EXPECT_LT(rel, 1e-9);
+    std::printf("rotated %s: max relative probe difference %.3g\n", name, rel);
+    EXPECT_LT(rel, 1e-9) << name;
   }
 }
 
