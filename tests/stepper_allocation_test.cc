@@ -392,6 +392,25 @@ TEST_F(StepperAllocationTest, CableWithEndCylinderGmresStepsDoNotAllocate) {
   ExpectStepsDoNotAllocate(scene, 0.005, 200);
 }
 
+TEST_F(StepperAllocationTest, SpatialCableWithSpunCylinderStepsDoNotAllocate) {
+  // The spatial model: 12-coordinate elements, a body in natural
+  // coordinates with its six axis rows, a spherical pin, a FIXED joint and a
+  // torque on the body.
+  Scene scene = CableWithEndCylinder(LinearSolverKind::kMinres);
+  ASSERT_FALSE(scene.bodies.empty());
+  scene.initial_velocity.angular_rad_s = Eigen::Vector3d(0, 4, 0);
+  LoadSpec torque;
+  torque.at.body = 0;
+  torque.torque_nm = Eigen::Vector3d(1e-4, 0, 2e-4);
+  scene.loads.push_back(torque);
+  {
+    auto model = MultibodyModel::Build(scene);
+    ASSERT_TRUE(model.ok()) << model.status();
+    ASSERT_EQ(model->dimension(), 3);
+  }
+  ExpectStepsDoNotAllocate(scene, 0.005, 200);
+}
+
 }  // namespace
 }  // namespace cablesim
 
