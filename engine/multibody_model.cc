@@ -620,7 +620,8 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
     }
     m.jac_pattern_.row_start.push_back(static_cast<int>(m.jac_pattern_.col.size()));
   }
-  m.mono_slot_.assign(m.mono_a_.size(), -1);
+  m.mono_row_.assign(m.mono_a_.size(), -1);
+  m.mono_col_.assign(m.mono_a_.size(), -1);
   m.mono_factor_.assign(m.mono_a_.size(), 0.0);
   for (const Row& row : m.rows_) {
     const int* coord = &m.row_coord_[row.coord_begin];
@@ -631,7 +632,8 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
       // w q_a q_b has Hessian entries (a, b) and (b, a) equal to w; on z
       // they land on (ja, jb) and (jb, ja): stored once off the diagonal,
       // twice (2 w) on it.
-      m.mono_slot_[k] = m.mass_.Slot(std::max(ja, jb), std::min(ja, jb));
+      m.mono_row_[k] = std::max(ja, jb);
+      m.mono_col_[k] = std::min(ja, jb);
       m.mono_factor_[k] = m.mono_w_[k] * m.s_(a) * m.s_(b) * (ja == jb ? 2 : 1);
     }
   }
@@ -773,8 +775,9 @@ void MultibodyModel::AddConstraintHessian(const VectorXd& q, const VectorXd& lam
   for (size_t i = 0; i < rows_.size(); ++i) {
     const Row& row = rows_[i];
     const double f = scale * lambda(i);
+    // Slots are looked up in `a` (any pattern containing envelope()).
     for (int k = row.mono_begin; k < row.mono_end; ++k)
-      if (mono_slot_[k] >= 0) values[mono_slot_[k]] += f * mono_factor_[k];
+      if (mono_row_[k] >= 0) values[a->Slot(mono_row_[k], mono_col_[k])] += f * mono_factor_[k];
   }
 }
 

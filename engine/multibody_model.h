@@ -217,8 +217,9 @@ class MultibodyModel {
   std::vector<double> lin_value_;
   std::vector<int> mono_a_, mono_b_;
   std::vector<double> mono_w_;
-  // Per monomial: skyline slot of its Hessian entry (or -1) and factor.
-  std::vector<int> mono_slot_;
+  // Per monomial: the (row >= col) entry of its Hessian on z (or -1) and
+  // its factor.
+  std::vector<int> mono_row_, mono_col_;
   std::vector<double> mono_factor_;
 
   // Probes: per probe and component d < 3, a linear form over q (as flat
