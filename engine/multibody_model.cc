@@ -7,6 +7,7 @@
 #include <type_traits>
 #include <utility>
 
+#include <Eigen/Dense>
 #include <Eigen/Geometry>
 
 #include "absl/status/status.h"
@@ -75,13 +76,6 @@ LinearVector Combination(const std::vector<std::pair<double, LinearVector>>& ter
   LinearVector r;
   for (const auto& [s, v] : terms) r = Add(r, v, s);
   return r;
-}
-
-// A unit vector perpendicular to `t`, nearest to e_z (e_x if t is along z).
-Vector3d PerpendicularTowardsZ(const Vector3d& t) {
-  Vector3d m = Vector3d::UnitZ() - Vector3d::UnitZ().dot(t) * t;
-  if (m.norm() < 1e-9) m = Vector3d::UnitX() - Vector3d::UnitX().dot(t) * t;
-  return m.normalized();
 }
 
 }  // namespace
@@ -350,13 +344,27 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
     if (!fixed || b.IsGround()) continue;
     if (a.cable < 0 && b.cable >= 0) std::swap(a, b);  // a node first
     if (a.cable >= 0 && b.cable >= 0) {
-      // Two cable tangents parallel: (t_a x t_b) . m = 0 for the one (planar)
-      // or two (spatial) directions m normal to the initial tangent.
+      // Two cables welded end to end: the slopes stay equal, r_x,b = c r_x,a
+      // with c = |r_x,b| / |r_x,a| at t = 0 (1 for a cable split at the
+      // joint): D linear rows, of full rank in every configuration. (Rows
+      // (r_x,a x r_x,b) . m with fixed m lose rank once the tangent turns
+      // onto m.) The stretch on both sides is thereby tied; that is exact for
+      // a uniform cable without a point load at the joint.
       const LinearVector ta = node_slope(node_of(a)), tb = node_slope(node_of(b));
-      const Vector3d t0 = eval(ta).normalized();
-      const Vector3d m1 = D == 2 ? Vector3d::UnitZ() : PerpendicularTowardsZ(t0);
-      pending.push_back({CrossDot(ta, tb, m1), Row::kDirection, ji, -1});
-      if (D == 3) pending.push_back({CrossDot(ta, tb, t0.cross(m1)), Row::kDirection, ji, -1});
+      const Vector3d t0a = eval(ta), t0b = eval(tb);
+      const double sine = t0a.cross(t0b).norm() / (t0a.norm() * t0b.norm());
+      if (!(sine <= 1e-6) || t0a.dot(t0b) <= 0) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "joints[%d]: FIXED between two cables needs their tangents parallel and in the same "
+            "sense at t = 0 (sine of the angle between them: %.6g)",
+            ji, sine));
+      }
+      const double ratio = t0b.norm() / t0a.norm();
+      for (int d = 0; d < D; ++d) {
+        LinearForm diff = tb[d];
+        diff += ta[d].Scaled(-ratio);
+        pending.push_back({QuadraticForm::FromLinear(diff), Row::kSlope, ji, -1});
+      }
     } else if (a.cable >= 0) {
       // A cable tangent along the body's x axis: t . e2 = 0 (and t . e3 = 0).
       const LinearVector t = node_slope(node_of(a));
@@ -489,14 +497,19 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
   // welded body) is satisfied by construction, as far as the check above
   // allows, and could never be corrected: it would only make the system
   // singular.
+  // The test is the row's gradient on z at t = 0 (the rows are linear or
+  // bilinear, so a row with a zero reduced gradient there is one that the
+  // elimination has made constant, e.g. a clamped node welded to a body
+  // welded to ground).
   for (const PendingRow& r : pending) {
-    bool movable = false;
-    for (const auto& [i, v] : r.f.linear) movable |= v != 0 && m.j_[i] >= 0 && m.s_(i) != 0;
+    VectorXd grad = VectorXd::Zero(m.dofs_);
+    for (const auto& [i, v] : r.f.linear)
+      if (m.j_[i] >= 0) grad(m.j_[i]) += v * m.s_(i);
     for (const auto& [ij, v] : r.f.quadratic) {
-      movable |= v != 0 && ((m.j_[ij.first] >= 0 && m.s_(ij.first) != 0) ||
-                            (m.j_[ij.second] >= 0 && m.s_(ij.second) != 0));
+      if (m.j_[ij.first] >= 0) grad(m.j_[ij.first]) += v * m.s_(ij.first) * q0(ij.second);
+      if (m.j_[ij.second] >= 0) grad(m.j_[ij.second]) += v * m.s_(ij.second) * q0(ij.first);
     }
-    if (movable) m.AddRow(r.f, r.kind, r.joint, r.body);
+    if (grad.lpNorm<Eigen::Infinity>() > 1e-12) m.AddRow(r.f, r.kind, r.joint, r.body);
   }
 
   // ---- Elements. ----
@@ -637,10 +650,39 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
       m.mono_factor_[k] = m.mono_w_[k] * m.s_(a) * m.s_(b) * (ja == jb ? 2 : 1);
     }
   }
-  m.torque_axes_.resize(m.torques_.size());
-  for (size_t k = 0; k < m.torques_.size(); ++k) m.torque_axes_[k] = frame0[m.torques_[k].body];
   m.scratch_full_ = VectorXd::Zero(ncoord);
+  m.ProjectInitialVelocity();
   return m;
+}
+
+void MultibodyModel::ProjectInitialVelocity() {
+  // The scene's rigid initial motion need not respect the joints (a pin
+  // away from the rotation origin, say). Keep the part that does, nearest
+  // in kinetic energy: v0 -= M^-1 J^T (J M^-1 J^T)^-1 J v0, the velocity
+  // right after a perfectly inelastic impulse at the joints.
+  const int nrows = multipliers();
+  if (nrows == 0) return;
+  VectorXd q0(coordinates()), phi(nrows);
+  ToFull(z0_, &q0);
+  SparseRows jac = jac_pattern_;
+  Constraints(q0, &phi, &jac);
+  VectorXd jv(nrows);
+  jac.Multiply(v0_.data(), jv.data());
+  if (jv.lpNorm<Eigen::Infinity>() <= 1e-14 * (1 + v0_.lpNorm<Eigen::Infinity>())) return;
+  SkylineLdlt mass = mass_;
+  if (!mass.Factor()) return;
+  Eigen::MatrixXd minv_jt = Eigen::MatrixXd::Zero(dofs_, nrows);
+  for (int r = 0; r < nrows; ++r) {
+    for (int k = jac.row_start[r]; k < jac.row_start[r + 1]; ++k)
+      minv_jt(jac.col[k], r) += jac.value[k];
+    mass.Solve(minv_jt.col(r).data());
+  }
+  Eigen::MatrixXd schur(nrows, nrows);
+  for (int r = 0; r < nrows; ++r) jac.Multiply(minv_jt.col(r).data(), schur.col(r).data());
+  // Redundant rows make the Schur complement singular: least squares.
+  const VectorXd mu = schur.completeOrthogonalDecomposition().solve(jv);
+  initial_velocity_correction_ = (minv_jt * mu).lpNorm<Eigen::Infinity>();
+  v0_ -= minv_jt * mu;
 }
 
 template <int D>
@@ -741,11 +783,15 @@ double MultibodyModel::NetForce(const VectorXd& q, double load_factor, VectorXd*
       }
     }
   }
-  double size = full.lpNorm<Eigen::Infinity>();
+  // The size of the applied terms counts only coordinates that move: a
+  // heavy body welded to ground must not loosen the tolerance elsewhere.
+  double size = 0;
+  const int n = coordinates();
+  for (int i = 0; i < n; ++i)
+    if (j_[i] >= 0) size = std::max(size, std::abs(full(i)));
   size = std::max(size, dim_ == 2 ? ElementForces<2>(q, &full, stiffness, stiffness_scale)
                                   : ElementForces<3>(q, &full, stiffness, stiffness_scale));
   f->setZero();
-  const int n = coordinates();
   for (int i = 0; i < n; ++i)
     if (j_[i] >= 0) (*f)(j_[i]) += s_(i) * full(i);
   return size;
@@ -827,26 +873,33 @@ EnergySample MultibodyModel::Energy(const VectorXd& q, const VectorXd& qdot,
   // Gravity and point loads are constant forces on q: V = -F . q. Element
   // gravity is exactly -Q_g . e (MODEL.md section 2).
   en.potential = -load_factor * constant_force_.dot(q);
-  // Torques: the work T . dphi of each body rotation since the last call.
-  for (size_t k = 0; k < torques_.size(); ++k) {
-    const int c = bodies_[torques_[k].body].coord;
-    Eigen::Matrix3d& last = torque_axes_[k];
-    if (D == 2) {
-      const Eigen::Vector2d u0 = last.col(0).head<2>(), u1 = q.segment<2>(c + 2);
-      const double dphi = std::atan2(u0.x() * u1.y() - u0.y() * u1.x(), u0.dot(u1));
-      torque_work_ += load_factor * torques_[k].torque.z() * dphi;
-      last.col(0).head<2>() = u1;
-    } else {
-      Eigen::Matrix3d now;
-      for (int a = 0; a < 3; ++a) now.col(a) = q.segment<3>(c + 3 + 3 * a);
-      const Eigen::AngleAxisd delta(Eigen::Matrix3d(now * last.transpose()));
-      torque_work_ += load_factor * torques_[k].torque.dot(delta.angle() * delta.axis());
-      last = now;
-    }
-  }
+  // Torques: their work so far (AccumulateTorqueWork).
   en.potential -= torque_work_;
   en.total = en.kinetic + en.potential + en.axial + en.bending;
   return en;
+}
+
+void MultibodyModel::AccumulateTorqueWork(const VectorXd& q_before, const VectorXd& q_after,
+                                          double load_factor) {
+  for (const TorqueLoad& t : torques_) {
+    const int c = bodies_[t.body].coord;
+    if (dim_ == 2) {
+      // Exact for a constant torque: T_z times the angle turned.
+      const Eigen::Vector2d u0 = q_before.segment<2>(c + 2), u1 = q_after.segment<2>(c + 2);
+      torque_work_ += load_factor * t.torque.z() *
+                      std::atan2(u0.x() * u1.y() - u0.y() * u1.x(), u0.dot(u1));
+    } else {
+      // T . phi with phi the rotation vector of the step (exact when the
+      // rotation axis is fixed over the step, second order otherwise).
+      Eigen::Matrix3d before, after;
+      for (int k = 0; k < 3; ++k) {
+        before.col(k) = q_before.segment<3>(c + 3 + 3 * k);
+        after.col(k) = q_after.segment<3>(c + 3 + 3 * k);
+      }
+      const Eigen::AngleAxisd delta(Eigen::Matrix3d(after * before.transpose()));
+      torque_work_ += load_factor * t.torque.dot(delta.angle() * delta.axis());
+    }
+  }
 }
 
 template <int D>

@@ -70,7 +70,10 @@ class MultibodyModel {
   int nodes() const { return num_nodes_; }
   ModelInfo Info() const;
 
-  // Initial unknowns and their rates (the scene's rigid initial motion).
+  // Initial unknowns and their rates: the scene's rigid initial motion,
+  // projected onto the joints (ProjectInitialVelocity in the .cc); the
+  // largest change the projection made [m/s or 1/s].
+  double initial_velocity_correction() const { return initial_velocity_correction_; }
   const Eigen::VectorXd& initial_z() const { return z0_; }
   const Eigen::VectorXd& initial_v() const { return v0_; }
 
@@ -88,11 +91,12 @@ class MultibodyModel {
   // f = load_factor * Q_a(q) - Q_k(q) on the unknowns: gravity and applied
   // loads (scaled) minus elastic forces. `q` is the full configuration.
   // When `stiffness` is not null, also adds stiffness_scale * d(-f)/dz (the
-  // tangent stiffness K_T, with the configuration-dependent body loads) to
-  // it; its pattern is envelope(). One pass over the elements does both.
+  // elastic tangent stiffness K_T; the skew-symmetric derivative of torque
+  // loads is left out, see NetForce in the .cc) to it; its pattern is
+  // envelope(). One pass over the elements does both.
   // Returns the size of the terms that were added, max(|Q_a|_inf, |Q_k|_inf)
-  // over the full coordinates: the scale against which Newton residuals are
-  // small (the two nearly cancel at equilibrium).
+  // over the coordinates that move: the scale against which Newton residuals
+  // are small (the two nearly cancel at equilibrium).
   double NetForce(const Eigen::VectorXd& q, double load_factor, Eigen::VectorXd* f,
                   SkylineLdlt* stiffness = nullptr, double stiffness_scale = 0);
 
@@ -115,13 +119,19 @@ class MultibodyModel {
   void ConstraintGamma(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
                        Eigen::VectorXd* gamma) const;
 
-  // Energy of a full state; potential includes the constant loads. A torque
-  // on a body is not a constant force in these coordinates: its work is
-  // accumulated from the body's rotation between successive calls (exact
-  // for planar rotations of less than half a turn between calls), so call
-  // this along the trajectory in time order.
+  // Energy of a full state; potential includes the constant loads, and
+  // minus the work torques have done so far (AccumulateTorqueWork).
   EnergySample Energy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
                       double load_factor) const;
+
+  // A torque on a body is not a constant force in these coordinates, so its
+  // work is summed step by step: call this after every accepted step (or
+  // load increment) with the full configurations before and after it.
+  // Exact in the plane; in space, exact when the step's rotation axis is
+  // fixed, second order otherwise.
+  bool has_torques() const { return !torques_.empty(); }
+  void AccumulateTorqueWork(const Eigen::VectorXd& q_before, const Eigen::VectorXd& q_after,
+                            double load_factor);
 
   // Angular momentum about the world origin [kg m^2/s], exact for the
   // discretised mass: sum over elements of mbar_ab r_a x rdot_b (r_a the
@@ -161,7 +171,7 @@ class MultibodyModel {
   struct Row {
     int joint = -1;  // scene joint, or -1 for a body's own axis constraint
     int body = -1;   // the body of an axis constraint
-    enum Kind { kPosition, kDirection, kAxes } kind = kPosition;
+    enum Kind { kPosition, kDirection, kSlope, kAxes } kind = kPosition;
     double c = 0;
     int coord_begin = 0, coord_end = 0;  // into row_coord_
     int lin_begin = 0, lin_end = 0;      // into lin_local_, lin_value_
@@ -184,6 +194,7 @@ class MultibodyModel {
   // Local gradient of a row: grad[k] for coordinate row_coord_[begin + k].
   void RowGradient(const Row& row, const Eigen::VectorXd& q, double* grad) const;
   void AddRow(const QuadraticForm& f, Row::Kind kind, int joint, int body);
+  void ProjectInitialVelocity();
   template <int D>
   const std::vector<ElementData<D>>& Elements() const {
     if constexpr (D == 2) {
@@ -203,6 +214,7 @@ class MultibodyModel {
   int dofs_ = 0;
   int num_nodes_ = 0;
   Eigen::VectorXd z0_, v0_;
+  double initial_velocity_correction_ = 0;
 
   std::vector<ElementData<2>> elements2_;
   std::vector<ElementData<3>> elements3_;
@@ -241,10 +253,8 @@ class MultibodyModel {
   SparseRows jac_pattern_;
   // Scratch (full size) for NetForce.
   Eigen::VectorXd scratch_full_;
-  // Torque work bookkeeping for Energy(): the last axes seen per torque
-  // load, and the work done so far [J].
-  mutable std::vector<Eigen::Matrix3d> torque_axes_;
-  mutable double torque_work_ = 0;
+  // Work done by the torques so far [J].
+  double torque_work_ = 0;
 };
 
 }  // namespace cablesim

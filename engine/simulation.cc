@@ -54,6 +54,29 @@ class FrameRecorder {
   Eigen::VectorXd q_, qd_, qdd_, phi_;
 };
 
+// Sums the work of torque loads over accepted steps, for the energy
+// balance (MultibodyModel::AccumulateTorqueWork); nothing without torques.
+class TorqueWork {
+ public:
+  explicit TorqueWork(MultibodyModel* model) : model_(model) {
+    if (!model->has_torques()) return;
+    before_.setZero(model->coordinates());
+    after_.setZero(model->coordinates());
+  }
+  void Before(const Eigen::VectorXd& z) {
+    if (model_->has_torques()) model_->ToFull(z, &before_);
+  }
+  void After(const Eigen::VectorXd& z, double load_factor) {
+    if (!model_->has_torques()) return;
+    model_->ToFull(z, &after_);
+    model_->AccumulateTorqueWork(before_, after_, load_factor);
+  }
+
+ private:
+  MultibodyModel* model_;
+  Eigen::VectorXd before_, after_;
+};
+
 void Fail(RunSummary* s, double t, const std::string& reason) {
   s->status = "failed";
   s->failure_time_s = t;
@@ -89,6 +112,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     summary->error = std::string(s.message());
     return;
   }
+  TorqueWork torque_work(model);
   const double h_nominal = settings.step_s;
   const double h_min = std::ldexp(h_nominal, -settings.max_step_halvings);
   const double interval =
@@ -106,12 +130,14 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       const double remaining = t_frame - t;
       const double substeps = std::ceil(remaining / h - 1e-9);
       const double h_try = remaining / substeps;
+      torque_work.Before(stepper.z());
       const auto st = stepper.Step(h_try);
       summary->newton_iterations += st.newton_iterations;
       summary->linear_iterations += st.linear_iterations;
       summary->max_linear_residual = std::max(summary->max_linear_residual, st.max_linear_residual);
       if (st.converged) {
         t += h_try;
+        torque_work.After(stepper.z(), 1);
         ++summary->steps;
         summary->min_step_s = std::min(summary->min_step_s, h_try);
         summary->max_newton_residual = std::max(summary->max_newton_residual, st.residual);
@@ -145,6 +171,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
 void RunStatic(MultibodyModel* model, const SolverSettings& settings, const RunControl& control,
                FrameRecorder* rec, RunSummary* summary) {
   StaticSolver solver(model, settings);
+  TorqueWork torque_work(model);
   const int n = settings.load_steps;
   const double min_increment = std::ldexp(1.0 / n, -settings.max_step_halvings);
   double alpha = 0;
@@ -154,12 +181,14 @@ void RunStatic(MultibodyModel* model, const SolverSettings& settings, const RunC
     while (target - alpha > 1e-12) {
       if (!MayStep(control, alpha, summary)) return;
       d = std::min(d, target - alpha);
+      torque_work.Before(solver.z());
       const auto st = solver.Solve(alpha + d);
       summary->newton_iterations += st.newton_iterations;
       summary->linear_iterations += st.linear_iterations;
       summary->max_linear_residual = std::max(summary->max_linear_residual, st.max_linear_residual);
       if (st.converged) {
         alpha += d;
+        torque_work.After(solver.z(), alpha);
         ++summary->steps;
         summary->max_newton_residual = std::max(summary->max_newton_residual, st.residual);
         summary->end_time_s = alpha;
