@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <Eigen/Eigenvalues>
@@ -70,21 +71,32 @@ Balance ForceBalance(MultibodyModel* model, const Eigen::VectorXd& z, SkylineLdl
   return bal;
 }
 
+// Whether z balances the full loads: the residual f - Phi_z^T lambda is
+// below `tolerance` times the forces' size, or at the rounding level of
+// forces computed from positions, 100 machine epsilons of the stiffest
+// diagonal entry of K_T times (1 + |z|) (the model's force_roundoff, an
+// EA-sized bound, is too small for short stiff elements, whose K_T ~ EA / l).
 bool IsEquilibrium(MultibodyModel* model, const Eigen::VectorXd& z, double tolerance) {
-  Balance bal = ForceBalance(model, z, nullptr);
+  SkylineLdlt stiffness;
+  stiffness.SetPattern(model->envelope());
+  stiffness.SetZero();
+  Balance bal = ForceBalance(model, z, &stiffness);
   Eigen::VectorXd bt_lambda = Eigen::VectorXd::Zero(model->dofs());
   if (model->multipliers() > 0) {
     Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(bal.b.transpose());
     bal.lambda = qr.solve(bal.f);
     bt_lambda = bal.b.transpose() * bal.lambda;
   }
-  const double scale =
-      std::max({bal.force_size, bt_lambda.lpNorm<Eigen::Infinity>(), 1e-300});
-  const double residual = (bal.f - bt_lambda).lpNorm<Eigen::Infinity>() / scale;
-  const double floor = model->force_roundoff() / scale;
+  double diag = 0;
+  for (int j = 0; j < model->dofs(); ++j)
+    diag = std::max(diag, std::abs(stiffness.values()[stiffness.Slot(j, j)]));
+  const double zscale = 1 + z.lpNorm<Eigen::Infinity>();
+  const double scale = std::max(bal.force_size, bt_lambda.lpNorm<Eigen::Infinity>());
+  const double rounding = std::max(model->force_roundoff(),
+                                   100 * std::numeric_limits<double>::epsilon() * diag * zscale);
+  const double residual = (bal.f - bt_lambda).lpNorm<Eigen::Infinity>();
   const double violation = bal.phi.size() ? bal.phi.lpNorm<Eigen::Infinity>() : 0.0;
-  return residual <= tolerance + floor &&
-         violation <= tolerance * (1 + z.lpNorm<Eigen::Infinity>());
+  return residual <= tolerance * scale + rounding && violation <= tolerance * zscale;
 }
 
 void Fail(RunSummary* s, double at, const std::string& reason) {

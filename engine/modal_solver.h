@@ -37,8 +37,9 @@ namespace cablesim {
 
 class ModalSolver {
  public:
-  // Largest number of unknowns (dofs) the dense eigen solver accepts.
-  static constexpr int kMaxDenseDofs = 4000;
+  // Largest number of unknowns (dofs) the dense eigen solver accepts: the
+  // O(n^3) solve measured 1.4 s at 1001 and 21 s at 2001 unknowns.
+  static constexpr int kMaxDenseDofs = 2500;
 
   struct Result {
     bool ok = false;
