@@ -7,6 +7,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
+#include <Spectra/SymGEigsShiftSolver.h>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -160,16 +161,163 @@ bool FindEquilibrium(MultibodyModel* model, const SolverSettings& settings,
   return true;
 }
 
+
+// y = M x, for the Lanczos iteration's M-inner product.
+class MassProduct {
+ public:
+  using Scalar = double;
+  explicit MassProduct(const SkylineLdlt* mass) : mass_(mass) {}
+  Eigen::Index rows() const { return mass_->size(); }
+  Eigen::Index cols() const { return mass_->size(); }
+  void perform_op(const double* x, double* y) const { mass_->Multiply(x, y); }
+
+ private:
+  const SkylineLdlt* mass_;
+};
+
+// y = Z (Z^T (K - sigma M) Z)^{-1} Z^T x: the constrained shift-invert
+// operator, from the KKT system [A B^T; B 0] [y; mu] = [x; 0] with
+// A = K - sigma M in skyline LDL^T and the m x m Schur complement
+// S = B A^{-1} B^T (dense: few constraint equations). Also counts, by
+// Sylvester's law of inertia, the constrained eigenvalues below sigma:
+// neg(KKT) = neg(A) + pos(S) = (eigenvalues below sigma) + m.
+class ConstrainedShiftInvert {
+ public:
+  using Scalar = double;
+  ConstrainedShiftInvert(const SkylineLdlt& k, const SkylineLdlt& mass, const Eigen::MatrixXd& b)
+      : k_(k), mass_(mass), b_(b) {
+    a_ = k;
+  }
+  Eigen::Index rows() const { return k_.size(); }
+  Eigen::Index cols() const { return k_.size(); }
+
+  void set_shift(double sigma) {
+    const int slots = k_.stored();
+    for (int i = 0; i < slots; ++i) a_.values()[i] = k_.values()[i] - sigma * mass_.values()[i];
+    ok_ = a_.Factor();
+    const int m = static_cast<int>(b_.rows());
+    if (m == 0 || !ok_) return;
+    y_ = b_.transpose();
+    for (int c = 0; c < m; ++c) a_.Solve(y_.col(c).data());
+    schur_ = b_ * y_;
+    schur_ = 0.5 * (schur_ + schur_.transpose()).eval();
+    lu_.compute(schur_);
+  }
+
+  void perform_op(const double* x, double* y) const {
+    const int n = k_.size();
+    Eigen::Map<Eigen::VectorXd> out(y, n);
+    out = Eigen::Map<const Eigen::VectorXd>(x, n);
+    a_.Solve(y);
+    if (b_.rows() > 0) out -= y_ * lu_.solve(b_ * out);
+  }
+
+  bool factored() const { return ok_ && a_.small_pivots() == 0; }
+  int negative_pivots() const { return a_.negative_pivots(); }
+  // Constrained eigenvalues below the current shift.
+  int CountBelowShift() const {
+    int count = a_.negative_pivots();
+    if (b_.rows() > 0) {
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(schur_, Eigen::EigenvaluesOnly);
+      count += static_cast<int>((eig.eigenvalues().array() > 0).count()) - static_cast<int>(b_.rows());
+    }
+    return count;
+  }
+  // The smallest pivot magnitude relative to the largest diagonal of K.
+  const SkylineLdlt& a() const { return a_; }
+
+ private:
+  const SkylineLdlt& k_;
+  const SkylineLdlt& mass_;
+  const Eigen::MatrixXd& b_;
+  SkylineLdlt a_;
+  bool ok_ = false;
+  Eigen::MatrixXd y_, schur_;
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
+};
+
+double MaxDiagonal(const SkylineLdlt& a) {
+  double d = 0;
+  for (int j = 0; j < a.size(); ++j) d = std::max(d, std::abs(a.values()[a.Slot(j, j)]));
+  return d;
+}
+
+// The `modes` lowest constrained eigenpairs by shift-invert Lanczos
+// (Spectra's SymGEigsShiftSolver, M-inner product), checked by a Sturm
+// count: a single-vector Lanczos can miss a copy of a repeated eigenvalue,
+// so when the inertia at the highest one found counts more eigenvalues below
+// it than were found, more are asked for and the solve repeated.
+bool LanczosModes(const SkylineLdlt& k, const SkylineLdlt& mass, const Eigen::MatrixXd& b,
+                  int free_dofs, int modes, Eigen::VectorXd* omega2, Eigen::MatrixXd* shapes,
+                  std::string* reason) {
+  const int n = k.size();
+  ConstrainedShiftInvert op(k, mass, b);
+  MassProduct mop(&mass);
+  // Shift: 0 (inverse iteration, best separated) when K_T is positive
+  // definite on the unknowns; otherwise (rigid modes, bodies held only by
+  // constraints, an unstable equilibrium) slightly below 0, where K - sigma M
+  // is definite but only ~1e10 times worse conditioned than K's scale.
+  double sigma = 0;
+  op.set_shift(0);
+  if (!op.factored() || op.negative_pivots() > 0) {
+    sigma = -1e-10 * MaxDiagonal(k) / std::max(MaxDiagonal(mass), 1e-300);
+  }
+  int nev = std::min(modes + 2, free_dofs - 1);
+  if (nev < modes) nev = modes;
+  for (int attempt = 0; attempt < 4; ++attempt) {
+    const int ncv = std::min(n, std::max(2 * nev + 1, nev + 30));
+    Spectra::SymGEigsShiftSolver<ConstrainedShiftInvert, MassProduct, Spectra::GEigsMode::ShiftInvert>
+        eigs(op, mop, nev, ncv, sigma);
+    eigs.init();
+    eigs.compute(Spectra::SortRule::LargestMagn, 1000, 1e-12);
+    if (eigs.info() != Spectra::CompInfo::Successful) {
+      *reason = absl::StrFormat("shift-invert Lanczos did not converge (%d of %d eigenvalues)",
+                                static_cast<int>(eigs.eigenvalues().size()), nev);
+      return false;
+    }
+    Eigen::VectorXd values = eigs.eigenvalues();
+    Eigen::MatrixXd vectors = eigs.eigenvectors();
+    std::vector<int> order(values.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+    std::sort(order.begin(), order.end(), [&](int i, int j) { return values[i] < values[j]; });
+    if (static_cast<int>(order.size()) < modes) {
+      *reason = "shift-invert Lanczos returned too few eigenvalues";
+      return false;
+    }
+    const double top = values[order[modes - 1]];
+    const double s = top + 1e-6 * std::abs(top) + 1e-9 * std::abs(sigma) + 1e-300;
+    op.set_shift(s);
+    const int below = op.CountBelowShift();
+    int found = 0;
+    for (int i : order) found += values[i] <= s ? 1 : 0;
+    if (below <= found) {
+      omega2->resize(modes);
+      shapes->resize(n, modes);
+      for (int c = 0; c < modes; ++c) {
+        (*omega2)[c] = values[order[c]];
+        Eigen::VectorXd x = vectors.col(order[c]);
+        Eigen::VectorXd mx(n);
+        mass.Multiply(x.data(), mx.data());
+        shapes->col(c) = x / std::sqrt(x.dot(mx));
+      }
+      return true;
+    }
+    nev = std::min(free_dofs - 1, nev + (below - found) + 2);
+  }
+  *reason = "shift-invert Lanczos kept missing repeated eigenvalues (Sturm count)";
+  return false;
+}
+
 }  // namespace
 
 absl::StatusOr<int> ModalSolver::ModeCount(const MultibodyModel& model,
                                            const SolverSettings& settings) {
   const int n = model.dofs();
-  if (n > kMaxDenseDofs) {
+  if (n > kDenseDofs && model.multipliers() > kMaxLanczosMultipliers) {
     return absl::InvalidArgumentError(absl::StrFormat(
-        "solver.analysis: MODAL is limited to %d unknowns (dense eigen solver); this scene has "
-        "%d (use fewer elements)",
-        kMaxDenseDofs, n));
+        "solver.analysis: MODAL of a scene with more than %d unknowns is limited to %d "
+        "constraint equations; this scene has %d unknowns and %d equations",
+        kDenseDofs, kMaxLanczosMultipliers, n, model.multipliers()));
   }
   // Independent constraints each remove one degree of freedom.
   const int free = std::max(0, n - model.multipliers());
@@ -187,7 +335,7 @@ absl::StatusOr<int> ModalSolver::ModeCount(const MultibodyModel& model,
 }
 
 ModalSolver::Result ModalSolver::Solve(MultibodyModel* model, const Eigen::VectorXd& z_eq,
-                                       int modes) {
+                                       int modes, Method method) {
   Result result;
   const int n = model->dofs();
   const int m = model->multipliers();
@@ -195,20 +343,41 @@ ModalSolver::Result ModalSolver::Solve(MultibodyModel* model, const Eigen::Vecto
   stiffness.SetPattern(model->envelope());
   stiffness.SetZero();
   Balance bal = ForceBalance(model, z_eq, &stiffness);
+  if (method == Method::kAuto) method = n > kDenseDofs ? Method::kLanczos : Method::kDense;
   Eigen::MatrixXd basis;  // Z, orthonormal basis of the null space of Phi_z
+  result.free_dofs = n;
   if (m > 0) {
     Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(bal.b.transpose());
     bal.lambda = qr.solve(bal.f);
     model->AddConstraintHessian(bal.q, bal.lambda, 1.0, &stiffness);
     const int rank = static_cast<int>(qr.rank());
-    basis = Eigen::MatrixXd::Identity(n, n).rightCols(n - rank);
-    basis.applyOnTheLeft(qr.householderQ());
+    result.free_dofs = n - rank;
+    if (method == Method::kDense) {
+      basis = Eigen::MatrixXd::Identity(n, n).rightCols(n - rank);
+      basis.applyOnTheLeft(qr.householderQ());
+    }
   }
-  result.free_dofs = m > 0 ? static_cast<int>(basis.cols()) : n;
   if (modes > result.free_dofs) {
     result.reason = absl::StrFormat(
         "%d modes asked for but the constraints leave %d degrees of freedom", modes,
         result.free_dofs);
+    return result;
+  }
+  if (method == Method::kLanczos) {
+    for (int i = 0; i < stiffness.stored(); ++i) {
+      if (!std::isfinite(stiffness.values()[i])) {
+        result.reason = "the tangent stiffness at the equilibrium is not finite";
+        return result;
+      }
+    }
+    if (result.free_dofs - 1 < modes) {
+      result.reason = absl::StrFormat(
+          "shift-invert Lanczos finds at most %d modes here (degrees of freedom minus 1)",
+          result.free_dofs - 1);
+      return result;
+    }
+    result.ok = LanczosModes(stiffness, model->mass(), bal.b, result.free_dofs, modes,
+                             &result.omega2, &result.shapes, &result.reason);
     return result;
   }
   Eigen::MatrixXd k = Dense(stiffness);

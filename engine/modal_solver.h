@@ -17,8 +17,16 @@
 // becomes (Z^T K Z) y = omega^2 (Z^T M Z) y, x = Z y, solved densely by
 // Eigen's GeneralizedSelfAdjointEigenSolver (Cholesky of Z^T M Z, then a
 // symmetric tridiagonal QR): every eigenvalue, repeated ones included, to
-// rounding. The cost is O(n^3) in the unknowns n, so MODAL is limited to
-// kMaxDenseDofs unknowns (README, "Modal analysis", gives measured times).
+// rounding. Its cost is O(n^3) in the unknowns n, so above kDenseDofs
+// unknowns the lowest modes come instead from shift-invert Lanczos (Spectra's
+// SymGEigsShiftSolver in the M-inner product) on the operator
+// y = Z (Z^T (K - sigma M) Z)^{-1} Z^T M x, applied through the KKT system
+// with K - sigma M in the banded SkylineLdlt and the dense Schur complement
+// of the constraint rows (so at most kMaxLanczosMultipliers of them); a
+// Sturm count (Sylvester's inertia of the KKT matrix) checks that no
+// eigenvalue below the highest one found was missed (a repeated one), and
+// more are asked for when one was. README, "Modal analysis", gives measured
+// times.
 //
 // lambda* is recovered from the equilibrium itself, as the least-squares
 // solution of Phi_z^T lambda = f(z*) (exact at an equilibrium), so any
@@ -37,9 +45,13 @@ namespace cablesim {
 
 class ModalSolver {
  public:
-  // Largest number of unknowns (dofs) the dense eigen solver accepts: the
-  // O(n^3) solve measured 1.4 s at 1001 and 21 s at 2001 unknowns.
-  static constexpr int kMaxDenseDofs = 2500;
+  // Up to this many unknowns (dofs) the dense solver is used: the O(n^3)
+  // solve measured 1.4 s at 1001 and 21 s at 2001 unknowns.
+  static constexpr int kDenseDofs = 600;
+  // The Lanczos path's dense Schur complement bounds the constraint rows.
+  static constexpr int kMaxLanczosMultipliers = 1000;
+
+  enum class Method { kAuto, kDense, kLanczos };
 
   struct Result {
     bool ok = false;
@@ -54,13 +66,14 @@ class ModalSolver {
   // The number of modes a MODAL run of `settings` computes on `model`
   // (settings.modes, or the default), or InvalidArgument naming
   // solver.modes (more modes than degrees of freedom) or solver.analysis
-  // (too many unknowns for the dense solver).
+  // (a large scene with too many constraint equations).
   static absl::StatusOr<int> ModeCount(const MultibodyModel& model,
                                        const SolverSettings& settings);
 
   // The `modes` lowest modes about the equilibrium `z_eq` of `model` under
-  // its full loads.
-  static Result Solve(MultibodyModel* model, const Eigen::VectorXd& z_eq, int modes);
+  // its full loads. kAuto: dense up to kDenseDofs unknowns, else Lanczos.
+  static Result Solve(MultibodyModel* model, const Eigen::VectorXd& z_eq, int modes,
+                      Method method = Method::kAuto);
 };
 
 // Runs a MODAL analysis: finds the equilibrium (load increments of the
