@@ -31,6 +31,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -97,7 +98,14 @@ std::string ToJson(const google::protobuf::Message& m) {
   return out;
 }
 
-std::string Num(double x) { return absl::StrFormat("%.17g", x); }
+// The shortest decimal form that reads back to the same double.
+std::string Num(double x) {
+  for (int digits = 6; digits < 17; ++digits) {
+    std::string s = absl::StrFormat("%.*g", digits, x);
+    if (std::strtod(s.c_str(), nullptr) == x) return s;
+  }
+  return absl::StrFormat("%.17g", x);
+}
 
 // A CSV field: quoted when it holds a comma, quote or newline.
 std::string Csv(const std::string& s) {
@@ -121,6 +129,11 @@ struct Outcome {
   RunSummary summary;
   ProbeTrajectory trajectory;
 };
+
+// Wall-clock limit of one run [s] (configuration key max_run_seconds): a run
+// past it is stopped and reported as failed, so one pathological variant
+// cannot stall the report.
+double g_max_run_seconds = 60;
 
 // Merges `patches` into `scene_json` in order and runs it `repeats` times.
 Outcome RunVariant(const std::string& scene_json, const std::vector<std::string>& patches,
@@ -151,7 +164,11 @@ Outcome RunVariant(const std::string& scene_json, const std::vector<std::string>
   for (int r = 0; r < std::max(1, repeats); ++r) {
     ProbeTrajectory trajectory;
     const auto start = Clock::now();
-    absl::StatusOr<RunSummary> summary = RunScene(*scene, &trajectory);
+    RunControl control;
+    control.should_stop = [start] {
+      return std::chrono::duration<double>(Clock::now() - start).count() > g_max_run_seconds;
+    };
+    absl::StatusOr<RunSummary> summary = RunScene(*scene, &trajectory, control);
     const double wall = std::chrono::duration<double>(Clock::now() - start).count();
     if (!summary.ok()) {
       out.status = "skipped";
@@ -162,7 +179,10 @@ Outcome RunVariant(const std::string& scene_json, const std::vector<std::string>
     out.trajectory = std::move(trajectory);
     if (summary->status != "ok") {
       out.status = "failed";
-      out.note = summary->error;
+      out.note = summary->status == "cancelled"
+                     ? absl::StrFormat("stopped after max_run_seconds = %g s at t = %g s",
+                                       g_max_run_seconds, summary->end_time_s)
+                     : summary->error;
       return out;
     }
     out.walls.push_back(wall);
@@ -445,6 +465,7 @@ int Main(int argc, char** argv) {
     std::cerr << "work_precision: cannot write " << csv_path << "\n";
     return 3;
   }
+  g_max_run_seconds = Number(config, "max_run_seconds", g_max_run_seconds);
   csv << kHeader << "\n";
   Report report(&csv, source_dir);
   for (const Value* scene : List(config, "scenes"))

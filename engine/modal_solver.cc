@@ -223,9 +223,6 @@ class ConstrainedShiftInvert {
     }
     return count;
   }
-  // The smallest pivot magnitude relative to the largest diagonal of K.
-  const SkylineLdlt& a() const { return a_; }
-
  private:
   const SkylineLdlt& k_;
   const SkylineLdlt& mass_;
