@@ -417,6 +417,10 @@ void RunModalAnalysis(MultibodyModel* model, const SolverSettings& settings, int
     Fail(summary, 1, absl::StrCat("MODAL: ", modal.reason));
     return;
   }
+  if (!modal.omega2.allFinite() || !modal.shapes.allFinite()) {
+    Fail(summary, 1, "MODAL: the eigen solver returned non-finite values");
+    return;
+  }
   for (int k = 0; k < modes; ++k) {
     const double w2 = modal.omega2[k];
     summary->frequencies_hz.push_back((w2 < 0 ? -1 : 1) * std::sqrt(std::abs(w2)) / kTwoPi);

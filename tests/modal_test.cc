@@ -4,6 +4,8 @@
 // null-space path (joints with multipliers).
 
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -274,6 +276,32 @@ TEST(ModalTest, ModesFieldIsValidated) {
   EXPECT_EQ(ok->solver.analysis, Analysis::kModal);
   EXPECT_EQ(ok->solver.modes, 4);
   EXPECT_EQ(AnalysisName(Analysis::kModal), "MODAL");
+}
+
+// The sample scene through the command line: exit code 0, the frequencies
+// in the summary line, the equilibrium and one row per mode in the CSV.
+TEST(ModalTest, SampleSceneThroughTheCommandLine) {
+  const std::string csv = absl::StrCat(::testing::TempDir(), "/hanging_chain_modes.csv");
+  const std::string command =
+      absl::StrCat(CABLESIM_BIN_DIR, "/cablesim run ", CABLESIM_SOURCE_DIR,
+                   "/scenes/hanging-chain-modes.json --out ", csv);
+  FILE* pipe = popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string out;
+  char buffer[4096];
+  while (size_t n = fread(buffer, 1, sizeof buffer, pipe)) out.append(buffer, n);
+  EXPECT_EQ(pclose(pipe), 0) << out;
+  EXPECT_THAT(out, HasSubstr(R"("analysis":"MODAL")"));
+  EXPECT_THAT(out, HasSubstr(R"("frequencies_hz":[0.59)"));  // Bessel: 0.5993884 Hz
+  EXPECT_THAT(out, HasSubstr(R"("frames":5,)"));
+  std::ifstream in(csv);
+  std::string line;
+  int rows = -1;  // the header
+  while (std::getline(in, line)) {
+    EXPECT_EQ(line.find("nan"), std::string::npos) << line;
+    ++rows;
+  }
+  EXPECT_EQ(rows, 5);
 }
 
 TEST(ModalTest, SummaryJsonListsFrequencies) {
