@@ -37,6 +37,7 @@
 #include <Eigen/Core>
 
 #include "absl/status/status.h"
+#include "absl/status/statusor.h"
 #include "engine/multibody_model.h"
 #include "engine/scene.h"
 #include "engine/simulation.h"
