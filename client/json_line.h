@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace cablesim {
 
@@ -23,6 +24,8 @@ class JsonLine {
   // non-finite value is written as null.
   JsonLine& Add(std::string_view key, double value);
   JsonLine& Add(std::string_view key, bool value);
+  // A JSON array of numbers, each written as by Add(key, double).
+  JsonLine& Add(std::string_view key, const std::vector<double>& values);
 
   // The object, e.g. `{"status":"ok","steps":10}`, without a newline.
   std::string ToString() const { return body_ + "}"; }

@@ -33,6 +33,7 @@ std::string SummaryToJson(const RunSummary& summary) {
       .Add("max_constraint_violation", summary.max_constraint_violation)
       .Add("max_newton_residual", summary.max_newton_residual)
       .Add("max_linear_residual", summary.max_linear_residual);
+  if (summary.analysis == "MODAL") json.Add("frequencies_hz", summary.frequencies_hz);
   return json.ToString();
 }
 

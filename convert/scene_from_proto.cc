@@ -51,6 +51,8 @@ constexpr int kMaxStepHalvings = 40;
 constexpr double kDefaultLinearTolerance = 1e-10;
 constexpr int kDefaultMaxLinearIterations = 200;
 constexpr int kMaxLinearIterations = 100000;
+// MODAL: the engine also bounds modes by the scene's degrees of freedom.
+constexpr int kMaxModes = 100000;
 
 absl::Status Invalid(absl::string_view path, absl::string_view rule) {
   return absl::InvalidArgumentError(absl::StrCat(path, ": ", rule));
@@ -520,6 +522,14 @@ class SceneConverter {
         s.has_max_linear_iterations() ? s.max_linear_iterations() : kDefaultMaxLinearIterations;
     CABLESIM_RETURN_IF_ERROR(CheckIntRange("solver.max_linear_iterations",
                                            out.max_linear_iterations, 1, kMaxLinearIterations));
+    if (s.has_modes()) {
+      if (out.analysis != Analysis::kModal) {
+        return Invalid("solver.modes", absl::StrCat("is only for MODAL analysis (solver.analysis is ",
+                                                    std::string(AnalysisName(out.analysis)), ")"));
+      }
+      CABLESIM_RETURN_IF_ERROR(CheckIntRange("solver.modes", s.modes(), 1, kMaxModes));
+      out.modes = s.modes();
+    }
     return absl::OkStatus();
   }
 
@@ -575,8 +585,10 @@ absl::StatusOr<Analysis> AnalysisFromProto(v1::Analysis analysis, std::string_vi
       return Analysis::kDynamic;
     case v1::STATIC:
       return Analysis::kStatic;
+    case v1::MODAL:
+      return Analysis::kModal;
     default:
-      return UnknownEnumValue(path, analysis, "DYNAMIC or STATIC");
+      return UnknownEnumValue(path, analysis, "DYNAMIC, STATIC or MODAL");
   }
 }
 
@@ -612,6 +624,8 @@ std::string_view AnalysisName(Analysis analysis) {
       return "DYNAMIC";
     case Analysis::kStatic:
       return "STATIC";
+    case Analysis::kModal:
+      return "MODAL";
   }
   return "UNKNOWN";
 }

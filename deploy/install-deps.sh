@@ -5,12 +5,12 @@
 set -euo pipefail
 packages=(
   cmake g++ make pkg-config
-  libeigen3-dev libabsl-dev
+  libeigen3-dev libabsl-dev libspectra-dev
   libprotobuf-dev protobuf-compiler
   libgrpc++-dev protobuf-compiler-grpc
   libgtest-dev libgmock-dev libbenchmark-dev
   libsqlite3-dev
-  python3
+  python3 python3-matplotlib
 )
 as_root=()
 if [ "$(id -u)" -ne 0 ]; then as_root=(sudo); fi

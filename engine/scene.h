@@ -19,7 +19,7 @@ namespace cablesim {
 enum class ModelChoice { kAuto, kPlanar, kSpatial };
 enum class BendingModel { kExact, kLinear, kNone };
 enum class JointType { kPin, kFixed };
-enum class Analysis { kDynamic, kStatic };
+enum class Analysis { kDynamic, kStatic, kModal };
 enum class Integrator { kImplicitEuler };
 enum class LinearSolverKind { kMinres, kGmres };
 
@@ -95,6 +95,9 @@ struct SolverSettings {
   int max_step_halvings = 12;
   double linear_tolerance = 1e-10;
   int max_linear_iterations = 200;
+  // MODAL: number of lowest modes; 0 means the default (10, or every degree
+  // of freedom when there are fewer).
+  int modes = 0;
 };
 
 struct Scene {

@@ -6,6 +6,7 @@
 
 #include "absl/strings/str_format.h"
 #include "engine/implicit_euler_stepper.h"
+#include "engine/modal_solver.h"
 #include "engine/multibody_model.h"
 #include "engine/static_solver.h"
 
@@ -217,6 +218,10 @@ void RunStatic(MultibodyModel* model, const SolverSettings& settings, const RunC
 absl::StatusOr<ModelInfo> DescribeModel(const Scene& scene) {
   absl::StatusOr<MultibodyModel> built = MultibodyModel::Build(scene);
   if (!built.ok()) return built.status();
+  if (scene.solver.analysis == Analysis::kModal) {
+    if (absl::StatusOr<int> modes = ModalSolver::ModeCount(*built, scene.solver); !modes.ok())
+      return modes.status();
+  }
   return built->Info();
 }
 
@@ -229,13 +234,23 @@ absl::StatusOr<RunSummary> RunScene(const Scene& scene, FrameSink* sink,
   RunSummary summary;
   summary.info = model.Info();
   const SolverSettings& settings = scene.solver;
-  summary.analysis = settings.analysis == Analysis::kStatic ? "STATIC" : "DYNAMIC";
+  summary.analysis = settings.analysis == Analysis::kStatic  ? "STATIC"
+                     : settings.analysis == Analysis::kModal ? "MODAL"
+                                                             : "DYNAMIC";
+  int modes = 0;
+  if (settings.analysis == Analysis::kModal) {
+    absl::StatusOr<int> count = ModalSolver::ModeCount(model, settings);
+    if (!count.ok()) return count.status();
+    modes = *count;
+  }
   summary.integrator = "IMPLICIT_EULER";
   summary.linear_solver = settings.linear_solver == LinearSolverKind::kGmres ? "GMRES" : "MINRES";
   if (absl::Status s = sink->OnStart(summary.info); !s.ok()) return s;
   FrameRecorder recorder(&model, sink, &summary);
   if (settings.analysis == Analysis::kStatic) {
     RunStatic(&model, settings, control, &recorder, &summary);
+  } else if (settings.analysis == Analysis::kModal) {
+    RunModalAnalysis(&model, settings, modes, control, sink, &summary);
   } else {
     RunDynamic(&model, settings, control, &recorder, &summary);
   }

@@ -1,7 +1,7 @@
 #ifndef CABLESIM_ENGINE_SIMULATION_H_
 #define CABLESIM_ENGINE_SIMULATION_H_
 
-// Runs a scene's analysis (DYNAMIC or STATIC) and reports it frame by frame
+// Runs a scene's analysis (DYNAMIC, STATIC or MODAL) and reports it frame by frame
 // to a FrameSink, then returns the run's summary: what it cost (steps,
 // iterations, wall time) and how far it can be trusted (energy balance,
 // constraint violation, Newton and linear residuals).
@@ -94,6 +94,8 @@ struct RunSummary {
   double max_constraint_violation = 0;
   double max_newton_residual = 0;  // largest accepted Newton residual norm
   double max_linear_residual = 0;  // largest true relative residual of a solve
+  // MODAL: the natural frequencies [Hz], ascending (engine/modal_solver.h).
+  std::vector<double> frequencies_hz;
 };
 
 // How a caller bounds and stops a run (a server's limits, deadlines and
