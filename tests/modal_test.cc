@@ -145,7 +145,8 @@ TEST(ModalTest, RodJoinedThroughFixedJointUsesConstraintNullSpace) {
                {"type": "FIXED", "a": {"cable": "a", "s": 0.5}, "b": {"cable": "b", "s": 0}}],
     "probes": [{"name": "tip", "cable": "b", "s": 0.5}],
     "solver": {"analysis": "MODAL", "modes": 3}})")), &sink);
-  EXPECT_EQ(s.info.multipliers, 3);
+  // The weld: 2 position rows and 2 equal-slope rows.
+  EXPECT_EQ(s.info.multipliers, 4);
   ASSERT_EQ(s.frequencies_hz.size(), 3u);
   const double beta_l[] = {1.8751041, 4.6940911, 7.8547574};
   for (int n = 0; n < 3; ++n) {
