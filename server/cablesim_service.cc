@@ -411,8 +411,15 @@ v1::SweepItem ItemOf(JobManager* jobs, const v1::Sweep& sweep, const v1::Job& jo
   item.set_state(job.state());
   if (job.has_summary()) *item.mutable_summary() = job.summary();
   if (Finished(job.state())) {
-    absl::StatusOr<std::vector<double>> row = jobs->store()->GetFinalRow(job.id());
-    if (row.ok()) item.mutable_final_values()->Assign(row->begin(), row->end());
+    absl::StatusOr<StoredResult> result = jobs->store()->GetResult(job.id());
+    if (result.ok()) {
+      const size_t columns = std::max(1, result->header.columns_size());
+      if (result->values.size() >= columns) {
+        item.mutable_final_values()->Assign(result->values.end() - columns, result->values.end());
+      }
+      *item.mutable_energy() =
+          EnergyFromTrajectory(result->header, result->values, job.summary()).report();
+    }
   }
   return item;
 }
