@@ -4,6 +4,7 @@
 #include <grpcpp/health_check_service_interface.h>
 
 #include <chrono>
+#include <iostream>
 
 #include "absl/strings/str_cat.h"
 
@@ -58,7 +59,10 @@ void CablesimServer::Shutdown(absl::Duration grace) {
   if (down_) return;
   down_ = true;
   if (server_ != nullptr) server_->GetHealthCheckService()->SetServingStatus(false);
-  if (jobs_ != nullptr) jobs_->Shutdown();
+  if (jobs_ != nullptr) {
+    jobs_->Shutdown();
+    std::cerr << "cablesim-server: workers stopped, unfinished jobs left queued\n";
+  }
   if (server_ != nullptr) {
     server_->Shutdown(std::chrono::system_clock::now() +
                       std::chrono::milliseconds(absl::ToInt64Milliseconds(grace)));
