@@ -31,7 +31,8 @@ ABSL_FLAG(int, max_sweep_items, 1000, "limit: items per sweep");
 ABSL_FLAG(int, max_streams, 64, "limit: concurrent Run streams");
 ABSL_FLAG(int, max_message_bytes, 16 << 20, "limit: gRPC message size");
 ABSL_FLAG(double, stall_timeout_s, 30, "cancel a stream whose client reads nothing this long");
-ABSL_FLAG(double, shutdown_grace_s, 5, "on SIGTERM, wait this long for calls to end");
+ABSL_FLAG(double, shutdown_grace_s, 2,
+          "on SIGTERM, wait this long for calls (and idle client connections) to end");
 
 int main(int argc, char** argv) {
   absl::SetProgramUsageMessage(
