@@ -19,11 +19,11 @@
 //
 // Run with --benchmark_repetitions=5 and read the medians.
 
+#include <benchmark/benchmark.h>
+
 #include <filesystem>
 #include <limits>
 #include <memory>
-
-#include <benchmark/benchmark.h>
 
 #include "client/service_client.h"
 #include "convert/scene_file.h"
@@ -110,9 +110,9 @@ void BM_Sweep(benchmark::State& state) {
   int64_t items = 0;
   for (auto _ : state) {
     state.PauseTiming();
-    const std::string dir = (std::filesystem::temp_directory_path() /
-                             absl::StrCat("cablesim_sweep_bench_", ::getpid()))
-                                .string();
+    const std::string dir =
+        (std::filesystem::temp_directory_path() / absl::StrCat("cablesim_sweep_bench_", ::getpid()))
+            .string();
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     ServerOptions options;

@@ -1,5 +1,7 @@
 #include "client/cli.h"
 
+#include <google/protobuf/util/json_util.h>
+
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -9,8 +11,6 @@
 #include <sstream>
 #include <thread>
 #include <utility>
-
-#include <google/protobuf/util/json_util.h>
 
 #include "absl/status/status.h"
 #include "absl/strings/ascii.h"
@@ -23,8 +23,8 @@
 #include "client/progress.h"
 #include "client/service_client.h"
 #include "client/summary_json.h"
-#include "convert/scene_file.h"
 #include "convert/run_proto.h"
+#include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
 #include "engine/simulation.h"
 
@@ -37,18 +37,23 @@ namespace cablesim {
 namespace {
 
 struct Arguments {
-  std::vector<std::string> positional;  // command first
-  std::optional<std::string> out;       // --out
-  std::optional<std::string> server;    // --server
+  std::vector<std::string> positional;         // command first
+  std::optional<std::string> out;              // --out
+  std::optional<std::string> server;           // --server
   std::map<std::string, std::string> options;  // the other --name value
   bool help = false;
 };
 
 // Options that take a value, besides --out and --server.
 const std::set<std::string>& ValueOptions() {
-  static const std::set<std::string>* options = new std::set<std::string>{
-      "state", "sweep", "limit", "workers", "max-energy-drift", "max-wall-seconds",
-      "max-constraint-violation"};
+  static const std::set<std::string>* options =
+      new std::set<std::string>{"state",
+                                "sweep",
+                                "limit",
+                                "workers",
+                                "max-energy-drift",
+                                "max-wall-seconds",
+                                "max-constraint-violation"};
   return *options;
 }
 
@@ -164,9 +169,9 @@ int ExitCodeFor(const absl::Status& s) {
 int CallFailed(std::ostream& err, const absl::Status& s, const std::string& what) {
   const int code = ExitCodeFor(s);
   err << "cablesim: " << (code == kExitBadInput && !what.empty() ? what + ": " : "")
-      << (code == kExitBadInput ? std::string(s.message())
-                                : absl::StrCat(absl::StatusCodeToString(s.code()), ": ",
-                                               s.message()))
+      << (code == kExitBadInput
+              ? std::string(s.message())
+              : absl::StrCat(absl::StatusCodeToString(s.code()), ": ", s.message()))
       << "\n";
   err.flush();
   return code;
@@ -195,8 +200,8 @@ std::unique_ptr<Connection> ConnectOrReport(const std::optional<std::string>& se
   return std::move(*c);
 }
 
-int Validate(const std::string& path, const std::optional<std::string>& server,
-             std::ostream& out, std::ostream& err) {
+int Validate(const std::string& path, const std::optional<std::string>& server, std::ostream& out,
+             std::ostream& err) {
   std::string error;
   const std::optional<v1::Scene> proto = ReadScene(path, err, &error);
   auto invalid = [&](const std::string& message) {
@@ -261,8 +266,8 @@ int ReportSummary(const RunSummary& summary, std::ostream& out, std::ostream& er
   out << SummaryToJson(summary) << "\n";
   out.flush();
   if (summary.status == "failed") {
-    err << "cablesim: numerical failure at t = "
-        << absl::StrFormat("%.10g", summary.failure_time_s) << ": " << summary.error << "\n";
+    err << "cablesim: numerical failure at t = " << absl::StrFormat("%.10g", summary.failure_time_s)
+        << ": " << summary.error << "\n";
     return kExitNumericalFailure;
   }
   if (summary.status != "ok") {
@@ -312,7 +317,8 @@ std::string JobJson(const v1::Job& job) {
       .Add("progress_time_s", job.progress_time_s())
       .Add("end_time_s", job.end_time_s())
       .Add("created_unix_ms", static_cast<int64_t>(job.created_unix_ms()));
-  if (!job.sweep_id().empty()) json.Add("sweep_id", job.sweep_id()).Add("sweep_index", job.sweep_index());
+  if (!job.sweep_id().empty())
+    json.Add("sweep_id", job.sweep_id()).Add("sweep_index", job.sweep_index());
   if (job.has_summary()) {
     json.Add("status", job.summary().status());
     if (!job.summary().error().empty()) json.Add("error", job.summary().error());
@@ -407,9 +413,9 @@ int Watch(const Arguments& a, std::ostream& out, std::ostream& err) {
         err << "cablesim: " << id << " " << v1::JobState_Name(job.state()) << "\n";
       }
       last = job.state();
-      progress.Update(job.end_time_s() > 0 ? job.progress_time_s() / job.end_time_s() : 0,
-                      absl::StrFormat("%s t = %.4g s", v1::JobState_Name(job.state()),
-                                      job.progress_time_s()));
+      progress.Update(
+          job.end_time_s() > 0 ? job.progress_time_s() / job.end_time_s() : 0,
+          absl::StrFormat("%s t = %.4g s", v1::JobState_Name(job.state()), job.progress_time_s()));
     }
     const absl::Status status = FromGrpc(reader->Finish());
     if (!status.ok()) return CallFailed(err, status, "");
@@ -480,8 +486,8 @@ int Energy(const Arguments& a, std::ostream& out, std::ostream& err) {
     *request.mutable_scene() = *proto;
   } else {
     if (!a.server.has_value()) {
-      return UsageError(err, absl::StrCat("energy: \"", source,
-                                          "\" is no scene file; a job id needs --server"));
+      return UsageError(
+          err, absl::StrCat("energy: \"", source, "\" is no scene file; a job id needs --server"));
     }
     request.set_job_id(source);
   }
@@ -594,9 +600,9 @@ int SweepCommand(const Arguments& a, std::ostream& out, std::ostream& err) {
       v1::SweepEvent event;
       while (reader->Read(&event)) {
         const v1::Sweep& p = event.progress();
-        progress.Update(p.items() ? static_cast<double>(p.finished()) / p.items() : 1,
-                        absl::StrFormat("%d/%d items, %d failed", p.finished(), p.items(),
-                                        p.failed()));
+        progress.Update(
+            p.items() ? static_cast<double>(p.finished()) / p.items() : 1,
+            absl::StrFormat("%d/%d items, %d failed", p.finished(), p.items(), p.failed()));
       }
       const absl::Status status = FromGrpc(reader->Finish());
       if (status.ok()) break;
@@ -632,16 +638,17 @@ int SweepCommand(const Arguments& a, std::ostream& out, std::ostream& err) {
     table << item.index() << "," << item.job_id() << "," << v1::JobState_Name(item.state());
     for (double v : item.axis_values()) table << "," << JsonLine::Number(v);
     table << "," << CsvCell(s.status()) << "," << CsvCell(s.error());
-    for (double v : {s.wall_seconds(), static_cast<double>(s.frames()),
-                     static_cast<double>(s.steps()), static_cast<double>(s.rejected_steps()),
-                     static_cast<double>(s.newton_iterations()), s.end_time_s(),
-                     s.energy_initial(), s.energy_final(), s.energy_dissipated(),
-                     item.energy().relative_drift(), s.max_constraint_violation()}) {
+    for (double v :
+         {s.wall_seconds(), static_cast<double>(s.frames()), static_cast<double>(s.steps()),
+          static_cast<double>(s.rejected_steps()), static_cast<double>(s.newton_iterations()),
+          s.end_time_s(), s.energy_initial(), s.energy_final(), s.energy_dissipated(),
+          item.energy().relative_drift(), s.max_constraint_violation()}) {
       table << "," << absl::StrFormat("%.17g", v);
     }
     for (int k = 0; k < results.final_columns_size(); ++k) {
-      table << "," << (k < item.final_values_size() ? absl::StrFormat("%.17g", item.final_values(k))
-                                                    : std::string());
+      table << ","
+            << (k < item.final_values_size() ? absl::StrFormat("%.17g", item.final_values(k))
+                                             : std::string());
     }
     table << "\n";
     const std::string who = absl::StrCat("sweep item ", item.index(), " (", item.job_id(), ")");
@@ -735,9 +742,8 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   if (a.positional.empty()) return UsageError(err, "missing command");
   const std::string& command = a.positional[0];
   static const std::map<std::string, const char*> kArgument = {
-      {"run", "SCENE"},  {"validate", "SCENE"}, {"submit", "SCENE"}, {"jobs", nullptr},
-      {"watch", "JOB"},  {"cancel", "JOB"},     {"energy", "SCENE or JOB"},
-      {"sweep", "SWEEP.json"}};
+      {"run", "SCENE"}, {"validate", "SCENE"}, {"submit", "SCENE"},        {"jobs", nullptr},
+      {"watch", "JOB"}, {"cancel", "JOB"},     {"energy", "SCENE or JOB"}, {"sweep", "SWEEP.json"}};
   const auto known = kArgument.find(command);
   if (known == kArgument.end()) {
     return UsageError(err, absl::StrCat("unknown command \"", command, "\""));
@@ -747,8 +753,8 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
     return UsageError(err, absl::StrCat(command, ": missing ", known->second));
   }
   if (a.positional.size() > wanted) {
-    return UsageError(err, absl::StrCat(command, ": unexpected argument \"",
-                                        a.positional[wanted], "\""));
+    return UsageError(
+        err, absl::StrCat(command, ": unexpected argument \"", a.positional[wanted], "\""));
   }
   for (const auto& [name, value] : a.options) {
     const bool allowed =

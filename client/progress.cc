@@ -10,8 +10,11 @@
 namespace cablesim {
 
 Progress::Progress(std::ostream* err, bool terminal, std::string label)
-    : err_(err), terminal_(terminal), label_(std::move(label)),
-      start_(std::chrono::steady_clock::now()), last_(start_) {}
+    : err_(err),
+      terminal_(terminal),
+      label_(std::move(label)),
+      start_(std::chrono::steady_clock::now()),
+      last_(start_) {}
 
 Progress::~Progress() { Done(); }
 
@@ -27,9 +30,8 @@ void Progress::Update(double fraction, const std::string& detail) {
     if (drawn_ && since_last < 0.1 && fraction < 1) return;
     constexpr int kWidth = 30;
     const int filled = static_cast<int>(fraction * kWidth);
-    *err_ << "\r" << label_ << " [" << std::string(filled, '#')
-          << std::string(kWidth - filled, ' ') << "] "
-          << absl::StrFormat("%3.0f%% ", 100 * fraction) << detail << "\033[K";
+    *err_ << "\r" << label_ << " [" << std::string(filled, '#') << std::string(kWidth - filled, ' ')
+          << "] " << absl::StrFormat("%3.0f%% ", 100 * fraction) << detail << "\033[K";
     err_->flush();
     drawn_ = true;
   } else {

@@ -43,6 +43,7 @@ absl::StatusOr<std::unique_ptr<Connection>> Connect(const std::optional<std::str
     options.limits.max_sweep_items = std::numeric_limits<int>::max();
     options.limits.max_streams = std::numeric_limits<int>::max() / 2;
     options.limits.stall_timeout = absl::Hours(24 * 365);
+    options.log = false;
     options.workers = workers > 0 ? workers : std::max(1u, std::thread::hardware_concurrency());
     if (jobs) {
       std::string templ = (std::filesystem::temp_directory_path() / "cablesim-XXXXXX").string();
@@ -61,9 +62,9 @@ absl::StatusOr<std::unique_ptr<Connection>> Connect(const std::optional<std::str
   return c;
 }
 
-absl::StatusOr<RunSummary> ReadRunStream(
-    grpc::ClientContext* context, grpc::ClientReader<v1::RunEvent>* reader, FrameSink* sink,
-    const std::function<void(double, double)>& on_frame_time) {
+absl::StatusOr<RunSummary> ReadRunStream(grpc::ClientContext* context,
+                                         grpc::ClientReader<v1::RunEvent>* reader, FrameSink* sink,
+                                         const std::function<void(double, double)>& on_frame_time) {
   v1::RunEvent event;
   int probes = 0;
   int columns = 0;
@@ -84,8 +85,7 @@ absl::StatusOr<RunSummary> ReadRunStream(
         sink_error = absl::InternalError("malformed frame batch from the server");
       }
       for (int r = 0; sink_error.ok() && r < b.rows(); ++r) {
-        FrameFromRow(absl::MakeConstSpan(b.values().data() + r * columns, columns), probes,
-                     &frame);
+        FrameFromRow(absl::MakeConstSpan(b.values().data() + r * columns, columns), probes, &frame);
         sink_error = sink->OnFrame(frame);
         if (on_frame_time) on_frame_time(frame.t, end_time);
       }

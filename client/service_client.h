@@ -6,12 +6,12 @@
 // `cablesim run` goes through the same service code either way), and the
 // reading of a Run / GetJobResult stream into a FrameSink.
 
+#include <grpcpp/grpcpp.h>
+
 #include <functional>
 #include <memory>
 #include <optional>
 #include <string>
-
-#include <grpcpp/grpcpp.h>
 
 #include "absl/status/statusor.h"
 #include "cablesim/v1/service.grpc.pb.h"

@@ -7,9 +7,8 @@
 // `gravity.y`, `bodies[1].cylinder.diameter`. Works through protobuf
 // reflection, so every field added to scene.proto can be swept at once.
 
-#include "absl/strings/string_view.h"
-
 #include "absl/status/status.h"
+#include "absl/strings/string_view.h"
 #include "cablesim/v1/scene.pb.h"
 
 namespace cablesim {

@@ -18,9 +18,11 @@ absl::StatusOr<std::unique_ptr<CablesimServer>> CablesimServer::Start(
     absl::StatusOr<std::unique_ptr<JobStore>> store = JobStore::Open(options.data_dir);
     if (!store.ok()) return store.status();
     s->store_ = std::move(*store);
-    s->jobs_ = std::make_unique<JobManager>(s->store_.get(), options.workers, options.limits);
+    s->jobs_ =
+        std::make_unique<JobManager>(s->store_.get(), options.workers, options.limits, options.log);
   }
-  s->service_ = std::make_unique<CablesimServiceImpl>(s->jobs_.get(), options.limits);
+  s->service_ = std::make_unique<CablesimServiceImpl>(s->jobs_.get(), options.limits, options.log);
+  s->log_ = options.log;
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
@@ -61,7 +63,7 @@ void CablesimServer::Shutdown(absl::Duration grace) {
   if (server_ != nullptr) server_->GetHealthCheckService()->SetServingStatus(false);
   if (jobs_ != nullptr) {
     jobs_->Shutdown();
-    std::cerr << "cablesim-server: workers stopped, unfinished jobs left queued\n";
+    if (log_) std::cerr << "cablesim-server: workers stopped, unfinished jobs left queued\n";
   }
   if (server_ != nullptr) {
     server_->Shutdown(std::chrono::system_clock::now() +

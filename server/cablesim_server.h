@@ -7,10 +7,10 @@
 // Used by cablesim-server, by `cablesim` (in-process, no port) and by the
 // tests and benchmarks.
 
+#include <grpcpp/grpcpp.h>
+
 #include <memory>
 #include <string>
-
-#include <grpcpp/grpcpp.h>
 
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
@@ -29,6 +29,8 @@ struct ServerOptions {
   std::string data_dir;
   int workers = 1;
   ServerLimits limits;
+  // Report jobs, sweeps and shutdown on stderr.
+  bool log = true;
 };
 
 class CablesimServer {
@@ -53,6 +55,7 @@ class CablesimServer {
   std::unique_ptr<grpc::Server> server_;
   int port_ = 0;
   bool down_ = false;
+  bool log_ = true;
 };
 
 }  // namespace cablesim

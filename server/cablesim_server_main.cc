@@ -35,8 +35,7 @@ ABSL_FLAG(double, shutdown_grace_s, 2,
           "on SIGTERM, wait this long for calls (and idle client connections) to end");
 
 int main(int argc, char** argv) {
-  absl::SetProgramUsageMessage(
-      "cablesim-server --listen HOST:PORT --data-dir DIR [--workers N]");
+  absl::SetProgramUsageMessage("cablesim-server --listen HOST:PORT --data-dir DIR [--workers N]");
   // Accept --data-dir as well as absl's --data_dir spelling.
   std::vector<std::string> args(argv, argv + argc);
   for (size_t i = 1; i < args.size(); ++i) {
@@ -82,9 +81,8 @@ int main(int argc, char** argv) {
     std::cerr << "cablesim-server: " << server.status().message() << "\n";
     return 1;
   }
-  std::cerr << "cablesim-server: listening on port " << (*server)->port() << " ("
-            << options.listen << "), data in " << options.data_dir << ", " << options.workers
-            << " workers\n";
+  std::cerr << "cablesim-server: listening on port " << (*server)->port() << " (" << options.listen
+            << "), data in " << options.data_dir << ", " << options.workers << " workers\n";
   const std::string port_file = absl::GetFlag(FLAGS_port_file);
   if (!port_file.empty()) {
     const std::string tmp = port_file + ".tmp";

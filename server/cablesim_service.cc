@@ -73,7 +73,10 @@ class StreamingSink : public FrameSink {
  public:
   StreamingSink(grpc::ServerWriter<v1::RunEvent>* writer, CablesimServiceImpl::StreamWatch* watch,
                 int batch, std::string scene_name, double end_time_s)
-      : writer_(writer), watch_(watch), batch_(batch), scene_name_(std::move(scene_name)),
+      : writer_(writer),
+        watch_(watch),
+        batch_(batch),
+        scene_name_(std::move(scene_name)),
         end_time_s_(end_time_s) {}
 
   absl::Status OnStart(const ModelInfo& info) override {
@@ -147,8 +150,8 @@ RunControl ControlFor(grpc::ServerContext* context, const ServerLimits& limits) 
 
 }  // namespace
 
-CablesimServiceImpl::CablesimServiceImpl(JobManager* jobs, ServerLimits limits)
-    : jobs_(jobs), limits_(limits) {
+CablesimServiceImpl::CablesimServiceImpl(JobManager* jobs, ServerLimits limits, bool log)
+    : jobs_(jobs), limits_(limits), log_(log) {
   watchdog_ = std::thread([this] { Watchdog(); });
 }
 
@@ -172,9 +175,10 @@ void CablesimServiceImpl::Watchdog() {
     for (auto& [watch, unused] : watched_) {
       const int64_t started = watch->write_started_ns.load();
       if (started != 0 && now - started > stall_ns) {
-        std::cerr << "cablesim-server: cancelling a stream whose client has read nothing for "
-                  << absl::FormatDuration(limits_.stall_timeout) << " (" << watch->context->peer()
-                  << ")\n";
+        if (log_)
+          std::cerr << "cablesim-server: cancelling a stream whose client has read nothing for "
+                    << absl::FormatDuration(limits_.stall_timeout) << " (" << watch->context->peer()
+                    << ")\n";
         watch->context->TryCancel();
         watch->write_started_ns = 0;
       }
@@ -251,7 +255,7 @@ grpc::Status CablesimServiceImpl::SubmitJob(grpc::ServerContext*,
   absl::StatusOr<v1::Job> job = jobs_->Submit(request->scene());
   if (!job.ok()) return ToGrpc(job.status());
   *response = std::move(*job);
-  std::cerr << "cablesim-server: job " << response->id() << " queued\n";
+  if (log_) std::cerr << "cablesim-server: job " << response->id() << " queued\n";
   return grpc::Status::OK;
 }
 
@@ -318,9 +322,9 @@ grpc::Status CablesimServiceImpl::GetJobResult(grpc::ServerContext* context,
   absl::StatusOr<v1::Job> job = jobs_->Get(request->id());
   if (!job.ok()) return ToGrpc(job.status());
   if (!Finished(job->state()) || !job->has_summary()) {
-    return grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
-                        absl::StrCat("job ", job->id(), " is ", v1::JobState_Name(job->state()),
-                                     ": no result"));
+    return grpc::Status(
+        grpc::StatusCode::FAILED_PRECONDITION,
+        absl::StrCat("job ", job->id(), " is ", v1::JobState_Name(job->state()), ": no result"));
   }
   absl::StatusOr<StoredResult> result = jobs_->store()->GetResult(request->id());
   if (!result.ok()) return ToGrpc(result.status());
@@ -379,9 +383,9 @@ grpc::Status CablesimServiceImpl::GetEnergy(grpc::ServerContext* context,
   absl::StatusOr<v1::Job> job = jobs_->Get(request->job_id());
   if (!job.ok()) return ToGrpc(job.status());
   if (!Finished(job->state()) || !job->has_summary()) {
-    return grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
-                        absl::StrCat("job ", job->id(), " is ", v1::JobState_Name(job->state()),
-                                     ": no result"));
+    return grpc::Status(
+        grpc::StatusCode::FAILED_PRECONDITION,
+        absl::StrCat("job ", job->id(), " is ", v1::JobState_Name(job->state()), ": no result"));
   }
   absl::StatusOr<StoredResult> result = jobs_->store()->GetResult(job->id());
   if (!result.ok()) return ToGrpc(result.status());
@@ -396,8 +400,9 @@ grpc::Status CablesimServiceImpl::SubmitSweep(grpc::ServerContext*,
   absl::StatusOr<v1::Sweep> sweep = jobs_->SubmitSweep(*request);
   if (!sweep.ok()) return ToGrpc(sweep.status());
   *response = std::move(*sweep);
-  std::cerr << "cablesim-server: sweep " << response->id() << " queued (" << response->items()
-            << " items)\n";
+  if (log_)
+    std::cerr << "cablesim-server: sweep " << response->id() << " queued (" << response->items()
+              << " items)\n";
   return grpc::Status::OK;
 }
 

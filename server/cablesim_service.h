@@ -28,7 +28,8 @@ class CablesimServiceImpl final : public v1::CablesimService::Service {
  public:
   // `jobs` may be null (an in-process service for `cablesim run`): the job
   // and sweep calls then answer UNIMPLEMENTED.
-  CablesimServiceImpl(JobManager* jobs, ServerLimits limits);
+  // `log`: report on stderr.
+  CablesimServiceImpl(JobManager* jobs, ServerLimits limits, bool log = true);
   ~CablesimServiceImpl() override;
 
   grpc::Status Validate(grpc::ServerContext* context, const v1::ValidateRequest* request,
@@ -69,6 +70,7 @@ class CablesimServiceImpl final : public v1::CablesimService::Service {
 
   JobManager* jobs_;
   const ServerLimits limits_;
+  const bool log_;
   std::atomic<int> streams_{0};
   absl::Mutex mu_;
   std::map<StreamWatch*, bool> watched_ ABSL_GUARDED_BY(mu_);

@@ -44,8 +44,8 @@ v1::JobState StateOf(const RunSummary& s) {
 
 }  // namespace
 
-JobManager::JobManager(JobStore* store, int workers, ServerLimits limits)
-    : store_(store), workers_(std::max(1, workers)), limits_(limits) {}
+JobManager::JobManager(JobStore* store, int workers, ServerLimits limits, bool log)
+    : store_(store), workers_(std::max(1, workers)), limits_(limits), log_(log) {}
 
 JobManager::~JobManager() { Shutdown(); }
 
@@ -54,7 +54,7 @@ absl::Status JobManager::Start() {
   if (!requeued.ok()) return requeued.status();
   absl::StatusOr<std::vector<std::string>> queued = store_->QueuedJobIds();
   if (!queued.ok()) return queued.status();
-  if (*requeued > 0 || !queued->empty()) {
+  if (log_ && (*requeued > 0 || !queued->empty())) {
     std::cerr << "cablesim-server: " << queued->size() << " queued jobs (" << *requeued
               << " interrupted and requeued)\n";
   }
@@ -159,7 +159,8 @@ void JobManager::Work() {
     std::string id;
     {
       absl::MutexLock lock(&mu_);
-      auto ready = [&]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) { return stopping_ || !queue_.empty(); };
+      auto ready = [&]()
+                       ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) { return stopping_ || !queue_.empty(); };
       mu_.Await(absl::Condition(&ready));
       if (stopping_) return;
       id = queue_.front();
@@ -183,7 +184,8 @@ void JobManager::RunOne(const std::string& id) {
   };
   absl::StatusOr<bool> claimed = store_->MarkRunning(id);
   if (!claimed.ok() || !*claimed) {  // cancelled meanwhile, or already run
-    if (!claimed.ok()) std::cerr << "cablesim-server: " << id << ": " << claimed.status() << "\n";
+    if (!claimed.ok() && log_)
+      std::cerr << "cablesim-server: " << id << ": " << claimed.status() << "\n";
     forget();
     return;
   }
@@ -221,16 +223,18 @@ void JobManager::RunOne(const std::string& id) {
   if (running->stop.load() == 2) {
     // Shutdown: leave the job for the next start.
     if (absl::Status s = store_->Requeue(id); !s.ok()) {
-      std::cerr << "cablesim-server: " << id << ": " << s << "\n";
+      if (log_) std::cerr << "cablesim-server: " << id << ": " << s << "\n";
     }
     forget();
     return;
   }
   const v1::JobState state = StateOf(summary);
   absl::StatusOr<bool> finished = store_->Finish(id, state, SummaryToProto(summary), result);
-  if (!finished.ok()) std::cerr << "cablesim-server: " << id << ": " << finished.status() << "\n";
-  std::cerr << "cablesim-server: job " << id << " " << v1::JobState_Name(state) << " ("
-            << summary.frames << " frames, " << summary.wall_seconds << " s)\n";
+  if (!finished.ok() && log_)
+    std::cerr << "cablesim-server: " << id << ": " << finished.status() << "\n";
+  if (log_)
+    std::cerr << "cablesim-server: job " << id << " " << v1::JobState_Name(state) << " ("
+              << summary.frames << " frames, " << summary.wall_seconds << " s)\n";
   forget();
 }
 

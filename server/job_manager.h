@@ -27,7 +27,8 @@ namespace cablesim {
 class JobManager {
  public:
   // `store` must outlive the manager.
-  JobManager(JobStore* store, int workers, ServerLimits limits);
+  // `log`: report jobs on stderr.
+  JobManager(JobStore* store, int workers, ServerLimits limits, bool log = true);
   ~JobManager();  // Shutdown()
 
   // Requeues jobs interrupted by a crash and starts the workers.
@@ -64,6 +65,7 @@ class JobManager {
   JobStore* store_;
   const int workers_;
   const ServerLimits limits_;
+  const bool log_;
   absl::Mutex mu_;
   std::deque<std::string> queue_ ABSL_GUARDED_BY(mu_);
   std::map<std::string, std::shared_ptr<Running>> running_ ABSL_GUARDED_BY(mu_);

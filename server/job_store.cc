@@ -159,8 +159,8 @@ absl::StatusOr<std::unique_ptr<JobStore>> JobStore::Open(const std::string& dir)
   sqlite3_busy_timeout(db, 5000);
   // WAL: readers do not block the writer; synchronous=FULL: a committed
   // transaction is on disk before the call returns.
-  for (const char* sql : {"PRAGMA journal_mode=WAL", "PRAGMA synchronous=FULL",
-                          "PRAGMA foreign_keys=ON", kSchema}) {
+  for (const char* sql :
+       {"PRAGMA journal_mode=WAL", "PRAGMA synchronous=FULL", "PRAGMA foreign_keys=ON", kSchema}) {
     if (absl::Status s = store->Exec(sql); !s.ok()) {
       return absl::UnavailableError(absl::StrCat(path, ": ", s.message()));
     }
@@ -276,8 +276,9 @@ absl::StatusOr<std::vector<v1::Job>> JobStore::ListJobs(v1::JobState state,
                            " FROM jobs WHERE (?1 = 0 OR state = ?1) AND (?2 = 0 OR sweep_seq = ?2)"
                            " ORDER BY seq DESC LIMIT ?3")
                   .c_str());
-  s.Bind(1, int64_t{state}).Bind(2, sweep_id.empty() ? 0 : SweepSeq(sweep_id)).Bind(3,
-                                                                                    int64_t{limit});
+  s.Bind(1, int64_t{state})
+      .Bind(2, sweep_id.empty() ? 0 : SweepSeq(sweep_id))
+      .Bind(3, int64_t{limit});
   std::vector<v1::Job> jobs;
   int rc;
   while ((rc = s.Step()) == SQLITE_ROW) jobs.push_back(JobFromRow(s));
@@ -301,8 +302,10 @@ absl::StatusOr<bool> JobStore::MarkRunning(const std::string& id) {
   Stmt s(db_,
          "UPDATE jobs SET state = ?1, started_ms = ?2, attempts = attempts + 1 "
          "WHERE seq = ?3 AND state = ?4");
-  s.Bind(1, int64_t{v1::RUNNING}).Bind(2, NowUnixMs()).Bind(3, JobSeq(id)).Bind(4,
-                                                                                int64_t{v1::QUEUED});
+  s.Bind(1, int64_t{v1::RUNNING})
+      .Bind(2, NowUnixMs())
+      .Bind(3, JobSeq(id))
+      .Bind(4, int64_t{v1::QUEUED});
   if (absl::Status st = s.Done(); !st.ok()) return st;
   return sqlite3_changes(db_) == 1;
 }
@@ -326,8 +329,7 @@ absl::StatusOr<bool> JobStore::CancelQueued(const std::string& id) {
 }
 
 absl::StatusOr<bool> JobStore::Finish(const std::string& id, v1::JobState state,
-                                      const v1::RunSummary& summary,
-                                      const StoredResult& result) {
+                                      const v1::RunSummary& summary, const StoredResult& result) {
   const int64_t seq = JobSeq(id);
   const std::string summary_blob = summary.SerializeAsString();
   const std::string header_blob = result.header.SerializeAsString();
@@ -352,7 +354,8 @@ absl::StatusOr<bool> JobStore::Finish(const std::string& id, v1::JobState state,
     Exec("ROLLBACK").IgnoreError();
     return false;
   }
-  Stmt r(db_, "INSERT OR REPLACE INTO results (job_seq, header, vals, final_row) VALUES (?1,?2,?3,?4)");
+  Stmt r(db_,
+         "INSERT OR REPLACE INTO results (job_seq, header, vals, final_row) VALUES (?1,?2,?3,?4)");
   r.Bind(1, seq)
       .BindBlob(2, header_blob.data(), header_blob.size())
       .BindBlob(3, result.values.data(), result.values.size() * sizeof(double))

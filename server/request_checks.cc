@@ -29,9 +29,9 @@ absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimi
     checked.frames = solver.load_steps;
   }
   if (checked.nominal_steps > limits.max_steps) {
-    return absl::ResourceExhaustedError(absl::StrFormat(
-        "solver: %d steps asked for, the server's limit is %d (max_steps)", checked.nominal_steps,
-        limits.max_steps));
+    return absl::ResourceExhaustedError(
+        absl::StrFormat("solver: %d steps asked for, the server's limit is %d (max_steps)",
+                        checked.nominal_steps, limits.max_steps));
   }
   if (checked.frames > limits.max_frames) {
     return absl::ResourceExhaustedError(absl::StrFormat(
@@ -41,9 +41,9 @@ absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimi
   int64_t requested_elements = 0;
   for (const CableSpec& cable : checked.scene.cables) requested_elements += cable.elements;
   if (requested_elements > limits.max_elements) {
-    return absl::ResourceExhaustedError(absl::StrFormat(
-        "cables: %d elements asked for, the server's limit is %d (max_elements)",
-        requested_elements, limits.max_elements));
+    return absl::ResourceExhaustedError(
+        absl::StrFormat("cables: %d elements asked for, the server's limit is %d (max_elements)",
+                        requested_elements, limits.max_elements));
   }
   absl::StatusOr<ModelInfo> info = DescribeModel(checked.scene);
   if (!info.ok()) return info.status();
@@ -84,8 +84,9 @@ absl::StatusOr<std::vector<v1::Scene>> ExpandSweep(const v1::SubmitSweepRequest&
     }
     items *= axis.values_size();
     if (items > limits.max_sweep_items) {
-      return absl::ResourceExhaustedError(absl::StrFormat(
-          "axes: more than %d items, the server's limit (max_sweep_items)", limits.max_sweep_items));
+      return absl::ResourceExhaustedError(
+          absl::StrFormat("axes: more than %d items, the server's limit (max_sweep_items)",
+                          limits.max_sweep_items));
     }
   }
   std::vector<v1::Scene> scenes;
@@ -99,8 +100,8 @@ absl::StatusOr<std::vector<v1::Scene>> ExpandSweep(const v1::SubmitSweepRequest&
       rest /= request.axes(a).values_size();
     }
     for (int a = 0; a < request.axes_size(); ++a) {
-      if (absl::Status s = SetSceneField(&scene, request.axes(a).path(),
-                                         request.axes(a).values(which[a]));
+      if (absl::Status s =
+              SetSceneField(&scene, request.axes(a).path(), request.axes(a).values(which[a]));
           !s.ok()) {
         return absl::InvalidArgumentError(
             absl::StrCat("axes[", a, "].values[", which[a], "]: ", s.message()));

@@ -17,12 +17,12 @@
 namespace cablesim {
 
 struct ServerLimits {
-  int max_elements = 5000;          // cable elements (inserted nodes included)
-  int64_t max_steps = 5'000'000;    // nominal steps (duration / step) or load steps
-  int64_t max_frames = 200'000;     // output frames per run
-  int max_sweep_items = 1000;       // items of one sweep
-  int max_streams = 64;             // concurrent Run / GetEnergy(scene) calls
-  int max_message_bytes = 16 << 20; // gRPC receive limit
+  int max_elements = 5000;           // cable elements (inserted nodes included)
+  int64_t max_steps = 5'000'000;     // nominal steps (duration / step) or load steps
+  int64_t max_frames = 200'000;      // output frames per run
+  int max_sweep_items = 1000;        // items of one sweep
+  int max_streams = 64;              // concurrent Run / GetEnergy(scene) calls
+  int max_message_bytes = 16 << 20;  // gRPC receive limit
   // A Run stream whose client reads nothing for this long is cancelled.
   absl::Duration stall_timeout = absl::Seconds(30);
 };

@@ -151,8 +151,8 @@ TEST_F(CliServerTest, SweepWritesOneRowPerItemAndFailsOnAThreshold) {
 
   // Backward Euler dissipates a few percent here: a drift limit of 1e-9
   // is exceeded by every item; exit code 3, the table still written.
-  const CliResult strict = Cli({"sweep", sweep, "--out", csv, "--server", server_->address(),
-                                "--max-energy-drift", "1e-9"});
+  const CliResult strict = Cli(
+      {"sweep", sweep, "--out", csv, "--server", server_->address(), "--max-energy-drift", "1e-9"});
   EXPECT_EQ(strict.code, 3);
   EXPECT_THAT(strict.err, HasSubstr("energy drift"));
   EXPECT_EQ(std::vector<std::string>(absl::StrSplit(Read(csv), '\n', absl::SkipEmpty())).size(),

@@ -19,9 +19,9 @@ namespace cablesim {
 namespace {
 
 using ::testing::HasSubstr;
-using ::testing::StartsWith;
 using testing::Pendulum;
 using testing::ServerProcess;
+using ::testing::StartsWith;
 
 struct Streamed {
   grpc::Status status;
@@ -60,9 +60,9 @@ Streamed RunOnServer(v1::CablesimService::Stub* stub, const v1::Scene& scene, in
 class ServerTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    server_ = new ServerProcess(testing::FreshDir("server_test"),
-                                {"--workers=1", "--max-elements=200", "--max-frames=20000",
-                                 "--max-streams=40"});
+    server_ = new ServerProcess(
+        testing::FreshDir("server_test"),
+        {"--workers=1", "--max-elements=200", "--max-frames=20000", "--max-streams=40"});
   }
   static void TearDownTestSuite() {
     delete server_;

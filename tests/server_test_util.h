@@ -5,6 +5,9 @@
 // server as a child process (so it can be killed with SIGKILL), a stub, raw
 // calls for the health and reflection services, and scenes.
 
+#include <grpcpp/generic/generic_stub.h>
+#include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/types.h>
 #include <sys/wait.h>
@@ -19,10 +22,6 @@
 #include <thread>
 #include <vector>
 
-#include <grpcpp/generic/generic_stub.h>
-#include <grpcpp/grpcpp.h>
-#include <gtest/gtest.h>
-
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
 #include "cablesim/v1/service.grpc.pb.h"
@@ -32,8 +31,7 @@ namespace cablesim::testing {
 
 // A fresh empty directory under the test's temporary directory.
 inline std::string FreshDir(const std::string& name) {
-  const std::string dir =
-      absl::StrCat(::testing::TempDir(), "/cablesim_", name, "_", ::getpid());
+  const std::string dir = absl::StrCat(::testing::TempDir(), "/cablesim_", name, "_", ::getpid());
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
@@ -93,8 +91,8 @@ class ServerProcess {
   pid_t pid() const { return pid_; }
   int port() const { return port_; }
   std::string address() const { return absl::StrCat("127.0.0.1:", port_); }
-  std::shared_ptr<grpc::Channel> Channel() const {
-    grpc::ChannelArguments args;
+  std::shared_ptr<grpc::Channel> Channel() const { return Channel(grpc::ChannelArguments()); }
+  std::shared_ptr<grpc::Channel> Channel(grpc::ChannelArguments args) const {
     args.SetMaxReceiveMessageSize(64 << 20);
     // A fresh connection per channel (no sharing between test clients).
     args.SetInt("grpc.use_local_subchannel_pool", 1);
