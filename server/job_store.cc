@@ -1,7 +1,11 @@
 #include "server/job_store.h"
 
+#include <fcntl.h>
 #include <sqlite3.h>
+#include <sys/file.h>
+#include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstring>
 #include <utility>
@@ -147,15 +151,26 @@ int64_t NowUnixMs() {
 }
 
 absl::StatusOr<std::unique_ptr<JobStore>> JobStore::Open(const std::string& dir) {
+  const std::string lock_path = absl::StrCat(dir, "/lock");
+  const int lock_fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (lock_fd < 0) {
+    return absl::UnavailableError(absl::StrCat(lock_path, ": ", std::strerror(errno)));
+  }
+  if (::flock(lock_fd, LOCK_EX | LOCK_NB) != 0) {
+    ::close(lock_fd);
+    return absl::FailedPreconditionError(
+        absl::StrCat(dir, ": in use by another cablesim-server (", lock_path, " is locked)"));
+  }
   const std::string path = absl::StrCat(dir, "/cablesim.db");
   sqlite3* db = nullptr;
   if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr) !=
       SQLITE_OK) {
     const std::string message = db ? sqlite3_errmsg(db) : "out of memory";
     sqlite3_close(db);
+    ::close(lock_fd);
     return absl::UnavailableError(absl::StrCat(path, ": ", message));
   }
-  std::unique_ptr<JobStore> store(new JobStore(db));
+  std::unique_ptr<JobStore> store(new JobStore(db, lock_fd));
   sqlite3_busy_timeout(db, 5000);
   // WAL: readers do not block the writer; synchronous=FULL: a committed
   // transaction is on disk before the call returns.
@@ -168,7 +183,10 @@ absl::StatusOr<std::unique_ptr<JobStore>> JobStore::Open(const std::string& dir)
   return store;
 }
 
-JobStore::~JobStore() { sqlite3_close(db_); }
+JobStore::~JobStore() {
+  sqlite3_close(db_);
+  ::close(lock_fd_);  // releases the lock
+}
 
 absl::Status JobStore::Exec(const char* sql) {
   char* error = nullptr;

@@ -8,6 +8,10 @@
 // accepted job is either finished with its result or runs again, never
 // both. Thread-safe (one connection behind a mutex).
 //
+// One server per directory: Open takes an exclusive lock on DIR/lock (the
+// kernel drops it when the process dies, even by kill -9), so two servers
+// can never run the same job.
+//
 // Ids: job `j-NNNNNN`, sweep `s-NNNNNN` (the row numbers).
 
 #include <cstdint>
@@ -74,11 +78,12 @@ class JobStore {
   absl::StatusOr<v1::Sweep> GetSweep(const std::string& id);
 
  private:
-  explicit JobStore(sqlite3* db) : db_(db) {}
+  JobStore(sqlite3* db, int lock_fd) : db_(db), lock_fd_(lock_fd) {}
   absl::Status Exec(const char* sql);
 
   absl::Mutex mu_;
   sqlite3* db_;
+  int lock_fd_;
 };
 
 // Job id <-> row number; -1 for a malformed id.

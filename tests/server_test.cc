@@ -431,5 +431,17 @@ TEST_F(ServerTest, InvalidSweepNamesTheAxis) {
   }
 }
 
+TEST_F(ServerTest, ASecondServerOnTheSameDataDirectoryRefusesToStart) {
+  // Two servers on one store could run a job twice.
+  const std::string dir = testing::FreshDir("server_test_second");
+  ServerProcess first(dir);
+  const std::string binary = absl::StrCat(CABLESIM_BIN_DIR, "/cablesim-server");
+  const int status = std::system(
+      absl::StrCat("'", binary, "' --listen=127.0.0.1:0 --data-dir='", dir, "' 2>/dev/null")
+          .c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+}
+
 }  // namespace
 }  // namespace cablesim
