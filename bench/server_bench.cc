@@ -16,14 +16,20 @@
 //                            a fresh SQLite store and run by N workers until
 //                            the last finishes. items_per_s counter; parallel
 //                            efficiency = rate(2) / (2 rate(1)).
+//   EngineThreads/N:         the same 8 runs on N plain threads without the
+//                            service: the machine's own parallel efficiency,
+//                            the ceiling for Sweep.
 //
 // Run with --benchmark_repetitions=5 and read the medians.
 
 #include <benchmark/benchmark.h>
 
+#include <atomic>
 #include <filesystem>
 #include <limits>
 #include <memory>
+#include <thread>
+#include <vector>
 
 #include "client/service_client.h"
 #include "convert/scene_file.h"
@@ -152,10 +158,44 @@ void BM_Sweep(benchmark::State& state) {
   state.counters["items_per_s"] = benchmark::Counter(items, benchmark::Counter::kIsRate);
 }
 
+// The reference for BM_Sweep: the same 8 runs on N plain threads, engine
+// only (no service, no SQLite): what the machine itself gives in parallel.
+void BM_EngineThreads(benchmark::State& state) {
+  const int threads = static_cast<int>(state.range(0));
+  constexpr int kItems = 8;
+  std::vector<Scene> scenes;
+  for (int i = 0; i < kItems; ++i) {
+    v1::Scene proto = Pendulum(1e-2);
+    proto.mutable_gravity()->set_y(-9.81 + 0.01 * i);
+    scenes.push_back(*SceneFromProto(proto));
+  }
+  int64_t items = 0;
+  for (auto _ : state) {
+    std::atomic<int> next{0};
+    std::vector<std::thread> pool;
+    for (int t = 0; t < threads; ++t) {
+      pool.emplace_back([&] {
+        DiscardingSink sink;
+        for (int i; (i = next.fetch_add(1)) < kItems;)
+          benchmark::DoNotOptimize(RunScene(scenes[i], &sink));
+      });
+    }
+    for (std::thread& t : pool) t.join();
+    items += kItems;
+  }
+  state.counters["items_per_s"] = benchmark::Counter(items, benchmark::Counter::kIsRate);
+}
+
 BENCHMARK(BM_StreamInProcessEngine)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_StreamServerLoopback)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_StreamInProcessChannel)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Sweep)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+BENCHMARK(BM_EngineThreads)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(3);
 
 }  // namespace
 }  // namespace cablesim
