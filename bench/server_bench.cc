@@ -59,6 +59,7 @@ v1::Scene Pendulum(double output_interval_s) {
 ServerLimits NoLimits() {
   ServerLimits limits;
   limits.max_frames = std::numeric_limits<int64_t>::max();
+  limits.max_trajectory_values = std::numeric_limits<int64_t>::max();
   limits.max_steps = std::numeric_limits<int64_t>::max() / 4;
   return limits;
 }

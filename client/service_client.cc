@@ -40,6 +40,7 @@ absl::StatusOr<std::unique_ptr<Connection>> Connect(const std::optional<std::str
     options.limits.max_elements = std::numeric_limits<int>::max();
     options.limits.max_steps = std::numeric_limits<int64_t>::max() / 4;
     options.limits.max_frames = std::numeric_limits<int64_t>::max();
+    options.limits.max_trajectory_values = std::numeric_limits<int64_t>::max();
     options.limits.max_sweep_items = std::numeric_limits<int>::max();
     options.limits.max_streams = std::numeric_limits<int>::max() / 2;
     options.limits.stall_timeout = absl::Hours(24 * 365);

@@ -27,6 +27,7 @@ ABSL_FLAG(std::string, port_file, "", "write the bound port to this file once se
 ABSL_FLAG(int, max_elements, 5000, "limit: cable elements per scene");
 ABSL_FLAG(int64_t, max_steps, 5'000'000, "limit: time steps (or load steps) per run");
 ABSL_FLAG(int64_t, max_frames, 200'000, "limit: output frames per run");
+ABSL_FLAG(int64_t, max_trajectory_values, 32 << 20, "limit: frames x columns kept per run");
 ABSL_FLAG(int, max_sweep_items, 1000, "limit: items per sweep");
 ABSL_FLAG(int, max_streams, 64, "limit: concurrent Run streams");
 ABSL_FLAG(int, max_message_bytes, 16 << 20, "limit: gRPC message size");
@@ -62,6 +63,7 @@ int main(int argc, char** argv) {
   limits.max_elements = absl::GetFlag(FLAGS_max_elements);
   limits.max_steps = absl::GetFlag(FLAGS_max_steps);
   limits.max_frames = absl::GetFlag(FLAGS_max_frames);
+  limits.max_trajectory_values = absl::GetFlag(FLAGS_max_trajectory_values);
   limits.max_sweep_items = absl::GetFlag(FLAGS_max_sweep_items);
   limits.max_streams = absl::GetFlag(FLAGS_max_streams);
   limits.max_message_bytes = absl::GetFlag(FLAGS_max_message_bytes);

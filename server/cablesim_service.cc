@@ -49,6 +49,8 @@ grpc::Status ToGrpc(const absl::Status& s) {
   return grpc::Status(static_cast<grpc::StatusCode>(s.code()), std::string(s.message()));
 }
 
+constexpr int kMaxBatchValues = 128 * 1024;
+
 int BatchSize(int requested) {
   if (requested <= 0) return 64;
   return std::min(requested, 4096);
@@ -94,7 +96,8 @@ class StreamingSink : public FrameSink {
     v1::FrameBatch* b = event_.mutable_frames();
     AppendFrameRow(frame, b->mutable_values());
     b->set_rows(b->rows() + 1);
-    if (b->rows() >= batch_) return Flush();
+    // Also bound the message (1 MiB of numbers), whatever the probe count.
+    if (b->rows() >= batch_ || b->values_size() >= kMaxBatchValues) return Flush();
     return absl::OkStatus();
   }
   absl::Status Flush() {
@@ -207,6 +210,7 @@ grpc::Status CablesimServiceImpl::Validate(grpc::ServerContext*, const v1::Valid
   unlimited.max_elements = std::numeric_limits<int>::max();
   unlimited.max_steps = std::numeric_limits<int64_t>::max();
   unlimited.max_frames = std::numeric_limits<int64_t>::max();
+  unlimited.max_trajectory_values = std::numeric_limits<int64_t>::max();
   absl::StatusOr<CheckedScene> checked = CheckScene(request->scene(), unlimited);
   if (checked.ok()) {
     response->set_valid(true);
@@ -348,8 +352,9 @@ grpc::Status CablesimServiceImpl::GetJobResult(grpc::ServerContext* context,
   const size_t columns = std::max(1, result->header.columns_size());
   const size_t batch = BatchSize(request->frames_per_batch());
   const size_t rows = result->values.size() / columns;
-  for (size_t r = 0; r < rows; r += batch) {
-    const size_t n = std::min(batch, rows - r);
+  const size_t rows_per_message = std::max<size_t>(1, std::min(batch, kMaxBatchValues / columns));
+  for (size_t r = 0; r < rows; r += rows_per_message) {
+    const size_t n = std::min(rows_per_message, rows - r);
     event.mutable_frames()->set_rows(static_cast<int>(n));
     event.mutable_frames()->mutable_values()->Assign(result->values.begin() + r * columns,
                                                      result->values.begin() + (r + n) * columns);

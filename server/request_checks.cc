@@ -4,6 +4,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "convert/run_proto.h"
 #include "convert/scene_field_path.h"
 #include "convert/scene_from_proto.h"
 
@@ -37,6 +38,15 @@ absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimi
     return absl::ResourceExhaustedError(absl::StrFormat(
         "solver.output_interval: %d frames asked for, the server's limit is %d (max_frames)",
         checked.frames, limits.max_frames));
+  }
+  const int64_t values =
+      checked.frames *
+      (1 + kValuesPerProbe * static_cast<int64_t>(checked.scene.probes.size()) + kTrailingValues);
+  if (values > limits.max_trajectory_values) {
+    return absl::ResourceExhaustedError(absl::StrFormat(
+        "probes: %d frames of %d probes make %d numbers, the server's limit is %d "
+        "(max_trajectory_values)",
+        checked.frames, checked.scene.probes.size(), values, limits.max_trajectory_values));
   }
   int64_t requested_elements = 0;
   for (const CableSpec& cable : checked.scene.cables) requested_elements += cable.elements;

@@ -17,9 +17,12 @@
 namespace cablesim {
 
 struct ServerLimits {
-  int max_elements = 5000;           // cable elements (inserted nodes included)
-  int64_t max_steps = 5'000'000;     // nominal steps (duration / step) or load steps
-  int64_t max_frames = 200'000;      // output frames per run
+  int max_elements = 5000;        // cable elements (inserted nodes included)
+  int64_t max_steps = 5'000'000;  // nominal steps (duration / step) or load steps
+  int64_t max_frames = 200'000;   // output frames per run
+  // Numbers in a run's trajectory (frames x columns): a job keeps them in
+  // memory and in SQLite. 32 Mi doubles = 256 MiB.
+  int64_t max_trajectory_values = 32 << 20;
   int max_sweep_items = 1000;        // items of one sweep
   int max_streams = 64;              // concurrent Run / GetEnergy(scene) calls
   int max_message_bytes = 16 << 20;  // gRPC receive limit

@@ -60,9 +60,9 @@ Streamed RunOnServer(v1::CablesimService::Stub* stub, const v1::Scene& scene, in
 class ServerTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    server_ = new ServerProcess(
-        testing::FreshDir("server_test"),
-        {"--workers=1", "--max-elements=200", "--max-frames=20000", "--max-streams=40"});
+    server_ = new ServerProcess(testing::FreshDir("server_test"),
+                                {"--workers=1", "--max-elements=200", "--max-frames=20000",
+                                 "--max-streams=40", "--max-trajectory-values=1048576"});
   }
   static void TearDownTestSuite() {
     delete server_;
@@ -160,6 +160,19 @@ TEST_F(ServerTest, LimitsAreResourceExhausted) {
   s = RunOnServer(stub.get(), scene);
   EXPECT_EQ(s.status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
   EXPECT_THAT(s.status.error_message(), HasSubstr("max_frames"));
+
+  // 1001 frames of 200 probes (1807 numbers each) are 1.8 M numbers, over
+  // the limit of 1 Mi given below.
+  scene = Pendulum(1, 1e-3, 1e-3);
+  for (int i = 0; i < 200; ++i) {
+    v1::Probe* probe = scene.add_probes();
+    probe->set_name(absl::StrCat("p", i));
+    probe->set_cable("beam");
+    probe->set_s(1.2 * i / 200);
+  }
+  s = RunOnServer(stub.get(), scene);
+  EXPECT_EQ(s.status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(s.status.error_message(), HasSubstr("max_trajectory_values"));
 
   // A message above the receive limit (16 MiB by default).
   scene = Pendulum(0.01, 1e-3, 1e-3);
