@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <latch>
 #include <thread>
 
 #include "absl/strings/str_join.h"
@@ -247,24 +248,39 @@ TEST_F(ServerTest, DeadlineStopsTheRun) {
 }
 
 TEST_F(ServerTest, ThirtyTwoClientsStreamAtOnce) {
-  const v1::Scene scene = Pendulum(0.02, 1e-3, 1e-3);  // 21 frames each
+  const v1::Scene scene = Pendulum(0.1, 1e-3, 1e-3);  // 101 frames each
   constexpr int kClients = 32;
   std::vector<Streamed> results(kClients);
+  // Every client reads its header, then waits until all 32 have theirs: the
+  // 32 streams are open on the server at the same time.
+  std::latch all_started(kClients);
   std::vector<std::thread> threads;
   for (int i = 0; i < kClients; ++i) {
     threads.emplace_back([&, i] {
       auto stub = v1::CablesimService::NewStub(server_->Channel());  // own connection
-      results[i] = RunOnServer(stub.get(), scene, 4);
+      grpc::ClientContext context;
+      context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
+      v1::RunRequest request;
+      *request.mutable_scene() = scene;
+      request.set_frames_per_batch(4);
+      auto reader = stub->Run(&context, request);
+      v1::RunEvent header;
+      const bool got_header = reader->Read(&header) && header.has_header();
+      all_started.count_down();
+      all_started.wait();
+      results[i] = ReadAll(reader.get());
+      if (got_header) results[i].header = header.header();
     });
   }
   for (std::thread& t : threads) t.join();
   for (int i = 0; i < kClients; ++i) {
     ASSERT_TRUE(results[i].status.ok()) << i << ": " << results[i].status.error_message();
     ASSERT_TRUE(results[i].summary.has_value());
-    EXPECT_EQ(results[i].summary->frames(), 21);
+    EXPECT_EQ(results[i].summary->frames(), 101);
+    ASSERT_EQ(results[i].header.columns_size(), 16) << i;
     // Every client gets the same, complete trajectory.
+    EXPECT_EQ(results[i].values.size(), 101u * 16);
     EXPECT_EQ(results[i].values, results[0].values) << i;
-    EXPECT_EQ(results[i].values.size(), 21u * results[i].header.columns_size());
   }
 }
 
