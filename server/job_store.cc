@@ -41,8 +41,7 @@ CREATE INDEX IF NOT EXISTS jobs_by_sweep ON jobs(sweep_seq, sweep_index);
 CREATE TABLE IF NOT EXISTS results (
   job_seq INTEGER PRIMARY KEY REFERENCES jobs(seq),
   header BLOB NOT NULL,         -- cablesim.v1.RunHeader
-  vals BLOB NOT NULL,           -- row-major doubles, native byte order
-  final_row BLOB NOT NULL);
+  vals BLOB NOT NULL);          -- row-major doubles, native byte order
 )sql";
 
 // One prepared statement; finalized on destruction.
@@ -68,8 +67,10 @@ class Stmt {
     sqlite3_bind_text(stmt_, i, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT);
     return *this;
   }
+  // An empty blob (never NULL, even when `data` is null).
   Stmt& BindBlob(int i, const void* data, size_t bytes) {
-    sqlite3_bind_blob64(stmt_, i, data, bytes, SQLITE_TRANSIENT);
+    static const char kEmpty = 0;
+    sqlite3_bind_blob64(stmt_, i, data != nullptr ? data : &kEmpty, bytes, SQLITE_TRANSIENT);
     return *this;
   }
   // SQLITE_ROW, SQLITE_DONE or an error code.
@@ -351,8 +352,6 @@ absl::StatusOr<bool> JobStore::Finish(const std::string& id, v1::JobState state,
   const int64_t seq = JobSeq(id);
   const std::string summary_blob = summary.SerializeAsString();
   const std::string header_blob = result.header.SerializeAsString();
-  const size_t columns = std::max(1, result.header.columns_size());
-  const size_t rows = result.values.size() / columns;
   absl::MutexLock lock(&mu_);
   if (absl::Status st = Exec("BEGIN IMMEDIATE"); !st.ok()) return st;
   auto rollback = [&](absl::Status st) {
@@ -372,13 +371,10 @@ absl::StatusOr<bool> JobStore::Finish(const std::string& id, v1::JobState state,
     Exec("ROLLBACK").IgnoreError();
     return false;
   }
-  Stmt r(db_,
-         "INSERT OR REPLACE INTO results (job_seq, header, vals, final_row) VALUES (?1,?2,?3,?4)");
+  Stmt r(db_, "INSERT OR REPLACE INTO results (job_seq, header, vals) VALUES (?1,?2,?3)");
   r.Bind(1, seq)
       .BindBlob(2, header_blob.data(), header_blob.size())
-      .BindBlob(3, result.values.data(), result.values.size() * sizeof(double))
-      .BindBlob(4, rows ? result.values.data() + (rows - 1) * columns : nullptr,
-                rows ? columns * sizeof(double) : 0);
+      .BindBlob(3, result.values.data(), result.values.size() * sizeof(double));
   if (absl::Status st = r.Done(); !st.ok()) return rollback(st);
   if (absl::Status st = Exec("COMMIT"); !st.ok()) return rollback(st);
   return true;
@@ -395,16 +391,6 @@ absl::StatusOr<StoredResult> JobStore::GetResult(const std::string& id) {
   result.header.ParseFromString(s.Blob(0));
   result.values = DoublesFromBlob(s.Blob(1));
   return result;
-}
-
-absl::StatusOr<std::vector<double>> JobStore::GetFinalRow(const std::string& id) {
-  absl::MutexLock lock(&mu_);
-  Stmt s(db_, "SELECT final_row FROM results WHERE job_seq = ?1");
-  s.Bind(1, JobSeq(id));
-  const int rc = s.Step();
-  if (rc == SQLITE_DONE) return std::vector<double>();
-  if (rc != SQLITE_ROW) return SqlError(db_);
-  return DoublesFromBlob(s.Blob(0));
 }
 
 absl::StatusOr<v1::Sweep> JobStore::GetSweep(const std::string& id) {

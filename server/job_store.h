@@ -71,8 +71,6 @@ class JobStore {
 
   // NotFound when the job has no result.
   absl::StatusOr<StoredResult> GetResult(const std::string& id);
-  // The last row of the result (empty when none).
-  absl::StatusOr<std::vector<double>> GetFinalRow(const std::string& id);
 
   // The sweep with its counts and job ids.
   absl::StatusOr<v1::Sweep> GetSweep(const std::string& id);
