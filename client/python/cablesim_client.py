@@ -55,8 +55,12 @@ def run(stub, scene, frames_per_batch=256, timeout=None):
     Raises grpc.RpcError (INVALID_ARGUMENT naming the field for a bad
     scene)."""
     request = service_pb2.RunRequest(scene=scene, frames_per_batch=frames_per_batch)
+    return _read_stream(stub.Run(request, timeout=timeout))
+
+
+def _read_stream(events):
     header, summary, chunks = None, None, []
-    for event in stub.Run(request, timeout=timeout):
+    for event in events:
         kind = event.WhichOneof("event")
         if kind == "header":
             header = event.header
@@ -67,6 +71,25 @@ def run(stub, scene, frames_per_batch=256, timeout=None):
     ncol = len(header.columns)
     flat = np.concatenate(chunks) if chunks else np.zeros(0)
     return RunResult(header, flat.reshape(-1, ncol), summary)
+
+
+def submit(stub, scene):
+    """Queues `scene` as a durable job; returns its id at once."""
+    return stub.SubmitJob(service_pb2.SubmitJobRequest(scene=scene)).id
+
+
+def wait(stub, job_id, timeout=None):
+    """Follows the job until it is finished; returns the last Job message
+    (state SUCCEEDED, FAILED or CANCELLED)."""
+    job = None
+    for job in stub.WatchJob(service_pb2.WatchJobRequest(id=job_id), timeout=timeout):
+        pass
+    return job
+
+
+def job_result(stub, job_id):
+    """A finished job's trajectory and summary, as run() returns them."""
+    return _read_stream(stub.GetJobResult(service_pb2.GetJobResultRequest(id=job_id)))
 
 
 def plot(result, png_path, probe=None):

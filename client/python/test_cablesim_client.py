@@ -71,6 +71,17 @@ class ClientTest(unittest.TestCase):
         with open(png, "rb") as f:
             self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
 
+    def test_job_keeps_the_streamed_trajectory(self):
+        scene = self.scene()
+        streamed = cablesim_client.run(self.stub, scene)
+        job_id = cablesim_client.submit(self.stub, scene)
+        self.assertTrue(job_id.startswith("j-"))
+        job = cablesim_client.wait(self.stub, job_id, timeout=60)
+        self.assertEqual(job.state, cablesim_client.service_pb2.SUCCEEDED)
+        kept = cablesim_client.job_result(self.stub, job_id)
+        np.testing.assert_array_equal(kept.data, streamed.data)
+        self.assertEqual(kept.summary.frames, 101)
+
     def test_invalid_scene_names_the_field(self):
         scene = self.scene()
         scene.cables[0].length = -1
