@@ -16,14 +16,16 @@ namespace cablesim {
 // stall watchdog.
 class StreamSlot {
  public:
-  StreamSlot(CablesimServiceImpl* service, grpc::ServerContext* context)
-      : service_(service), watch_{context} {
-    acquired_ = service_->streams_.fetch_add(1) < service_->limits_.max_streams;
+  // `counted`: the stream takes one of the max_streams slots (runs do;
+  // watchers and result downloads only register with the watchdog).
+  StreamSlot(CablesimServiceImpl* service, grpc::ServerContext* context, bool counted = true)
+      : service_(service), watch_{context}, counted_(counted) {
+    acquired_ = !counted_ || service_->streams_.fetch_add(1) < service_->limits_.max_streams;
     absl::MutexLock lock(&service_->mu_);
     service_->watched_[&watch_] = true;
   }
   ~StreamSlot() {
-    service_->streams_.fetch_sub(1);
+    if (counted_) service_->streams_.fetch_sub(1);
     absl::MutexLock lock(&service_->mu_);
     service_->watched_.erase(&watch_);
   }
@@ -33,6 +35,7 @@ class StreamSlot {
  private:
   CablesimServiceImpl* service_;
   CablesimServiceImpl::StreamWatch watch_;
+  const bool counted_;
   bool acquired_ = false;
 };
 
@@ -61,7 +64,8 @@ bool Finished(v1::JobState s) {
 }
 
 // Writes `event`, recording the wait for the watchdog.
-bool TimedWrite(grpc::ServerWriter<v1::RunEvent>* writer, const v1::RunEvent& event,
+template <typename Message>
+bool TimedWrite(grpc::ServerWriter<Message>* writer, const Message& event,
                 CablesimServiceImpl::StreamWatch* watch) {
   watch->write_started_ns = NowNs();
   const bool ok = writer->Write(event);
@@ -309,6 +313,7 @@ grpc::Status CablesimServiceImpl::WatchJob(grpc::ServerContext* context,
                                            const v1::WatchJobRequest* request,
                                            grpc::ServerWriter<v1::Job>* writer) {
   if (jobs_ == nullptr) return NoJobs();
+  StreamSlot slot(this, context, /*counted=*/false);
   std::string last;
   while (true) {
     const uint64_t seen = jobs_->version();
@@ -316,7 +321,9 @@ grpc::Status CablesimServiceImpl::WatchJob(grpc::ServerContext* context,
     if (!job.ok()) return ToGrpc(job.status());
     std::string now = job->SerializeAsString();
     if (now != last) {
-      if (!writer->Write(*job)) return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
+      if (!TimedWrite(writer, *job, slot.watch())) {
+        return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
+      }
       last = std::move(now);
     }
     if (Finished(job->state())) return grpc::Status::OK;
@@ -341,7 +348,7 @@ grpc::Status CablesimServiceImpl::GetJobResult(grpc::ServerContext* context,
   }
   absl::StatusOr<StoredResult> result = jobs_->store()->GetResult(request->id());
   if (!result.ok()) return ToGrpc(result.status());
-  StreamSlot slot(this, context);
+  StreamSlot slot(this, context, /*counted=*/false);
   v1::RunEvent event;
   *event.mutable_header() = result->header;
   event.mutable_header()->set_scene_name(job->name());
@@ -449,6 +456,7 @@ grpc::Status CablesimServiceImpl::WatchSweep(grpc::ServerContext* context,
                                              const v1::WatchSweepRequest* request,
                                              grpc::ServerWriter<v1::SweepEvent>* writer) {
   if (jobs_ == nullptr) return NoJobs();
+  StreamSlot slot(this, context, /*counted=*/false);
   std::set<std::string> reported;
   bool first = true;
   while (true) {
@@ -461,7 +469,9 @@ grpc::Status CablesimServiceImpl::WatchSweep(grpc::ServerContext* context,
     if (first) {
       v1::SweepEvent event;
       *event.mutable_progress() = *sweep;
-      if (!writer->Write(event)) return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
+      if (!TimedWrite(writer, event, slot.watch())) {
+        return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
+      }
       first = false;
     }
     // Oldest item first.
@@ -471,7 +481,9 @@ grpc::Status CablesimServiceImpl::WatchSweep(grpc::ServerContext* context,
       v1::SweepEvent event;
       *event.mutable_progress() = *sweep;
       *event.mutable_item() = ItemOf(jobs_, *sweep, *it);
-      if (!writer->Write(event)) return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
+      if (!TimedWrite(writer, event, slot.watch())) {
+        return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
+      }
     }
     if (sweep->finished() == sweep->items()) return grpc::Status::OK;
     if (context->IsCancelled()) return grpc::Status(grpc::StatusCode::CANCELLED, "cancelled");

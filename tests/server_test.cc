@@ -460,6 +460,41 @@ TEST_F(ServerTest, InvalidSweepNamesTheAxis) {
   }
 }
 
+TEST(ServerLimitTest, StreamsBeyondTheLimitAreResourceExhausted) {
+  ServerProcess server(testing::FreshDir("server_test_streams"), {"--max-streams=1"});
+  // The first stream stays open: its client reads only the header and keeps
+  // HTTP/2's default 64 KiB window (no BDP probing), far less than the run.
+  grpc::ChannelArguments small_window;
+  small_window.SetInt("grpc.http2.bdp_probe", 0);
+  auto stub = v1::CablesimService::NewStub(server.Channel(small_window));
+  grpc::ClientContext first;
+  v1::RunRequest request;
+  *request.mutable_scene() = Pendulum(15, 1e-3, 1e-3);  // 15001 frames, 1.9 MB
+  auto reader = stub->Run(&first, request);
+  v1::RunEvent event;
+  ASSERT_TRUE(reader->Read(&event));
+  ASSERT_TRUE(event.has_header());
+
+  auto other = server.Stub();
+  const Streamed second = RunOnServer(other.get(), Pendulum(0.01, 1e-3, 1e-3));
+  EXPECT_EQ(second.status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(second.status.error_message(), HasSubstr("max_streams"));
+
+  first.TryCancel();
+  while (reader->Read(&event)) {
+  }
+  reader->Finish();
+  // The slot is free again (the server notices the cancellation within a
+  // step; retry briefly).
+  grpc::Status status;
+  for (int i = 0; i < 100; ++i) {
+    status = RunOnServer(other.get(), Pendulum(0.01, 1e-3, 1e-3)).status;
+    if (status.ok()) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_TRUE(status.ok()) << status.error_message();
+}
+
 TEST_F(ServerTest, ASecondServerOnTheSameDataDirectoryRefusesToStart) {
   // Two servers on one store could run a job twice.
   const std::string dir = testing::FreshDir("server_test_second");
