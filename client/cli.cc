@@ -1,16 +1,23 @@
 #include "client/cli.h"
 
+#include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <utility>
 
 #include "absl/status/status.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "client/csv_writer.h"
+#include "client/cli_common.h"
+#include "client/cli_jobs.h"
+#include "client/cli_sweep.h"
 #include "client/json_line.h"
+#include "client/progress.h"
+#include "client/service_client.h"
 #include "client/summary_json.h"
+#include "convert/run_proto.h"
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
 #include "engine/simulation.h"
@@ -23,11 +30,26 @@
 namespace cablesim {
 namespace {
 
-struct Arguments {
-  std::vector<std::string> positional;  // command first
-  std::optional<std::string> out;       // --out
-  bool help = false;
-};
+using cli_internal::Arguments;
+using cli_internal::CallFailed;
+using cli_internal::ConnectOrReport;
+using cli_internal::LazyCsvSink;
+using cli_internal::ReadScene;
+using cli_internal::ReportSummary;
+using cli_internal::UsageError;
+
+// Options that take a value, besides --out and --server.
+const std::set<std::string>& ValueOptions() {
+  static const std::set<std::string>* options =
+      new std::set<std::string>{"state",
+                                "sweep",
+                                "limit",
+                                "workers",
+                                "max-energy-drift",
+                                "max-wall-seconds",
+                                "max-constraint-violation"};
+  return *options;
+}
 
 // Parses `args`; returns an error message for a usage error.
 absl::StatusOr<Arguments> ParseArguments(const std::vector<std::string>& args) {
@@ -37,81 +59,78 @@ absl::StatusOr<Arguments> ParseArguments(const std::vector<std::string>& args) {
     const std::string& arg = args[i];
     if (options_done || arg.size() < 2 || arg[0] != '-') {
       parsed.positional.push_back(arg);
-    } else if (arg == "--") {
+      continue;
+    }
+    if (arg == "--") {
       options_done = true;
-    } else if (arg == "--help" || arg == "-h" || arg == "-help") {
+      continue;
+    }
+    if (arg == "--help" || arg == "-h" || arg == "-help") {
       parsed.help = true;
-    } else if (arg == "--out" || arg == "-out" || arg == "-o") {
-      if (i + 1 >= args.size())
-        return absl::InvalidArgumentError(absl::StrCat(arg, " needs a file"));
-      parsed.out = args[++i];
-    } else if (absl::StartsWith(arg, "--out=") || absl::StartsWith(arg, "-out=")) {
-      parsed.out = arg.substr(arg.find('=') + 1);
-    } else {
+      continue;
+    }
+    std::string name = arg.substr(arg[1] == '-' ? 2 : 1);
+    std::optional<std::string> value;
+    if (const size_t eq = name.find('='); eq != std::string::npos) {
+      value = name.substr(eq + 1);
+      name = name.substr(0, eq);
+    }
+    if (name == "o") name = "out";
+    if (name != "out" && name != "server" && !ValueOptions().count(name)) {
       return absl::InvalidArgumentError(absl::StrCat("unknown option ", arg));
     }
-    if (parsed.out.has_value() && parsed.out->empty()) {
-      return absl::InvalidArgumentError("--out needs a file");
+    if (!value.has_value()) {
+      if (i + 1 >= args.size()) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(arg, name == "out" ? " needs a file" : " needs a value"));
+      }
+      value = args[++i];
+    }
+    if (value->empty()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("--", name, name == "out" ? " needs a file" : " needs a value"));
+    }
+    if (name == "out") {
+      parsed.out = *value;
+    } else if (name == "server") {
+      parsed.server = *value;
+    } else {
+      parsed.options[name] = *value;
     }
   }
   return parsed;
 }
 
-int UsageError(std::ostream& err, absl::string_view message) {
-  err << "cablesim: " << message << "\n\n" << CliUsage();
-  err.flush();
-  return kExitBadInput;
-}
-
-// Discards the frames of a run without --out.
-class DiscardingSink : public FrameSink {
- public:
-  absl::Status OnFrame(const Frame&) override { return absl::OkStatus(); }
-};
-
-// Reads and validates the scene at `path`; on failure reports it on `err`
-// and returns nullopt.
-std::optional<Scene> LoadScene(const std::string& path, std::ostream& err,
-                               std::string* error_message) {
-  absl::StatusOr<v1::Scene> proto = ReadSceneFile(path);
-  if (!proto.ok()) {
-    // ReadSceneFile's messages start with the path.
-    *error_message = std::string(proto.status().message());
-    err << "cablesim: " << *error_message << "\n";
-    return std::nullopt;
-  }
-  absl::StatusOr<Scene> scene = SceneFromProto(*proto);
-  if (!scene.ok()) {
-    *error_message = std::string(scene.status().message());
-    err << "cablesim: " << path << ": " << *error_message << "\n";
-    return std::nullopt;
-  }
-  return std::move(*scene);
-}
-
-int Validate(const std::string& path, std::ostream& out, std::ostream& err) {
+int Validate(const std::string& path, const std::optional<std::string>& server, std::ostream& out,
+             std::ostream& err) {
   std::string error;
-  const std::optional<Scene> scene = LoadScene(path, err, &error);
-  if (!scene.has_value()) {
-    out << JsonLine().Add("status", "invalid").Add("file", path).Add("error", error).ToString()
+  const std::optional<v1::Scene> proto = ReadScene(path, err, &error);
+  auto invalid = [&](const std::string& message) {
+    out << JsonLine().Add("status", "invalid").Add("file", path).Add("error", message).ToString()
         << "\n";
     out.flush();
     return kExitBadInput;
+  };
+  if (!proto.has_value()) return invalid(error);
+  std::unique_ptr<Connection> c = ConnectOrReport(server, false, 0, err);
+  if (c == nullptr) return kExitIoError;
+  grpc::ClientContext context;
+  v1::ValidateRequest request;
+  *request.mutable_scene() = *proto;
+  v1::ValidateResponse response;
+  const absl::Status status = FromGrpc(c->stub->Validate(&context, request, &response));
+  if (!status.ok()) return CallFailed(err, status, path);
+  if (!response.valid()) {
+    const v1::FieldError& e = response.errors(0);
+    const std::string message =
+        e.path().empty() ? e.message() : absl::StrCat(e.path(), ": ", e.message());
+    err << "cablesim: " << path << ": " << message << "\n";
+    return invalid(message);
   }
-  // The engine's own checks (joint sides that do not meet at t = 0, ...)
-  // and what it would build.
-  const absl::StatusOr<ModelInfo> info = DescribeModel(*scene);
-  if (!info.ok()) {
-    err << "cablesim: " << path << ": " << info.status().message() << "\n";
-    out << JsonLine()
-               .Add("status", "invalid")
-               .Add("file", path)
-               .Add("error", std::string(info.status().message()))
-               .ToString()
-        << "\n";
-    out.flush();
-    return kExitBadInput;
-  }
+  // Valid: describe it (the counts and settings, with the defaults applied).
+  const absl::StatusOr<Scene> scene = SceneFromProto(*proto);
+  if (!scene.ok()) return invalid(std::string(scene.status().message()));
+  const ModelInfo info = ModelInfoFromProto(response.model());
   const SolverSettings& solver = scene->solver;
   JsonLine json;
   json.Add("status", "ok")
@@ -125,12 +144,12 @@ int Validate(const std::string& path, std::ostream& out, std::ostream& err) {
       .Add("analysis", AnalysisName(solver.analysis))
       .Add("integrator", IntegratorName(solver.integrator))
       .Add("linear_solver", LinearSolverName(solver.linear_solver))
-      .Add("model", info->model)
-      .Add("coordinates", static_cast<int64_t>(info->coordinates))
-      .Add("dofs", static_cast<int64_t>(info->dofs))
-      .Add("multipliers", static_cast<int64_t>(info->multipliers))
-      .Add("elements", static_cast<int64_t>(info->elements))
-      .Add("nodes", static_cast<int64_t>(info->nodes));
+      .Add("model", info.model)
+      .Add("coordinates", static_cast<int64_t>(info.coordinates))
+      .Add("dofs", static_cast<int64_t>(info.dofs))
+      .Add("multipliers", static_cast<int64_t>(info.multipliers))
+      .Add("elements", static_cast<int64_t>(info.elements))
+      .Add("nodes", static_cast<int64_t>(info.nodes));
   if (solver.analysis == Analysis::kDynamic) {
     json.Add("duration_s", solver.duration_s)
         .Add("step_s", solver.step_s)
@@ -143,70 +162,75 @@ int Validate(const std::string& path, std::ostream& out, std::ostream& err) {
   return kExitOk;
 }
 
-int Run(const std::string& path, const std::optional<std::string>& csv_path, std::ostream& out,
-        std::ostream& err) {
+int Run(const std::string& path, const std::optional<std::string>& csv_path,
+        const std::optional<std::string>& server, std::ostream& out, std::ostream& err) {
   std::string error;
-  const std::optional<Scene> scene = LoadScene(path, err, &error);
-  if (!scene.has_value()) return kExitBadInput;
+  const std::optional<v1::Scene> proto = ReadScene(path, err, &error);
+  if (!proto.has_value()) return kExitBadInput;
+  std::unique_ptr<Connection> c = ConnectOrReport(server, false, 0, err);
+  if (c == nullptr) return kExitIoError;
 
-  std::unique_ptr<CsvWriter> csv;
-  DiscardingSink discard;
-  FrameSink* sink = &discard;
-  if (csv_path.has_value()) {
-    absl::StatusOr<std::unique_ptr<CsvWriter>> created = CsvWriter::Create(*csv_path);
-    if (!created.ok()) {
-      err << "cablesim: " << created.status().message() << "\n";
-      return kExitIoError;
-    }
-    csv = std::move(*created);
-    sink = csv.get();
-  }
-
-  const absl::StatusOr<RunSummary> summary = RunScene(*scene, sink);
-  const absl::Status csv_status = csv != nullptr ? csv->Finish() : absl::OkStatus();
-  if (summary.ok()) {
-    out << SummaryToJson(*summary) << "\n";
-    out.flush();
-  }
-  // A failed CSV write stops the run, whatever the engine then reports.
+  LazyCsvSink sink(csv_path);
+  Progress progress(&err, Progress::IsTerminal(err), "run");
+  grpc::ClientContext context;
+  v1::RunRequest request;
+  *request.mutable_scene() = *proto;
+  request.set_frames_per_batch(256);
+  std::unique_ptr<grpc::ClientReader<v1::RunEvent>> reader = c->stub->Run(&context, request);
+  const absl::StatusOr<RunSummary> summary =
+      ReadRunStream(&context, reader.get(), &sink, [&](double t, double end) {
+        progress.Update(end > 0 ? t / end : 0, absl::StrFormat("t = %.4g s", t));
+      });
+  progress.Done();
+  const absl::Status csv_status = sink.Finish();
+  // A failed CSV write stops the run, whatever the service then reports.
   if (!csv_status.ok()) {
     err << "cablesim: " << csv_status.message() << "\n";
     return kExitIoError;
   }
-  if (!summary.ok()) {
-    err << "cablesim: " << path << ": " << summary.status().message() << "\n";
-    return kExitBadInput;
-  }
-  if (summary->status == "failed") {
-    err << "cablesim: numerical failure at t = "
-        << absl::StrFormat("%.10g", summary->failure_time_s) << ": " << summary->error << "\n";
-    return kExitNumericalFailure;
-  }
-  if (summary->status != "ok") {
-    err << "cablesim: run " << summary->status
-        << (summary->error.empty() ? "" : absl::StrCat(": ", summary->error)) << "\n";
-    return kExitIoError;
-  }
-  return kExitOk;
+  if (!summary.ok()) return CallFailed(err, summary.status(), path);
+  return ReportSummary(*summary, out, err);
 }
 
 }  // namespace
 
 std::string CliUsage() {
   return R"(Usage:
-  cablesim run SCENE [--out FILE.csv]
+  cablesim run SCENE [--out FILE.csv] [--server HOST:PORT]
       Run the scene's analysis and print the run summary as one JSON line.
       With --out, write the trajectory (one row per output frame) as CSV.
-  cablesim validate SCENE
+      The run goes through the cablesim service: one started in this
+      process, or the cablesim-server at --server.
+  cablesim validate SCENE [--server HOST:PORT]
       Check the scene and print one JSON line describing it.
+  cablesim submit SCENE --server HOST:PORT
+      Queue the scene as a durable job; print the job (its id) at once.
+  cablesim jobs --server HOST:PORT [--state STATE] [--sweep ID] [--limit N]
+      List jobs, newest first, one JSON line each.
+  cablesim watch JOB --server HOST:PORT [--out FILE.csv]
+      Follow a job until it finishes; print its summary (and with --out
+      write its trajectory).
+  cablesim cancel JOB --server HOST:PORT
+      Cancel a queued or running job.
+  cablesim energy (SCENE | JOB) [--server HOST:PORT] [--out FILE.csv]
+      Energy diagnostics of a scene (run for the purpose) or a finished job:
+      one JSON line with the report; --out writes the time series.
+  cablesim sweep SWEEP.json [--out results.csv] [--server HOST:PORT]
+                 [--workers N] [--max-energy-drift X] [--max-wall-seconds X]
+                 [--max-constraint-violation X]
+      Queue a parameter sweep, wait for every item and write one row per
+      item (axis values, summary, final probe values). Without --server the
+      sweep runs in this process on N workers (default: the cores).
   cablesim help
       Print this text.
 
 SCENE is a cablesim.v1.Scene (proto/cablesim/v1/scene.proto) in protobuf
 JSON, or in text format when its name ends in .txtpb, .textproto or .pbtxt.
+SWEEP.json is a cablesim.v1.SweepFile (proto/cablesim/v1/service.proto).
 
-Exit status: 0 success, 1 error writing the output, 2 bad input (usage,
-scene file or scene), 3 numerical failure of the run.
+Exit status: 0 success, 1 error writing the output or reaching the server,
+2 bad input (usage, scene file or scene), 3 numerical failure of the run
+(for sweep: an item failed or a threshold was exceeded).
 )";
 }
 
@@ -221,20 +245,39 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   }
   if (a.positional.empty()) return UsageError(err, "missing command");
   const std::string& command = a.positional[0];
-  if (command != "run" && command != "validate") {
+  static const std::map<std::string, const char*> kArgument = {
+      {"run", "SCENE"}, {"validate", "SCENE"}, {"submit", "SCENE"},        {"jobs", nullptr},
+      {"watch", "JOB"}, {"cancel", "JOB"},     {"energy", "SCENE or JOB"}, {"sweep", "SWEEP.json"}};
+  const auto known = kArgument.find(command);
+  if (known == kArgument.end()) {
     return UsageError(err, absl::StrCat("unknown command \"", command, "\""));
   }
-  if (a.positional.size() < 2) return UsageError(err, absl::StrCat(command, ": missing SCENE"));
-  if (a.positional.size() > 2) {
-    return UsageError(err,
-                      absl::StrCat(command, ": unexpected argument \"", a.positional[2], "\""));
+  const size_t wanted = known->second != nullptr ? 2 : 1;
+  if (a.positional.size() < wanted) {
+    return UsageError(err, absl::StrCat(command, ": missing ", known->second));
   }
-  const std::string& scene_path = a.positional[1];
-  if (command == "validate") {
-    if (a.out.has_value()) return UsageError(err, "validate: --out is only for run");
-    return Validate(scene_path, out, err);
+  if (a.positional.size() > wanted) {
+    return UsageError(
+        err, absl::StrCat(command, ": unexpected argument \"", a.positional[wanted], "\""));
   }
-  return Run(scene_path, a.out, out, err);
+  for (const auto& [name, value] : a.options) {
+    const bool allowed =
+        (command == "jobs" && (name == "state" || name == "sweep" || name == "limit")) ||
+        (command == "sweep" && name != "state" && name != "sweep" && name != "limit");
+    if (!allowed) return UsageError(err, absl::StrCat(command, ": no option --", name));
+  }
+  if (a.out.has_value() && command != "run" && command != "watch" && command != "energy" &&
+      command != "sweep") {
+    return UsageError(err, absl::StrCat(command, ": --out is only for run"));
+  }
+  if (command == "validate") return Validate(a.positional[1], a.server, out, err);
+  if (command == "run") return Run(a.positional[1], a.out, a.server, out, err);
+  if (command == "submit") return cli_internal::Submit(a, out, err);
+  if (command == "jobs") return cli_internal::Jobs(a, out, err);
+  if (command == "watch") return cli_internal::Watch(a, out, err);
+  if (command == "cancel") return cli_internal::Cancel(a, out, err);
+  if (command == "energy") return cli_internal::Energy(a, out, err);
+  return cli_internal::SweepCommand(a, out, err);
 }
 
 int RunCli(int argc, char** argv, std::ostream& out, std::ostream& err) {

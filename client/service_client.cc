@@ -1,0 +1,110 @@
+#include "client/service_client.h"
+
+#include <stdlib.h>
+
+#include <filesystem>
+#include <limits>
+#include <thread>
+
+#include "absl/strings/str_cat.h"
+#include "convert/run_proto.h"
+
+namespace cablesim {
+
+Connection::~Connection() {
+  stub.reset();
+  channel.reset();
+  if (local != nullptr) local->Shutdown(absl::ZeroDuration());
+  local.reset();
+  if (!local_data_dir.empty()) {
+    std::error_code ignored;
+    std::filesystem::remove_all(local_data_dir, ignored);
+  }
+}
+
+absl::Status FromGrpc(const grpc::Status& status) {
+  if (status.ok()) return absl::OkStatus();
+  return absl::Status(static_cast<absl::StatusCode>(status.error_code()), status.error_message());
+}
+
+absl::StatusOr<std::unique_ptr<Connection>> Connect(const std::optional<std::string>& server,
+                                                    bool jobs, int workers) {
+  auto c = std::make_unique<Connection>();
+  if (server.has_value()) {
+    grpc::ChannelArguments args;
+    args.SetMaxReceiveMessageSize(64 << 20);
+    c->channel = grpc::CreateCustomChannel(*server, grpc::InsecureChannelCredentials(), args);
+  } else {
+    ServerOptions options;
+    // The user's own process: no limits beyond the engine's.
+    options.limits.max_elements = std::numeric_limits<int>::max();
+    options.limits.max_steps = std::numeric_limits<int64_t>::max() / 4;
+    options.limits.max_frames = std::numeric_limits<int64_t>::max();
+    options.limits.max_trajectory_values = std::numeric_limits<int64_t>::max();
+    options.limits.max_sweep_items = std::numeric_limits<int>::max();
+    options.limits.max_streams = std::numeric_limits<int>::max() / 2;
+    options.limits.stall_timeout = absl::Hours(24 * 365);
+    options.log = false;
+    options.workers = workers > 0 ? workers : std::max(1u, std::thread::hardware_concurrency());
+    if (jobs) {
+      std::string templ = (std::filesystem::temp_directory_path() / "cablesim-XXXXXX").string();
+      if (mkdtemp(templ.data()) == nullptr) {
+        return absl::UnavailableError("cannot create a temporary directory for the jobs");
+      }
+      c->local_data_dir = templ;
+      options.data_dir = templ;
+    }
+    absl::StatusOr<std::unique_ptr<CablesimServer>> local = CablesimServer::Start(options);
+    if (!local.ok()) return local.status();
+    c->local = std::move(*local);
+    c->channel = c->local->InProcessChannel();
+  }
+  c->stub = v1::CablesimService::NewStub(c->channel);
+  return c;
+}
+
+absl::StatusOr<RunSummary> ReadRunStream(grpc::ClientContext* context,
+                                         grpc::ClientReader<v1::RunEvent>* reader, FrameSink* sink,
+                                         const std::function<void(double, double)>& on_frame_time) {
+  v1::RunEvent event;
+  int probes = 0;
+  int columns = 0;
+  double end_time = 0;
+  Frame frame;
+  std::optional<RunSummary> summary;
+  absl::Status sink_error;
+  while (reader->Read(&event)) {
+    if (event.has_header()) {
+      const ModelInfo info = ModelInfoFromProto(event.header().info());
+      probes = static_cast<int>(info.probe_names.size());
+      columns = FrameRowSize(probes);
+      end_time = event.header().end_time_s();
+      sink_error = sink->OnStart(info);
+    } else if (event.has_frames()) {
+      const v1::FrameBatch& b = event.frames();
+      if (columns == 0 || b.values_size() != b.rows() * columns) {
+        sink_error = absl::InternalError("malformed frame batch from the server");
+      }
+      for (int r = 0; sink_error.ok() && r < b.rows(); ++r) {
+        FrameFromRow(absl::MakeConstSpan(b.values().data() + r * columns, columns), probes, &frame);
+        sink_error = sink->OnFrame(frame);
+        if (on_frame_time) on_frame_time(frame.t, end_time);
+      }
+    } else if (event.has_summary()) {
+      summary = SummaryFromProto(event.summary());
+    }
+    if (!sink_error.ok()) {
+      context->TryCancel();
+      while (reader->Read(&event)) {
+      }
+      (void)reader->Finish();
+      return sink_error;
+    }
+  }
+  const absl::Status status = FromGrpc(reader->Finish());
+  if (!status.ok()) return status;
+  if (!summary.has_value()) return absl::UnavailableError("the stream ended without a summary");
+  return *summary;
+}
+
+}  // namespace cablesim

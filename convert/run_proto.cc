@@ -1,0 +1,135 @@
+#include "convert/run_proto.h"
+
+#include "absl/strings/str_cat.h"
+
+namespace cablesim {
+
+v1::ModelInfo ModelInfoToProto(const ModelInfo& info) {
+  v1::ModelInfo p;
+  p.set_model(info.model);
+  p.set_coordinates(info.coordinates);
+  p.set_dofs(info.dofs);
+  p.set_multipliers(info.multipliers);
+  p.set_elements(info.elements);
+  p.set_nodes(info.nodes);
+  for (const std::string& name : info.probe_names) p.add_probe_names(name);
+  return p;
+}
+
+ModelInfo ModelInfoFromProto(const v1::ModelInfo& p) {
+  ModelInfo info;
+  info.model = p.model();
+  info.coordinates = p.coordinates();
+  info.dofs = p.dofs();
+  info.multipliers = p.multipliers();
+  info.elements = p.elements();
+  info.nodes = p.nodes();
+  info.probe_names.assign(p.probe_names().begin(), p.probe_names().end());
+  return info;
+}
+
+v1::RunSummary SummaryToProto(const RunSummary& s) {
+  v1::RunSummary p;
+  p.set_status(s.status);
+  p.set_error(s.error);
+  p.set_failure_time_s(s.failure_time_s);
+  p.set_analysis(s.analysis);
+  p.set_integrator(s.integrator);
+  p.set_linear_solver(s.linear_solver);
+  *p.mutable_info() = ModelInfoToProto(s.info);
+  p.set_frames(s.frames);
+  p.set_steps(s.steps);
+  p.set_rejected_steps(s.rejected_steps);
+  p.set_newton_iterations(s.newton_iterations);
+  p.set_linear_iterations(s.linear_iterations);
+  p.set_min_step_s(s.min_step_s);
+  p.set_wall_seconds(s.wall_seconds);
+  p.set_end_time_s(s.end_time_s);
+  p.set_energy_initial(s.energy_initial);
+  p.set_energy_final(s.energy_final);
+  p.set_energy_dissipated(s.energy_dissipated);
+  p.set_energy_max_increase(s.energy_max_increase);
+  p.set_max_constraint_violation(s.max_constraint_violation);
+  p.set_max_newton_residual(s.max_newton_residual);
+  p.set_max_linear_residual(s.max_linear_residual);
+  for (double f : s.frequencies_hz) p.add_frequencies_hz(f);
+  return p;
+}
+
+RunSummary SummaryFromProto(const v1::RunSummary& p) {
+  RunSummary s;
+  s.status = p.status();
+  s.error = p.error();
+  s.failure_time_s = p.failure_time_s();
+  s.analysis = p.analysis();
+  s.integrator = p.integrator();
+  s.linear_solver = p.linear_solver();
+  s.info = ModelInfoFromProto(p.info());
+  s.frames = p.frames();
+  s.steps = p.steps();
+  s.rejected_steps = p.rejected_steps();
+  s.newton_iterations = p.newton_iterations();
+  s.linear_iterations = p.linear_iterations();
+  s.min_step_s = p.min_step_s();
+  s.wall_seconds = p.wall_seconds();
+  s.end_time_s = p.end_time_s();
+  s.energy_initial = p.energy_initial();
+  s.energy_final = p.energy_final();
+  s.energy_dissipated = p.energy_dissipated();
+  s.energy_max_increase = p.energy_max_increase();
+  s.max_constraint_violation = p.max_constraint_violation();
+  s.max_newton_residual = p.max_newton_residual();
+  s.max_linear_residual = p.max_linear_residual();
+  s.frequencies_hz.assign(p.frequencies_hz().begin(), p.frequencies_hz().end());
+  return s;
+}
+
+std::vector<std::string> FrameColumns(const std::vector<std::string>& probe_names) {
+  std::vector<std::string> columns = {"t"};
+  for (const std::string& name : probe_names) {
+    for (const char* c : {"x", "y", "z", "vx", "vy", "vz", "ax", "ay", "az"}) {
+      columns.push_back(absl::StrCat(name, ".", c));
+    }
+  }
+  for (const char* c : {"energy.kinetic", "energy.potential", "energy.axial", "energy.bending",
+                        "energy.total", "constraint.violation"}) {
+    columns.push_back(c);
+  }
+  return columns;
+}
+
+void AppendFrameRow(const Frame& frame, google::protobuf::RepeatedField<double>* values) {
+  values->Add(frame.t);
+  for (const ProbeSample& p : frame.probes) {
+    for (int k = 0; k < 3; ++k) values->Add(p.position_m[k]);
+    for (int k = 0; k < 3; ++k) values->Add(p.velocity_m_s[k]);
+    for (int k = 0; k < 3; ++k) values->Add(p.acceleration_m_s2[k]);
+  }
+  const EnergySample& e = frame.energy;
+  values->Add(e.kinetic);
+  values->Add(e.potential);
+  values->Add(e.axial);
+  values->Add(e.bending);
+  values->Add(e.total);
+  values->Add(frame.constraint_violation);
+}
+
+void FrameFromRow(absl::Span<const double> row, int probes, Frame* frame) {
+  frame->t = row[0];
+  frame->probes.resize(probes);
+  size_t i = 1;
+  for (ProbeSample& p : frame->probes) {
+    for (int k = 0; k < 3; ++k) p.position_m[k] = row[i++];
+    for (int k = 0; k < 3; ++k) p.velocity_m_s[k] = row[i++];
+    for (int k = 0; k < 3; ++k) p.acceleration_m_s2[k] = row[i++];
+  }
+  EnergySample& e = frame->energy;
+  e.kinetic = row[i++];
+  e.potential = row[i++];
+  e.axial = row[i++];
+  e.bending = row[i++];
+  e.total = row[i++];
+  frame->constraint_violation = row[i++];
+}
+
+}  // namespace cablesim

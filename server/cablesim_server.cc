@@ -1,0 +1,75 @@
+#include "server/cablesim_server.h"
+
+#include <grpcpp/ext/proto_server_reflection_plugin.h>
+#include <grpcpp/health_check_service_interface.h>
+
+#include <chrono>
+#include <iostream>
+
+#include "absl/strings/str_cat.h"
+
+namespace cablesim {
+
+absl::StatusOr<std::unique_ptr<CablesimServer>> CablesimServer::Start(
+    const ServerOptions& options) {
+  std::unique_ptr<CablesimServer> s(new CablesimServer());
+  s->limits_ = options.limits;
+  if (!options.data_dir.empty()) {
+    absl::StatusOr<std::unique_ptr<JobStore>> store = JobStore::Open(options.data_dir);
+    if (!store.ok()) return store.status();
+    s->store_ = std::move(*store);
+    s->jobs_ =
+        std::make_unique<JobManager>(s->store_.get(), options.workers, options.limits, options.log);
+  }
+  s->service_ = std::make_unique<CablesimServiceImpl>(s->jobs_.get(), options.limits, options.log);
+  s->log_ = options.log;
+
+  grpc::EnableDefaultHealthCheckService(true);
+  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+  grpc::ServerBuilder builder;
+  if (!options.listen.empty()) {
+    builder.AddListeningPort(options.listen, grpc::InsecureServerCredentials(), &s->port_);
+  }
+  builder.SetMaxReceiveMessageSize(options.limits.max_message_bytes);
+  builder.SetMaxSendMessageSize(options.limits.max_message_bytes);
+  builder.RegisterService(s->service_.get());
+  s->server_ = builder.BuildAndStart();
+  if (s->server_ == nullptr || (!options.listen.empty() && s->port_ == 0)) {
+    s->down_ = true;
+    return absl::UnavailableError(absl::StrCat("cannot listen on ", options.listen));
+  }
+  if (s->jobs_ != nullptr) {
+    if (absl::Status st = s->jobs_->Start(); !st.ok()) {
+      s->Shutdown(absl::ZeroDuration());
+      return st;
+    }
+  }
+  s->server_->GetHealthCheckService()->SetServingStatus(true);
+  return s;
+}
+
+CablesimServer::~CablesimServer() { Shutdown(absl::ZeroDuration()); }
+
+std::shared_ptr<grpc::Channel> CablesimServer::InProcessChannel() {
+  grpc::ChannelArguments args;
+  args.SetMaxReceiveMessageSize(limits_.max_message_bytes);
+  args.SetMaxSendMessageSize(limits_.max_message_bytes);
+  return server_->InProcessChannel(args);
+}
+
+void CablesimServer::Shutdown(absl::Duration grace) {
+  if (down_) return;
+  down_ = true;
+  if (server_ != nullptr) server_->GetHealthCheckService()->SetServingStatus(false);
+  if (jobs_ != nullptr) {
+    jobs_->Shutdown();
+    if (log_) std::cerr << "cablesim-server: workers stopped, unfinished jobs left queued\n";
+  }
+  if (server_ != nullptr) {
+    server_->Shutdown(std::chrono::system_clock::now() +
+                      std::chrono::milliseconds(absl::ToInt64Milliseconds(grace)));
+    server_->Wait();
+  }
+}
+
+}  // namespace cablesim

@@ -1,0 +1,63 @@
+#ifndef CABLESIM_SERVER_CABLESIM_SERVER_H_
+#define CABLESIM_SERVER_CABLESIM_SERVER_H_
+
+// A running cablesim service: the gRPC server with CablesimService, the
+// gRPC health service (grpc.health.v1, SERVING while up) and server
+// reflection; with a data directory, the job store and its workers.
+// Used by cablesim-server, by `cablesim` (in-process, no port) and by the
+// tests and benchmarks.
+
+#include <grpcpp/grpcpp.h>
+
+#include <memory>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "absl/time/time.h"
+#include "server/cablesim_service.h"
+#include "server/job_manager.h"
+#include "server/job_store.h"
+#include "server/request_checks.h"
+
+namespace cablesim {
+
+struct ServerOptions {
+  // host:port to listen on (port 0: any free port, see port()); empty: no
+  // network port, in-process channels only.
+  std::string listen;
+  // Directory of the job store; empty: no jobs (Run and Validate only).
+  std::string data_dir;
+  int workers = 1;
+  ServerLimits limits;
+  // Report jobs, sweeps and shutdown on stderr.
+  bool log = true;
+};
+
+class CablesimServer {
+ public:
+  static absl::StatusOr<std::unique_ptr<CablesimServer>> Start(const ServerOptions& options);
+  ~CablesimServer();  // Shutdown(0)
+
+  // The port bound (0 when not listening).
+  int port() const { return port_; }
+  std::shared_ptr<grpc::Channel> InProcessChannel();
+
+  // Stops the workers (running jobs go back to QUEUED), then the server:
+  // calls still running after `grace` are cancelled. Idempotent.
+  void Shutdown(absl::Duration grace);
+
+ private:
+  CablesimServer() = default;
+  ServerLimits limits_;
+  std::unique_ptr<JobStore> store_;
+  std::unique_ptr<JobManager> jobs_;
+  std::unique_ptr<CablesimServiceImpl> service_;
+  std::unique_ptr<grpc::Server> server_;
+  int port_ = 0;
+  bool down_ = false;
+  bool log_ = true;
+};
+
+}  // namespace cablesim
+
+#endif  // CABLESIM_SERVER_CABLESIM_SERVER_H_

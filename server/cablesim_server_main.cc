@@ -1,0 +1,100 @@
+// cablesim-server: the cablesim gRPC service (proto/cablesim/v1/service.proto).
+//
+//   cablesim-server --listen 127.0.0.1:50051 --data-dir DIR [--workers N]
+//
+// Jobs and results live in SQLite under DIR. SIGTERM or SIGINT shuts down
+// gracefully: running jobs stop at their next step and stay queued for the
+// next start. Logs go to stderr. With --port-file, the port actually bound
+// (useful with port 0) is written to that file once the server serves.
+
+#include <signal.h>
+
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <thread>
+#include <vector>
+
+#include "absl/flags/flag.h"
+#include "absl/flags/parse.h"
+#include "absl/flags/usage.h"
+#include "server/cablesim_server.h"
+
+ABSL_FLAG(std::string, listen, "127.0.0.1:50051", "host:port to listen on (port 0: any free)");
+ABSL_FLAG(std::string, data_dir, "", "directory of the job database (required)");
+ABSL_FLAG(int, workers, 0, "job worker threads (0: the number of cores)");
+ABSL_FLAG(std::string, port_file, "", "write the bound port to this file once serving");
+ABSL_FLAG(int, max_elements, 5000, "limit: cable elements per scene");
+ABSL_FLAG(int64_t, max_steps, 5'000'000, "limit: time steps (or load steps) per run");
+ABSL_FLAG(int64_t, max_frames, 200'000, "limit: output frames per run");
+ABSL_FLAG(int64_t, max_trajectory_values, 32 << 20, "limit: frames x columns kept per run");
+ABSL_FLAG(int, max_sweep_items, 1000, "limit: items per sweep");
+ABSL_FLAG(int, max_streams, 64, "limit: concurrent Run streams");
+ABSL_FLAG(int, max_message_bytes, 16 << 20, "limit: gRPC message size");
+ABSL_FLAG(double, stall_timeout_s, 30, "cancel a stream whose client reads nothing this long");
+ABSL_FLAG(double, shutdown_grace_s, 2,
+          "on SIGTERM, wait this long for calls (and idle client connections) to end");
+
+int main(int argc, char** argv) {
+  absl::SetProgramUsageMessage("cablesim-server --listen HOST:PORT --data-dir DIR [--workers N]");
+  // Accept --data-dir as well as absl's --data_dir spelling.
+  std::vector<std::string> args(argv, argv + argc);
+  for (size_t i = 1; i < args.size(); ++i) {
+    std::string& a = args[i];
+    if (a.rfind("--", 0) != 0) continue;
+    const size_t end = std::min(a.find('='), a.size());
+    for (size_t k = 2; k < end; ++k) {
+      if (a[k] == '-') a[k] = '_';
+    }
+  }
+  std::vector<char*> arg_ptrs;
+  for (std::string& a : args) arg_ptrs.push_back(a.data());
+  absl::ParseCommandLine(static_cast<int>(arg_ptrs.size()), arg_ptrs.data());
+  cablesim::ServerOptions options;
+  options.listen = absl::GetFlag(FLAGS_listen);
+  options.data_dir = absl::GetFlag(FLAGS_data_dir);
+  if (options.data_dir.empty()) {
+    std::cerr << "cablesim-server: --data-dir is required\n";
+    return 2;
+  }
+  options.workers = absl::GetFlag(FLAGS_workers);
+  if (options.workers <= 0) options.workers = std::max(1u, std::thread::hardware_concurrency());
+  cablesim::ServerLimits& limits = options.limits;
+  limits.max_elements = absl::GetFlag(FLAGS_max_elements);
+  limits.max_steps = absl::GetFlag(FLAGS_max_steps);
+  limits.max_frames = absl::GetFlag(FLAGS_max_frames);
+  limits.max_trajectory_values = absl::GetFlag(FLAGS_max_trajectory_values);
+  limits.max_sweep_items = absl::GetFlag(FLAGS_max_sweep_items);
+  limits.max_streams = absl::GetFlag(FLAGS_max_streams);
+  limits.max_message_bytes = absl::GetFlag(FLAGS_max_message_bytes);
+  limits.stall_timeout = absl::Seconds(absl::GetFlag(FLAGS_stall_timeout_s));
+
+  // Block the shutdown signals in every thread; the main thread waits for
+  // them below.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+
+  absl::StatusOr<std::unique_ptr<cablesim::CablesimServer>> server =
+      cablesim::CablesimServer::Start(options);
+  if (!server.ok()) {
+    std::cerr << "cablesim-server: " << server.status().message() << "\n";
+    return 1;
+  }
+  std::cerr << "cablesim-server: listening on port " << (*server)->port() << " (" << options.listen
+            << "), data in " << options.data_dir << ", " << options.workers << " workers\n";
+  const std::string port_file = absl::GetFlag(FLAGS_port_file);
+  if (!port_file.empty()) {
+    const std::string tmp = port_file + ".tmp";
+    { std::ofstream(tmp) << (*server)->port() << "\n"; }
+    std::rename(tmp.c_str(), port_file.c_str());
+  }
+  int signal = 0;
+  sigwait(&signals, &signal);
+  std::cerr << "cablesim-server: signal " << signal << ", shutting down\n";
+  (*server)->Shutdown(absl::Seconds(absl::GetFlag(FLAGS_shutdown_grace_s)));
+  std::cerr << "cablesim-server: stopped\n";
+  return 0;
+}

@@ -1,0 +1,517 @@
+#include "server/cablesim_service.h"
+
+#include <chrono>
+#include <iostream>
+#include <set>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "convert/run_proto.h"
+#include "server/energy_report.h"
+
+namespace cablesim {
+
+// Holds one of the limited stream slots and registers the stream with the
+// stall watchdog.
+class StreamSlot {
+ public:
+  // `counted`: the stream takes one of the max_streams slots (runs do;
+  // watchers and result downloads only register with the watchdog).
+  StreamSlot(CablesimServiceImpl* service, grpc::ServerContext* context, bool counted = true)
+      : service_(service), watch_{context}, counted_(counted) {
+    acquired_ = !counted_ || service_->streams_.fetch_add(1) < service_->limits_.max_streams;
+    absl::MutexLock lock(&service_->mu_);
+    service_->watched_[&watch_] = true;
+  }
+  ~StreamSlot() {
+    if (counted_) service_->streams_.fetch_sub(1);
+    absl::MutexLock lock(&service_->mu_);
+    service_->watched_.erase(&watch_);
+  }
+  bool acquired() const { return acquired_; }
+  CablesimServiceImpl::StreamWatch* watch() { return &watch_; }
+
+ private:
+  CablesimServiceImpl* service_;
+  CablesimServiceImpl::StreamWatch watch_;
+  const bool counted_;
+  bool acquired_ = false;
+};
+
+namespace {
+
+int64_t NowNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+grpc::Status ToGrpc(const absl::Status& s) {
+  if (s.ok()) return grpc::Status::OK;
+  return grpc::Status(static_cast<grpc::StatusCode>(s.code()), std::string(s.message()));
+}
+
+constexpr int kMaxBatchValues = 128 * 1024;
+
+int BatchSize(int requested) {
+  if (requested <= 0) return 64;
+  return std::min(requested, 4096);
+}
+
+bool Finished(v1::JobState s) {
+  return s == v1::SUCCEEDED || s == v1::FAILED || s == v1::CANCELLED;
+}
+
+// Writes `event`, recording the wait for the watchdog.
+template <typename Message>
+bool TimedWrite(grpc::ServerWriter<Message>* writer, const Message& event,
+                CablesimServiceImpl::StreamWatch* watch) {
+  watch->write_started_ns = NowNs();
+  const bool ok = writer->Write(event);
+  watch->write_started_ns = 0;
+  return ok;
+}
+
+// Streams a run: header, batches of frame rows, (the caller writes the
+// summary).
+class StreamingSink : public FrameSink {
+ public:
+  StreamingSink(grpc::ServerWriter<v1::RunEvent>* writer, CablesimServiceImpl::StreamWatch* watch,
+                int batch, std::string scene_name, double end_time_s)
+      : writer_(writer),
+        watch_(watch),
+        batch_(batch),
+        scene_name_(std::move(scene_name)),
+        end_time_s_(end_time_s) {}
+
+  absl::Status OnStart(const ModelInfo& info) override {
+    v1::RunEvent header;
+    v1::RunHeader* h = header.mutable_header();
+    *h->mutable_info() = ModelInfoToProto(info);
+    for (std::string& c : FrameColumns(info.probe_names)) h->add_columns(std::move(c));
+    h->set_scene_name(scene_name_);
+    h->set_end_time_s(end_time_s_);
+    if (!TimedWrite(writer_, header, watch_)) return Gone();
+    event_.mutable_frames()->mutable_values()->Reserve(batch_ * h->columns_size());
+    return absl::OkStatus();
+  }
+  absl::Status OnFrame(const Frame& frame) override {
+    v1::FrameBatch* b = event_.mutable_frames();
+    AppendFrameRow(frame, b->mutable_values());
+    b->set_rows(b->rows() + 1);
+    // Also bound the message (1 MiB of numbers), whatever the probe count.
+    if (b->rows() >= batch_ || b->values_size() >= kMaxBatchValues) return Flush();
+    return absl::OkStatus();
+  }
+  absl::Status Flush() {
+    v1::FrameBatch* b = event_.mutable_frames();
+    if (b->rows() == 0) return absl::OkStatus();
+    const bool ok = TimedWrite(writer_, event_, watch_);
+    b->set_rows(0);
+    b->mutable_values()->Clear();
+    return ok ? absl::OkStatus() : Gone();
+  }
+  bool gone() const { return gone_; }
+
+ private:
+  absl::Status Gone() {
+    gone_ = true;
+    return absl::CancelledError("the client went away");
+  }
+  grpc::ServerWriter<v1::RunEvent>* writer_;
+  CablesimServiceImpl::StreamWatch* watch_;
+  const int batch_;
+  const std::string scene_name_;
+  const double end_time_s_;
+  v1::RunEvent event_;
+  bool gone_ = false;
+};
+
+// Keeps the rows of a run in memory (GetEnergy of a scene).
+class RowSink : public FrameSink {
+ public:
+  explicit RowSink(StoredResult* result) : result_(result) {}
+  absl::Status OnStart(const ModelInfo& info) override {
+    for (std::string& c : FrameColumns(info.probe_names)) result_->header.add_columns(std::move(c));
+    return absl::OkStatus();
+  }
+  absl::Status OnFrame(const Frame& frame) override {
+    scratch_.Clear();
+    AppendFrameRow(frame, &scratch_);
+    result_->values.insert(result_->values.end(), scratch_.begin(), scratch_.end());
+    return absl::OkStatus();
+  }
+
+ private:
+  StoredResult* result_;
+  google::protobuf::RepeatedField<double> scratch_;
+};
+
+RunControl ControlFor(grpc::ServerContext* context, const ServerLimits& limits) {
+  RunControl control;
+  // ServerContext::IsCancelled polls the call's completion queue (a system
+  // call): at every step it doubled the cost of a small scene. Ask at most
+  // every millisecond instead, so a cancelled or expired call stops at the
+  // first step after that.
+  control.should_stop = [context, next = int64_t{0}]() mutable {
+    const int64_t now = NowNs();
+    if (now < next) return false;
+    next = now + 1'000'000;
+    return context->IsCancelled();
+  };
+  control.max_steps = 2 * limits.max_steps;
+  return control;
+}
+
+}  // namespace
+
+CablesimServiceImpl::CablesimServiceImpl(JobManager* jobs, ServerLimits limits, bool log)
+    : jobs_(jobs), limits_(limits), log_(log) {
+  watchdog_ = std::thread([this] { Watchdog(); });
+}
+
+CablesimServiceImpl::~CablesimServiceImpl() {
+  {
+    absl::MutexLock lock(&mu_);
+    stop_ = true;
+  }
+  watchdog_.join();
+}
+
+void CablesimServiceImpl::Watchdog() {
+  const absl::Duration period =
+      std::clamp(limits_.stall_timeout / 10, absl::Milliseconds(10), absl::Milliseconds(500));
+  const int64_t stall_ns = absl::ToInt64Nanoseconds(limits_.stall_timeout);
+  absl::MutexLock lock(&mu_);
+  while (true) {
+    auto stopping = [this]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) { return stop_; };
+    if (mu_.AwaitWithTimeout(absl::Condition(&stopping), period)) return;
+    const int64_t now = NowNs();
+    for (auto& [watch, unused] : watched_) {
+      const int64_t started = watch->write_started_ns.load();
+      if (started != 0 && now - started > stall_ns) {
+        if (log_)
+          std::cerr << "cablesim-server: cancelling a stream whose client has read nothing for "
+                    << absl::FormatDuration(limits_.stall_timeout) << " (" << watch->context->peer()
+                    << ")\n";
+        watch->context->TryCancel();
+        watch->write_started_ns = 0;
+      }
+    }
+  }
+}
+
+grpc::Status CablesimServiceImpl::NoJobs() const {
+  return grpc::Status(grpc::StatusCode::UNIMPLEMENTED,
+                      "this service has no job store (start cablesim-server with --data-dir)");
+}
+
+grpc::Status CablesimServiceImpl::Validate(grpc::ServerContext*, const v1::ValidateRequest* request,
+                                           v1::ValidateResponse* response) {
+  // Validation only: the limits are not part of the verdict.
+  ServerLimits unlimited;
+  unlimited.max_elements = std::numeric_limits<int>::max();
+  unlimited.max_steps = std::numeric_limits<int64_t>::max();
+  unlimited.max_frames = std::numeric_limits<int64_t>::max();
+  unlimited.max_trajectory_values = std::numeric_limits<int64_t>::max();
+  absl::StatusOr<CheckedScene> checked = CheckScene(request->scene(), unlimited);
+  if (checked.ok()) {
+    response->set_valid(true);
+    *response->mutable_model() = ModelInfoToProto(checked->info);
+    return grpc::Status::OK;
+  }
+  if (checked.status().code() != absl::StatusCode::kInvalidArgument) {
+    return ToGrpc(checked.status());
+  }
+  response->set_valid(false);
+  const std::string message(checked.status().message());
+  v1::FieldError* error = response->add_errors();
+  // Messages read `path: rule` (convert/scene_from_proto.h).
+  const size_t colon = message.find(": ");
+  if (colon != std::string::npos && message.find(' ') >= colon) {
+    error->set_path(message.substr(0, colon));
+    error->set_message(message.substr(colon + 2));
+  } else {
+    error->set_message(message);
+  }
+  return grpc::Status::OK;
+}
+
+grpc::Status CablesimServiceImpl::Run(grpc::ServerContext* context, const v1::RunRequest* request,
+                                      grpc::ServerWriter<v1::RunEvent>* writer) {
+  StreamSlot slot(this, context);
+  if (!slot.acquired()) {
+    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                        absl::StrCat("the server already runs ", limits_.max_streams,
+                                     " streams (max_streams); try again later"));
+  }
+  absl::StatusOr<CheckedScene> checked = CheckScene(request->scene(), limits_);
+  if (!checked.ok()) return ToGrpc(checked.status());
+  StreamingSink sink(writer, slot.watch(), BatchSize(request->frames_per_batch()),
+                     checked->scene.name, checked->end_time_s);
+  absl::StatusOr<RunSummary> summary =
+      RunScene(checked->scene, &sink, ControlFor(context, limits_));
+  if (!summary.ok()) return ToGrpc(summary.status());
+  if (sink.gone() || context->IsCancelled()) {
+    return grpc::Status(grpc::StatusCode::CANCELLED, "the client cancelled or went away");
+  }
+  if (!sink.Flush().ok()) return grpc::Status(grpc::StatusCode::CANCELLED, "the client went away");
+  v1::RunEvent last;
+  *last.mutable_summary() = SummaryToProto(*summary);
+  if (!TimedWrite(writer, last, slot.watch())) {
+    return grpc::Status(grpc::StatusCode::CANCELLED, "the client went away");
+  }
+  return grpc::Status::OK;
+}
+
+grpc::Status CablesimServiceImpl::SubmitJob(grpc::ServerContext*,
+                                            const v1::SubmitJobRequest* request,
+                                            v1::Job* response) {
+  if (jobs_ == nullptr) return NoJobs();
+  absl::StatusOr<v1::Job> job = jobs_->Submit(request->scene());
+  if (!job.ok()) return ToGrpc(job.status());
+  *response = std::move(*job);
+  if (log_) std::cerr << "cablesim-server: job " << response->id() << " queued\n";
+  return grpc::Status::OK;
+}
+
+grpc::Status CablesimServiceImpl::GetJob(grpc::ServerContext*, const v1::GetJobRequest* request,
+                                         v1::Job* response) {
+  if (jobs_ == nullptr) return NoJobs();
+  absl::StatusOr<v1::Job> job = jobs_->Get(request->id());
+  if (!job.ok()) return ToGrpc(job.status());
+  *response = std::move(*job);
+  return grpc::Status::OK;
+}
+
+grpc::Status CablesimServiceImpl::ListJobs(grpc::ServerContext*, const v1::ListJobsRequest* request,
+                                           v1::ListJobsResponse* response) {
+  if (jobs_ == nullptr) return NoJobs();
+  const int limit = request->limit() <= 0 ? 100 : std::min(request->limit(), 10000);
+  absl::StatusOr<std::vector<v1::Job>> jobs =
+      jobs_->store()->ListJobs(request->state(), request->sweep_id(), limit);
+  if (!jobs.ok()) return ToGrpc(jobs.status());
+  for (v1::Job& job : *jobs) {
+    jobs_->AddProgress(&job);
+    *response->add_jobs() = std::move(job);
+  }
+  return grpc::Status::OK;
+}
+
+grpc::Status CablesimServiceImpl::CancelJob(grpc::ServerContext*,
+                                            const v1::CancelJobRequest* request,
+                                            v1::Job* response) {
+  if (jobs_ == nullptr) return NoJobs();
+  absl::StatusOr<v1::Job> job = jobs_->Cancel(request->id());
+  if (!job.ok()) return ToGrpc(job.status());
+  *response = std::move(*job);
+  return grpc::Status::OK;
+}
+
+grpc::Status CablesimServiceImpl::WatchJob(grpc::ServerContext* context,
+                                           const v1::WatchJobRequest* request,
+                                           grpc::ServerWriter<v1::Job>* writer) {
+  if (jobs_ == nullptr) return NoJobs();
+  StreamSlot slot(this, context, /*counted=*/false);
+  std::string last;
+  while (true) {
+    const uint64_t seen = jobs_->version();
+    absl::StatusOr<v1::Job> job = jobs_->Get(request->id());
+    if (!job.ok()) return ToGrpc(job.status());
+    std::string now = job->SerializeAsString();
+    if (now != last) {
+      if (!TimedWrite(writer, *job, slot.watch())) {
+        return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
+      }
+      last = std::move(now);
+    }
+    if (Finished(job->state())) return grpc::Status::OK;
+    if (context->IsCancelled()) return grpc::Status(grpc::StatusCode::CANCELLED, "cancelled");
+    if (jobs_->shutting_down()) {
+      return grpc::Status(grpc::StatusCode::UNAVAILABLE, "the server is shutting down");
+    }
+    jobs_->WaitForChange(seen, absl::Seconds(1));
+  }
+}
+
+grpc::Status CablesimServiceImpl::GetJobResult(grpc::ServerContext* context,
+                                               const v1::GetJobResultRequest* request,
+                                               grpc::ServerWriter<v1::RunEvent>* writer) {
+  if (jobs_ == nullptr) return NoJobs();
+  absl::StatusOr<v1::Job> job = jobs_->Get(request->id());
+  if (!job.ok()) return ToGrpc(job.status());
+  if (!Finished(job->state()) || !job->has_summary()) {
+    return grpc::Status(
+        grpc::StatusCode::FAILED_PRECONDITION,
+        absl::StrCat("job ", job->id(), " is ", v1::JobState_Name(job->state()), ": no result"));
+  }
+  absl::StatusOr<StoredResult> result = jobs_->store()->GetResult(request->id());
+  if (!result.ok()) return ToGrpc(result.status());
+  StreamSlot slot(this, context, /*counted=*/false);
+  v1::RunEvent event;
+  *event.mutable_header() = result->header;
+  event.mutable_header()->set_scene_name(job->name());
+  event.mutable_header()->set_end_time_s(job->end_time_s());
+  if (!TimedWrite(writer, event, slot.watch())) {
+    return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
+  }
+  const size_t columns = std::max(1, result->header.columns_size());
+  const size_t batch = BatchSize(request->frames_per_batch());
+  const size_t rows = result->values.size() / columns;
+  const size_t rows_per_message = std::max<size_t>(1, std::min(batch, kMaxBatchValues / columns));
+  for (size_t r = 0; r < rows; r += rows_per_message) {
+    const size_t n = std::min(rows_per_message, rows - r);
+    event.mutable_frames()->set_rows(static_cast<int>(n));
+    event.mutable_frames()->mutable_values()->Assign(result->values.begin() + r * columns,
+                                                     result->values.begin() + (r + n) * columns);
+    if (!TimedWrite(writer, event, slot.watch())) {
+      return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
+    }
+  }
+  *event.mutable_summary() = job->summary();
+  if (!TimedWrite(writer, event, slot.watch())) {
+    return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
+  }
+  return grpc::Status::OK;
+}
+
+grpc::Status CablesimServiceImpl::GetEnergy(grpc::ServerContext* context,
+                                            const v1::EnergyRequest* request,
+                                            v1::EnergyResponse* response) {
+  if (request->has_scene()) {
+    StreamSlot slot(this, context);
+    if (!slot.acquired()) {
+      return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                          absl::StrCat("the server already runs ", limits_.max_streams,
+                                       " streams (max_streams); try again later"));
+    }
+    absl::StatusOr<CheckedScene> checked = CheckScene(request->scene(), limits_);
+    if (!checked.ok()) return ToGrpc(checked.status());
+    StoredResult result;
+    RowSink sink(&result);
+    absl::StatusOr<RunSummary> summary =
+        RunScene(checked->scene, &sink, ControlFor(context, limits_));
+    if (!summary.ok()) return ToGrpc(summary.status());
+    if (context->IsCancelled()) return grpc::Status(grpc::StatusCode::CANCELLED, "cancelled");
+    *response = EnergyFromTrajectory(result.header, result.values, SummaryToProto(*summary));
+    return grpc::Status::OK;
+  }
+  if (request->job_id().empty()) {
+    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, "source: give job_id or scene");
+  }
+  if (jobs_ == nullptr) return NoJobs();
+  absl::StatusOr<v1::Job> job = jobs_->Get(request->job_id());
+  if (!job.ok()) return ToGrpc(job.status());
+  if (!Finished(job->state()) || !job->has_summary()) {
+    return grpc::Status(
+        grpc::StatusCode::FAILED_PRECONDITION,
+        absl::StrCat("job ", job->id(), " is ", v1::JobState_Name(job->state()), ": no result"));
+  }
+  absl::StatusOr<StoredResult> result = jobs_->store()->GetResult(job->id());
+  if (!result.ok()) return ToGrpc(result.status());
+  *response = EnergyFromTrajectory(result->header, result->values, job->summary());
+  return grpc::Status::OK;
+}
+
+grpc::Status CablesimServiceImpl::SubmitSweep(grpc::ServerContext*,
+                                              const v1::SubmitSweepRequest* request,
+                                              v1::Sweep* response) {
+  if (jobs_ == nullptr) return NoJobs();
+  absl::StatusOr<v1::Sweep> sweep = jobs_->SubmitSweep(*request);
+  if (!sweep.ok()) return ToGrpc(sweep.status());
+  *response = std::move(*sweep);
+  if (log_)
+    std::cerr << "cablesim-server: sweep " << response->id() << " queued (" << response->items()
+              << " items)\n";
+  return grpc::Status::OK;
+}
+
+namespace {
+
+v1::SweepItem ItemOf(JobManager* jobs, const v1::Sweep& sweep, const v1::Job& job) {
+  v1::SweepItem item;
+  item.set_index(job.sweep_index());
+  for (double v : SweepAxisValues(sweep.axes(), job.sweep_index())) item.add_axis_values(v);
+  item.set_job_id(job.id());
+  item.set_state(job.state());
+  if (job.has_summary()) *item.mutable_summary() = job.summary();
+  if (Finished(job.state())) {
+    absl::StatusOr<StoredResult> result = jobs->store()->GetResult(job.id());
+    if (result.ok()) {
+      const size_t columns = std::max(1, result->header.columns_size());
+      if (result->values.size() >= columns) {
+        item.mutable_final_values()->Assign(result->values.end() - columns, result->values.end());
+      }
+      *item.mutable_energy() =
+          EnergyFromTrajectory(result->header, result->values, job.summary()).report();
+    }
+  }
+  return item;
+}
+
+}  // namespace
+
+grpc::Status CablesimServiceImpl::WatchSweep(grpc::ServerContext* context,
+                                             const v1::WatchSweepRequest* request,
+                                             grpc::ServerWriter<v1::SweepEvent>* writer) {
+  if (jobs_ == nullptr) return NoJobs();
+  StreamSlot slot(this, context, /*counted=*/false);
+  std::set<std::string> reported;
+  bool first = true;
+  while (true) {
+    const uint64_t seen = jobs_->version();
+    absl::StatusOr<v1::Sweep> sweep = jobs_->store()->GetSweep(request->id());
+    if (!sweep.ok()) return ToGrpc(sweep.status());
+    absl::StatusOr<std::vector<v1::Job>> items =
+        jobs_->store()->ListJobs(v1::JOB_STATE_UNSPECIFIED, request->id(), sweep->items());
+    if (!items.ok()) return ToGrpc(items.status());
+    if (first) {
+      v1::SweepEvent event;
+      *event.mutable_progress() = *sweep;
+      if (!TimedWrite(writer, event, slot.watch())) {
+        return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
+      }
+      first = false;
+    }
+    // Oldest item first.
+    for (auto it = items->rbegin(); it != items->rend(); ++it) {
+      if (!Finished(it->state()) || reported.count(it->id())) continue;
+      reported.insert(it->id());
+      v1::SweepEvent event;
+      *event.mutable_progress() = *sweep;
+      *event.mutable_item() = ItemOf(jobs_, *sweep, *it);
+      if (!TimedWrite(writer, event, slot.watch())) {
+        return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
+      }
+    }
+    if (sweep->finished() == sweep->items()) return grpc::Status::OK;
+    if (context->IsCancelled()) return grpc::Status(grpc::StatusCode::CANCELLED, "cancelled");
+    if (jobs_->shutting_down()) {
+      return grpc::Status(grpc::StatusCode::UNAVAILABLE, "the server is shutting down");
+    }
+    jobs_->WaitForChange(seen, absl::Seconds(1));
+  }
+}
+
+grpc::Status CablesimServiceImpl::GetSweepResults(grpc::ServerContext*,
+                                                  const v1::GetSweepResultsRequest* request,
+                                                  v1::SweepResults* response) {
+  if (jobs_ == nullptr) return NoJobs();
+  absl::StatusOr<v1::Sweep> sweep = jobs_->store()->GetSweep(request->id());
+  if (!sweep.ok()) return ToGrpc(sweep.status());
+  absl::StatusOr<std::vector<v1::Job>> jobs =
+      jobs_->store()->ListJobs(v1::JOB_STATE_UNSPECIFIED, request->id(), sweep->items());
+  if (!jobs.ok()) return ToGrpc(jobs.status());
+  *response->mutable_sweep() = *sweep;
+  for (auto it = jobs->rbegin(); it != jobs->rend(); ++it) {
+    *response->add_items() = ItemOf(jobs_, *sweep, *it);
+    if (response->final_columns().empty() && Finished(it->state())) {
+      absl::StatusOr<StoredResult> result = jobs_->store()->GetResult(it->id());
+      if (result.ok()) *response->mutable_final_columns() = result->header.columns();
+    }
+  }
+  return grpc::Status::OK;
+}
+
+}  // namespace cablesim

@@ -1,0 +1,85 @@
+#ifndef CABLESIM_SERVER_CABLESIM_SERVICE_H_
+#define CABLESIM_SERVER_CABLESIM_SERVICE_H_
+
+// cablesim.v1.CablesimService (proto/cablesim/v1/service.proto): a thin
+// layer that converts requests, validates them (convert/), checks the
+// server's limits (server/request_checks.h), runs the engine
+// (engine/simulation.h) or hands work to the JobManager, and converts the
+// results back (convert/run_proto.h).
+//
+// Streams honour flow control: the engine runs in the RPC's thread and
+// waits while a frame batch cannot be sent, so a slow reader never makes
+// the server buffer more than one batch; a watchdog cancels a stream whose
+// write has waited longer than the stall timeout.
+
+#include <atomic>
+#include <map>
+#include <memory>
+#include <thread>
+
+#include "absl/synchronization/mutex.h"
+#include "cablesim/v1/service.grpc.pb.h"
+#include "server/job_manager.h"
+#include "server/request_checks.h"
+
+namespace cablesim {
+
+class CablesimServiceImpl final : public v1::CablesimService::Service {
+ public:
+  // `jobs` may be null (an in-process service for `cablesim run`): the job
+  // and sweep calls then answer UNIMPLEMENTED.
+  // `log`: report on stderr.
+  CablesimServiceImpl(JobManager* jobs, ServerLimits limits, bool log = true);
+  ~CablesimServiceImpl() override;
+
+  grpc::Status Validate(grpc::ServerContext* context, const v1::ValidateRequest* request,
+                        v1::ValidateResponse* response) override;
+  grpc::Status Run(grpc::ServerContext* context, const v1::RunRequest* request,
+                   grpc::ServerWriter<v1::RunEvent>* writer) override;
+  grpc::Status SubmitJob(grpc::ServerContext* context, const v1::SubmitJobRequest* request,
+                         v1::Job* response) override;
+  grpc::Status GetJob(grpc::ServerContext* context, const v1::GetJobRequest* request,
+                      v1::Job* response) override;
+  grpc::Status ListJobs(grpc::ServerContext* context, const v1::ListJobsRequest* request,
+                        v1::ListJobsResponse* response) override;
+  grpc::Status CancelJob(grpc::ServerContext* context, const v1::CancelJobRequest* request,
+                         v1::Job* response) override;
+  grpc::Status WatchJob(grpc::ServerContext* context, const v1::WatchJobRequest* request,
+                        grpc::ServerWriter<v1::Job>* writer) override;
+  grpc::Status GetJobResult(grpc::ServerContext* context, const v1::GetJobResultRequest* request,
+                            grpc::ServerWriter<v1::RunEvent>* writer) override;
+  grpc::Status GetEnergy(grpc::ServerContext* context, const v1::EnergyRequest* request,
+                         v1::EnergyResponse* response) override;
+  grpc::Status SubmitSweep(grpc::ServerContext* context, const v1::SubmitSweepRequest* request,
+                           v1::Sweep* response) override;
+  grpc::Status WatchSweep(grpc::ServerContext* context, const v1::WatchSweepRequest* request,
+                          grpc::ServerWriter<v1::SweepEvent>* writer) override;
+  grpc::Status GetSweepResults(grpc::ServerContext* context,
+                               const v1::GetSweepResultsRequest* request,
+                               v1::SweepResults* response) override;
+
+  // Tracks one stream's writes for the stall watchdog.
+  struct StreamWatch {
+    grpc::ServerContext* context;
+    std::atomic<int64_t> write_started_ns{0};  // 0: not writing
+  };
+
+ private:
+  grpc::Status NoJobs() const;
+  void Watchdog();
+
+  JobManager* jobs_;
+  const ServerLimits limits_;
+  const bool log_;
+  std::atomic<int> streams_{0};
+  absl::Mutex mu_;
+  std::map<StreamWatch*, bool> watched_ ABSL_GUARDED_BY(mu_);
+  bool stop_ ABSL_GUARDED_BY(mu_) = false;
+  std::thread watchdog_;
+
+  friend class StreamSlot;
+};
+
+}  // namespace cablesim
+
+#endif  // CABLESIM_SERVER_CABLESIM_SERVICE_H_

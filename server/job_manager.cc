@@ -1,0 +1,241 @@
+#include "server/job_manager.h"
+
+#include <iostream>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "convert/run_proto.h"
+#include "convert/scene_from_proto.h"
+
+namespace cablesim {
+namespace {
+
+// Keeps a job's frames in memory as rows and reports progress.
+class CollectingSink : public FrameSink {
+ public:
+  CollectingSink(StoredResult* result, std::function<void(double)> progress)
+      : result_(result), progress_(std::move(progress)) {}
+  absl::Status OnStart(const ModelInfo& info) override {
+    *result_->header.mutable_info() = ModelInfoToProto(info);
+    for (std::string& c : FrameColumns(info.probe_names)) result_->header.add_columns(std::move(c));
+    probes_ = static_cast<int>(info.probe_names.size());
+    return absl::OkStatus();
+  }
+  absl::Status OnFrame(const Frame& frame) override {
+    scratch_.Clear();
+    AppendFrameRow(frame, &scratch_);
+    result_->values.insert(result_->values.end(), scratch_.begin(), scratch_.end());
+    progress_(frame.t);
+    return absl::OkStatus();
+  }
+
+ private:
+  StoredResult* result_;
+  std::function<void(double)> progress_;
+  google::protobuf::RepeatedField<double> scratch_;
+  int probes_ = 0;
+};
+
+v1::JobState StateOf(const RunSummary& s) {
+  if (s.status == "ok") return v1::SUCCEEDED;
+  if (s.status == "cancelled") return v1::CANCELLED;
+  return v1::FAILED;
+}
+
+}  // namespace
+
+JobManager::JobManager(JobStore* store, int workers, ServerLimits limits, bool log)
+    : store_(store), workers_(std::max(1, workers)), limits_(limits), log_(log) {}
+
+JobManager::~JobManager() { Shutdown(); }
+
+absl::Status JobManager::Start() {
+  absl::StatusOr<int> requeued = store_->RequeueRunning();
+  if (!requeued.ok()) return requeued.status();
+  absl::StatusOr<std::vector<std::string>> queued = store_->QueuedJobIds();
+  if (!queued.ok()) return queued.status();
+  if (log_ && (*requeued > 0 || !queued->empty())) {
+    std::cerr << "cablesim-server: " << queued->size() << " queued jobs (" << *requeued
+              << " interrupted and requeued)\n";
+  }
+  {
+    absl::MutexLock lock(&mu_);
+    for (const std::string& id : *queued) queue_.push_back(id);
+  }
+  for (int i = 0; i < workers_; ++i) threads_.emplace_back([this] { Work(); });
+  return absl::OkStatus();
+}
+
+void JobManager::Shutdown() {
+  {
+    absl::MutexLock lock(&mu_);
+    if (stopping_ && threads_.empty()) return;
+    stopping_ = true;
+    for (auto& [id, r] : running_) r->stop = 2;
+    ++version_;
+  }
+  for (std::thread& t : threads_) t.join();
+  threads_.clear();
+}
+
+uint64_t JobManager::version() {
+  absl::MutexLock lock(&mu_);
+  return version_;
+}
+
+bool JobManager::shutting_down() {
+  absl::MutexLock lock(&mu_);
+  return stopping_;
+}
+
+void JobManager::WaitForChange(uint64_t seen, absl::Duration timeout) {
+  absl::MutexLock lock(&mu_);
+  auto changed = [&]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) { return version_ > seen || stopping_; };
+  mu_.AwaitWithTimeout(absl::Condition(&changed), timeout);
+}
+
+void JobManager::Changed() {
+  absl::MutexLock lock(&mu_);
+  ++version_;
+}
+
+void JobManager::Enqueue(const std::string& id) {
+  absl::MutexLock lock(&mu_);
+  queue_.push_back(id);
+  ++version_;
+}
+
+absl::StatusOr<v1::Job> JobManager::Submit(const v1::Scene& scene) {
+  absl::StatusOr<CheckedScene> checked = CheckScene(scene, limits_);
+  if (!checked.ok()) return checked.status();
+  absl::StatusOr<v1::Job> job = store_->InsertJob(scene, checked->end_time_s);
+  if (!job.ok()) return job.status();
+  Enqueue(job->id());
+  return job;
+}
+
+absl::StatusOr<v1::Sweep> JobManager::SubmitSweep(const v1::SubmitSweepRequest& request) {
+  std::vector<double> end_times;
+  absl::StatusOr<std::vector<v1::Scene>> items = ExpandSweep(request, limits_, &end_times);
+  if (!items.ok()) return items.status();
+  absl::StatusOr<v1::Sweep> sweep = store_->InsertSweep(request, *items, end_times);
+  if (!sweep.ok()) return sweep.status();
+  absl::MutexLock lock(&mu_);
+  for (const std::string& id : sweep->job_ids()) queue_.push_back(id);
+  ++version_;
+  return sweep;
+}
+
+absl::StatusOr<v1::Job> JobManager::Cancel(const std::string& id) {
+  {
+    absl::MutexLock lock(&mu_);
+    if (auto it = running_.find(id); it != running_.end()) it->second->stop = 1;
+  }
+  absl::StatusOr<bool> cancelled = store_->CancelQueued(id);
+  if (!cancelled.ok()) return cancelled.status();
+  Changed();
+  return Get(id);
+}
+
+absl::StatusOr<v1::Job> JobManager::Get(const std::string& id) {
+  absl::StatusOr<v1::Job> job = store_->GetJob(id);
+  if (job.ok()) AddProgress(&*job);
+  return job;
+}
+
+void JobManager::AddProgress(v1::Job* job) {
+  if (job->state() == v1::SUCCEEDED || job->state() == v1::FAILED) {
+    job->set_progress_time_s(job->summary().end_time_s());
+    return;
+  }
+  absl::MutexLock lock(&mu_);
+  if (auto it = running_.find(job->id()); it != running_.end()) {
+    job->set_progress_time_s(it->second->t.load());
+  }
+}
+
+void JobManager::Work() {
+  while (true) {
+    std::string id;
+    {
+      absl::MutexLock lock(&mu_);
+      auto ready = [&]()
+                       ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) { return stopping_ || !queue_.empty(); };
+      mu_.Await(absl::Condition(&ready));
+      if (stopping_) return;
+      id = queue_.front();
+      queue_.pop_front();
+    }
+    RunOne(id);
+  }
+}
+
+void JobManager::RunOne(const std::string& id) {
+  auto running = std::make_shared<Running>();
+  {
+    absl::MutexLock lock(&mu_);
+    if (stopping_) return;
+    running_[id] = running;
+  }
+  auto forget = [&] {
+    absl::MutexLock lock(&mu_);
+    running_.erase(id);
+    ++version_;
+  };
+  absl::StatusOr<bool> claimed = store_->MarkRunning(id);
+  if (!claimed.ok() || !*claimed) {  // cancelled meanwhile, or already run
+    if (!claimed.ok() && log_)
+      std::cerr << "cablesim-server: " << id << ": " << claimed.status() << "\n";
+    forget();
+    return;
+  }
+  Changed();
+  StoredResult result;
+  RunSummary summary;
+  absl::StatusOr<v1::Scene> proto = store_->GetScene(id);
+  absl::StatusOr<Scene> scene =
+      proto.ok() ? SceneFromProto(*proto) : absl::StatusOr<Scene>(proto.status());
+  if (scene.ok()) {
+    absl::Time last_report = absl::InfinitePast();
+    CollectingSink sink(&result, [&](double t) {
+      running->t = t;
+      const absl::Time now = absl::Now();
+      if (now - last_report > absl::Milliseconds(200)) {
+        last_report = now;
+        Changed();
+      }
+    });
+    RunControl control;
+    control.should_stop = [&] { return running->stop.load() != 0; };
+    // Rejected steps count too: allow the nominal limit twice over.
+    control.max_steps = 2 * limits_.max_steps;
+    absl::StatusOr<RunSummary> ran = RunScene(*scene, &sink, control);
+    if (ran.ok()) {
+      summary = std::move(*ran);
+    } else {
+      summary.status = "failed";
+      summary.error = std::string(ran.status().message());
+    }
+  } else {
+    summary.status = "failed";
+    summary.error = std::string(scene.status().message());
+  }
+  if (running->stop.load() == 2) {
+    // Shutdown: leave the job for the next start.
+    if (absl::Status s = store_->Requeue(id); !s.ok()) {
+      if (log_) std::cerr << "cablesim-server: " << id << ": " << s << "\n";
+    }
+    forget();
+    return;
+  }
+  const v1::JobState state = StateOf(summary);
+  absl::StatusOr<bool> finished = store_->Finish(id, state, SummaryToProto(summary), result);
+  if (!finished.ok() && log_)
+    std::cerr << "cablesim-server: " << id << ": " << finished.status() << "\n";
+  if (log_)
+    std::cerr << "cablesim-server: job " << id << " " << v1::JobState_Name(state) << " ("
+              << summary.frames << " frames, " << summary.wall_seconds << " s)\n";
+  forget();
+}
+
+}  // namespace cablesim

@@ -1,0 +1,79 @@
+#ifndef CABLESIM_SERVER_JOB_MANAGER_H_
+#define CABLESIM_SERVER_JOB_MANAGER_H_
+
+// Runs the durable jobs of a JobStore on a pool of worker threads, oldest
+// first. Cancelling a running job stops it at its next step (through the
+// engine's RunControl); shutting down stops running jobs the same way but
+// puts them back to QUEUED, so they run again after a restart. Watchers
+// wait for changes (a job's state, or its progress at most every 200 ms).
+
+#include <atomic>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "absl/synchronization/mutex.h"
+#include "absl/time/time.h"
+#include "server/job_store.h"
+#include "server/request_checks.h"
+
+namespace cablesim {
+
+class JobManager {
+ public:
+  // `store` must outlive the manager.
+  // `log`: report jobs on stderr.
+  JobManager(JobStore* store, int workers, ServerLimits limits, bool log = true);
+  ~JobManager();  // Shutdown()
+
+  // Requeues jobs interrupted by a crash and starts the workers.
+  absl::Status Start();
+  // Stops the workers; running jobs go back to QUEUED. Idempotent.
+  void Shutdown();
+
+  absl::StatusOr<v1::Job> Submit(const v1::Scene& scene);
+  absl::StatusOr<v1::Sweep> SubmitSweep(const v1::SubmitSweepRequest& request);
+  absl::StatusOr<v1::Job> Cancel(const std::string& id);
+  // The stored job with the progress of a running one.
+  absl::StatusOr<v1::Job> Get(const std::string& id);
+  void AddProgress(v1::Job* job);
+
+  // A counter that grows at every change; WaitForChange returns when it
+  // exceeds `seen`, after `timeout`, or at shutdown.
+  uint64_t version();
+  void WaitForChange(uint64_t seen, absl::Duration timeout);
+  bool shutting_down();
+
+  JobStore* store() { return store_; }
+  const ServerLimits& limits() const { return limits_; }
+
+ private:
+  struct Running {
+    std::atomic<int> stop{0};  // 1 cancel, 2 shutdown
+    std::atomic<double> t{0};
+  };
+  void Enqueue(const std::string& id);
+  void Work();
+  void RunOne(const std::string& id);
+  void Changed();
+
+  JobStore* store_;
+  const int workers_;
+  const ServerLimits limits_;
+  const bool log_;
+  absl::Mutex mu_;
+  std::deque<std::string> queue_ ABSL_GUARDED_BY(mu_);
+  std::map<std::string, std::shared_ptr<Running>> running_ ABSL_GUARDED_BY(mu_);
+  uint64_t version_ ABSL_GUARDED_BY(mu_) = 0;
+  bool stopping_ ABSL_GUARDED_BY(mu_) = false;
+  std::vector<std::thread> threads_;
+};
+
+}  // namespace cablesim
+
+#endif  // CABLESIM_SERVER_JOB_MANAGER_H_

@@ -1,0 +1,429 @@
+#include "server/job_store.h"
+
+#include <fcntl.h>
+#include <sqlite3.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <utility>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+
+namespace cablesim {
+namespace {
+
+constexpr char kSchema[] = R"sql(
+CREATE TABLE IF NOT EXISTS sweeps (
+  seq INTEGER PRIMARY KEY AUTOINCREMENT,
+  name TEXT NOT NULL,
+  axes BLOB NOT NULL,           -- cablesim.v1.Sweep with only the axes
+  created_ms INTEGER NOT NULL);
+CREATE TABLE IF NOT EXISTS jobs (
+  seq INTEGER PRIMARY KEY AUTOINCREMENT,
+  state INTEGER NOT NULL,       -- cablesim.v1.JobState
+  name TEXT NOT NULL,
+  scene BLOB NOT NULL,          -- cablesim.v1.Scene
+  end_time_s REAL NOT NULL,
+  created_ms INTEGER NOT NULL,
+  started_ms INTEGER NOT NULL DEFAULT 0,
+  finished_ms INTEGER NOT NULL DEFAULT 0,
+  attempts INTEGER NOT NULL DEFAULT 0,
+  summary BLOB,                 -- cablesim.v1.RunSummary once finished
+  sweep_seq INTEGER NOT NULL DEFAULT 0,
+  sweep_index INTEGER NOT NULL DEFAULT 0);
+CREATE INDEX IF NOT EXISTS jobs_by_state ON jobs(state, seq);
+CREATE INDEX IF NOT EXISTS jobs_by_sweep ON jobs(sweep_seq, sweep_index);
+CREATE TABLE IF NOT EXISTS results (
+  job_seq INTEGER PRIMARY KEY REFERENCES jobs(seq),
+  header BLOB NOT NULL,         -- cablesim.v1.RunHeader
+  vals BLOB NOT NULL);          -- row-major doubles, native byte order
+)sql";
+
+// One prepared statement; finalized on destruction.
+class Stmt {
+ public:
+  Stmt(sqlite3* db, const char* sql) : db_(db) {
+    rc_ = sqlite3_prepare_v2(db, sql, -1, &stmt_, nullptr);
+  }
+  ~Stmt() { sqlite3_finalize(stmt_); }
+  absl::Status status() const {
+    return rc_ == SQLITE_OK ? absl::OkStatus()
+                            : absl::InternalError(absl::StrCat("sqlite: ", sqlite3_errmsg(db_)));
+  }
+  Stmt& Bind(int i, int64_t v) {
+    sqlite3_bind_int64(stmt_, i, v);
+    return *this;
+  }
+  Stmt& Bind(int i, double v) {
+    sqlite3_bind_double(stmt_, i, v);
+    return *this;
+  }
+  Stmt& Bind(int i, const std::string& v) {
+    sqlite3_bind_text(stmt_, i, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT);
+    return *this;
+  }
+  // An empty blob (never NULL, even when `data` is null).
+  Stmt& BindBlob(int i, const void* data, size_t bytes) {
+    static const char kEmpty = 0;
+    sqlite3_bind_blob64(stmt_, i, data != nullptr ? data : &kEmpty, bytes, SQLITE_TRANSIENT);
+    return *this;
+  }
+  // SQLITE_ROW, SQLITE_DONE or an error code.
+  int Step() { return stmt_ ? sqlite3_step(stmt_) : rc_; }
+  absl::Status Done() {
+    const int rc = Step();
+    if (rc == SQLITE_DONE || rc == SQLITE_ROW) return absl::OkStatus();
+    return absl::InternalError(absl::StrCat("sqlite: ", sqlite3_errmsg(db_)));
+  }
+  int64_t Int(int c) { return sqlite3_column_int64(stmt_, c); }
+  double Real(int c) { return sqlite3_column_double(stmt_, c); }
+  std::string Text(int c) {
+    const auto* p = sqlite3_column_text(stmt_, c);
+    return p ? std::string(reinterpret_cast<const char*>(p), sqlite3_column_bytes(stmt_, c)) : "";
+  }
+  std::string Blob(int c) {
+    const void* p = sqlite3_column_blob(stmt_, c);
+    return p ? std::string(static_cast<const char*>(p), sqlite3_column_bytes(stmt_, c)) : "";
+  }
+
+ private:
+  sqlite3* db_;
+  sqlite3_stmt* stmt_ = nullptr;
+  int rc_;
+};
+
+absl::Status SqlError(sqlite3* db) {
+  return absl::InternalError(absl::StrCat("sqlite: ", sqlite3_errmsg(db)));
+}
+
+constexpr char kJobColumns[] =
+    "seq, state, name, created_ms, started_ms, finished_ms, attempts, end_time_s, summary, "
+    "sweep_seq, sweep_index";
+
+v1::Job JobFromRow(Stmt& s) {
+  v1::Job job;
+  job.set_id(JobId(s.Int(0)));
+  job.set_state(static_cast<v1::JobState>(s.Int(1)));
+  job.set_name(s.Text(2));
+  job.set_created_unix_ms(s.Int(3));
+  job.set_started_unix_ms(s.Int(4));
+  job.set_finished_unix_ms(s.Int(5));
+  job.set_attempts(static_cast<int>(s.Int(6)));
+  job.set_end_time_s(s.Real(7));
+  const std::string summary = s.Blob(8);
+  if (!summary.empty()) job.mutable_summary()->ParseFromString(summary);
+  if (s.Int(9) > 0) {
+    job.set_sweep_id(SweepId(s.Int(9)));
+    job.set_sweep_index(static_cast<int>(s.Int(10)));
+  }
+  return job;
+}
+
+std::vector<double> DoublesFromBlob(const std::string& blob) {
+  std::vector<double> v(blob.size() / sizeof(double));
+  if (!v.empty()) std::memcpy(v.data(), blob.data(), v.size() * sizeof(double));
+  return v;
+}
+
+int64_t SeqFromId(const std::string& id, char prefix) {
+  int64_t seq = -1;
+  if (id.size() < 3 || id[0] != prefix || id[1] != '-' ||
+      !absl::SimpleAtoi(absl::string_view(id).substr(2), &seq) || seq <= 0) {
+    return -1;
+  }
+  return seq;
+}
+
+}  // namespace
+
+std::string JobId(int64_t seq) { return absl::StrFormat("j-%06d", seq); }
+int64_t JobSeq(const std::string& id) { return SeqFromId(id, 'j'); }
+std::string SweepId(int64_t seq) { return absl::StrFormat("s-%06d", seq); }
+int64_t SweepSeq(const std::string& id) { return SeqFromId(id, 's'); }
+int64_t NowUnixMs() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+absl::StatusOr<std::unique_ptr<JobStore>> JobStore::Open(const std::string& dir) {
+  const std::string lock_path = absl::StrCat(dir, "/lock");
+  const int lock_fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (lock_fd < 0) {
+    return absl::UnavailableError(absl::StrCat(lock_path, ": ", std::strerror(errno)));
+  }
+  if (::flock(lock_fd, LOCK_EX | LOCK_NB) != 0) {
+    ::close(lock_fd);
+    return absl::FailedPreconditionError(
+        absl::StrCat(dir, ": in use by another cablesim-server (", lock_path, " is locked)"));
+  }
+  const std::string path = absl::StrCat(dir, "/cablesim.db");
+  sqlite3* db = nullptr;
+  if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr) !=
+      SQLITE_OK) {
+    const std::string message = db ? sqlite3_errmsg(db) : "out of memory";
+    sqlite3_close(db);
+    ::close(lock_fd);
+    return absl::UnavailableError(absl::StrCat(path, ": ", message));
+  }
+  std::unique_ptr<JobStore> store(new JobStore(db, lock_fd));
+  sqlite3_busy_timeout(db, 5000);
+  // WAL: readers do not block the writer; synchronous=FULL: a committed
+  // transaction is on disk before the call returns.
+  for (const char* sql :
+       {"PRAGMA journal_mode=WAL", "PRAGMA synchronous=FULL", "PRAGMA foreign_keys=ON", kSchema}) {
+    if (absl::Status s = store->Exec(sql); !s.ok()) {
+      return absl::UnavailableError(absl::StrCat(path, ": ", s.message()));
+    }
+  }
+  return store;
+}
+
+JobStore::~JobStore() {
+  sqlite3_close(db_);
+  ::close(lock_fd_);  // releases the lock
+}
+
+absl::Status JobStore::Exec(const char* sql) {
+  char* error = nullptr;
+  if (sqlite3_exec(db_, sql, nullptr, nullptr, &error) != SQLITE_OK) {
+    absl::Status s = absl::InternalError(absl::StrCat("sqlite: ", error ? error : "error"));
+    sqlite3_free(error);
+    return s;
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<int> JobStore::RequeueRunning() {
+  absl::MutexLock lock(&mu_);
+  Stmt s(db_, "UPDATE jobs SET state = ?1 WHERE state = ?2");
+  s.Bind(1, int64_t{v1::QUEUED}).Bind(2, int64_t{v1::RUNNING});
+  if (absl::Status st = s.Done(); !st.ok()) return st;
+  return sqlite3_changes(db_);
+}
+
+absl::StatusOr<v1::Job> JobStore::InsertJob(const v1::Scene& scene, double end_time_s) {
+  int64_t seq;
+  {
+    absl::MutexLock lock(&mu_);
+    Stmt s(db_,
+           "INSERT INTO jobs (state, name, scene, end_time_s, created_ms) VALUES (?1,?2,?3,?4,?5)");
+    const std::string blob = scene.SerializeAsString();
+    s.Bind(1, int64_t{v1::QUEUED})
+        .Bind(2, scene.name())
+        .BindBlob(3, blob.data(), blob.size())
+        .Bind(4, end_time_s)
+        .Bind(5, NowUnixMs());
+    if (absl::Status st = s.Done(); !st.ok()) return st;
+    seq = sqlite3_last_insert_rowid(db_);
+  }
+  return GetJob(JobId(seq));
+}
+
+absl::StatusOr<v1::Sweep> JobStore::InsertSweep(const v1::SubmitSweepRequest& request,
+                                                const std::vector<v1::Scene>& items,
+                                                const std::vector<double>& end_times_s) {
+  int64_t sweep_seq;
+  {
+    absl::MutexLock lock(&mu_);
+    if (absl::Status st = Exec("BEGIN IMMEDIATE"); !st.ok()) return st;
+    auto rollback = [&](absl::Status st) {
+      Exec("ROLLBACK").IgnoreError();
+      return st;
+    };
+    v1::Sweep axes;
+    *axes.mutable_axes() = request.axes();
+    const std::string axes_blob = axes.SerializeAsString();
+    const int64_t now = NowUnixMs();
+    {
+      Stmt s(db_, "INSERT INTO sweeps (name, axes, created_ms) VALUES (?1, ?2, ?3)");
+      s.Bind(1, request.name()).BindBlob(2, axes_blob.data(), axes_blob.size()).Bind(3, now);
+      if (absl::Status st = s.Done(); !st.ok()) return rollback(st);
+      sweep_seq = sqlite3_last_insert_rowid(db_);
+    }
+    for (size_t i = 0; i < items.size(); ++i) {
+      Stmt s(db_,
+             "INSERT INTO jobs (state, name, scene, end_time_s, created_ms, sweep_seq, "
+             "sweep_index) VALUES (?1,?2,?3,?4,?5,?6,?7)");
+      const std::string blob = items[i].SerializeAsString();
+      s.Bind(1, int64_t{v1::QUEUED})
+          .Bind(2, items[i].name())
+          .BindBlob(3, blob.data(), blob.size())
+          .Bind(4, end_times_s[i])
+          .Bind(5, now)
+          .Bind(6, sweep_seq)
+          .Bind(7, static_cast<int64_t>(i));
+      if (absl::Status st = s.Done(); !st.ok()) return rollback(st);
+    }
+    if (absl::Status st = Exec("COMMIT"); !st.ok()) return rollback(st);
+  }
+  return GetSweep(SweepId(sweep_seq));
+}
+
+absl::StatusOr<v1::Job> JobStore::GetJob(const std::string& id) {
+  const int64_t seq = JobSeq(id);
+  absl::MutexLock lock(&mu_);
+  Stmt s(db_, absl::StrCat("SELECT ", kJobColumns, " FROM jobs WHERE seq = ?1").c_str());
+  s.Bind(1, seq);
+  const int rc = s.Step();
+  if (rc == SQLITE_ROW) return JobFromRow(s);
+  if (rc == SQLITE_DONE) return absl::NotFoundError(absl::StrCat("no job \"", id, "\""));
+  return SqlError(db_);
+}
+
+absl::StatusOr<v1::Scene> JobStore::GetScene(const std::string& id) {
+  absl::MutexLock lock(&mu_);
+  Stmt s(db_, "SELECT scene FROM jobs WHERE seq = ?1");
+  s.Bind(1, JobSeq(id));
+  const int rc = s.Step();
+  if (rc == SQLITE_DONE) return absl::NotFoundError(absl::StrCat("no job \"", id, "\""));
+  if (rc != SQLITE_ROW) return SqlError(db_);
+  v1::Scene scene;
+  if (!scene.ParseFromString(s.Blob(0))) return absl::DataLossError("stored scene unreadable");
+  return scene;
+}
+
+absl::StatusOr<std::vector<v1::Job>> JobStore::ListJobs(v1::JobState state,
+                                                        const std::string& sweep_id, int limit) {
+  absl::MutexLock lock(&mu_);
+  Stmt s(db_, absl::StrCat("SELECT ", kJobColumns,
+                           " FROM jobs WHERE (?1 = 0 OR state = ?1) AND (?2 = 0 OR sweep_seq = ?2)"
+                           " ORDER BY seq DESC LIMIT ?3")
+                  .c_str());
+  s.Bind(1, int64_t{state})
+      .Bind(2, sweep_id.empty() ? 0 : SweepSeq(sweep_id))
+      .Bind(3, int64_t{limit});
+  std::vector<v1::Job> jobs;
+  int rc;
+  while ((rc = s.Step()) == SQLITE_ROW) jobs.push_back(JobFromRow(s));
+  if (rc != SQLITE_DONE) return SqlError(db_);
+  return jobs;
+}
+
+absl::StatusOr<std::vector<std::string>> JobStore::QueuedJobIds() {
+  absl::MutexLock lock(&mu_);
+  Stmt s(db_, "SELECT seq FROM jobs WHERE state = ?1 ORDER BY seq");
+  s.Bind(1, int64_t{v1::QUEUED});
+  std::vector<std::string> ids;
+  int rc;
+  while ((rc = s.Step()) == SQLITE_ROW) ids.push_back(JobId(s.Int(0)));
+  if (rc != SQLITE_DONE) return SqlError(db_);
+  return ids;
+}
+
+absl::StatusOr<bool> JobStore::MarkRunning(const std::string& id) {
+  absl::MutexLock lock(&mu_);
+  Stmt s(db_,
+         "UPDATE jobs SET state = ?1, started_ms = ?2, attempts = attempts + 1 "
+         "WHERE seq = ?3 AND state = ?4");
+  s.Bind(1, int64_t{v1::RUNNING})
+      .Bind(2, NowUnixMs())
+      .Bind(3, JobSeq(id))
+      .Bind(4, int64_t{v1::QUEUED});
+  if (absl::Status st = s.Done(); !st.ok()) return st;
+  return sqlite3_changes(db_) == 1;
+}
+
+absl::Status JobStore::Requeue(const std::string& id) {
+  absl::MutexLock lock(&mu_);
+  Stmt s(db_, "UPDATE jobs SET state = ?1 WHERE seq = ?2 AND state = ?3");
+  s.Bind(1, int64_t{v1::QUEUED}).Bind(2, JobSeq(id)).Bind(3, int64_t{v1::RUNNING});
+  return s.Done();
+}
+
+absl::StatusOr<bool> JobStore::CancelQueued(const std::string& id) {
+  absl::MutexLock lock(&mu_);
+  Stmt s(db_, "UPDATE jobs SET state = ?1, finished_ms = ?2 WHERE seq = ?3 AND state = ?4");
+  s.Bind(1, int64_t{v1::CANCELLED})
+      .Bind(2, NowUnixMs())
+      .Bind(3, JobSeq(id))
+      .Bind(4, int64_t{v1::QUEUED});
+  if (absl::Status st = s.Done(); !st.ok()) return st;
+  return sqlite3_changes(db_) == 1;
+}
+
+absl::StatusOr<bool> JobStore::Finish(const std::string& id, v1::JobState state,
+                                      const v1::RunSummary& summary, const StoredResult& result) {
+  const int64_t seq = JobSeq(id);
+  const std::string summary_blob = summary.SerializeAsString();
+  const std::string header_blob = result.header.SerializeAsString();
+  absl::MutexLock lock(&mu_);
+  if (absl::Status st = Exec("BEGIN IMMEDIATE"); !st.ok()) return st;
+  auto rollback = [&](absl::Status st) {
+    Exec("ROLLBACK").IgnoreError();
+    return st;
+  };
+  Stmt u(db_,
+         "UPDATE jobs SET state = ?1, finished_ms = ?2, summary = ?3 WHERE seq = ?4 AND "
+         "state = ?5");
+  u.Bind(1, int64_t{state})
+      .Bind(2, NowUnixMs())
+      .BindBlob(3, summary_blob.data(), summary_blob.size())
+      .Bind(4, seq)
+      .Bind(5, int64_t{v1::RUNNING});
+  if (absl::Status st = u.Done(); !st.ok()) return rollback(st);
+  if (sqlite3_changes(db_) != 1) {
+    Exec("ROLLBACK").IgnoreError();
+    return false;
+  }
+  Stmt r(db_, "INSERT OR REPLACE INTO results (job_seq, header, vals) VALUES (?1,?2,?3)");
+  r.Bind(1, seq)
+      .BindBlob(2, header_blob.data(), header_blob.size())
+      .BindBlob(3, result.values.data(), result.values.size() * sizeof(double));
+  if (absl::Status st = r.Done(); !st.ok()) return rollback(st);
+  if (absl::Status st = Exec("COMMIT"); !st.ok()) return rollback(st);
+  return true;
+}
+
+absl::StatusOr<StoredResult> JobStore::GetResult(const std::string& id) {
+  absl::MutexLock lock(&mu_);
+  Stmt s(db_, "SELECT header, vals FROM results WHERE job_seq = ?1");
+  s.Bind(1, JobSeq(id));
+  const int rc = s.Step();
+  if (rc == SQLITE_DONE) return absl::NotFoundError(absl::StrCat("job \"", id, "\" has no result"));
+  if (rc != SQLITE_ROW) return SqlError(db_);
+  StoredResult result;
+  result.header.ParseFromString(s.Blob(0));
+  result.values = DoublesFromBlob(s.Blob(1));
+  return result;
+}
+
+absl::StatusOr<v1::Sweep> JobStore::GetSweep(const std::string& id) {
+  const int64_t seq = SweepSeq(id);
+  absl::MutexLock lock(&mu_);
+  v1::Sweep sweep;
+  {
+    Stmt s(db_, "SELECT name, axes, created_ms FROM sweeps WHERE seq = ?1");
+    s.Bind(1, seq);
+    const int rc = s.Step();
+    if (rc == SQLITE_DONE) return absl::NotFoundError(absl::StrCat("no sweep \"", id, "\""));
+    if (rc != SQLITE_ROW) return SqlError(db_);
+    sweep.ParseFromString(s.Blob(1));
+    sweep.set_id(id);
+    sweep.set_name(s.Text(0));
+    sweep.set_created_unix_ms(s.Int(2));
+  }
+  Stmt s(db_, "SELECT seq, state FROM jobs WHERE sweep_seq = ?1 ORDER BY sweep_index");
+  s.Bind(1, seq);
+  int rc;
+  int items = 0, finished = 0, failed = 0;
+  while ((rc = s.Step()) == SQLITE_ROW) {
+    ++items;
+    sweep.add_job_ids(JobId(s.Int(0)));
+    const auto state = static_cast<v1::JobState>(s.Int(1));
+    if (state == v1::SUCCEEDED || state == v1::FAILED || state == v1::CANCELLED) ++finished;
+    if (state == v1::FAILED || state == v1::CANCELLED) ++failed;
+  }
+  if (rc != SQLITE_DONE) return SqlError(db_);
+  sweep.set_items(items);
+  sweep.set_finished(finished);
+  sweep.set_failed(failed);
+  return sweep;
+}
+
+}  // namespace cablesim

@@ -1,0 +1,96 @@
+#ifndef CABLESIM_SERVER_JOB_STORE_H_
+#define CABLESIM_SERVER_JOB_STORE_H_
+
+// Durable jobs, sweeps and results in one SQLite database
+// (DIR/cablesim.db, write-ahead log, synchronous=FULL): a job is stored
+// before its id is returned, and a job's result and its final state are
+// written in one transaction, so after `kill -9` and a restart every
+// accepted job is either finished with its result or runs again, never
+// both. Thread-safe (one connection behind a mutex).
+//
+// One server per directory: Open takes an exclusive lock on DIR/lock (the
+// kernel drops it when the process dies, even by kill -9), so two servers
+// can never run the same job.
+//
+// Ids: job `j-NNNNNN`, sweep `s-NNNNNN` (the row numbers).
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "absl/synchronization/mutex.h"
+#include "cablesim/v1/service.pb.h"
+
+struct sqlite3;
+
+namespace cablesim {
+
+// A finished job's trajectory: the header (columns) and the rows.
+struct StoredResult {
+  v1::RunHeader header;
+  std::vector<double> values;  // row-major, header.columns_size() per row
+};
+
+class JobStore {
+ public:
+  // Opens (creating if needed) DIR/cablesim.db; DIR must exist.
+  static absl::StatusOr<std::unique_ptr<JobStore>> Open(const std::string& dir);
+  ~JobStore();
+
+  // Puts jobs left RUNNING by a crash or shutdown back to QUEUED; returns
+  // how many.
+  absl::StatusOr<int> RequeueRunning();
+
+  // Stores a QUEUED job for `scene`, `end_time_s` the run's end (progress).
+  absl::StatusOr<v1::Job> InsertJob(const v1::Scene& scene, double end_time_s);
+  // Stores the sweep and its item jobs in one transaction.
+  absl::StatusOr<v1::Sweep> InsertSweep(const v1::SubmitSweepRequest& request,
+                                        const std::vector<v1::Scene>& items,
+                                        const std::vector<double>& end_times_s);
+
+  absl::StatusOr<v1::Job> GetJob(const std::string& id);
+  absl::StatusOr<v1::Scene> GetScene(const std::string& id);
+  // Newest first.
+  absl::StatusOr<std::vector<v1::Job>> ListJobs(v1::JobState state, const std::string& sweep_id,
+                                                int limit);
+  // Ids of QUEUED jobs, oldest first.
+  absl::StatusOr<std::vector<std::string>> QueuedJobIds();
+
+  // QUEUED -> RUNNING (attempts + 1); false when the job was not QUEUED.
+  absl::StatusOr<bool> MarkRunning(const std::string& id);
+  // RUNNING -> QUEUED (shutdown before it finished).
+  absl::Status Requeue(const std::string& id);
+  // QUEUED -> CANCELLED; false when the job was not QUEUED.
+  absl::StatusOr<bool> CancelQueued(const std::string& id);
+  // RUNNING -> `state` with the summary and the trajectory, in one
+  // transaction; false when the job was not RUNNING.
+  absl::StatusOr<bool> Finish(const std::string& id, v1::JobState state,
+                              const v1::RunSummary& summary, const StoredResult& result);
+
+  // NotFound when the job has no result.
+  absl::StatusOr<StoredResult> GetResult(const std::string& id);
+
+  // The sweep with its counts and job ids.
+  absl::StatusOr<v1::Sweep> GetSweep(const std::string& id);
+
+ private:
+  JobStore(sqlite3* db, int lock_fd) : db_(db), lock_fd_(lock_fd) {}
+  absl::Status Exec(const char* sql);
+
+  absl::Mutex mu_;
+  sqlite3* db_;
+  int lock_fd_;
+};
+
+// Job id <-> row number; -1 for a malformed id.
+std::string JobId(int64_t seq);
+int64_t JobSeq(const std::string& id);
+std::string SweepId(int64_t seq);
+int64_t SweepSeq(const std::string& id);
+int64_t NowUnixMs();
+
+}  // namespace cablesim
+
+#endif  // CABLESIM_SERVER_JOB_STORE_H_

@@ -1,0 +1,137 @@
+#include "server/request_checks.h"
+
+#include <cmath>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "convert/run_proto.h"
+#include "convert/scene_field_path.h"
+#include "convert/scene_from_proto.h"
+
+namespace cablesim {
+
+absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimits& limits) {
+  CheckedScene checked;
+  absl::StatusOr<Scene> scene = SceneFromProto(proto);
+  if (!scene.ok()) return scene.status();
+  checked.scene = std::move(*scene);
+  const SolverSettings& solver = checked.scene.solver;
+  // Steps and frames from the settings, before building anything large.
+  if (solver.analysis == Analysis::kDynamic) {
+    checked.end_time_s = solver.duration_s;
+    checked.nominal_steps = static_cast<int64_t>(
+        std::min(9e18, std::ceil(solver.duration_s / solver.step_s * (1 - 1e-12))));
+    const double interval = solver.output_interval_s > 0 ? solver.output_interval_s : solver.step_s;
+    checked.frames = 1 + static_cast<int64_t>(
+                             std::min(9e18, std::ceil(solver.duration_s / interval * (1 - 1e-12))));
+  } else {
+    checked.end_time_s = 1;
+    checked.nominal_steps = solver.load_steps;
+    checked.frames = solver.load_steps;
+  }
+  if (checked.nominal_steps > limits.max_steps) {
+    return absl::ResourceExhaustedError(
+        absl::StrFormat("solver: %d steps asked for, the server's limit is %d (max_steps)",
+                        checked.nominal_steps, limits.max_steps));
+  }
+  if (checked.frames > limits.max_frames) {
+    return absl::ResourceExhaustedError(absl::StrFormat(
+        "solver.output_interval: %d frames asked for, the server's limit is %d (max_frames)",
+        checked.frames, limits.max_frames));
+  }
+  const int64_t values =
+      checked.frames *
+      (1 + kValuesPerProbe * static_cast<int64_t>(checked.scene.probes.size()) + kTrailingValues);
+  if (values > limits.max_trajectory_values) {
+    return absl::ResourceExhaustedError(absl::StrFormat(
+        "probes: %d frames of %d probes make %d numbers, the server's limit is %d "
+        "(max_trajectory_values)",
+        checked.frames, checked.scene.probes.size(), values, limits.max_trajectory_values));
+  }
+  int64_t requested_elements = 0;
+  for (const CableSpec& cable : checked.scene.cables) requested_elements += cable.elements;
+  if (requested_elements > limits.max_elements) {
+    return absl::ResourceExhaustedError(
+        absl::StrFormat("cables: %d elements asked for, the server's limit is %d (max_elements)",
+                        requested_elements, limits.max_elements));
+  }
+  absl::StatusOr<ModelInfo> info = DescribeModel(checked.scene);
+  if (!info.ok()) return info.status();
+  checked.info = std::move(*info);
+  if (checked.info.elements > limits.max_elements) {
+    return absl::ResourceExhaustedError(absl::StrFormat(
+        "cables: the model has %d elements, the server's limit is %d (max_elements)",
+        checked.info.elements, limits.max_elements));
+  }
+  return checked;
+}
+
+std::vector<double> SweepAxisValues(const google::protobuf::RepeatedPtrField<v1::SweepAxis>& axes,
+                                    int64_t index) {
+  std::vector<double> values(axes.size());
+  for (int a = axes.size() - 1; a >= 0; --a) {
+    const int64_t n = axes[a].values_size();
+    values[a] = axes[a].values(static_cast<int>(index % n));
+    index /= n;
+  }
+  return values;
+}
+
+absl::StatusOr<std::vector<v1::Scene>> ExpandSweep(const v1::SubmitSweepRequest& request,
+                                                   const ServerLimits& limits,
+                                                   std::vector<double>* end_times_s) {
+  if (request.axes().empty()) return absl::InvalidArgumentError("axes: at least one axis");
+  int64_t items = 1;
+  for (int a = 0; a < request.axes_size(); ++a) {
+    const v1::SweepAxis& axis = request.axes(a);
+    if (axis.values().empty()) {
+      return absl::InvalidArgumentError(absl::StrCat("axes[", a, "].values: at least one value"));
+    }
+    // Each path must name a settable field of the base scene.
+    v1::Scene probe = request.base();
+    if (absl::Status s = SetSceneField(&probe, axis.path(), axis.values(0)); !s.ok()) {
+      return absl::InvalidArgumentError(absl::StrCat("axes[", a, "].path: ", s.message()));
+    }
+    items *= axis.values_size();
+    if (items > limits.max_sweep_items) {
+      return absl::ResourceExhaustedError(
+          absl::StrFormat("axes: more than %d items, the server's limit (max_sweep_items)",
+                          limits.max_sweep_items));
+    }
+  }
+  std::vector<v1::Scene> scenes;
+  end_times_s->clear();
+  for (int64_t i = 0; i < items; ++i) {
+    v1::Scene scene = request.base();
+    int64_t rest = i;
+    std::vector<int> which(request.axes_size());
+    for (int a = request.axes_size() - 1; a >= 0; --a) {
+      which[a] = static_cast<int>(rest % request.axes(a).values_size());
+      rest /= request.axes(a).values_size();
+    }
+    for (int a = 0; a < request.axes_size(); ++a) {
+      if (absl::Status s =
+              SetSceneField(&scene, request.axes(a).path(), request.axes(a).values(which[a]));
+          !s.ok()) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("axes[", a, "].values[", which[a], "]: ", s.message()));
+      }
+    }
+    absl::StatusOr<CheckedScene> checked = CheckScene(scene, limits);
+    if (!checked.ok()) {
+      // Name the axis values that make the item invalid.
+      std::string where;
+      for (int a = 0; a < request.axes_size(); ++a) {
+        absl::StrAppend(&where, a ? ", " : "", "axes[", a, "].values[", which[a], "]");
+      }
+      return absl::Status(checked.status().code(),
+                          absl::StrCat(where, " (item ", i, "): ", checked.status().message()));
+    }
+    if (scene.name().empty()) scene.set_name(request.name());
+    end_times_s->push_back(checked->end_time_s);
+    scenes.push_back(std::move(scene));
+  }
+  return scenes;
+}
+
+}  // namespace cablesim

@@ -1,0 +1,169 @@
+// The command line against a cablesim-server on a loopback port, and its
+// sweep command in-process: the same output as the in-process run, the job
+// commands, and a sweep that fails on a threshold.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "absl/strings/str_split.h"
+#include "client/cli.h"
+#include "server_test_util.h"
+
+namespace cablesim {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+struct CliResult {
+  int code = -1;
+  std::string out, err;
+};
+
+CliResult Cli(const std::vector<std::string>& args) {
+  std::ostringstream out, err;
+  CliResult r;
+  r.code = RunCli(args, out, err);
+  r.out = out.str();
+  r.err = err.str();
+  return r;
+}
+
+std::string Read(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string WithoutWallTime(const std::string& json) {
+  const size_t at = json.find("\"wall_seconds\":");
+  const size_t end = json.find(',', at);
+  return json.substr(0, at) + json.substr(end + 1);
+}
+
+class CliServerTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new std::string(testing::FreshDir("cli_server"));
+    server_ = new testing::ServerProcess(*dir_, {"--workers=1"});
+  }
+  static void TearDownTestSuite() {
+    delete server_;
+    delete dir_;
+  }
+  static std::string Scene(const std::string& name, double duration) {
+    const std::string path = absl::StrCat(*dir_, "/", name, ".json");
+    std::string json = Read(absl::StrCat(CABLESIM_SOURCE_DIR, "/scenes/falling-pendulum.json"));
+    const size_t at = json.find("\"duration\": 1.0");
+    json.replace(at, 15, absl::StrCat("\"duration\": ", duration));
+    std::ofstream(path) << json;
+    return path;
+  }
+  static std::string* dir_;
+  static testing::ServerProcess* server_;
+};
+std::string* CliServerTest::dir_ = nullptr;
+testing::ServerProcess* CliServerTest::server_ = nullptr;
+
+TEST_F(CliServerTest, RunOnTheServerPrintsWhatTheInProcessRunPrints) {
+  const std::string scene = Scene("short", 0.05);
+  const std::string local_csv = *dir_ + "/local.csv", remote_csv = *dir_ + "/remote.csv";
+  const CliResult local = Cli({"run", scene, "--out", local_csv});
+  const CliResult remote = Cli({"run", scene, "--out", remote_csv, "--server", server_->address()});
+  ASSERT_EQ(local.code, 0) << local.err;
+  ASSERT_EQ(remote.code, 0) << remote.err;
+  EXPECT_EQ(WithoutWallTime(remote.out), WithoutWallTime(local.out));
+  EXPECT_EQ(Read(remote_csv), Read(local_csv));
+  EXPECT_EQ(std::count(local.out.begin(), local.out.end(), '\n'), 1);
+}
+
+TEST_F(CliServerTest, InvalidSceneOnTheServerIsExitCode2WithTheField) {
+  const std::string path = *dir_ + "/bad.json";
+  std::ofstream(path) << R"({"cables": [{"name": "c", "length": -1, "density": 1,
+                             "youngs_modulus": 1, "diameter": 0.01}],
+                             "solver": {"duration": 1}})";
+  const CliResult r = Cli({"run", path, "--server", server_->address()});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, absl::StrCat("cablesim: ", path, ": cables[0].length: must be > 0 (got -1)\n"));
+}
+
+TEST_F(CliServerTest, UnreachableServerIsExitCode1) {
+  const CliResult r = Cli({"run", Scene("short", 0.01), "--server", "127.0.0.1:1"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_THAT(r.err, StartsWith("cablesim: UNAVAILABLE"));
+}
+
+TEST_F(CliServerTest, SubmitWatchJobsEnergyCancel) {
+  const std::string address = server_->address();
+  const CliResult submitted = Cli({"submit", Scene("job", 0.1), "--server", address});
+  ASSERT_EQ(submitted.code, 0) << submitted.err;
+  EXPECT_THAT(submitted.out, StartsWith(R"({"id":"j-)"));
+  const std::string id = submitted.out.substr(7, 8);
+  const std::string csv = *dir_ + "/job.csv";
+  const CliResult watched = Cli({"watch", id, "--server", address, "--out", csv});
+  ASSERT_EQ(watched.code, 0) << watched.err;
+  EXPECT_THAT(watched.out, StartsWith(R"({"status":"ok",)"));
+  EXPECT_THAT(watched.out, HasSubstr(R"("frames":101,)"));
+  const std::vector<std::string> lines = absl::StrSplit(Read(csv), '\n', absl::SkipEmpty());
+  EXPECT_EQ(lines.size(), 102u);  // header + 101 frames
+
+  const CliResult jobs = Cli({"jobs", "--server", address, "--state", "succeeded"});
+  ASSERT_EQ(jobs.code, 0) << jobs.err;
+  EXPECT_THAT(jobs.out, HasSubstr(absl::StrCat(R"({"id":")", id, R"(","state":"SUCCEEDED")")));
+
+  const CliResult energy = Cli({"energy", id, "--server", address});
+  ASSERT_EQ(energy.code, 0) << energy.err;
+  EXPECT_THAT(energy.out, HasSubstr(R"("frames":101,)"));
+  EXPECT_THAT(energy.out, HasSubstr(R"("relative_drift":-)"));  // dissipation
+
+  const CliResult long_job = Cli({"submit", Scene("long", 19), "--server", address});
+  ASSERT_EQ(long_job.code, 0);
+  const std::string long_id = long_job.out.substr(7, 8);
+  const CliResult cancelled = Cli({"cancel", long_id, "--server", address});
+  ASSERT_EQ(cancelled.code, 0) << cancelled.err;
+  const CliResult after = Cli({"watch", long_id, "--server", address});
+  EXPECT_EQ(after.code, 1);  // cancelled is not success
+  EXPECT_THAT(after.out, HasSubstr("\"cancel"));
+
+  EXPECT_EQ(Cli({"submit", Scene("x", 0.1)}).code, 2);  // needs --server
+}
+
+TEST_F(CliServerTest, SweepWritesOneRowPerItemAndFailsOnAThreshold) {
+  const std::string sweep = *dir_ + "/sweep.json";
+  std::ofstream(sweep) << R"({"name": "steps", "base_file": "short.json",
+    "axes": [{"path": "solver.step", "values": [1e-3, 5e-4]},
+             {"path": "cables[0].elements", "values": [4, 6, 8]}]})";
+  Scene("short", 0.05);
+  const std::string csv = *dir_ + "/sweep.csv";
+  // In-process (no --server), 2 workers.
+  const CliResult ok = Cli({"sweep", sweep, "--out", csv, "--workers", "2"});
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  const std::vector<std::string> rows = absl::StrSplit(Read(csv), '\n', absl::SkipEmpty());
+  ASSERT_EQ(rows.size(), 7u);
+  EXPECT_THAT(rows[0], StartsWith("index,job_id,state,solver.step,cables[0].elements,status,"));
+  EXPECT_THAT(rows[0], HasSubstr(",final.tip.x,"));
+  EXPECT_THAT(rows[1], StartsWith("0,j-000001,SUCCEEDED,0.001,4,ok,"));
+  EXPECT_THAT(rows[6], StartsWith("5,j-000006,SUCCEEDED,5e-04,8,ok,"));
+
+  // Backward Euler dissipates a few percent here: a drift limit of 1e-9
+  // is exceeded by every item; exit code 3, the table still written.
+  const CliResult strict = Cli(
+      {"sweep", sweep, "--out", csv, "--server", server_->address(), "--max-energy-drift", "1e-9"});
+  EXPECT_EQ(strict.code, 3);
+  EXPECT_THAT(strict.err, HasSubstr("energy drift"));
+  EXPECT_EQ(std::vector<std::string>(absl::StrSplit(Read(csv), '\n', absl::SkipEmpty())).size(),
+            7u);
+  // An invalid axis is bad input.
+  std::ofstream(sweep) << R"({"base_file": "short.json",
+    "axes": [{"path": "cables[3].elements", "values": [4]}]})";
+  const CliResult bad = Cli({"sweep", sweep, "--out", csv});
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_THAT(bad.err, HasSubstr("axes[0].path: "));
+}
+
+}  // namespace
+}  // namespace cablesim

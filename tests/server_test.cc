@@ -1,0 +1,511 @@
+// The service against a real cablesim-server on a loopback port: run and
+// stream, validation, limits, health, reflection, cancellation and
+// deadlines, jobs, energy and a small sweep.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <latch>
+#include <thread>
+
+#include "absl/strings/str_join.h"
+#include "client/csv_writer.h"
+#include "convert/run_proto.h"
+#include "convert/scene_from_proto.h"
+#include "server_test_util.h"
+#include "test_util.h"
+
+namespace cablesim {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::Pendulum;
+using testing::ServerProcess;
+using ::testing::StartsWith;
+
+struct Streamed {
+  grpc::Status status;
+  v1::RunHeader header;
+  std::vector<double> values;
+  int batches = 0;
+  std::optional<v1::RunSummary> summary;
+};
+
+Streamed ReadAll(grpc::ClientReader<v1::RunEvent>* reader) {
+  Streamed s;
+  v1::RunEvent event;
+  while (reader->Read(&event)) {
+    if (event.has_header()) s.header = event.header();
+    if (event.has_frames()) {
+      s.values.insert(s.values.end(), event.frames().values().begin(),
+                      event.frames().values().end());
+      ++s.batches;
+    }
+    if (event.has_summary()) s.summary = event.summary();
+  }
+  s.status = reader->Finish();
+  return s;
+}
+
+Streamed RunOnServer(v1::CablesimService::Stub* stub, const v1::Scene& scene, int batch = 0) {
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
+  v1::RunRequest request;
+  *request.mutable_scene() = scene;
+  request.set_frames_per_batch(batch);
+  auto reader = stub->Run(&context, request);
+  return ReadAll(reader.get());
+}
+
+class ServerTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    server_ = new ServerProcess(testing::FreshDir("server_test"),
+                                {"--workers=1", "--max-elements=200", "--max-frames=20000",
+                                 "--max-streams=40", "--max-trajectory-values=1048576"});
+  }
+  static void TearDownTestSuite() {
+    delete server_;
+    server_ = nullptr;
+  }
+  static ServerProcess* server_;
+};
+ServerProcess* ServerTest::server_ = nullptr;
+
+TEST_F(ServerTest, RunStreamsTheSameFramesAsTheEngine) {
+  // Reference: the engine in this process (no service in between).
+  const v1::Scene proto = Pendulum(0.05, 1e-3, 1e-3);
+  const Scene scene = *SceneFromProto(proto);
+  testing::CollectingSink reference;
+  const RunSummary expected = *RunScene(scene, &reference);
+
+  auto stub = server_->Stub();
+  const Streamed s = RunOnServer(stub.get(), proto, 16);
+  ASSERT_TRUE(s.status.ok()) << s.status.error_message();
+  // Header: the model and the CSV columns.
+  EXPECT_EQ(s.header.info().model(), "planar");
+  EXPECT_EQ(s.header.info().elements(), 12);
+  EXPECT_EQ(absl::StrJoin(s.header.columns(), ","), CsvWriter::Header({"tip"}));
+  // Frames: 51, in batches of 16; bit-identical to the engine's.
+  const int columns = s.header.columns_size();
+  ASSERT_EQ(s.values.size(), reference.frames().size() * columns);
+  EXPECT_EQ(s.batches, 4);
+  for (size_t r = 0; r < reference.frames().size(); ++r) {
+    Frame frame;
+    FrameFromRow(absl::MakeConstSpan(s.values.data() + r * columns, columns), 1, &frame);
+    EXPECT_EQ(frame.t, reference.frames()[r].t);
+    EXPECT_EQ(frame.probes[0].position_m, reference.frames()[r].probes[0].position_m);
+    EXPECT_EQ(frame.energy.total, reference.frames()[r].energy.total);
+  }
+  ASSERT_TRUE(s.summary.has_value());
+  EXPECT_EQ(s.summary->status(), "ok");
+  EXPECT_EQ(s.summary->frames(), expected.frames);
+  EXPECT_EQ(s.summary->steps(), expected.steps);
+  EXPECT_EQ(s.summary->energy_final(), expected.energy_final);
+}
+
+TEST_F(ServerTest, InvalidSceneIsInvalidArgumentNamingTheField) {
+  v1::Scene scene = Pendulum(0.01, 1e-3, 1e-3);
+  scene.mutable_cables(0)->set_length(-1);
+  auto stub = server_->Stub();
+  const Streamed s = RunOnServer(stub.get(), scene);
+  EXPECT_EQ(s.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(s.status.error_message(), StartsWith("cables[0].length: must be > 0"));
+  EXPECT_FALSE(s.summary.has_value());
+
+  grpc::ClientContext context;
+  v1::SubmitJobRequest submit;
+  *submit.mutable_scene() = scene;
+  v1::Job job;
+  const grpc::Status st = stub->SubmitJob(&context, submit, &job);
+  EXPECT_EQ(st.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(st.error_message(), StartsWith("cables[0].length"));
+}
+
+TEST_F(ServerTest, ValidateReportsTheModelOrTheField) {
+  auto stub = server_->Stub();
+  {
+    grpc::ClientContext context;
+    v1::ValidateRequest request;
+    *request.mutable_scene() = Pendulum(1, 1e-3, 1e-3);
+    v1::ValidateResponse response;
+    ASSERT_TRUE(stub->Validate(&context, request, &response).ok());
+    EXPECT_TRUE(response.valid());
+    EXPECT_EQ(response.model().model(), "planar");
+    EXPECT_EQ(response.model().elements(), 12);
+    EXPECT_EQ(response.model().coordinates(), 13 * 4);  // 13 nodes, r and r_x in the plane
+  }
+  {
+    grpc::ClientContext context;
+    v1::ValidateRequest request;
+    *request.mutable_scene() = Pendulum(1, 1e-3, 1e-3);
+    request.mutable_scene()->mutable_cables(0)->set_density(-5);
+    v1::ValidateResponse response;
+    ASSERT_TRUE(stub->Validate(&context, request, &response).ok());
+    EXPECT_FALSE(response.valid());
+    ASSERT_EQ(response.errors_size(), 1);
+    EXPECT_EQ(response.errors(0).path(), "cables[0].density");
+  }
+}
+
+TEST_F(ServerTest, LimitsAreResourceExhausted) {
+  auto stub = server_->Stub();
+  v1::Scene scene = Pendulum(0.01, 1e-3, 1e-3);
+  scene.mutable_cables(0)->set_elements(201);  // --max-elements=200
+  Streamed s = RunOnServer(stub.get(), scene);
+  EXPECT_EQ(s.status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(s.status.error_message(), HasSubstr("max_elements"));
+
+  scene = Pendulum(30, 1e-3, 1e-3);  // 30001 frames, --max-frames=20000
+  s = RunOnServer(stub.get(), scene);
+  EXPECT_EQ(s.status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(s.status.error_message(), HasSubstr("max_frames"));
+
+  // 1001 frames of 200 probes (1807 numbers each) are 1.8 M numbers, over
+  // the limit of 1 Mi given below.
+  scene = Pendulum(1, 1e-3, 1e-3);
+  for (int i = 0; i < 200; ++i) {
+    v1::Probe* probe = scene.add_probes();
+    probe->set_name(absl::StrCat("p", i));
+    probe->set_cable("beam");
+    probe->set_s(1.2 * i / 200);
+  }
+  s = RunOnServer(stub.get(), scene);
+  EXPECT_EQ(s.status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(s.status.error_message(), HasSubstr("max_trajectory_values"));
+
+  // A message above the receive limit (16 MiB by default).
+  scene = Pendulum(0.01, 1e-3, 1e-3);
+  scene.set_name(std::string(17 << 20, 'x'));
+  s = RunOnServer(stub.get(), scene);
+  EXPECT_EQ(s.status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+}
+
+TEST_F(ServerTest, HealthServiceIsServing) {
+  std::string response;
+  // grpc.health.v1.HealthCheckRequest{service: ""} is empty on the wire;
+  // the response {status: SERVING (1)} is field 1, varint 1: 08 01.
+  const grpc::Status status =
+      testing::RawCall(server_->Channel(), "/grpc.health.v1.Health/Check", "", &response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(response, std::string("\x08\x01", 2));
+}
+
+TEST_F(ServerTest, ReflectionListsTheService) {
+  // ServerReflectionRequest{list_services: ""}: field 7, length-delimited.
+  std::string response;
+  const grpc::Status status = testing::RawCall(
+      server_->Channel(), "/grpc.reflection.v1alpha.ServerReflection/ServerReflectionInfo",
+      std::string("\x3a\x00", 2), &response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_THAT(response, HasSubstr("cablesim.v1.CablesimService"));
+  EXPECT_THAT(response, HasSubstr("grpc.health.v1.Health"));
+}
+
+TEST_F(ServerTest, CancellingAStreamStopsTheRunAndTheServerCarriesOn) {
+  auto stub = server_->Stub();
+  grpc::ClientContext context;
+  v1::RunRequest request;
+  *request.mutable_scene() = Pendulum(15, 1e-3, 1e-3);  // ~15000 steps
+  request.set_frames_per_batch(8);
+  auto reader = stub->Run(&context, request);
+  v1::RunEvent event;
+  int batches = 0;
+  while (batches < 3 && reader->Read(&event)) batches += event.has_frames();
+  ASSERT_EQ(batches, 3);
+  context.TryCancel();
+  while (reader->Read(&event)) {
+  }
+  EXPECT_EQ(reader->Finish().error_code(), grpc::StatusCode::CANCELLED);
+  // The next run is served.
+  const Streamed s = RunOnServer(stub.get(), Pendulum(0.01, 1e-3, 1e-3));
+  EXPECT_TRUE(s.status.ok()) << s.status.error_message();
+}
+
+TEST_F(ServerTest, DeadlineStopsTheRun) {
+  auto stub = server_->Stub();
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::milliseconds(300));
+  v1::RunRequest request;
+  *request.mutable_scene() = Pendulum(19, 1e-4, 1e-3);  // 190000 steps: minutes of work
+  auto reader = stub->Run(&context, request);
+  const auto start = std::chrono::steady_clock::now();
+  const Streamed s = ReadAll(reader.get());
+  EXPECT_EQ(s.status.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED);
+  EXPECT_FALSE(s.summary.has_value());
+  // The server stops at the next step: a later job starts at once. (A
+  // generous bound; this checks that the work stopped, not its speed.)
+  v1::Job job;
+  {
+    grpc::ClientContext c;
+    v1::SubmitJobRequest submit;
+    *submit.mutable_scene() = Pendulum(0.01, 1e-3, 1e-3);
+    ASSERT_TRUE(stub->SubmitJob(&c, submit, &job).ok());
+  }
+  EXPECT_EQ(testing::WaitForJob(stub.get(), job.id()), v1::SUCCEEDED);
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(20));
+}
+
+TEST_F(ServerTest, ThirtyTwoClientsStreamAtOnce) {
+  const v1::Scene scene = Pendulum(0.1, 1e-3, 1e-3);  // 101 frames each
+  constexpr int kClients = 32;
+  std::vector<Streamed> results(kClients);
+  // Every client reads its header, then waits until all 32 have theirs: the
+  // 32 streams are open on the server at the same time.
+  std::latch all_started(kClients);
+  std::vector<std::thread> threads;
+  for (int i = 0; i < kClients; ++i) {
+    threads.emplace_back([&, i] {
+      auto stub = v1::CablesimService::NewStub(server_->Channel());  // own connection
+      grpc::ClientContext context;
+      context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
+      v1::RunRequest request;
+      *request.mutable_scene() = scene;
+      request.set_frames_per_batch(4);
+      auto reader = stub->Run(&context, request);
+      v1::RunEvent header;
+      const bool got_header = reader->Read(&header) && header.has_header();
+      all_started.count_down();
+      all_started.wait();
+      results[i] = ReadAll(reader.get());
+      if (got_header) results[i].header = header.header();
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  for (int i = 0; i < kClients; ++i) {
+    ASSERT_TRUE(results[i].status.ok()) << i << ": " << results[i].status.error_message();
+    ASSERT_TRUE(results[i].summary.has_value());
+    EXPECT_EQ(results[i].summary->frames(), 101);
+    ASSERT_EQ(results[i].header.columns_size(), 16) << i;
+    // Every client gets the same, complete trajectory.
+    EXPECT_EQ(results[i].values.size(), 101u * 16);
+    EXPECT_EQ(results[i].values, results[0].values) << i;
+  }
+}
+
+TEST_F(ServerTest, JobRunsAndKeepsItsTrajectoryAndEnergy) {
+  auto stub = server_->Stub();
+  v1::Job job;
+  {
+    grpc::ClientContext context;
+    v1::SubmitJobRequest submit;
+    *submit.mutable_scene() = Pendulum(0.2, 1e-3, 1e-2);
+    ASSERT_TRUE(stub->SubmitJob(&context, submit, &job).ok());
+  }
+  EXPECT_THAT(job.id(), StartsWith("j-"));
+  EXPECT_EQ(job.state(), v1::QUEUED);
+  v1::Job done;
+  ASSERT_EQ(testing::WaitForJob(stub.get(), job.id(), &done), v1::SUCCEEDED);
+  EXPECT_EQ(done.summary().status(), "ok");
+  EXPECT_EQ(done.summary().frames(), 21);
+  EXPECT_EQ(done.attempts(), 1);
+
+  grpc::ClientContext context;
+  v1::GetJobResultRequest get;
+  get.set_id(job.id());
+  auto reader = stub->GetJobResult(&context, get);
+  const Streamed s = ReadAll(reader.get());
+  ASSERT_TRUE(s.status.ok()) << s.status.error_message();
+  EXPECT_EQ(s.values.size(), 21u * s.header.columns_size());
+
+  grpc::ClientContext ec;
+  v1::EnergyRequest energy_request;
+  energy_request.set_job_id(job.id());
+  v1::EnergyResponse energy;
+  ASSERT_TRUE(stub->GetEnergy(&ec, energy_request, &energy).ok());
+  ASSERT_EQ(energy.total_size(), 21);
+  const v1::EnergyReport& r = energy.report();
+  // The report restates the series (exact: copies of the same doubles).
+  EXPECT_EQ(r.initial(), energy.total(0));
+  EXPECT_EQ(r.final(), energy.total(20));
+  EXPECT_EQ(r.energy_dissipated(), done.summary().energy_dissipated());
+  for (int i = 0; i < energy.total_size(); ++i) {
+    // total = kinetic + potential + axial + bending, to rounding (1e-12 of
+    // the largest component).
+    const double sum =
+        energy.kinetic(i) + energy.potential(i) + energy.axial(i) + energy.bending(i);
+    EXPECT_NEAR(energy.total(i), sum, 1e-12 * (1 + std::abs(energy.potential(i))));
+    EXPECT_LE(r.min(), energy.total(i));
+    EXPECT_GE(r.max(), energy.total(i));
+  }
+  // Backward Euler only removes energy from the falling pendulum.
+  EXPECT_LT(r.relative_drift(), 0);
+  EXPECT_GT(r.scale(), 0);
+}
+
+TEST_F(ServerTest, CancelARunningJob) {
+  auto stub = server_->Stub();
+  v1::Job job;
+  {
+    grpc::ClientContext context;
+    v1::SubmitJobRequest submit;
+    *submit.mutable_scene() = Pendulum(19, 1e-4, 1e-2);  // minutes of work
+    ASSERT_TRUE(stub->SubmitJob(&context, submit, &job).ok());
+  }
+  // Wait until it runs.
+  for (int i = 0; i < 500; ++i) {
+    grpc::ClientContext context;
+    v1::GetJobRequest get;
+    get.set_id(job.id());
+    ASSERT_TRUE(stub->GetJob(&context, get, &job).ok());
+    if (job.state() == v1::RUNNING) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_EQ(job.state(), v1::RUNNING);
+  grpc::ClientContext context;
+  v1::CancelJobRequest cancel;
+  cancel.set_id(job.id());
+  ASSERT_TRUE(stub->CancelJob(&context, cancel, &job).ok());
+  v1::Job done;
+  EXPECT_EQ(testing::WaitForJob(stub.get(), job.id(), &done), v1::CANCELLED);
+  EXPECT_EQ(done.summary().status(), "cancelled");
+  EXPECT_LT(done.summary().end_time_s(), 19);
+}
+
+TEST_F(ServerTest, UnknownJobIsNotFound) {
+  auto stub = server_->Stub();
+  grpc::ClientContext context;
+  v1::GetJobRequest get;
+  get.set_id("j-999999");
+  v1::Job job;
+  EXPECT_EQ(stub->GetJob(&context, get, &job).error_code(), grpc::StatusCode::NOT_FOUND);
+}
+
+TEST_F(ServerTest, SweepSetsTheFieldsOfEachItem) {
+  auto stub = server_->Stub();
+  v1::SubmitSweepRequest request;
+  request.set_name("elements");
+  *request.mutable_base() = Pendulum(0.01, 1e-3, 1e-3);
+  v1::SweepAxis* a = request.add_axes();
+  a->set_path("cables[0].elements");
+  a->add_values(4);
+  a->add_values(6);
+  v1::SweepAxis* b = request.add_axes();
+  b->set_path("solver.step");
+  b->add_values(1e-3);
+  b->add_values(5e-4);
+  v1::Sweep sweep;
+  {
+    grpc::ClientContext context;
+    ASSERT_TRUE(stub->SubmitSweep(&context, request, &sweep).ok());
+  }
+  EXPECT_EQ(sweep.items(), 4);
+  grpc::ClientContext context;
+  v1::WatchSweepRequest watch;
+  watch.set_id(sweep.id());
+  auto reader = stub->WatchSweep(&context, watch);
+  v1::SweepEvent event;
+  int items = 0;
+  while (reader->Read(&event)) items += event.has_item();
+  ASSERT_TRUE(reader->Finish().ok());
+  EXPECT_EQ(items, 4);
+
+  grpc::ClientContext rc;
+  v1::GetSweepResultsRequest get;
+  get.set_id(sweep.id());
+  v1::SweepResults results;
+  ASSERT_TRUE(stub->GetSweepResults(&rc, get, &results).ok());
+  ASSERT_EQ(results.items_size(), 4);
+  EXPECT_EQ(absl::StrJoin(results.final_columns(), ","), CsvWriter::Header({"tip"}));
+  for (int i = 0; i < 4; ++i) {
+    const v1::SweepItem& item = results.items(i);
+    EXPECT_EQ(item.index(), i);
+    EXPECT_EQ(item.state(), v1::SUCCEEDED);
+    // Last axis fastest: (4, 1e-3), (4, 5e-4), (6, 1e-3), (6, 5e-4).
+    EXPECT_EQ(item.axis_values(0), i < 2 ? 4 : 6);
+    EXPECT_EQ(item.axis_values(1), i % 2 == 0 ? 1e-3 : 5e-4);
+    // The engine built what the item asked for: elements, and steps of
+    // 0.01 s / step.
+    EXPECT_EQ(item.summary().info().elements(), i < 2 ? 4 : 6);
+    EXPECT_EQ(item.summary().steps(), i % 2 == 0 ? 10 : 20);
+    EXPECT_EQ(item.final_values_size(), results.final_columns_size());
+    EXPECT_NEAR(item.final_values(0), 0.01, 1e-12);  // t of the last frame
+  }
+}
+
+TEST_F(ServerTest, InvalidSweepNamesTheAxis) {
+  auto stub = server_->Stub();
+  v1::SubmitSweepRequest request;
+  *request.mutable_base() = Pendulum(0.01, 1e-3, 1e-3);
+  v1::SweepAxis* a = request.add_axes();
+  a->set_path("cables[0].elements");
+  a->add_values(4);
+  v1::SweepAxis* b = request.add_axes();
+  b->set_path("solver.stepp");
+  b->add_values(1e-3);
+  v1::Sweep sweep;
+  {
+    grpc::ClientContext context;
+    const grpc::Status s = stub->SubmitSweep(&context, request, &sweep);
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_THAT(s.error_message(), StartsWith("axes[1].path: "));
+    EXPECT_THAT(s.error_message(), HasSubstr("stepp"));
+  }
+  b->set_path("solver.step");
+  a->add_values(0);  // elements 0 is invalid
+  {
+    grpc::ClientContext context;
+    const grpc::Status s = stub->SubmitSweep(&context, request, &sweep);
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_THAT(s.error_message(), StartsWith("axes[0].values[1], axes[1].values[0] (item 1): "
+                                              "cables[0].elements"));
+  }
+  a->set_values(1, 4.5);  // not a whole number
+  {
+    grpc::ClientContext context;
+    const grpc::Status s = stub->SubmitSweep(&context, request, &sweep);
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_THAT(s.error_message(), StartsWith("axes[0].values[1]: "));
+  }
+}
+
+TEST(ServerLimitTest, StreamsBeyondTheLimitAreResourceExhausted) {
+  ServerProcess server(testing::FreshDir("server_test_streams"), {"--max-streams=1"});
+  // The first stream stays open: its client reads only the header and keeps
+  // HTTP/2's default 64 KiB window (no BDP probing), far less than the run.
+  grpc::ChannelArguments small_window;
+  small_window.SetInt("grpc.http2.bdp_probe", 0);
+  auto stub = v1::CablesimService::NewStub(server.Channel(small_window));
+  grpc::ClientContext first;
+  v1::RunRequest request;
+  *request.mutable_scene() = Pendulum(15, 1e-3, 1e-3);  // 15001 frames, 1.9 MB
+  auto reader = stub->Run(&first, request);
+  v1::RunEvent event;
+  ASSERT_TRUE(reader->Read(&event));
+  ASSERT_TRUE(event.has_header());
+
+  auto other = server.Stub();
+  const Streamed second = RunOnServer(other.get(), Pendulum(0.01, 1e-3, 1e-3));
+  EXPECT_EQ(second.status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(second.status.error_message(), HasSubstr("max_streams"));
+
+  first.TryCancel();
+  while (reader->Read(&event)) {
+  }
+  reader->Finish();
+  // The slot is free again (the server notices the cancellation within a
+  // step; retry briefly).
+  grpc::Status status;
+  for (int i = 0; i < 100; ++i) {
+    status = RunOnServer(other.get(), Pendulum(0.01, 1e-3, 1e-3)).status;
+    if (status.ok()) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_TRUE(status.ok()) << status.error_message();
+}
+
+TEST_F(ServerTest, ASecondServerOnTheSameDataDirectoryRefusesToStart) {
+  // Two servers on one store could run a job twice.
+  const std::string dir = testing::FreshDir("server_test_second");
+  ServerProcess first(dir);
+  const std::string binary = absl::StrCat(CABLESIM_BIN_DIR, "/cablesim-server");
+  const int status = std::system(
+      absl::StrCat("'", binary, "' --listen=127.0.0.1:0 --data-dir='", dir, "' 2>/dev/null")
+          .c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+}
+
+}  // namespace
+}  // namespace cablesim

@@ -1,0 +1,183 @@
+#ifndef CABLESIM_TESTS_SERVER_TEST_UTIL_H_
+#define CABLESIM_TESTS_SERVER_TEST_UTIL_H_
+
+// Helpers for tests against a real cablesim-server on a loopback port: the
+// server as a child process (so it can be killed with SIGKILL), a stub, raw
+// calls for the health and reflection services, and scenes.
+
+#include <grpcpp/generic/generic_stub.h>
+#include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_replace.h"
+#include "cablesim/v1/service.grpc.pb.h"
+#include "convert/scene_file.h"
+
+namespace cablesim::testing {
+
+// A fresh empty directory under the test's temporary directory.
+inline std::string FreshDir(const std::string& name) {
+  const std::string dir = absl::StrCat(::testing::TempDir(), "/cablesim_", name, "_", ::getpid());
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+// cablesim-server as a child process listening on 127.0.0.1 on a free port
+// (it binds port 0 and writes the port it got to a file).
+class ServerProcess {
+ public:
+  ServerProcess(std::string data_dir, std::vector<std::string> flags = {})
+      : data_dir_(std::move(data_dir)), flags_(std::move(flags)) {
+    Start();
+  }
+  ~ServerProcess() {
+    if (pid_ > 0) Kill(SIGKILL);
+  }
+
+  void Start() {
+    const std::string port_file = absl::StrCat(data_dir_, "/port");
+    std::filesystem::remove(port_file);
+    std::vector<std::string> args = {absl::StrCat(CABLESIM_BIN_DIR, "/cablesim-server"),
+                                     "--listen=127.0.0.1:0", "--data-dir=" + data_dir_,
+                                     "--port-file=" + port_file};
+    args.insert(args.end(), flags_.begin(), flags_.end());
+    pid_ = fork();
+    if (pid_ == 0) {
+      std::vector<char*> argv;
+      for (std::string& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      execv(argv[0], argv.data());
+      _exit(127);
+    }
+    ASSERT_GT(pid_, 0);
+    for (int i = 0; i < 300 && port_ == 0; ++i) {
+      std::ifstream in(port_file);
+      if (!(in >> port_)) {
+        port_ = 0;
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
+    }
+    ASSERT_GT(port_, 0) << "cablesim-server did not start";
+  }
+
+  // Sends `signal` and waits for the process; returns its wait status.
+  int Kill(int signal) {
+    ::kill(pid_, signal);
+    int status = 0;
+    waitpid(pid_, &status, 0);
+    pid_ = -1;
+    port_ = 0;
+    return status;
+  }
+
+  // Restarts on the same data directory (a new port).
+  void Restart() { Start(); }
+
+  pid_t pid() const { return pid_; }
+  int port() const { return port_; }
+  std::string address() const { return absl::StrCat("127.0.0.1:", port_); }
+  std::shared_ptr<grpc::Channel> Channel() const { return Channel(grpc::ChannelArguments()); }
+  std::shared_ptr<grpc::Channel> Channel(grpc::ChannelArguments args) const {
+    args.SetMaxReceiveMessageSize(64 << 20);
+    // A fresh connection per channel (no sharing between test clients).
+    args.SetInt("grpc.use_local_subchannel_pool", 1);
+    return grpc::CreateCustomChannel(address(), grpc::InsecureChannelCredentials(), args);
+  }
+  std::unique_ptr<v1::CablesimService::Stub> Stub() const {
+    return v1::CablesimService::NewStub(Channel());
+  }
+
+ private:
+  std::string data_dir_;
+  std::vector<std::string> flags_;
+  pid_t pid_ = -1;
+  int port_ = 0;
+};
+
+// One request message and the first response message of `method`, as raw
+// bytes (for services whose .proto is not installed: health, reflection).
+inline grpc::Status RawCall(const std::shared_ptr<grpc::Channel>& channel,
+                            const std::string& method, const std::string& request,
+                            std::string* response) {
+  grpc::GenericStub stub(channel);
+  grpc::CompletionQueue cq;
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
+  auto call = stub.PrepareCall(&context, method, &cq);
+  void* tag;
+  bool ok;
+  auto step = [&](int t) {
+    EXPECT_TRUE(cq.Next(&tag, &ok));
+    EXPECT_EQ(tag, reinterpret_cast<void*>(t));
+    return ok;
+  };
+  call->StartCall(reinterpret_cast<void*>(1));
+  step(1);
+  grpc::Slice slice(request);
+  grpc::ByteBuffer out(&slice, 1);
+  call->Write(out, reinterpret_cast<void*>(2));
+  step(2);
+  call->WritesDone(reinterpret_cast<void*>(3));
+  step(3);
+  grpc::ByteBuffer in;
+  call->Read(&in, reinterpret_cast<void*>(4));
+  if (step(4)) {
+    std::vector<grpc::Slice> slices;
+    (void)in.Dump(&slices);
+    response->clear();
+    for (const grpc::Slice& s : slices) {
+      response->append(reinterpret_cast<const char*>(s.begin()), s.size());
+    }
+  }
+  grpc::Status status;
+  call->Finish(&status, reinterpret_cast<void*>(5));
+  step(5);
+  cq.Shutdown();
+  while (cq.Next(&tag, &ok)) {
+  }
+  return status;
+}
+
+// The falling pendulum of scenes/ with another duration, step and output
+// interval.
+inline v1::Scene Pendulum(double duration_s, double step_s, double output_interval_s) {
+  auto scene = ReadSceneFile(absl::StrCat(CABLESIM_SOURCE_DIR, "/scenes/falling-pendulum.json"));
+  EXPECT_TRUE(scene.ok()) << scene.status();
+  scene->mutable_solver()->set_duration(duration_s);
+  scene->mutable_solver()->set_step(step_s);
+  scene->mutable_solver()->set_output_interval(output_interval_s);
+  return *scene;
+}
+
+inline v1::JobState WaitForJob(v1::CablesimService::Stub* stub, const std::string& id,
+                               v1::Job* last = nullptr) {
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(120));
+  v1::WatchJobRequest request;
+  request.set_id(id);
+  auto reader = stub->WatchJob(&context, request);
+  v1::Job job, latest;
+  while (reader->Read(&job)) latest = job;
+  EXPECT_TRUE(reader->Finish().ok());
+  if (last) *last = latest;
+  return latest.state();
+}
+
+}  // namespace cablesim::testing
+
+#endif  // CABLESIM_TESTS_SERVER_TEST_UTIL_H_
