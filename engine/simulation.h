@@ -90,6 +90,20 @@ struct RunSummary {
   double max_constraint_violation = 0;
   double max_newton_residual = 0;  // largest accepted Newton residual norm
   double max_linear_residual = 0;  // largest true relative residual of a solve
+  // DYNAMIC: the stepper's cost and step sizes.
+  std::string linear_solver_used;  // what AUTO resolved to (else linear_solver)
+  int64_t factorizations = 0;      // Newton matrices assembled and factored
+  int64_t direct_fallbacks = 0;    // DIRECT solves that had to run MINRES
+  double max_step_s = 0;           // largest step taken
+  bool adaptive = false;
+  double rho_infinity = 0;         // GENERALIZED_ALPHA and HHT
+  // solver.error_estimate: an estimate of the largest probe-position error
+  // of the run [m] (over every frame and probe), and how it was obtained.
+  // error_estimate_m < 0 when no estimate could be made (the method says why).
+  bool has_error_estimate = false;
+  double error_estimate_m = -1;
+  std::string error_estimate_method;
+  double error_estimate_seconds = 0;  // wall time of the companion run
 };
 
 // How a caller bounds and stops a run (a server's limits, deadlines and
