@@ -646,9 +646,9 @@ absl::StatusOr<Integrator> IntegratorFromProto(v1::Integrator integrator,
   switch (integrator) {
     case v1::IMPLICIT_EULER:
       return Integrator::kImplicitEuler;
-    case v1::INTEGRATOR_UNSPECIFIED:
     case v1::GENERALIZED_ALPHA:
       return Integrator::kGeneralizedAlpha;
+    case v1::INTEGRATOR_UNSPECIFIED:
     case v1::HHT:
       return Integrator::kHht;
     default:

@@ -59,6 +59,9 @@
 // Convergence is judged as in ImplicitEulerStepper: position increment
 // s |d zdd|_inf below tol (1 + |z|_inf), momentum residual below tol times
 // its largest term (or the rounding floor), |Phi|_inf below tol (1 + |z|).
+// A residual that stays above tol while the corrections are at the last
+// bits of z (16 eps (1 + |z|)) is rounding, and is accepted when below
+// sqrt(tol).
 //
 // Newton economy (settings.reuse_factorization): the factored Newton matrix
 // is kept across iterations and steps while c (below) stays within 20 % of
@@ -124,6 +127,7 @@ class GeneralizedAlphaStepper final : public Stepper {
   // State: z, v, physical and algorithmic accelerations, multipliers, and
   // g = Phi_z^T lambda - f at the state (HHT).
   Eigen::VectorXd z_, v_, zdd_, acc_, lambda_, g_;
+  Eigen::VectorXd acc_h_;  // a_n shifted to the current step (variable steps)
   Eigen::VectorXd z_old_, v_old_, zdd_old_, acc_old_, lambda_old_, g_old_;
   // Newton work vectors.
   Eigen::VectorXd z_pred_, v_pred_, z1_, zdd1_, lambda1_, q_, f_, phi_, bt_lambda_, rhs_, dx_;
