@@ -170,14 +170,16 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
       return st;
     }
   }
-  z_old_ = z_;
-  v_old_ = v_;
-  a_old_ = a_;
-  lambda_old_ = lambda_;
-  a_ = (v1_ - v_) / h;
-  v_ = v1_;
-  z_ = z1_;
-  lambda_ = lambda1_;
+  // Keep the previous state for Restore() (swaps, no copies: z1_, v1_ and
+  // lambda1_ are rewritten at the start of every step).
+  z_old_.swap(z_);
+  v_old_.swap(v_);
+  a_old_.swap(a_);
+  lambda_old_.swap(lambda_);
+  z_.swap(z1_);
+  v_.swap(v1_);
+  lambda_.swap(lambda1_);
+  a_ = (v_ - v_old_) / h;
   return st;
 }
 

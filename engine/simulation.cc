@@ -311,7 +311,8 @@ const char* LinearSolverLabel(LinearSolverKind kind) {
 // e(h) ~ |x_h - x_{h/2}| 2^p / (2^p - 1). Adaptive: the companion is much
 // more accurate, so the difference itself is the estimate.
 void EstimateError(MultibodyModel* model, const SolverSettings& settings,
-                   const ProbeRecordingSink& main, RunSummary* summary) {
+                   const RunControl& control, const ProbeRecordingSink& main,
+                   RunSummary* summary) {
   const auto start = Clock::now();
   summary->has_error_estimate = true;
   SolverSettings companion = settings;
@@ -335,7 +336,8 @@ void EstimateError(MultibodyModel* model, const SolverSettings& settings,
   ProbeRecordingSink recorded(nullptr);
   RunSummary companion_summary;
   FrameRecorder recorder(model, &recorded, &companion_summary);
-  RunDynamic(model, companion, RunControl{}, &recorder, &companion_summary);
+  // The caller's stop request and step limit apply to the companion too.
+  RunDynamic(model, companion, control, &recorder, &companion_summary);
   summary->error_estimate_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   if (companion_summary.status != "ok") {
     summary->error_estimate_method += " (the companion run failed: " + companion_summary.error + ")";
@@ -393,7 +395,7 @@ absl::StatusOr<RunSummary> RunScene(const Scene& scene, FrameSink* sink,
     if (!std::isfinite(summary.min_step_s)) summary.min_step_s = 0;
     if (estimate) {
       if (summary.status == "ok") {
-        EstimateError(&model, settings, recording, &summary);
+        EstimateError(&model, settings, control, recording, &summary);
       } else {
         summary.has_error_estimate = true;
         summary.error_estimate_method = "none: the run did not finish";

@@ -161,6 +161,40 @@ TEST(AlphaStepperTest, DirectAndMinresGiveTheSameMotionWithConstraints) {
   EXPECT_EQ(a.linear_solver_used, "DIRECT");
 }
 
+TEST(AlphaStepperTest, MinresIterationsDoNotGrowWithStepOrStiffness) {
+  // The block preconditioner diag(L|D|L^T, B (L|D|L^T)^{-1} B^T) leaves
+  // three eigenvalues when the Newton block is definite (Murphy, Golub and
+  // Wathen 2000): MINRES needs at most 3 iterations per solve in exact
+  // arithmetic, whatever h and E. Allowed here: 6 per Newton iteration on
+  // average (rounding, and the refinement pass when the true residual is
+  // above 100 times the tolerance), over h from 1e-2 to 1e-4 and E from
+  // 1e7 to 1e11 on the cable with an end cylinder (3 multipliers).
+  for (double youngs : {1e7, 1e9, 1e11}) {
+    for (double h : {1e-2, 1e-3, 1e-4}) {
+      const std::string json = absl::StrFormat(R"({
+        "gravity": {"y": -9.81},
+        "cables": [{"name": "cable", "length": 0.5, "elements": 20, "direction": {"x": 1},
+                    "density": 1000, "youngs_modulus": %g, "diameter": 0.01}],
+        "bodies": [{"name": "cylinder", "cylinder": {"diameter": 0.04, "height": 0.1},
+                    "density": 1000, "position": {"x": 0.55}, "axis": {"x": 1}}],
+        "joints": [{"type": "PIN", "a": {"cable": "cable", "s": 0}},
+                   {"type": "FIXED", "a": {"cable": "cable", "s": 0.5},
+                    "b": {"body": "cylinder", "point": {"x": -0.05}}}],
+        "probes": [{"name": "centre", "body": "cylinder"}],
+        "solver": {"duration": %g, "step": %g, "integrator": "HHT", "linear_solver": "MINRES",
+                   "reuse_factorization": false}})",
+                                               youngs, 20 * h, h);
+      CollectingSink sink;
+      const RunSummary s = RunOk(SceneFromJson(json), &sink);
+      const double per_newton =
+          static_cast<double>(s.linear_iterations) / static_cast<double>(s.newton_iterations);
+      std::printf("E = %g, h = %g: %.2f MINRES iterations per Newton iteration\n", youngs, h,
+                  per_newton);
+      EXPECT_LE(per_newton, 6.0) << "E = " << youngs << ", h = " << h;
+    }
+  }
+}
+
 TEST(AlphaStepperTest, AdaptiveStepsMeetTighterTolerancesWithMoreSteps) {
   // The tip error against a converged run (h = 1e-5) must shrink as the
   // tolerance does; steps and rejections are counted.
