@@ -660,13 +660,13 @@ absl::StatusOr<LinearSolverKind> LinearSolverFromProto(v1::LinearSolver solver,
                                                        std::string_view path_std) {
   const absl::string_view path(path_std.data(), path_std.size());
   switch (solver) {
-    case v1::LINEAR_SOLVER_UNSPECIFIED:
     case v1::MINRES:
       return LinearSolverKind::kMinres;
     case v1::GMRES:
       return LinearSolverKind::kGmres;
     case v1::DIRECT:
       return LinearSolverKind::kDirect;
+    case v1::LINEAR_SOLVER_UNSPECIFIED:
     case v1::AUTO:
       return LinearSolverKind::kAuto;
     default:

@@ -85,7 +85,7 @@ struct SolverSettings {
   double step_s = 1e-3;
   double output_interval_s = 0;  // 0: every step
   Integrator integrator = Integrator::kHht;
-  LinearSolverKind linear_solver = LinearSolverKind::kMinres;
+  LinearSolverKind linear_solver = LinearSolverKind::kAuto;
   int load_steps = 10;
   double newton_tolerance = 1e-8;
   int max_newton_iterations = 25;
@@ -95,7 +95,7 @@ struct SolverSettings {
   // Numerical damping of GENERALIZED_ALPHA and HHT: the spectral radius of
   // the amplification matrix at infinite frequency, in [0, 1] ([0.5, 1] for
   // HHT); 1 conserves the energy of linear problems.
-  double rho_infinity = 0.7;
+  double rho_infinity = 0.5;
   // Adaptive steps: the step grows and shrinks so that the estimated local
   // error of every unknown stays below tolerance_m + relative_tolerance |z|.
   bool adaptive = false;

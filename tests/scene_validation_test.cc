@@ -621,16 +621,17 @@ TEST(SceneConversionTest, JointBetweenTwoPointsOfOneCable) {
 
 TEST(SceneConversionTest, SteppersAndTheirSettings) {
   // Defaults: HHT (measured as fast as generalized-alpha at a given error
-  // and more robust), rho_infinity 0.7, factorization reuse, fixed steps, no error estimate.
+  // and more robust), rho_infinity 0.5, factorization reuse, fixed steps, no error estimate.
   absl::StatusOr<Scene> scene = ConvertJson(Scene1(""));
   ASSERT_TRUE(scene.ok()) << scene.status();
   EXPECT_EQ(scene->solver.integrator, Integrator::kHht);
-  EXPECT_EQ(scene->solver.rho_infinity, 0.7);
+  EXPECT_EQ(scene->solver.rho_infinity, 0.5);
   EXPECT_TRUE(scene->solver.reuse_factorization);
   EXPECT_FALSE(scene->solver.adaptive);
   EXPECT_FALSE(scene->solver.error_estimate);
   EXPECT_EQ(scene->solver.tolerance_m, 1e-4);
   EXPECT_EQ(scene->solver.relative_tolerance, 0);
+  EXPECT_EQ(scene->solver.linear_solver, LinearSolverKind::kAuto);
 
   scene = ConvertJson(absl::StrCat(R"({"cables": [)", kCable, R"(], "solver": {
       "duration": 1, "integrator": "HHT", "rho_infinity": 0.5, "linear_solver": "DIRECT",
