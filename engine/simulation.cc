@@ -198,14 +198,17 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     }
     t = t_frame;
     rec->Evaluate(t, 1, stepper.z(), &stepper.v(), &stepper.a());
-    const double rise = rec->frame().energy.total - summary->energy_initial;
-    if (rise > kEnergyRiseLimit * rec->energy_scale()) {
+    const EnergySample& e = rec->frame().energy;
+    const double rise = e.total - summary->energy_initial;
+    const double scale = std::max({rec->energy_scale(), std::abs(e.kinetic),
+                                   std::abs(e.potential), std::abs(e.axial) + std::abs(e.bending)});
+    if (rise > kEnergyRiseLimit * scale) {
       Fail(summary, t,
            absl::StrFormat("the total energy rose by %.3g J (more than %g %% of the largest "
                            "energy term, %.3g J) by t = %.9g s: the stepper is unstable at this "
                            "step; use a smaller solver.step, adaptive steps or a smaller "
                            "rho_infinity",
-                           rise, 100 * kEnergyRiseLimit, rec->energy_scale(), t));
+                           rise, 100 * kEnergyRiseLimit, scale, t));
       return;
     }
     if (absl::Status s = rec->Deliver(); !s.ok()) {
