@@ -17,8 +17,10 @@
 // with MINRES (or GMRES) under SaddlePointSolver's preconditioner. Newton
 // stops when the position increment h |dv|_inf is below
 // tol (1 + |z|_inf), the momentum residual below tol times its largest term
-// and |Phi|_inf below tol (1 + |z|_inf); otherwise the step is reported as
-// not converged and the caller retries with a smaller step. Nothing is
+// and |Phi|_inf below tol (1 + |z|_inf) (a residual left above tol while the
+// corrections move z only in its last bits, 16 eps (1 + |z|), is the
+// rounding floor of the forces and is accepted when below sqrt(tol));
+// otherwise the step is reported as not converged and the caller retries with a smaller step. Nothing is
 // accepted silently.
 //
 // Backward Euler is first order and removes energy at high frequencies;

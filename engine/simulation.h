@@ -78,7 +78,7 @@ struct RunSummary {
   int64_t newton_iterations = 0;
   int64_t linear_iterations = 0;
   double min_step_s = 0;        // smallest step taken
-  double wall_seconds = 0;
+  double wall_seconds = 0;     // the whole run, error-estimate companion included
   double end_time_s = 0;        // last converged time (or load factor)
   double energy_initial = 0;
   double energy_final = 0;

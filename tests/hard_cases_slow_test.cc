@@ -228,6 +228,16 @@ TEST(HardCasesTest, HundredSecondsWithoutNumericalDamping) {
   std::printf("100 s, HHT rho_infinity 0.9: %lld steps, energy removed %.4g J\n",
               static_cast<long long>(d.steps), d.energy_dissipated);
   EXPECT_LE(MaxEnergyRise(damped), 1e-6 * EnergyScale(damped));
+  // And the defaults (HHT, rho_infinity 0.5, AUTO).
+  CollectingSink defaults;
+  const RunSummary ds =
+      RunOk(SceneFromJson(FallingPendulum(12, 9.81, 100, R"("step": 1e-3)")), &defaults);
+  std::printf("100 s, defaults (%s, rho %g, %s): %lld steps, %lld rejected, energy removed "
+              "%.4g J\n",
+              ds.integrator.c_str(), ds.rho_infinity, ds.linear_solver_used.c_str(),
+              static_cast<long long>(ds.steps), static_cast<long long>(ds.rejected_steps),
+              ds.energy_dissipated);
+  EXPECT_LE(MaxEnergyRise(defaults), 1e-6 * EnergyScale(defaults));
 }
 
 TEST(HardCasesTest, SettingThatCannotConvergeFailsWithAMessage) {
