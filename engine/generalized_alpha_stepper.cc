@@ -207,12 +207,14 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
     }
     const double floor = w_ * model_->force_roundoff() / scale;
     // At the rounding floor: the last correction moved z by a few units in
-    // its last place, so Newton cannot improve the state in double
-    // precision; the residual left is the rounding of the forces (short,
-    // stiff elements far from the origin: eps |x| / l amplified by EA).
-    // Accepted only if that residual is still small (below sqrt(tol)).
-    const bool at_rounding = last_increment <= kRoundingIncrement * zscale &&
-                             res <= std::sqrt(tol);
+    // its last place, or by a thousandth of the tolerance, so Newton cannot
+    // usefully improve the state; the residual left is the rounding of the
+    // forces (short, stiff elements far from the origin: eps |x| / l
+    // amplified by EA). Accepted only if that residual is still small
+    // (below sqrt(tol)).
+    const bool at_rounding =
+        last_increment <= std::max(kRoundingIncrement, 1e-3 * tol) * zscale &&
+        res <= std::sqrt(tol);
     if (checking && (res <= tol + floor || at_rounding) && viol <= tol * zscale) {
       st.converged = true;
       st.residual = res;

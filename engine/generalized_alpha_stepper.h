@@ -60,8 +60,8 @@
 // s |d zdd|_inf below tol (1 + |z|_inf), momentum residual below tol times
 // its largest term (or the rounding floor), |Phi|_inf below tol (1 + |z|).
 // A residual that stays above tol while the corrections are at the last
-// bits of z (16 eps (1 + |z|)) is rounding, and is accepted when below
-// sqrt(tol).
+// bits of z (16 eps (1 + |z|)) or below tol / 1000 (1 + |z|) is rounding,
+// and is accepted when below sqrt(tol).
 //
 // Newton economy (settings.reuse_factorization): the factored Newton matrix
 // is kept across iterations and steps while c (below) stays within 20 % of

@@ -122,10 +122,12 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
     // the tolerance or at the rounding floor of the elastic forces.
     const double floor = h * model_->force_roundoff() / scale;
     // At the rounding floor: the last correction moved z only in its last
-    // bits (16 eps (1 + |z|)), so the residual left is the rounding of the
-    // forces; accepted when below sqrt(tol).
+    // bits (16 eps (1 + |z|)) or by a thousandth of the tolerance, so the
+    // residual left is the rounding of the forces; accepted when below
+    // sqrt(tol).
     const bool at_rounding =
-        last_increment <= 16 * 2.220446049250313e-16 * zscale && res <= std::sqrt(tol);
+        last_increment <= std::max(16 * 2.220446049250313e-16, 1e-3 * tol) * zscale &&
+        res <= std::sqrt(tol);
     if (checking && (res <= tol + floor || at_rounding) && viol <= tol * zscale) {
       st.converged = true;
       st.residual = res;

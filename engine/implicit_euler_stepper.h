@@ -18,7 +18,8 @@
 // stops when the position increment h |dv|_inf is below
 // tol (1 + |z|_inf), the momentum residual below tol times its largest term
 // and |Phi|_inf below tol (1 + |z|_inf) (a residual left above tol while the
-// corrections move z only in its last bits, 16 eps (1 + |z|), is the
+// corrections move z only in its last bits, 16 eps (1 + |z|), or by less
+// than tol / 1000 (1 + |z|), is the
 // rounding floor of the forces and is accepted when below sqrt(tol));
 // otherwise the step is reported as not converged and the caller retries with a smaller step. Nothing is
 // accepted silently.
