@@ -17,6 +17,8 @@
 // reports tip_error_m, the largest tip distance over the frames from a
 // converged run of the same mesh (generalized-alpha, rho 1, h = 1e-5).
 //
+//   step_scaling/N:   whole runs of that cable (100 steps of 1e-5 s, HHT +
+//                     DIRECT): us_per_step against elements.
 //   newton_iteration/N: one Newton iteration (assemble, factor, solve) on
 //                     an N-element soft cable (as soft_cable_200), DIRECT
 //                     and MINRES: time per iteration against elements.
@@ -175,6 +177,8 @@ void RunBenchmark(benchmark::State& state, const Scene& scene) {
   state.counters["dofs"] = benchmark::Counter(dofs);
   state.counters["us_per_step"] =
       benchmark::Counter(1e6 * wall / static_cast<double>(steps));
+  state.counters["us_per_newton"] =
+      benchmark::Counter(1e6 * wall / static_cast<double>(std::max<int64_t>(newton, 1)));
   if (scene.solver.output_interval_s == 0.01 && scene.cables[0].elements == 12)
     state.counters["tip_error_m"] = benchmark::Counter(TipError(scene));
 }
@@ -280,6 +284,22 @@ void NewtonIteration(benchmark::State& state, LinearSolverKind kind) {
   state.counters["krylov_per_solve"] =
       benchmark::Counter(static_cast<double>(iterations) / state.iterations());
 }
+// Whole runs: the N-element soft cable, 100 steps of 1e-5 s with the
+// defaults (HHT, factorization reuse) and DIRECT; us_per_step includes the
+// model build and the frames (every 10 steps); us_per_newton divides by
+// the Newton iterations instead (their number per step grows with N).
+void BM_StepScaling_Direct(benchmark::State& state) {
+  constexpr double kPi = std::numbers::pi;
+  const double d = 0.01;
+  Scene scene = PinnedCable("soft-cable", 2.0, static_cast<int>(state.range(0)), 1000, 1e7,
+                            kPi * d * d / 4, kPi * d * d * d * d / 64, 1e-3,
+                            LinearSolverKind::kDirect);
+  scene.solver.integrator = Integrator::kHht;
+  scene.solver.step_s = 1e-5;
+  scene.solver.output_interval_s = 1e-4;
+  RunBenchmark(state, scene);
+}
+
 void BM_NewtonIteration_Direct(benchmark::State& state) {
   NewtonIteration(state, LinearSolverKind::kDirect);
 }
@@ -306,6 +326,7 @@ CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_Fastest_NoReuse);
 CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_Fastest_Hht);
 CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_Fastest_Minres);
 CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_Adaptive_tol1e4);
+CABLESIM_RUN_BENCHMARK(BM_StepScaling_Direct)->Arg(1000)->Arg(3000)->Arg(10000);
 BENCHMARK(BM_NewtonIteration_Direct)
     ->Unit(benchmark::kMicrosecond)
     ->UseRealTime()
