@@ -42,6 +42,13 @@ class FrameRecorder {
   }
   const Frame& frame() const { return frame_; }
 
+  // Energy of a state, without evaluating or delivering a frame.
+  EnergySample StateEnergy(const Eigen::VectorXd& z, const Eigen::VectorXd& v) {
+    model_->ToFull(z, &q_);
+    model_->RateToFull(v, &qd_);
+    return model_->Energy(q_, qd_, 1.0);
+  }
+
   // Records the evaluated frame in the summary and delivers it.
   absl::Status Deliver() {
     if (summary_->frames == 0) summary_->energy_initial = frame_.energy.total;
@@ -81,6 +88,9 @@ class FrameRecorder {
 // second-order steppers can, on stiff nonlinear cables at large steps): the
 // run stops and says so rather than deliver it.
 constexpr double kEnergyRiseLimit = 0.05;
+// Steps that took at least this many Newton iterations have their energy
+// checked against that limit before they are accepted.
+constexpr int kEnergyCheckNewton = 4;
 
 void Fail(RunSummary* s, double t, const std::string& reason) {
   s->status = "failed";
@@ -136,6 +146,8 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   double t = 0;
   double h = h_nominal;
   int successes = 0;
+  // Backward Euler never raises the energy; the second-order steppers may.
+  const bool check_steps = settings.integrator != Integrator::kImplicitEuler;
   summary->min_step_s = settings.adaptive ? std::numeric_limits<double>::infinity() : h_nominal;
   for (long k = 1; k <= frames; ++k) {
     const double t_frame = std::min(duration, k * interval);
@@ -150,6 +162,30 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       summary->factorizations += st.factorizations;
       summary->direct_fallbacks += st.direct_fallbacks;
       summary->max_linear_residual = std::max(summary->max_linear_residual, st.max_linear_residual);
+      if (st.converged && check_steps && st.newton_iterations >= kEnergyCheckNewton) {
+        // A step Newton found hard may have landed on a spurious root (an
+        // element folded through itself: Green-Lagrange strain does not see
+        // it); its energy says so. Take it back and halve the step.
+        const EnergySample e = rec->StateEnergy(stepper.z(), stepper.v());
+        const double scale =
+            std::max({rec->energy_scale(), std::abs(e.kinetic), std::abs(e.potential),
+                      std::abs(e.axial) + std::abs(e.bending)});
+        if (e.total - summary->energy_initial > kEnergyRiseLimit * scale) {
+          stepper.Restore();
+          ++summary->rejected_steps;
+          successes = 0;
+          h = h_try / 2;
+          if (h < h_min * (1 - 1e-12)) {
+            Fail(summary, t + h_try,
+                 absl::StrFormat("step from t = %.9g s raises the total energy by %.3g J down to "
+                                 "h = %.3g s: the stepper is unstable here; use a smaller "
+                                 "rho_infinity",
+                                 t, e.total - summary->energy_initial, h_try));
+            return;
+          }
+          continue;
+        }
+      }
       if (st.converged && settings.adaptive) {
         // Adaptive steps: accept when the local error estimate meets the
         // tolerance, and choose the next step from it either way.

@@ -271,21 +271,30 @@ TEST(AlphaStepperTest, FineMeshesReachTheRoundingFloorWithoutHalving) {
   }
 }
 
-TEST(AlphaStepperTest, UnstableLargeStepFailsInsteadOfDeliveringGarbage) {
+TEST(AlphaStepperTest, UnstableLargeStepNeverDeliversGarbage) {
   // rho = 1 at h = 0.01 on this soft cable: the nonlinear stretch modes make
-  // generalized-alpha gain energy; the run must stop and say so.
+  // generalized-alpha gain energy (before the energy checks it delivered a
+  // 3.6e6 J "ok" run). Now a step that Newton found hard and that raises the
+  // energy is taken back and halved, and a frame above the guard stops the
+  // run: either way no delivered frame rises above 5 % of the 82 J scale.
   CollectingSink sink;
   auto s = RunScene(SceneFromJson(FallingPendulum(
                         R"("step": 0.01, "integrator": "GENERALIZED_ALPHA", "rho_infinity": 1)",
                         1.0)),
                     &sink);
   ASSERT_TRUE(s.ok());
-  EXPECT_EQ(s->status, "failed");
-  EXPECT_FALSE(s->error.empty());
+  std::printf("status %s, %lld steps, %lld rejected, largest rise %.3g J %s\n", s->status.c_str(),
+              static_cast<long long>(s->steps), static_cast<long long>(s->rejected_steps),
+              s->energy_max_increase, s->error.c_str());
+  if (s->status != "ok") {
+    EXPECT_EQ(s->status, "failed");
+    EXPECT_NE(s->error.find("energy"), std::string::npos) << s->error;
+  } else {
+    EXPECT_GT(s->rejected_steps, 0);  // it did need the step check
+  }
   for (const Frame& f : sink.frames()) {
     EXPECT_TRUE(std::isfinite(f.energy.total));
-    EXPECT_LT(f.energy.total - sink.frames()[0].energy.total,
-              0.05 * 82 + 1e-9);  // the guard's limit on this scene's 82 J scale
+    EXPECT_LT(f.energy.total - sink.frames()[0].energy.total, 0.05 * 82 + 1e-9);
   }
 }
 

@@ -215,7 +215,7 @@ TEST(HardCasesTest, HundredSecondsWithoutNumericalDamping) {
   EXPECT_LE(drift, 0.05 * scale);
   if (s->status != "ok") {
     EXPECT_EQ(s->status, "failed");
-    EXPECT_NE(s->error.find("energy rose"), std::string::npos) << s->error;
+    EXPECT_NE(s->error.find("energy"), std::string::npos) << s->error;
   }
   // HHT with rho_infinity = 0.9 (alpha = -0.053) finishes the same 100 s,
   // and the energy never rises (Newton-tolerance share of the scale).
