@@ -10,13 +10,29 @@
 // Each is run with MINRES and with GMRES. Counters per run: steps_per_s
 // (accepted steps over the summary's wall time), newton_per_step,
 // linear_per_step (Krylov iterations per accepted step) and dofs.
+//
+// Issue 5 configurations of the falling pendulum (frames every 0.01 s):
+// generalized-alpha and HHT with DIRECT at the paper's step, the fastest
+// configuration found with tip error <= 1e-3 m, and adaptive steps. Each
+// reports tip_error_m, the largest tip distance over the frames from a
+// converged run of the same mesh (generalized-alpha, rho 1, h = 1e-5).
+//
+//   step_scaling/N:   whole runs of that cable (100 steps of 1e-5 s, HHT +
+//                     DIRECT): us_per_step against elements.
+//   newton_iteration/N: one Newton iteration (assemble, factor, solve) on
+//                     an N-element soft cable (as soft_cable_200), DIRECT
+//                     and MINRES: time per iteration against elements.
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include <benchmark/benchmark.h>
 
+#include "engine/multibody_model.h"
+#include "engine/saddle_point_solver.h"
 #include "engine/scene.h"
 #include "engine/simulation.h"
 
@@ -91,6 +107,46 @@ Scene SoftCable200(LinearSolverKind linear_solver) {
                      kPi * d * d * d * d / 64, 0.1, linear_solver);
 }
 
+// Keeps the tip position of every frame.
+class TipSink : public FrameSink {
+ public:
+  absl::Status OnFrame(const Frame& frame) override {
+    tips.push_back(frame.probes[0].position_m);
+    return absl::OkStatus();
+  }
+  std::vector<Eigen::Vector3d> tips;
+};
+
+Scene FastPendulum(Integrator integrator, LinearSolverKind ls, double step) {
+  Scene scene = FallingPendulum(ls);
+  scene.solver.integrator = integrator;
+  scene.solver.step_s = step;
+  scene.solver.output_interval_s = 0.01;
+  return scene;
+}
+
+// The converged reference of the falling pendulum (frames every 0.01 s).
+const std::vector<Eigen::Vector3d>& ReferenceTips() {
+  static const std::vector<Eigen::Vector3d> tips = [] {
+    Scene scene = FastPendulum(Integrator::kGeneralizedAlpha, LinearSolverKind::kDirect, 1e-5);
+    scene.solver.rho_infinity = 1;
+    TipSink sink;
+    (void)RunScene(scene, &sink);
+    return sink.tips;
+  }();
+  return tips;
+}
+
+double TipError(const Scene& scene) {
+  TipSink sink;
+  auto summary = RunScene(scene, &sink);
+  const auto& ref = ReferenceTips();
+  if (!summary.ok() || summary->status != "ok" || sink.tips.size() != ref.size()) return -1;
+  double worst = 0;
+  for (size_t i = 0; i < ref.size(); ++i) worst = std::max(worst, (sink.tips[i] - ref[i]).norm());
+  return worst;
+}
+
 void RunBenchmark(benchmark::State& state, const Scene& scene) {
   DiscardingSink sink;
   int64_t steps = 0, newton = 0, linear = 0;
@@ -119,6 +175,12 @@ void RunBenchmark(benchmark::State& state, const Scene& scene) {
   state.counters["linear_per_step"] =
       benchmark::Counter(static_cast<double>(linear) / static_cast<double>(steps));
   state.counters["dofs"] = benchmark::Counter(dofs);
+  state.counters["us_per_step"] =
+      benchmark::Counter(1e6 * wall / static_cast<double>(steps));
+  state.counters["us_per_newton"] =
+      benchmark::Counter(1e6 * wall / static_cast<double>(std::max<int64_t>(newton, 1)));
+  if (scene.solver.output_interval_s == 0.01 && scene.cables[0].elements == 12)
+    state.counters["tip_error_m"] = benchmark::Counter(TipError(scene));
 }
 
 void BM_FallingPendulum_Minres(benchmark::State& state) {
@@ -134,6 +196,117 @@ void BM_SoftCable200_Gmres(benchmark::State& state) {
   RunBenchmark(state, SoftCable200(LinearSolverKind::kGmres));
 }
 
+void BM_FallingPendulum_GeneralizedAlpha_Direct_h1e4(benchmark::State& state) {
+  RunBenchmark(state,
+               FastPendulum(Integrator::kGeneralizedAlpha, LinearSolverKind::kDirect, 1e-4));
+}
+void BM_FallingPendulum_Hht_Direct_h1e4(benchmark::State& state) {
+  RunBenchmark(state, FastPendulum(Integrator::kHht, LinearSolverKind::kDirect, 1e-4));
+}
+void BM_FallingPendulum_ImplicitEuler_Direct_h1e4(benchmark::State& state) {
+  RunBenchmark(state,
+               FastPendulum(Integrator::kImplicitEuler, LinearSolverKind::kDirect, 1e-4));
+}
+// The fastest configuration found with tip error <= 1e-3 m: generalized-
+// alpha (rho 0.8), DIRECT, factorization reuse, h = 6.25e-4 (16 steps per
+// frame), Newton tolerance 1e-5 (far below the 1e-3 m step error).
+Scene Fastest() {
+  Scene scene = FastPendulum(Integrator::kGeneralizedAlpha, LinearSolverKind::kDirect, 6.25e-4);
+  scene.solver.newton_tolerance = 1e-5;
+  scene.solver.rho_infinity = 0.8;
+  return scene;
+}
+void BM_FallingPendulum_Fastest(benchmark::State& state) { RunBenchmark(state, Fastest()); }
+void BM_FallingPendulum_Fastest_NoReuse(benchmark::State& state) {
+  Scene scene = Fastest();
+  scene.solver.reuse_factorization = false;
+  RunBenchmark(state, scene);
+}
+// HHT needs rho_infinity 0.9 (alpha = -0.053) for the same error bound.
+void BM_FallingPendulum_Fastest_Hht(benchmark::State& state) {
+  Scene scene = Fastest();
+  scene.solver.integrator = Integrator::kHht;
+  scene.solver.rho_infinity = 0.9;
+  RunBenchmark(state, scene);
+}
+void BM_FallingPendulum_Fastest_Minres(benchmark::State& state) {
+  Scene scene = Fastest();
+  scene.solver.linear_solver = LinearSolverKind::kMinres;
+  RunBenchmark(state, scene);
+}
+void BM_FallingPendulum_Adaptive_tol1e4(benchmark::State& state) {
+  Scene scene = Fastest();
+  scene.solver.step_s = 1e-3;
+  scene.solver.adaptive = true;
+  scene.solver.tolerance_m = 1e-4;
+  RunBenchmark(state, scene);
+}
+
+// One Newton iteration of generalized-alpha on an N-element cable (the
+// soft cable, 2 m): assemble M + c K_T with the forces, factor, solve. The
+// cost that a step repeats; per iteration rather than per run because the
+// step count of that scene depends on N (short elements hit the rounding
+// floor of the residual early in the run).
+void NewtonIteration(benchmark::State& state, LinearSolverKind kind) {
+  constexpr double kPi = std::numbers::pi;
+  const double d = 0.01;
+  const int n_el = static_cast<int>(state.range(0));
+  Scene scene = PinnedCable("soft-cable", 2.0, n_el, 1000, 1e7, kPi * d * d / 4,
+                            kPi * d * d * d * d / 64, 1e-3, kind);
+  auto model = MultibodyModel::Build(scene);
+  if (!model.ok()) {
+    state.SkipWithError(std::string(model.status().message()).c_str());
+    return;
+  }
+  SaddlePointSolver solver;
+  solver.Resize(model->envelope(), model->jacobian_pattern());
+  Eigen::VectorXd q(model->coordinates()), f(model->dofs()), rhs(model->dofs()), x(model->dofs());
+  // The cable stretched by 0.1 % (tension everywhere: A positive definite).
+  Eigen::VectorXd z = model->initial_z();
+  model->ToFull(z, &q);
+  for (int i = 0; i < q.size(); i += 4) q(i) *= 1.001;
+  const double c = 0.25 * 1e-4 * 1e-4;
+  int iterations = 0;
+  for (auto _ : state) {
+    const SkylineLdlt& mass = model->mass();
+    std::copy(mass.values(), mass.values() + mass.stored(), solver.a().values());
+    model->NetForce(q, 1.0, &f, &solver.a(), c);
+    if (!solver.Prepare()) {
+      state.SkipWithError("factorization failed");
+      return;
+    }
+    rhs = f;
+    const auto st = solver.Solve(kind, rhs, 1e-10, 200, &x);
+    iterations += st.iterations;
+    benchmark::DoNotOptimize(x.data());
+  }
+  state.counters["dofs"] = benchmark::Counter(model->dofs());
+  state.counters["krylov_per_solve"] =
+      benchmark::Counter(static_cast<double>(iterations) / state.iterations());
+}
+// Whole runs: the N-element soft cable, 100 steps of 1e-5 s with the
+// defaults (HHT, factorization reuse) and DIRECT; us_per_step includes the
+// model build and the frames (every 10 steps); us_per_newton divides by
+// the Newton iterations instead (their number per step grows with N).
+void BM_StepScaling_Direct(benchmark::State& state) {
+  constexpr double kPi = std::numbers::pi;
+  const double d = 0.01;
+  Scene scene = PinnedCable("soft-cable", 2.0, static_cast<int>(state.range(0)), 1000, 1e7,
+                            kPi * d * d / 4, kPi * d * d * d * d / 64, 1e-3,
+                            LinearSolverKind::kDirect);
+  scene.solver.integrator = Integrator::kHht;
+  scene.solver.step_s = 1e-5;
+  scene.solver.output_interval_s = 1e-4;
+  RunBenchmark(state, scene);
+}
+
+void BM_NewtonIteration_Direct(benchmark::State& state) {
+  NewtonIteration(state, LinearSolverKind::kDirect);
+}
+void BM_NewtonIteration_Minres(benchmark::State& state) {
+  NewtonIteration(state, LinearSolverKind::kMinres);
+}
+
 #define CABLESIM_RUN_BENCHMARK(fn)      \
   BENCHMARK(fn)                         \
       ->Unit(benchmark::kMillisecond)   \
@@ -145,6 +318,31 @@ CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_Minres);
 CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_Gmres);
 CABLESIM_RUN_BENCHMARK(BM_SoftCable200_Minres);
 CABLESIM_RUN_BENCHMARK(BM_SoftCable200_Gmres);
+CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_GeneralizedAlpha_Direct_h1e4);
+CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_Hht_Direct_h1e4);
+CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_ImplicitEuler_Direct_h1e4);
+CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_Fastest);
+CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_Fastest_NoReuse);
+CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_Fastest_Hht);
+CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_Fastest_Minres);
+CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_Adaptive_tol1e4);
+CABLESIM_RUN_BENCHMARK(BM_StepScaling_Direct)->Arg(1000)->Arg(3000)->Arg(10000);
+BENCHMARK(BM_NewtonIteration_Direct)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime()
+    ->Repetitions(5)
+    ->ReportAggregatesOnly(true)
+    ->Arg(1000)
+    ->Arg(3000)
+    ->Arg(10000);
+BENCHMARK(BM_NewtonIteration_Minres)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime()
+    ->Repetitions(5)
+    ->ReportAggregatesOnly(true)
+    ->Arg(1000)
+    ->Arg(3000)
+    ->Arg(10000);
 
 }  // namespace
 }  // namespace cablesim

@@ -34,6 +34,20 @@ std::string SummaryToJson(const RunSummary& summary) {
       .Add("max_newton_residual", summary.max_newton_residual)
       .Add("max_linear_residual", summary.max_linear_residual);
   if (summary.analysis == "MODAL") json.Add("frequencies_hz", summary.frequencies_hz);
+  if (summary.analysis == "DYNAMIC") {
+    json.Add("linear_solver_used", summary.linear_solver_used)
+        .Add("accepted_steps", summary.steps)
+        .Add("max_step_s", summary.max_step_s)
+        .Add("factorizations", summary.factorizations)
+        .Add("direct_fallbacks", summary.direct_fallbacks)
+        .Add("adaptive", summary.adaptive);
+    if (summary.integrator != "IMPLICIT_EULER") json.Add("rho_infinity", summary.rho_infinity);
+    if (summary.has_error_estimate) {
+      if (summary.error_estimate_m >= 0) json.Add("error_estimate_m", summary.error_estimate_m);
+      json.Add("error_estimate_method", summary.error_estimate_method)
+          .Add("error_estimate_seconds", summary.error_estimate_seconds);
+    }
+  }
   return json.ToString();
 }
 

@@ -53,6 +53,16 @@ v1::RunSummary SummaryToProto(const RunSummary& s) {
   p.set_max_newton_residual(s.max_newton_residual);
   p.set_max_linear_residual(s.max_linear_residual);
   for (double f : s.frequencies_hz) p.add_frequencies_hz(f);
+  p.set_linear_solver_used(s.linear_solver_used);
+  p.set_factorizations(s.factorizations);
+  p.set_direct_fallbacks(s.direct_fallbacks);
+  p.set_max_step_s(s.max_step_s);
+  p.set_adaptive(s.adaptive);
+  p.set_rho_infinity(s.rho_infinity);
+  p.set_has_error_estimate(s.has_error_estimate);
+  p.set_error_estimate_m(s.error_estimate_m);
+  p.set_error_estimate_method(s.error_estimate_method);
+  p.set_error_estimate_seconds(s.error_estimate_seconds);
   return p;
 }
 
@@ -81,6 +91,16 @@ RunSummary SummaryFromProto(const v1::RunSummary& p) {
   s.max_newton_residual = p.max_newton_residual();
   s.max_linear_residual = p.max_linear_residual();
   s.frequencies_hz.assign(p.frequencies_hz().begin(), p.frequencies_hz().end());
+  s.linear_solver_used = p.linear_solver_used();
+  s.factorizations = p.factorizations();
+  s.direct_fallbacks = p.direct_fallbacks();
+  s.max_step_s = p.max_step_s();
+  s.adaptive = p.adaptive();
+  s.rho_infinity = p.rho_infinity();
+  s.has_error_estimate = p.has_error_estimate();
+  s.error_estimate_m = p.error_estimate_m();
+  s.error_estimate_method = p.error_estimate_method();
+  s.error_estimate_seconds = p.error_estimate_seconds();
   return s;
 }
 

@@ -530,6 +530,56 @@ class SceneConverter {
       CABLESIM_RETURN_IF_ERROR(CheckIntRange("solver.modes", s.modes(), 1, kMaxModes));
       out.modes = s.modes();
     }
+
+    const bool alpha_family =
+        out.integrator == Integrator::kGeneralizedAlpha || out.integrator == Integrator::kHht;
+    if (s.has_rho_infinity()) {
+      if (!alpha_family) {
+        return Invalid("solver.rho_infinity",
+                       "applies to GENERALIZED_ALPHA and HHT only (solver.integrator is " +
+                           std::string(IntegratorName(out.integrator)) + ")");
+      }
+      const double lo = out.integrator == Integrator::kHht ? 0.5 : 0.0;
+      if (!(s.rho_infinity() >= lo && s.rho_infinity() <= 1)) {
+        return Invalid("solver.rho_infinity",
+                       absl::StrCat("must be in [", Num(lo), ", 1] for ",
+                                    std::string(IntegratorName(out.integrator)), " (got ",
+                                    Num(s.rho_infinity()), ")"));
+      }
+      out.rho_infinity = s.rho_infinity();
+    }
+    out.adaptive = s.adaptive();
+    out.error_estimate = s.error_estimate();
+    out.reuse_factorization = s.has_reuse_factorization() ? s.reuse_factorization() : alpha_family;
+    if (s.has_reuse_factorization() && s.reuse_factorization() && !alpha_family) {
+      return Invalid("solver.reuse_factorization",
+                     "applies to GENERALIZED_ALPHA and HHT only (solver.integrator is " +
+                         std::string(IntegratorName(out.integrator)) + ")");
+    }
+    for (const auto& [has, name] : {std::pair{s.has_tolerance(), "solver.tolerance"},
+                                    std::pair{s.has_relative_tolerance(),
+                                              "solver.relative_tolerance"}}) {
+      if (has && !out.adaptive) return Invalid(name, "needs solver.adaptive: true");
+    }
+    if ((out.adaptive || out.error_estimate) && out.analysis != Analysis::kDynamic) {
+      return Invalid(out.adaptive ? "solver.adaptive" : "solver.error_estimate",
+                     "applies to DYNAMIC analysis only");
+    }
+    if (s.has_tolerance()) {
+      CABLESIM_RETURN_IF_ERROR(CheckFinite("solver.tolerance", s.tolerance()));
+      CABLESIM_RETURN_IF_ERROR(CheckPositive("solver.tolerance", s.tolerance()));
+      out.tolerance_m = s.tolerance();
+    }
+    if (s.has_relative_tolerance()) {
+      CABLESIM_RETURN_IF_ERROR(CheckFinite("solver.relative_tolerance", s.relative_tolerance()));
+      CABLESIM_RETURN_IF_ERROR(
+          CheckNonNegative("solver.relative_tolerance", s.relative_tolerance()));
+      if (!(s.relative_tolerance() < 1)) {
+        return Invalid("solver.relative_tolerance",
+                       absl::StrCat("must be < 1 (got ", Num(s.relative_tolerance()), ")"));
+      }
+      out.relative_tolerance = s.relative_tolerance();
+    }
     return absl::OkStatus();
   }
 
@@ -596,11 +646,15 @@ absl::StatusOr<Integrator> IntegratorFromProto(v1::Integrator integrator,
                                                std::string_view path_std) {
   const absl::string_view path(path_std.data(), path_std.size());
   switch (integrator) {
-    case v1::INTEGRATOR_UNSPECIFIED:
     case v1::IMPLICIT_EULER:
       return Integrator::kImplicitEuler;
+    case v1::GENERALIZED_ALPHA:
+      return Integrator::kGeneralizedAlpha;
+    case v1::INTEGRATOR_UNSPECIFIED:
+    case v1::HHT:
+      return Integrator::kHht;
     default:
-      return UnknownEnumValue(path, integrator, "IMPLICIT_EULER");
+      return UnknownEnumValue(path, integrator, "IMPLICIT_EULER, GENERALIZED_ALPHA or HHT");
   }
 }
 
@@ -608,13 +662,17 @@ absl::StatusOr<LinearSolverKind> LinearSolverFromProto(v1::LinearSolver solver,
                                                        std::string_view path_std) {
   const absl::string_view path(path_std.data(), path_std.size());
   switch (solver) {
-    case v1::LINEAR_SOLVER_UNSPECIFIED:
     case v1::MINRES:
       return LinearSolverKind::kMinres;
     case v1::GMRES:
       return LinearSolverKind::kGmres;
+    case v1::DIRECT:
+      return LinearSolverKind::kDirect;
+    case v1::LINEAR_SOLVER_UNSPECIFIED:
+    case v1::AUTO:
+      return LinearSolverKind::kAuto;
     default:
-      return UnknownEnumValue(path, solver, "MINRES or GMRES");
+      return UnknownEnumValue(path, solver, "MINRES, GMRES, DIRECT or AUTO");
   }
 }
 
@@ -634,6 +692,10 @@ std::string_view IntegratorName(Integrator integrator) {
   switch (integrator) {
     case Integrator::kImplicitEuler:
       return "IMPLICIT_EULER";
+    case Integrator::kGeneralizedAlpha:
+      return "GENERALIZED_ALPHA";
+    case Integrator::kHht:
+      return "HHT";
   }
   return "UNKNOWN";
 }
@@ -644,6 +706,10 @@ std::string_view LinearSolverName(LinearSolverKind solver) {
       return "MINRES";
     case LinearSolverKind::kGmres:
       return "GMRES";
+    case LinearSolverKind::kDirect:
+      return "DIRECT";
+    case LinearSolverKind::kAuto:
+      return "AUTO";
   }
   return "UNKNOWN";
 }

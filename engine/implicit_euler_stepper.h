@@ -17,12 +17,19 @@
 // with MINRES (or GMRES) under SaddlePointSolver's preconditioner. Newton
 // stops when the position increment h |dv|_inf is below
 // tol (1 + |z|_inf), the momentum residual below tol times its largest term
-// and |Phi|_inf below tol (1 + |z|_inf); otherwise the step is reported as
-// not converged and the caller retries with a smaller step. Nothing is
+// and |Phi|_inf below tol (1 + |z|_inf) (a residual left above tol while the
+// corrections move z only in its last bits, 16 eps (1 + |z|), or by less
+// than tol / 1000 (1 + |z|), is the
+// rounding floor of the forces and is accepted when below sqrt(tol));
+// otherwise the step is reported as not converged and the caller retries with a smaller step. Nothing is
 // accepted silently.
 //
 // Backward Euler is first order and removes energy at high frequencies;
 // simulation.cc reports how much.
+//
+// Local error (for adaptive steps): against the second-order update
+// z0 + h (v0 + v1) / 2, backward Euler's position is off by
+// h (v1 - v0) / 2 = h^2 a1 / 2, the estimate LocalErrorNorm() uses.
 //
 // Step() allocates nothing.
 
@@ -33,33 +40,25 @@
 #include "engine/multibody_model.h"
 #include "engine/saddle_point_solver.h"
 #include "engine/scene.h"
+#include "engine/stepper.h"
 
 namespace cablesim {
 
-class ImplicitEulerStepper {
+class ImplicitEulerStepper final : public Stepper {
  public:
-  struct StepStats {
-    bool converged = false;
-    int newton_iterations = 0;
-    int linear_iterations = 0;
-    double residual = 0;               // relative momentum residual accepted
-    double max_linear_residual = 0;    // largest true relative residual
-    std::string reason;                // why it did not converge
-  };
-
   ImplicitEulerStepper(MultibodyModel* model, const SolverSettings& settings);
 
-  // Consistent initial acceleration from M a + Phi_z^T lambda = f,
-  // Phi_z a = gamma. Returns false (with `reason`) if the solve fails.
-  bool Initialize(std::string* reason);
+  bool Initialize(std::string* reason) override;
+  StepStats Step(double h) override;
+  void Restore() override;
+  double LocalErrorNorm(double h, double atol, double rtol) const override;
+  int local_error_order() const override { return 2; }
+  int order() const override { return 1; }
 
-  // Advances by h, or leaves the state unchanged and returns !converged.
-  StepStats Step(double h);
-
-  const Eigen::VectorXd& z() const { return z_; }
-  const Eigen::VectorXd& v() const { return v_; }
-  const Eigen::VectorXd& a() const { return a_; }
-  const Eigen::VectorXd& lambda() const { return lambda_; }
+  const Eigen::VectorXd& z() const override { return z_; }
+  const Eigen::VectorXd& v() const override { return v_; }
+  const Eigen::VectorXd& a() const override { return a_; }
+  const Eigen::VectorXd& lambda() const override { return lambda_; }
 
  private:
   // Newton matrix block a = M.
@@ -72,6 +71,7 @@ class ImplicitEulerStepper {
   SaddlePointSolver solver_;
   int n_ = 0, m_ = 0;
   Eigen::VectorXd z_, v_, a_, lambda_;
+  Eigen::VectorXd z_old_, v_old_, a_old_, lambda_old_;  // before the last step
   // Newton work vectors.
   Eigen::VectorXd z1_, v1_, lambda1_, q_, f_, phi_, mdv_, rhs_, dx_, bt_mu_;
 };

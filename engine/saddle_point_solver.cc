@@ -65,10 +65,23 @@ bool CholeskyInPlace(Eigen::MatrixXd& s) {
 }
 }  // namespace
 
+LinearSolverKind SaddlePointSolver::Resolve(LinearSolverKind kind, int n, int m) {
+  if (kind != LinearSolverKind::kAuto) return kind;
+  return static_cast<long>(n) * m <= kMaxDenseSchurEntries ? LinearSolverKind::kDirect
+                                                           : LinearSolverKind::kMinres;
+}
+
 bool SaddlePointSolver::Prepare() {
+  direct_ready_ = false;
   if (!a_.Factor()) return false;
+  // With positive pivots, (L|D|L^T)^{-1} = A^{-1}: the preconditioner's
+  // blocks are the exact elimination's.
+  const bool definite = a_.negative_pivots() == 0 && a_.small_pivots() == 0;
   const int m = b_.rows();
-  if (m == 0) return true;
+  if (m == 0) {
+    direct_ready_ = definite;
+    return true;
+  }
   if (schur_dense_) {
     y_.setZero();
     for (int r = 0; r < m; ++r) {
@@ -89,6 +102,7 @@ bool SaddlePointSolver::Prepare() {
     schur_.diagonal().array() += shift;
     schur_l_ = schur_;
     if (!CholeskyInPlace(schur_l_)) return false;
+    direct_ready_ = definite;
   } else {
     // diag(B diag(|A|)^{-1} B^T) as a cheap positive approximation.
     for (int r = 0; r < m; ++r) {
@@ -133,9 +147,39 @@ void SaddlePointSolver::Precondition(const Eigen::VectorXd& r, Eigen::VectorXd& 
   }
 }
 
-SaddlePointSolver::Stats SaddlePointSolver::Solve(LinearSolverKind kind,
+void SaddlePointSolver::SolveDirect(const Eigen::VectorXd& rhs, Eigen::VectorXd* x) {
+  const int n = a_.size(), m = b_.rows();
+  // x1 <- A^{-1} r1.
+  x->head(n) = rhs.head(n);
+  a_.Solve(x->data());
+  if (m == 0) return;
+  // x2 <- S^{-1} (B A^{-1} r1 - r2).
+  auto x2 = x->segment(n, m);
+  b_.Multiply(x->data(), x2.data());
+  x2 -= rhs.segment(n, m);
+  for (int i = 0; i < m; ++i) {  // L y = r
+    double v = x2(i);
+    for (int k = 0; k < i; ++k) v -= schur_l_(i, k) * x2(k);
+    x2(i) = v / schur_l_(i, i);
+  }
+  for (int i = m - 1; i >= 0; --i) {  // L^T x2 = y
+    double v = x2(i);
+    for (int k = i + 1; k < m; ++k) v -= schur_l_(k, i) * x2(k);
+    x2(i) = v / schur_l_(i, i);
+  }
+  // x1 <- A^{-1} r1 - (A^{-1} B^T) x2.
+  x->head(n).noalias() -= y_ * x2;
+}
+
+SaddlePointSolver::Stats SaddlePointSolver::Solve(LinearSolverKind kind_in,
                                                   const Eigen::VectorXd& rhs_in, double tolerance,
                                                   int max_iterations, Eigen::VectorXd* x) {
+  LinearSolverKind kind = Resolve(kind_in);
+  Stats stats;
+  if (kind == LinearSolverKind::kDirect && !direct_ready_) {
+    kind = LinearSolverKind::kMinres;
+    stats.fallback = true;
+  }
   const Eigen::VectorXd* rhs_ptr = &rhs_in;
   if (gamma_ != 0 && b_.rows() > 0) {
     // [A + gamma B^T B, B^T; B, 0] x = [r1 + gamma B^T r2; r2] has the
@@ -146,6 +190,27 @@ SaddlePointSolver::Stats SaddlePointSolver::Solve(LinearSolverKind kind,
     rhs_ptr = &augmented_rhs_;
   }
   const Eigen::VectorXd& rhs = *rhs_ptr;
+  const double bn = rhs.norm();
+  auto true_residual = [&] {
+    Multiply(*x, residual_);
+    residual_ = rhs - residual_;
+    return bn > 0 ? residual_.norm() / bn : residual_.norm();
+  };
+  if (kind == LinearSolverKind::kDirect) {
+    stats.direct = true;
+    SolveDirect(rhs, x);
+    stats.relative_residual = true_residual();
+    // One refinement pass removes the effect of the Schur shift and of
+    // rounding in badly scaled systems.
+    if (stats.relative_residual > tolerance && std::isfinite(stats.relative_residual)) {
+      tmp_ = residual_;
+      SolveDirect(tmp_, &correction_);
+      *x += correction_;
+      stats.relative_residual = true_residual();
+    }
+    stats.converged = std::isfinite(stats.relative_residual);
+    return stats;
+  }
   auto op = [this](const Eigen::VectorXd& in, Eigen::VectorXd& out) { Multiply(in, out); };
   auto prec = [this](const Eigen::VectorXd& in, Eigen::VectorXd& out) { Precondition(in, out); };
   auto krylov = [&](const Eigen::VectorXd& b, Eigen::VectorXd& out) {
@@ -154,14 +219,7 @@ SaddlePointSolver::Stats SaddlePointSolver::Solve(LinearSolverKind kind,
                : minres_.Solve(op, prec, b, tolerance, max_iterations, out);
   };
   KrylovResult kr = krylov(rhs, *x);
-  Stats stats;
   stats.iterations = kr.iterations;
-  const double bn = rhs.norm();
-  auto true_residual = [&] {
-    Multiply(*x, residual_);
-    residual_ = rhs - residual_;
-    return bn > 0 ? residual_.norm() / bn : residual_.norm();
-  };
   stats.relative_residual = true_residual();
   // MINRES stops on its residual estimate in the P^{-1} norm, which can sit
   // orders of magnitude below the true Euclidean residual when P is badly

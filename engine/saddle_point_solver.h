@@ -20,6 +20,20 @@
 // iterations whatever the step and the stiffness. After every solve the
 // true residual is computed and returned, never only the estimate.
 //
+// DIRECT is exact block elimination with the same two factorizations: when
+// A = L D L^T has only positive pivots (A positive definite, the usual case
+// for M + h^2 K_T) and the Schur complement S = B A^{-1} B^T is dense
+// (n m <= kMaxDenseSchurEntries),
+//
+//   S x2 = B A^{-1} r1 - r2,   x1 = A^{-1} r1 - (A^{-1} B^T) x2,
+//
+// one skyline solve and two dense triangular solves of size m, followed by
+// one refinement pass if the true residual is above the tolerance (the
+// Schur complement carries a 1e-12 relative shift against redundant
+// constraints). Otherwise (a negative pivot, or too many constraints for a
+// dense S) the solve falls back to preconditioned MINRES and says so in
+// Stats::fallback. AUTO is DIRECT when S is dense, MINRES otherwise.
+//
 // Nothing here allocates after Resize().
 
 #include <vector>
@@ -39,6 +53,8 @@ class SaddlePointSolver {
     int iterations = 0;
     double relative_residual = 0;  // true: |r - K x| / |r|
     bool converged = false;
+    bool fallback = false;  // DIRECT/AUTO could not eliminate: MINRES ran
+    bool direct = false;    // solved by block elimination
   };
 
   void Resize(const std::vector<int>& envelope, const SparseRows& jacobian_pattern);
@@ -65,7 +81,17 @@ class SaddlePointSolver {
   // y = K x.
   void Multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
 
+  // What AUTO resolves to for this system (after Resize), or for a system
+  // of n unknowns and m multipliers.
+  LinearSolverKind Resolve(LinearSolverKind kind) const { return Resolve(kind, n(), m()); }
+  static LinearSolverKind Resolve(LinearSolverKind kind, int n, int m);
+  // True when the last Prepare() allows exact block elimination.
+  bool direct_ready() const { return direct_ready_; }
+
  private:
+  // Block elimination (see the class comment); x must not alias rhs.
+  void SolveDirect(const Eigen::VectorXd& rhs, Eigen::VectorXd* x);
+
   void Precondition(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
 
   SkylineLdlt a_;
@@ -78,6 +104,7 @@ class SaddlePointSolver {
   double gamma_ = 0;
   Eigen::VectorXd augmented_rhs_;
   bool schur_dense_ = true;
+  bool direct_ready_ = false;
   Eigen::VectorXd schur_diag_;
   mutable Eigen::VectorXd col_, tmp_;
   Eigen::VectorXd residual_, correction_;

@@ -20,8 +20,10 @@ enum class ModelChoice { kAuto, kPlanar, kSpatial };
 enum class BendingModel { kExact, kLinear, kNone };
 enum class JointType { kPin, kFixed };
 enum class Analysis { kDynamic, kStatic, kModal };
-enum class Integrator { kImplicitEuler };
-enum class LinearSolverKind { kMinres, kGmres };
+enum class Integrator { kImplicitEuler, kGeneralizedAlpha, kHht };
+// kDirect: exact block elimination (skyline LDL^T of the Newton block and a
+// dense Schur complement); kAuto: picked per scene (SaddlePointSolver).
+enum class LinearSolverKind { kMinres, kGmres, kDirect, kAuto };
 
 struct CableSpec {
   std::string name;
@@ -87,8 +89,8 @@ struct SolverSettings {
   double duration_s = 0;
   double step_s = 1e-3;
   double output_interval_s = 0;  // 0: every step
-  Integrator integrator = Integrator::kImplicitEuler;
-  LinearSolverKind linear_solver = LinearSolverKind::kMinres;
+  Integrator integrator = Integrator::kHht;
+  LinearSolverKind linear_solver = LinearSolverKind::kAuto;
   int load_steps = 10;
   double newton_tolerance = 1e-8;
   int max_newton_iterations = 25;
@@ -98,6 +100,21 @@ struct SolverSettings {
   // MODAL: number of lowest modes; 0 means the default (10, or every degree
   // of freedom when there are fewer).
   int modes = 0;
+  // Numerical damping of GENERALIZED_ALPHA and HHT: the spectral radius of
+  // the amplification matrix at infinite frequency, in [0, 1] ([0.5, 1] for
+  // HHT); 1 conserves the energy of linear problems.
+  double rho_infinity = 0.5;
+  // Adaptive steps: the step grows and shrinks so that the estimated local
+  // error of every unknown stays below tolerance_m + relative_tolerance |z|.
+  bool adaptive = false;
+  double tolerance_m = 1e-4;
+  double relative_tolerance = 0;
+  // Adds an estimate of the run's largest probe-position error to the
+  // summary, from a companion run (RunScene).
+  bool error_estimate = false;
+  // Newton economy: keep the factorized Newton matrix across iterations and
+  // steps while Newton contracts fast enough (a fresh one otherwise).
+  bool reuse_factorization = true;  // GENERALIZED_ALPHA and HHT only
 };
 
 struct Scene {

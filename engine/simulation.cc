@@ -3,12 +3,16 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <memory>
 
 #include "absl/strings/str_format.h"
 #include "engine/implicit_euler_stepper.h"
 #include "engine/modal_solver.h"
 #include "engine/multibody_model.h"
+#include "engine/saddle_point_solver.h"
 #include "engine/static_solver.h"
+#include "engine/stepper.h"
 
 namespace cablesim {
 namespace {
@@ -26,8 +30,9 @@ class FrameRecorder {
     phi_.setZero(model->multipliers());
   }
 
-  absl::Status Emit(double t, double load_factor, const Eigen::VectorXd& z,
-                    const Eigen::VectorXd* v, const Eigen::VectorXd* a) {
+  // Evaluates the frame at a state without delivering it (frame()).
+  void Evaluate(double t, double load_factor, const Eigen::VectorXd& z, const Eigen::VectorXd* v,
+                const Eigen::VectorXd* a) {
     model_->ToFull(z, &q_);
     if (v) model_->RateToFull(*v, &qd_);
     if (a) model_->RateToFull(*a, &qdd_);
@@ -37,6 +42,18 @@ class FrameRecorder {
     frame_.angular_momentum = model_->AngularMomentum(q_, qd_);
     model_->Constraints(q_, &phi_, nullptr);
     frame_.constraint_violation = phi_.size() ? phi_.lpNorm<Eigen::Infinity>() : 0.0;
+  }
+  const Frame& frame() const { return frame_; }
+
+  // Energy of a state, without evaluating or delivering a frame.
+  EnergySample StateEnergy(const Eigen::VectorXd& z, const Eigen::VectorXd& v) {
+    model_->ToFull(z, &q_);
+    model_->RateToFull(v, &qd_);
+    return model_->Energy(q_, qd_, 1.0);
+  }
+
+  // Records the evaluated frame in the summary and delivers it.
+  absl::Status Deliver() {
     if (summary_->frames == 0) summary_->energy_initial = frame_.energy.total;
     summary_->energy_final = frame_.energy.total;
     summary_->energy_max_increase =
@@ -44,8 +61,20 @@ class FrameRecorder {
     summary_->max_constraint_violation =
         std::max(summary_->max_constraint_violation, frame_.constraint_violation);
     ++summary_->frames;
+    const EnergySample& e = frame_.energy;
+    energy_scale_ = std::max({energy_scale_, std::abs(e.kinetic), std::abs(e.potential),
+                              std::abs(e.axial) + std::abs(e.bending)});
     return sink_->OnFrame(frame_);
   }
+
+  absl::Status Emit(double t, double load_factor, const Eigen::VectorXd& z,
+                    const Eigen::VectorXd* v, const Eigen::VectorXd* a) {
+    Evaluate(t, load_factor, z, v, a);
+    return Deliver();
+  }
+
+  // Largest energy term seen so far [J].
+  double energy_scale() const { return energy_scale_; }
 
  private:
   MultibodyModel* model_;
@@ -53,6 +82,7 @@ class FrameRecorder {
   RunSummary* summary_;
   Frame frame_;
   Eigen::VectorXd q_, qd_, qdd_, phi_;
+  double energy_scale_ = 0;
 };
 
 // Sums the work of torque loads over accepted steps, for the energy
@@ -78,6 +108,16 @@ class TorqueWork {
   Eigen::VectorXd before_, after_;
 };
 
+// Every scene conserves its total energy (gravity and constant loads are
+// potential; nothing does work from outside), so a rise of more than this
+// fraction of the largest energy term is the stepper going unstable (the
+// second-order steppers can, on stiff nonlinear cables at large steps): the
+// run stops and says so rather than deliver it.
+constexpr double kEnergyRiseLimit = 0.05;
+// Steps that took at least this many Newton iterations have their energy
+// checked against that limit before they are accepted.
+constexpr int kEnergyCheckNewton = 4;
+
 void Fail(RunSummary* s, double t, const std::string& reason) {
   s->status = "failed";
   s->failure_time_s = t;
@@ -100,9 +140,19 @@ bool MayStep(const RunControl& control, double t, RunSummary* s) {
   return true;
 }
 
+// Step-size factor of the error controller: the usual safety factor 0.9 on
+// err^(-1/k) (k the power of h in the local error), bounded to [0.2, 2] so
+// that one estimate never moves the step far (Hairer, Norsett and Wanner,
+// Solving ODEs I, section II.4).
+double StepFactor(double err, int k) {
+  if (!(err > 0)) return 2.0;
+  return std::clamp(0.9 * std::pow(err, -1.0 / k), 0.2, 2.0);
+}
+
 void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const RunControl& control,
                 FrameRecorder* rec, RunSummary* summary) {
-  ImplicitEulerStepper stepper(model, settings);
+  std::unique_ptr<Stepper> stepper_owner = MakeStepper(model, settings);
+  Stepper& stepper = *stepper_owner;
   std::string reason;
   if (!stepper.Initialize(&reason)) {
     Fail(summary, 0, reason);
@@ -123,7 +173,9 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   double t = 0;
   double h = h_nominal;
   int successes = 0;
-  summary->min_step_s = h_nominal;
+  // Backward Euler never raises the energy; the second-order steppers may.
+  const bool check_steps = settings.integrator != Integrator::kImplicitEuler;
+  summary->min_step_s = settings.adaptive ? std::numeric_limits<double>::infinity() : h_nominal;
   for (long k = 1; k <= frames; ++k) {
     const double t_frame = std::min(duration, k * interval);
     while (t_frame - t > 1e-12 * std::max(1.0, t_frame)) {
@@ -135,16 +187,65 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       const auto st = stepper.Step(h_try);
       summary->newton_iterations += st.newton_iterations;
       summary->linear_iterations += st.linear_iterations;
+      summary->factorizations += st.factorizations;
+      summary->direct_fallbacks += st.direct_fallbacks;
       summary->max_linear_residual = std::max(summary->max_linear_residual, st.max_linear_residual);
+      if (st.converged && check_steps && st.newton_iterations >= kEnergyCheckNewton) {
+        // A step Newton found hard may have landed on a spurious root (an
+        // element folded through itself: Green-Lagrange strain does not see
+        // it); its energy says so. Take it back and halve the step.
+        const EnergySample e = rec->StateEnergy(stepper.z(), stepper.v());
+        const double scale =
+            std::max({rec->energy_scale(), std::abs(e.kinetic), std::abs(e.potential),
+                      std::abs(e.axial) + std::abs(e.bending)});
+        if (e.total - summary->energy_initial > kEnergyRiseLimit * scale) {
+          stepper.Restore();
+          ++summary->rejected_steps;
+          successes = 0;
+          h = h_try / 2;
+          if (h < h_min * (1 - 1e-12)) {
+            Fail(summary, t + h_try,
+                 absl::StrFormat("step from t = %.9g s raises the total energy by %.3g J down to "
+                                 "h = %.3g s: the stepper is unstable here; use a smaller "
+                                 "rho_infinity",
+                                 t, e.total - summary->energy_initial, h_try));
+            return;
+          }
+          continue;
+        }
+      }
+      if (st.converged && settings.adaptive) {
+        // Adaptive steps: accept when the local error estimate meets the
+        // tolerance, and choose the next step from it either way.
+        const double err = stepper.LocalErrorNorm(h_try, settings.tolerance_m,
+                                                  settings.relative_tolerance);
+        const double factor = StepFactor(err, stepper.local_error_order());
+        if (!(err <= 1)) {
+          stepper.Restore();
+          ++summary->rejected_steps;
+          h = h_try * factor;
+          if (h < h_min * (1 - 1e-12)) {
+            Fail(summary, t + h_try,
+                 absl::StrFormat("step from t = %.9g s cannot meet the tolerance: the local "
+                                 "error estimate is %.3g times the tolerance at h = %.3g s, the "
+                                 "smallest step allowed is %.3g s",
+                                 t, err, h_try, h_min));
+            return;
+          }
+          continue;
+        }
+        h = h_try * factor;
+      }
       if (st.converged) {
         t += h_try;
         torque_work.After(stepper.z(), 1);
         ++summary->steps;
         summary->min_step_s = std::min(summary->min_step_s, h_try);
+        summary->max_step_s = std::max(summary->max_step_s, h_try);
         summary->max_newton_residual = std::max(summary->max_newton_residual, st.residual);
         summary->end_time_s = t;
         // After a run of good steps, go back up towards the nominal step.
-        if (h < h_nominal && ++successes >= 4) {
+        if (!settings.adaptive && h < h_nominal && ++successes >= 4) {
           h = std::min(h_nominal, 2 * h);
           successes = 0;
         }
@@ -161,7 +262,21 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       }
     }
     t = t_frame;
-    if (absl::Status s = rec->Emit(t, 1, stepper.z(), &stepper.v(), &stepper.a()); !s.ok()) {
+    rec->Evaluate(t, 1, stepper.z(), &stepper.v(), &stepper.a());
+    const EnergySample& e = rec->frame().energy;
+    const double rise = e.total - summary->energy_initial;
+    const double scale = std::max({rec->energy_scale(), std::abs(e.kinetic),
+                                   std::abs(e.potential), std::abs(e.axial) + std::abs(e.bending)});
+    if (rise > kEnergyRiseLimit * scale) {
+      Fail(summary, t,
+           absl::StrFormat("the total energy rose by %.3g J (more than %g %% of the largest "
+                           "energy term, %.3g J) by t = %.9g s: the stepper is unstable at this "
+                           "step; use a smaller solver.step, adaptive steps or a smaller "
+                           "rho_infinity",
+                           rise, 100 * kEnergyRiseLimit, scale, t));
+      return;
+    }
+    if (absl::Status s = rec->Deliver(); !s.ok()) {
       summary->status = "cancelled";
       summary->error = std::string(s.message());
       return;
@@ -213,6 +328,107 @@ void RunStatic(MultibodyModel* model, const SolverSettings& settings, const RunC
   }
 }
 
+// Forwards frames and keeps every probe position (for the error estimate).
+class ProbeRecordingSink : public FrameSink {
+ public:
+  explicit ProbeRecordingSink(FrameSink* next) : next_(next) {}
+  absl::Status OnStart(const ModelInfo& info) override {
+    return next_ ? next_->OnStart(info) : absl::OkStatus();
+  }
+  absl::Status OnFrame(const Frame& frame) override {
+    times_.push_back(frame.t);
+    for (const ProbeSample& p : frame.probes) positions_.push_back(p.position_m);
+    return next_ ? next_->OnFrame(frame) : absl::OkStatus();
+  }
+  const std::vector<double>& times() const { return times_; }
+  const std::vector<Eigen::Vector3d>& positions() const { return positions_; }
+
+ private:
+  FrameSink* next_;
+  std::vector<double> times_;
+  std::vector<Eigen::Vector3d> positions_;
+};
+
+const char* IntegratorLabel(Integrator integrator) {
+  switch (integrator) {
+    case Integrator::kGeneralizedAlpha:
+      return "GENERALIZED_ALPHA";
+    case Integrator::kHht:
+      return "HHT";
+    case Integrator::kImplicitEuler:
+      break;
+  }
+  return "IMPLICIT_EULER";
+}
+
+const char* LinearSolverLabel(LinearSolverKind kind) {
+  switch (kind) {
+    case LinearSolverKind::kGmres:
+      return "GMRES";
+    case LinearSolverKind::kDirect:
+      return "DIRECT";
+    case LinearSolverKind::kAuto:
+      return "AUTO";
+    case LinearSolverKind::kMinres:
+      break;
+  }
+  return "MINRES";
+}
+
+// The error estimate of a DYNAMIC run (solver.error_estimate): a companion
+// run of the same model, with half the step (fixed steps) or tolerances 32
+// times tighter (adaptive steps), compared frame by frame at the probes.
+// Fixed steps: Richardson extrapolation for a method of order p,
+// e(h) ~ |x_h - x_{h/2}| 2^p / (2^p - 1). Adaptive: the companion is much
+// more accurate, so the difference itself is the estimate.
+void EstimateError(MultibodyModel* model, const SolverSettings& settings,
+                   const RunControl& control, const ProbeRecordingSink& main,
+                   RunSummary* summary) {
+  const auto start = Clock::now();
+  summary->has_error_estimate = true;
+  SolverSettings companion = settings;
+  companion.error_estimate = false;
+  const int order = settings.integrator == Integrator::kImplicitEuler ? 1 : 2;
+  double factor = 1;
+  if (settings.adaptive) {
+    companion.tolerance_m /= 32;
+    companion.relative_tolerance /= 32;
+    summary->error_estimate_method =
+        "difference to a companion run with tolerance and relative_tolerance / 32";
+  } else {
+    companion.step_s /= 2;
+    companion.max_step_halvings += 1;  // the same smallest step
+    factor = std::ldexp(1.0, order) / (std::ldexp(1.0, order) - 1);
+    summary->error_estimate_method = absl::StrFormat(
+        "Richardson extrapolation against a companion run at half the step (order %d: "
+        "%.4g times the difference)",
+        order, factor);
+  }
+  ProbeRecordingSink recorded(nullptr);
+  RunSummary companion_summary;
+  FrameRecorder recorder(model, &recorded, &companion_summary);
+  // The caller's stop request and step limit apply to the companion too.
+  RunDynamic(model, companion, control, &recorder, &companion_summary);
+  summary->error_estimate_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  if (companion_summary.status != "ok") {
+    summary->error_estimate_method += " (the companion run failed: " + companion_summary.error + ")";
+    return;
+  }
+  if (recorded.times().size() != main.times().size() ||
+      recorded.positions().size() != main.positions().size()) {
+    summary->error_estimate_method += " (the companion run's frames differ)";
+    return;
+  }
+  double worst = 0;
+  for (size_t i = 0; i < main.positions().size(); ++i)
+    worst = std::max(worst, (main.positions()[i] - recorded.positions()[i]).norm());
+  if (!std::isfinite(worst)) {
+    summary->error_estimate_method += " (not finite)";
+    return;
+  }
+  summary->error_estimate_m = factor * worst;
+}
+
 }  // namespace
 
 absl::StatusOr<ModelInfo> DescribeModel(const Scene& scene) {
@@ -243,16 +459,33 @@ absl::StatusOr<RunSummary> RunScene(const Scene& scene, FrameSink* sink,
     if (!count.ok()) return count.status();
     modes = *count;
   }
-  summary.integrator = "IMPLICIT_EULER";
-  summary.linear_solver = settings.linear_solver == LinearSolverKind::kGmres ? "GMRES" : "MINRES";
-  if (absl::Status s = sink->OnStart(summary.info); !s.ok()) return s;
-  FrameRecorder recorder(&model, sink, &summary);
+  summary.integrator = IntegratorLabel(settings.integrator);
+  summary.linear_solver = LinearSolverLabel(settings.linear_solver);
+  summary.linear_solver_used = LinearSolverLabel(
+      SaddlePointSolver::Resolve(settings.linear_solver, model.dofs(), model.multipliers()));
+  summary.adaptive = settings.adaptive;
+  if (settings.integrator != Integrator::kImplicitEuler)
+    summary.rho_infinity = settings.rho_infinity;
+  const bool estimate = settings.analysis == Analysis::kDynamic && settings.error_estimate;
+  ProbeRecordingSink recording(sink);
+  FrameSink* out = estimate ? &recording : sink;
+  if (absl::Status s = out->OnStart(summary.info); !s.ok()) return s;
+  FrameRecorder recorder(&model, out, &summary);
   if (settings.analysis == Analysis::kStatic) {
     RunStatic(&model, settings, control, &recorder, &summary);
   } else if (settings.analysis == Analysis::kModal) {
     RunModalAnalysis(&model, settings, modes, control, sink, &summary);
   } else {
     RunDynamic(&model, settings, control, &recorder, &summary);
+    if (!std::isfinite(summary.min_step_s)) summary.min_step_s = 0;
+    if (estimate) {
+      if (summary.status == "ok") {
+        EstimateError(&model, settings, control, recording, &summary);
+      } else {
+        summary.has_error_estimate = true;
+        summary.error_estimate_method = "none: the run did not finish";
+      }
+    }
   }
   if (settings.analysis == Analysis::kDynamic)
     summary.energy_dissipated = summary.energy_initial - summary.energy_final;

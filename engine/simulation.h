@@ -82,7 +82,7 @@ struct RunSummary {
   int64_t newton_iterations = 0;
   int64_t linear_iterations = 0;
   double min_step_s = 0;        // smallest step taken
-  double wall_seconds = 0;
+  double wall_seconds = 0;     // the whole run, error-estimate companion included
   double end_time_s = 0;        // last converged time (or load factor)
   double energy_initial = 0;
   double energy_final = 0;
@@ -96,6 +96,20 @@ struct RunSummary {
   double max_linear_residual = 0;  // largest true relative residual of a solve
   // MODAL: the natural frequencies [Hz], ascending (engine/modal_solver.h).
   std::vector<double> frequencies_hz;
+  // DYNAMIC: the stepper's cost and step sizes.
+  std::string linear_solver_used;  // what AUTO resolved to (else linear_solver)
+  int64_t factorizations = 0;      // Newton matrices assembled and factored
+  int64_t direct_fallbacks = 0;    // DIRECT solves that had to run MINRES
+  double max_step_s = 0;           // largest step taken
+  bool adaptive = false;
+  double rho_infinity = 0;         // GENERALIZED_ALPHA and HHT
+  // solver.error_estimate: an estimate of the largest probe-position error
+  // of the run [m] (over every frame and probe), and how it was obtained.
+  // error_estimate_m < 0 when no estimate could be made (the method says why).
+  bool has_error_estimate = false;
+  double error_estimate_m = -1;
+  std::string error_estimate_method;
+  double error_estimate_seconds = 0;  // wall time of the companion run
 };
 
 // How a caller bounds and stops a run (a server's limits, deadlines and

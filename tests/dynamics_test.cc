@@ -28,7 +28,9 @@ double EllipticK(double k) {
   return std::numbers::pi / (2 * a);
 }
 
-std::string FallingPendulum(int elements, double step, double duration, double g = 9.81) {
+// Backward Euler unless told: these tests are about the paper's stepper.
+std::string FallingPendulum(int elements, double step, double duration, double g = 9.81,
+                            const char* integrator = "IMPLICIT_EULER") {
   return absl::StrFormat(R"({
     "gravity": {"y": %g},
     "cables": [{"name": "beam", "length": 1.2, "elements": %d, "direction": {"x": 1},
@@ -36,8 +38,8 @@ std::string FallingPendulum(int elements, double step, double duration, double g
                 "area": 0.0018, "second_moment": 1.215e-8, "bending": "EXACT"}],
     "joints": [{"type": "PIN", "a": {"cable": "beam", "s": 0}}],
     "probes": [{"name": "tip", "cable": "beam", "s": 1.2}],
-    "solver": {"duration": %g, "step": %g, "output_interval": 0.001}})",
-                         -g, elements, duration, step);
+    "solver": {"duration": %g, "step": %g, "output_interval": 0.001, "integrator": "%s"}})",
+                         -g, elements, duration, step, integrator);
 }
 
 TEST(DynamicsTest, StiffRodPendulumHasTheCompoundPendulumPeriod) {

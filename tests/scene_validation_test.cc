@@ -281,6 +281,66 @@ std::vector<InvalidCase> InvalidCases() {
        absl::StrCat(R"({"cables": [)", kCable,
                     R"(], "solver": {"duration": 1, "max_linear_iterations": -5}})"),
        "solver.max_linear_iterations: ", "must be in [1, 100000]"},
+      {"RhoInfinityAboveOne",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"duration": 1, "integrator": "GENERALIZED_ALPHA",
+                                     "rho_infinity": 1.5}})"),
+       "solver.rho_infinity: ", "must be in [0, 1] for GENERALIZED_ALPHA"},
+      {"RhoInfinityNegativeDefaultIntegrator",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"duration": 1, "rho_infinity": -0.1}})"),
+       "solver.rho_infinity: ", "must be in [0.5, 1] for HHT"},
+      {"RhoInfinityBelowHhtRange",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"duration": 1, "integrator": "HHT", "rho_infinity": 0.3}})"),
+       "solver.rho_infinity: ", "must be in [0.5, 1] for HHT"},
+      {"RhoInfinityWithBackwardEuler",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"duration": 1, "integrator": "IMPLICIT_EULER",
+                                     "rho_infinity": 0.5}})"),
+       "solver.rho_infinity: ", "GENERALIZED_ALPHA and HHT only"},
+      {"ReuseWithBackwardEuler",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"duration": 1, "integrator": "IMPLICIT_EULER",
+                                     "reuse_factorization": true}})"),
+       "solver.reuse_factorization: ", "GENERALIZED_ALPHA and HHT only"},
+      {"ToleranceWithoutAdaptive",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"duration": 1, "tolerance": 1e-4}})"),
+       "solver.tolerance: ", "needs solver.adaptive: true"},
+      {"ZeroTolerance",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"duration": 1, "adaptive": true, "tolerance": 0}})"),
+       "solver.tolerance: ", "must be > 0"},
+      {"NanTolerance",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"duration": 1, "adaptive": true, "tolerance": "NaN"}})"),
+       "solver.tolerance: ", "must be finite"},
+      {"RelativeToleranceOne",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"duration": 1, "adaptive": true,
+                                     "relative_tolerance": 1}})"),
+       "solver.relative_tolerance: ", "must be < 1"},
+      {"NegativeRelativeTolerance",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"duration": 1, "adaptive": true,
+                                     "relative_tolerance": -1e-3}})"),
+       "solver.relative_tolerance: ", "must be >= 0"},
+      {"AdaptiveStatic",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"analysis": "STATIC", "adaptive": true}})"),
+       "solver.adaptive: ", "DYNAMIC analysis only"},
+      {"ErrorEstimateStatic",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"analysis": "STATIC", "error_estimate": true}})"),
+       "solver.error_estimate: ", "DYNAMIC analysis only"},
+      {"UnknownIntegrator",
+       absl::StrCat(R"({"cables": [)", kCable, R"(], "solver": {"duration": 1, "integrator": 9}})"),
+       "solver.integrator: ", "IMPLICIT_EULER, GENERALIZED_ALPHA or HHT"},
+      {"UnknownLinearSolver",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"duration": 1, "linear_solver": 9}})"),
+       "solver.linear_solver: ", "MINRES, GMRES, DIRECT or AUTO"},
   };
 }
 
@@ -583,10 +643,51 @@ TEST(SceneConversionTest, JointBetweenTwoPointsOfOneCable) {
   EXPECT_EQ(scene->joints[0].b.s_m, 1);
 }
 
+TEST(SceneConversionTest, SteppersAndTheirSettings) {
+  // Defaults: HHT (measured as fast as generalized-alpha at a given error
+  // and more robust), rho_infinity 0.5, factorization reuse, fixed steps, no error estimate.
+  absl::StatusOr<Scene> scene = ConvertJson(Scene1(""));
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  EXPECT_EQ(scene->solver.integrator, Integrator::kHht);
+  EXPECT_EQ(scene->solver.rho_infinity, 0.5);
+  EXPECT_TRUE(scene->solver.reuse_factorization);
+  EXPECT_FALSE(scene->solver.adaptive);
+  EXPECT_FALSE(scene->solver.error_estimate);
+  EXPECT_EQ(scene->solver.tolerance_m, 1e-4);
+  EXPECT_EQ(scene->solver.relative_tolerance, 0);
+  EXPECT_EQ(scene->solver.linear_solver, LinearSolverKind::kAuto);
+
+  scene = ConvertJson(absl::StrCat(R"({"cables": [)", kCable, R"(], "solver": {
+      "duration": 1, "integrator": "HHT", "rho_infinity": 0.5, "linear_solver": "DIRECT",
+      "adaptive": true, "tolerance": 1e-6, "relative_tolerance": 1e-3,
+      "error_estimate": true, "reuse_factorization": false}})"));
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  EXPECT_EQ(scene->solver.integrator, Integrator::kHht);
+  EXPECT_EQ(scene->solver.rho_infinity, 0.5);
+  EXPECT_EQ(scene->solver.linear_solver, LinearSolverKind::kDirect);
+  EXPECT_TRUE(scene->solver.adaptive);
+  EXPECT_EQ(scene->solver.tolerance_m, 1e-6);
+  EXPECT_EQ(scene->solver.relative_tolerance, 1e-3);
+  EXPECT_TRUE(scene->solver.error_estimate);
+  EXPECT_FALSE(scene->solver.reuse_factorization);
+
+  scene = ConvertJson(absl::StrCat(R"({"cables": [)", kCable,
+                                   R"(], "solver": {"duration": 1, "linear_solver": "AUTO",
+                                      "integrator": "IMPLICIT_EULER"}})"));
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  EXPECT_EQ(scene->solver.linear_solver, LinearSolverKind::kAuto);
+  EXPECT_EQ(scene->solver.integrator, Integrator::kImplicitEuler);
+  EXPECT_FALSE(scene->solver.reuse_factorization);  // backward Euler does not reuse
+}
+
 TEST(EnumConversionTest, Names) {
   EXPECT_EQ(AnalysisName(Analysis::kStatic), "STATIC");
   EXPECT_EQ(IntegratorName(Integrator::kImplicitEuler), "IMPLICIT_EULER");
   EXPECT_EQ(LinearSolverName(LinearSolverKind::kGmres), "GMRES");
+  EXPECT_EQ(IntegratorName(Integrator::kGeneralizedAlpha), "GENERALIZED_ALPHA");
+  EXPECT_EQ(IntegratorName(Integrator::kHht), "HHT");
+  EXPECT_EQ(LinearSolverName(LinearSolverKind::kDirect), "DIRECT");
+  EXPECT_EQ(LinearSolverName(LinearSolverKind::kAuto), "AUTO");
   const absl::StatusOr<JointType> none = JointTypeFromProto(v1::JOINT_TYPE_UNSPECIFIED, "j.type");
   ASSERT_FALSE(none.ok());
   EXPECT_THAT(std::string(none.status().message()), StartsWith("j.type: "));

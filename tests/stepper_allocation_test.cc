@@ -1,4 +1,6 @@
-// Proves that ImplicitEulerStepper::Step allocates nothing once warmed up.
+// Proves that the steppers (ImplicitEulerStepper, GeneralizedAlphaStepper in
+// both variants, with MINRES, GMRES and DIRECT, with and without
+// factorization reuse) allocate nothing per step once warmed up.
 //
 // This file replaces the global operator new/delete family (forwarding to
 // malloc/free, aligned_alloc for the aligned forms). On glibc it also
@@ -22,7 +24,9 @@
 #include <cerrno>
 #include <cstddef>
 #include <cstdlib>
+#include <cmath>
 #include <fstream>
+#include <memory>
 #include <new>
 #include <sstream>
 #include <string>
@@ -31,6 +35,7 @@
 #include <gtest/gtest.h>
 
 #include "engine/implicit_euler_stepper.h"
+#include "engine/stepper.h"
 #include "engine/multibody_model.h"
 #include "engine/scene.h"
 #include "tests/test_util.h"
@@ -284,23 +289,33 @@ TEST_F(StepperAllocationTest, CounterSeesEngineAllocations) {
 // ---- the stepper ----------------------------------------------------------
 
 // Builds the model, warms the stepper up with 5 steps, then counts
-// allocations over `steps` steps of size h; all must converge.
+// allocations over `steps` steps of size h; all must converge. Every step
+// also asks for the local error estimate, and every tenth is taken back
+// (Restore) and redone as two half steps, as the adaptive loop does.
 void ExpectStepsDoNotAllocate(const Scene& scene, double h, int steps) {
   absl::StatusOr<MultibodyModel> model = MultibodyModel::Build(scene);
   ASSERT_TRUE(model.ok()) << model.status();
-  ImplicitEulerStepper stepper(&*model, scene.solver);
+  std::unique_ptr<Stepper> owner = MakeStepper(&*model, scene.solver);
+  Stepper& stepper = *owner;
   std::string reason;
   ASSERT_TRUE(stepper.Initialize(&reason)) << reason;
   for (int i = 0; i < 5; ++i) {
-    const ImplicitEulerStepper::StepStats st = stepper.Step(h);
+    const Stepper::StepStats st = stepper.Step(h);
     ASSERT_TRUE(st.converged) << "warm-up step " << i << ": " << st.reason;
   }
 
   int not_converged = 0, first_failure = -1;
   long newton = 0;
+  double error_norms = 0;
   CountingWindow window;
   for (int i = 0; i < steps; ++i) {
-    const ImplicitEulerStepper::StepStats st = stepper.Step(h);
+    Stepper::StepStats st = stepper.Step(h);
+    error_norms += stepper.LocalErrorNorm(h, 1e-4, 1e-3);
+    if (i % 10 == 9 && st.converged) {
+      stepper.Restore();
+      st = stepper.Step(h / 2);
+      if (st.converged) st = stepper.Step(h / 2);
+    }
     newton += st.newton_iterations;
     if (!st.converged) {
       if (first_failure < 0) first_failure = i;
@@ -316,6 +331,7 @@ void ExpectStepsDoNotAllocate(const Scene& scene, double h, int steps) {
   EXPECT_EQ(counts.mallocs, 0) << "malloc-family calls in " << steps << " steps "
                                << "(rerun with CABLESIM_ALLOC_BACKTRACE=1 to see where)";
   EXPECT_TRUE(stepper.z().allFinite());
+  EXPECT_TRUE(std::isfinite(error_norms));
 }
 
 // scenes/falling-pendulum.json, built in C++ (12 elements, no multipliers:
@@ -350,6 +366,7 @@ Scene FallingPendulum() {
   scene.solver.step_s = 1e-4;
   scene.solver.output_interval_s = 1e-3;
   scene.solver.linear_solver = LinearSolverKind::kMinres;
+  scene.solver.integrator = Integrator::kImplicitEuler;
   return scene;
 }
 
@@ -361,6 +378,7 @@ Scene CableWithEndCylinder(LinearSolverKind linear_solver) {
   json << in.rdbuf();
   Scene scene = testing::SceneFromJson(json.str());
   scene.solver.linear_solver = linear_solver;
+  scene.solver.integrator = Integrator::kImplicitEuler;
   return scene;
 }
 
@@ -446,10 +464,44 @@ TEST_F(StepperAllocationTest, ManyConstraintRowsDoNotAllocate) {
   scene.joints.push_back(first01);
   scene.joints.push_back(first12);
   scene.solver.step_s = 1e-3;
+  scene.solver.integrator = Integrator::kImplicitEuler;
   absl::StatusOr<MultibodyModel> model = MultibodyModel::Build(scene);
   ASSERT_TRUE(model.ok()) << model.status();
   ASSERT_GE(model->multipliers(), 400);
   ExpectStepsDoNotAllocate(scene, 1e-3, 3);
+  // And with the second-order steppers and the direct solver.
+  for (Integrator integrator : {Integrator::kGeneralizedAlpha, Integrator::kHht}) {
+    for (LinearSolverKind ls : {LinearSolverKind::kMinres, LinearSolverKind::kDirect}) {
+      scene.solver.integrator = integrator;
+      scene.solver.linear_solver = ls;
+      ExpectStepsDoNotAllocate(scene, 1e-3, 3);
+    }
+  }
+}
+
+// Generalized-alpha and HHT, every linear solver, with and without
+// factorization reuse, on the falling pendulum (no multipliers) and the
+// cable with an end cylinder (3 multipliers).
+TEST_F(StepperAllocationTest, AlphaSteppersDoNotAllocate) {
+  for (Integrator integrator : {Integrator::kGeneralizedAlpha, Integrator::kHht}) {
+    for (LinearSolverKind ls : {LinearSolverKind::kMinres, LinearSolverKind::kGmres,
+                                LinearSolverKind::kDirect, LinearSolverKind::kAuto}) {
+      for (bool reuse : {false, true}) {
+        SCOPED_TRACE(::testing::Message() << "integrator " << static_cast<int>(integrator)
+                                        << " solver " << static_cast<int>(ls) << " reuse "
+                                        << reuse);
+        Scene pendulum = FallingPendulum();
+        pendulum.solver.integrator = integrator;
+        pendulum.solver.linear_solver = ls;
+        pendulum.solver.reuse_factorization = reuse;
+        ExpectStepsDoNotAllocate(pendulum, 1e-3, 50);
+        Scene cylinder = CableWithEndCylinder(ls);
+        cylinder.solver.integrator = integrator;
+        cylinder.solver.reuse_factorization = reuse;
+        ExpectStepsDoNotAllocate(cylinder, 0.005, 50);
+      }
+    }
+  }
 }
 
 }  // namespace

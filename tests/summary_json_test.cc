@@ -80,6 +80,36 @@ TEST(SummaryJsonTest, OkSummary) {
   EXPECT_EQ(json.back(), '}');
 }
 
+TEST(SummaryJsonTest, DynamicRunsAddStepperKeys) {
+  RunSummary s = OkSummary();
+  s.integrator = "HHT";
+  s.linear_solver = "AUTO";
+  s.linear_solver_used = "DIRECT";
+  s.max_step_s = 2e-3;
+  s.factorizations = 7;
+  s.adaptive = true;
+  s.rho_infinity = 0.7;
+  s.has_error_estimate = true;
+  s.error_estimate_m = 1.5e-4;
+  s.error_estimate_method = "Richardson";
+  const std::string json = SummaryToJson(s);
+  for (const char* key : {"linear_solver_used", "accepted_steps", "max_step_s", "factorizations",
+                          "direct_fallbacks", "adaptive", "rho_infinity", "error_estimate_m",
+                          "error_estimate_method", "error_estimate_seconds"}) {
+    EXPECT_THAT(json, HasSubstr(std::string("\"") + key + "\":")) << key;
+  }
+  EXPECT_THAT(json, HasSubstr(R"("linear_solver":"AUTO",)"));
+  EXPECT_THAT(json, HasSubstr(R"("linear_solver_used":"DIRECT",)"));
+  EXPECT_THAT(json, HasSubstr(R"("error_estimate_m":0.00015,)"));
+  EXPECT_THAT(json, HasSubstr(R"("adaptive":true,)"));
+  // No estimate could be made: the method says why, and no number.
+  s.error_estimate_m = -1;
+  EXPECT_THAT(SummaryToJson(s), Not(HasSubstr("\"error_estimate_m\":")));
+  // Backward Euler has no rho_infinity.
+  s.integrator = "IMPLICIT_EULER";
+  EXPECT_THAT(SummaryToJson(s), Not(HasSubstr("rho_infinity")));
+}
+
 TEST(SummaryJsonTest, FailedSummaryHasErrorAndTime) {
   RunSummary s = OkSummary();
   s.status = "failed";

@@ -1,0 +1,302 @@
+#include "engine/generalized_alpha_stepper.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "absl/strings/str_format.h"
+
+namespace cablesim {
+namespace {
+// A Newton correction below this times (1 + |z|_inf) changes z only in its
+// last few bits (16 machine epsilons).
+constexpr double kRoundingIncrement = 16 * 2.220446049250313e-16;
+}  // namespace
+
+GeneralizedAlphaStepper::GeneralizedAlphaStepper(MultibodyModel* model,
+                                                 const SolverSettings& settings, Variant variant)
+    : model_(model), settings_(settings), variant_(variant) {
+  const double rho = std::clamp(settings.rho_infinity, 0.0, 1.0);
+  if (variant == Variant::kGeneralizedAlpha) {
+    alpha_m_ = (2 * rho - 1) / (rho + 1);
+    alpha_f_ = rho / (rho + 1);
+    gamma_ = 0.5 + alpha_f_ - alpha_m_;
+    beta_ = 0.25 * (gamma_ + 0.5) * (gamma_ + 0.5);
+    w_ = 1;
+  } else {
+    const double alpha = std::clamp((rho - 1) / (rho + 1), -1.0 / 3, 0.0);
+    beta_ = 0.25 * (1 - alpha) * (1 - alpha);
+    gamma_ = 0.5 - alpha;
+    w_ = 1 + alpha;
+  }
+  n_ = model->dofs();
+  m_ = model->multipliers();
+  solver_.Resize(model->envelope(), model->jacobian_pattern());
+  jac_ = model->jacobian_pattern();
+  z_ = model->initial_z();
+  v_ = model->initial_v();
+  zdd_.setZero(n_);
+  acc_.setZero(n_);
+  acc_h_.setZero(n_);
+  lambda_.setZero(m_);
+  g_.setZero(n_);
+  for (Eigen::VectorXd* x : {&z_pred_, &v_pred_, &z1_, &zdd1_, &f_, &bt_lambda_}) x->setZero(n_);
+  lambda1_.setZero(m_);
+  phi_.setZero(m_);
+  q_.setZero(model->coordinates());
+  rhs_.setZero(n_ + m_);
+  dx_.setZero(n_ + m_);
+  z_old_ = z_;
+  v_old_ = v_;
+  zdd_old_ = zdd_;
+  acc_old_ = acc_;
+  lambda_old_ = lambda_;
+  g_old_ = g_;
+}
+
+void GeneralizedAlphaStepper::LoadMass() {
+  const SkylineLdlt& mass = model_->mass();
+  std::copy(mass.values(), mass.values() + mass.stored(), solver_.a().values());
+}
+
+bool GeneralizedAlphaStepper::Initialize(std::string* reason) {
+  model_->ToFull(z_, &q_);
+  model_->NetForce(q_, 1.0, &f_);
+  model_->Constraints(q_, &phi_, &solver_.b());
+  Eigen::VectorXd qdot(model_->coordinates()), gamma(m_);
+  model_->RateToFull(v_, &qdot);
+  model_->ConstraintGamma(q_, qdot, &gamma);
+  LoadMass();
+  have_factor_ = false;
+  if (!solver_.Prepare()) {
+    *reason = "the mass matrix could not be factorized";
+    return false;
+  }
+  rhs_.head(n_) = f_;
+  if (m_ > 0) rhs_.tail(m_) = gamma;
+  const auto stats = solver_.Solve(settings_.linear_solver, rhs_, 1e-12,
+                                   std::max(settings_.max_linear_iterations, 1000), &dx_);
+  if (!(stats.relative_residual <= 1e-8)) {
+    *reason = absl::StrFormat(
+        "the initial acceleration solve did not converge (relative residual %.3g)",
+        stats.relative_residual);
+    return false;
+  }
+  zdd_ = dx_.head(n_);
+  acc_ = zdd_;  // a_0 = zdd_0 (Arnold and Bruls' starting value)
+  lambda_ = dx_.tail(m_);
+  // g_0 = Phi_z^T lambda_0 - f_0.
+  g_ = -f_;
+  solver_.b().AddTransposeMultiply(lambda_.data(), g_.data());
+  zdd_old_ = zdd_;
+  acc_old_ = acc_;
+  lambda_old_ = lambda_;
+  g_old_ = g_;
+  return true;
+}
+
+void GeneralizedAlphaStepper::Restore() {
+  h_last_ = h_old_;
+  z_ = z_old_;
+  v_ = v_old_;
+  zdd_ = zdd_old_;
+  acc_ = acc_old_;
+  lambda_ = lambda_old_;
+  g_ = g_old_;
+}
+
+double GeneralizedAlphaStepper::LocalErrorNorm(double h, double atol, double rtol) const {
+  const double k = h * h * std::abs(beta_ - 1.0 / 6);
+  double worst = 0;
+  for (int i = 0; i < n_; ++i) {
+    worst = std::max(worst,
+                     k * std::abs(zdd_(i) - zdd_old_(i)) / (atol + rtol * std::abs(z_(i))));
+  }
+  return worst;
+}
+
+Stepper::StepStats GeneralizedAlphaStepper::Step(double h) {
+  const bool reuse = settings_.reuse_factorization;
+  StepStats st = Solve(h, !reuse || refresh_);
+  if (!st.converged && reuse && st.reason.find("non-finite pivot") == std::string::npos) {
+    // Safeguard: a kept Newton matrix may be what failed; retry once fresh.
+    StepStats again = Solve(h, true);
+    again.newton_iterations += st.newton_iterations;
+    again.linear_iterations += st.linear_iterations;
+    again.factorizations += st.factorizations;
+    again.direct_fallbacks += st.direct_fallbacks;
+    again.max_linear_residual = std::max(again.max_linear_residual, st.max_linear_residual);
+    st = std::move(again);
+  }
+  return st;
+}
+
+Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
+  StepStats st;
+  const double tol = settings_.newton_tolerance;
+  const bool reuse = settings_.reuse_factorization;
+  const bool ga = variant_ == Variant::kGeneralizedAlpha;
+  // Predictors: everything in z_{n+1}, v_{n+1} except s zdd_{n+1}.
+  double s, sv;
+  if (ga) {
+    const double k = 1 / (1 - alpha_m_);
+    // Variable steps: a_n approximates zdd(t_n + (alpha_m - alpha_f) h)
+    // (Arnold and Bruls, section 3), so a change of h shifts it, to first
+    // order a_n <- zdd_n + (h / h_last) (a_n - zdd_n). Without it, halving
+    // and regrowing the step feeds energy into the stiff modes.
+    acc_h_ = acc_;
+    if (h_last_ > 0 && h != h_last_) acc_h_ = zdd_ + (h / h_last_) * (acc_ - zdd_);
+    // a_{n+1} = k (alpha_f zdd_n - alpha_m a_n) + k (1 - alpha_f) zdd_{n+1}.
+    bt_lambda_ = k * (alpha_f_ * zdd_ - alpha_m_ * acc_h_);  // scratch: known part of a_{n+1}
+    z_pred_ = z_ + h * v_ + (h * h * (0.5 - beta_)) * acc_h_ + (h * h * beta_) * bt_lambda_;
+    v_pred_ = v_ + (h * (1 - gamma_)) * acc_h_ + (h * gamma_) * bt_lambda_;
+    s = h * h * beta_ * k * (1 - alpha_f_);
+    sv = h * gamma_ * k * (1 - alpha_f_);
+  } else {
+    z_pred_ = z_ + h * v_ + (h * h * (0.5 - beta_)) * zdd_;
+    v_pred_ = v_ + (h * (1 - gamma_)) * zdd_;
+    s = h * h * beta_;
+    sv = h * gamma_;
+  }
+  const double c = w_ * s;
+  // A kept matrix serves while c is within 20 % of its own (steps shortened
+  // to land on output times, or resized by the error controller): Newton
+  // then still contracts by about that fraction, and the safeguard below
+  // catches it when it does not.
+  if (!have_factor_ || !(std::abs(c - factor_c_) <= 0.2 * factor_c_)) fresh = true;
+  // Predictor: the acceleration extrapolated linearly from the last two
+  // steps (constant on the first step and after Restore()).
+  zdd1_ = zdd_;
+  if (h_last_ > 0) zdd1_ += (h / h_last_) * (zdd_ - zdd_old_);
+  lambda1_ = lambda_;
+  double last_increment = 0;
+  SkylineLdlt& a = solver_.a();
+  for (int it = 0; it <= settings_.max_newton_iterations; ++it) {
+    z1_ = z_pred_ + s * zdd1_;
+    model_->ToFull(z1_, &q_);
+    const bool checking = it > 0 && last_increment <= tol * (1 + z1_.lpNorm<Eigen::Infinity>());
+    // Assemble the Newton matrix with the forces when this iteration will
+    // need a fresh one and is not expected to be the converged one.
+    bool assembled = false;
+    double force_size;
+    if (fresh && !checking) {
+      LoadMass();
+      force_size = model_->NetForce(q_, 1.0, &f_, &a, c);
+      assembled = true;
+    } else {
+      force_size = model_->NetForce(q_, 1.0, &f_);
+    }
+    model_->Constraints(q_, &phi_, &jac_);
+    // R = M zdd + w (Phi_z^T lambda - f) + (1 - w) g_n.
+    auto r = rhs_.head(n_);
+    model_->mass().Multiply(zdd1_.data(), r.data());
+    const double inertia = r.lpNorm<Eigen::Infinity>();
+    bt_lambda_.setZero();
+    jac_.AddTransposeMultiply(lambda1_.data(), bt_lambda_.data());
+    const double scale =
+        std::max({inertia, w_ * force_size, w_ * bt_lambda_.lpNorm<Eigen::Infinity>(),
+                  (1 - w_) * g_.lpNorm<Eigen::Infinity>(), 1e-300});
+    r += w_ * (bt_lambda_ - f_);
+    if (w_ != 1) r += (1 - w_) * g_;
+    if (m_ > 0) rhs_.tail(m_) = phi_ / s;
+    const double zscale = 1 + z1_.lpNorm<Eigen::Infinity>();
+    const double res = r.lpNorm<Eigen::Infinity>() / scale;
+    const double viol = m_ > 0 ? phi_.lpNorm<Eigen::Infinity>() : 0.0;
+    if (!std::isfinite(res) || !std::isfinite(viol)) {
+      st.reason = "the residual is not finite (the step diverged)";
+      return st;
+    }
+    const double floor = w_ * model_->force_roundoff() / scale;
+    // At the rounding floor: the last correction moved z by a few units in
+    // its last place, or by a thousandth of the tolerance, so Newton cannot
+    // usefully improve the state; the residual left is the rounding of the
+    // forces (short, stiff elements far from the origin: eps |x| / l
+    // amplified by EA). Accepted only if that residual is still small
+    // (below sqrt(tol)).
+    const bool at_rounding =
+        last_increment <= std::max(kRoundingIncrement, 1e-3 * tol) * zscale &&
+        res <= std::sqrt(tol);
+    if (checking && (res <= tol + floor || at_rounding) && viol <= tol * zscale) {
+      st.converged = true;
+      st.residual = res;
+      break;
+    }
+    if (it == settings_.max_newton_iterations) {
+      st.reason = absl::StrFormat(
+          "Newton did not converge in %d iterations (position increment %.3g m, relative "
+          "residual %.3g, constraint violation %.3g)",
+          it, last_increment, res, viol);
+      if (reuse) refresh_ = true;
+      return st;
+    }
+    if (fresh) {
+      if (!assembled) {
+        LoadMass();
+        model_->NetForce(q_, 1.0, &f_, &a, c);
+      }
+      if (m_ > 0) model_->AddConstraintHessian(q_, lambda1_, c, &a);
+      std::copy(jac_.value.begin(), jac_.value.end(), solver_.b().value.begin());
+      ++st.factorizations;
+      have_factor_ = false;
+      if (!solver_.Prepare()) {
+        st.reason = "the Newton matrix has a non-finite pivot";
+        return st;
+      }
+      have_factor_ = true;
+      factor_c_ = c;
+      refresh_ = false;
+      // Keep this matrix for the next iterations only when asked to.
+      fresh = !reuse;
+    }
+    rhs_ = -rhs_;
+    const auto ls = solver_.Solve(settings_.linear_solver, rhs_, settings_.linear_tolerance,
+                                  settings_.max_linear_iterations, &dx_);
+    ++st.newton_iterations;
+    st.linear_iterations += ls.iterations;
+    st.max_linear_residual = std::max(st.max_linear_residual, ls.relative_residual);
+    st.direct_fallbacks += ls.fallback ? 1 : 0;
+    if (!(ls.relative_residual <= 1e-6)) {
+      st.reason = absl::StrFormat(
+          "the %s solve did not converge (true relative residual %.3g after %d iterations)",
+          ls.direct                                               ? "direct"
+          : settings_.linear_solver == LinearSolverKind::kGmres ? "GMRES"
+                                                                : "MINRES",
+          ls.relative_residual, ls.iterations);
+      if (reuse) refresh_ = true;
+      return st;
+    }
+    zdd1_ += dx_.head(n_);
+    if (m_ > 0) lambda1_ += dx_.tail(m_) / w_;
+    const double increment = s * dx_.head(n_).lpNorm<Eigen::Infinity>();
+    if (!std::isfinite(increment) || increment > 1e6 * zscale) {
+      st.reason = "Newton diverged";
+      if (reuse) refresh_ = true;
+      return st;
+    }
+    // Safeguard of the kept matrix: slow contraction asks for a fresh one.
+    if (reuse && it > 0 && increment > 0.5 * last_increment) fresh = true;
+    last_increment = increment;
+  }
+  z_old_.swap(z_);
+  v_old_.swap(v_);
+  zdd_old_.swap(zdd_);
+  acc_old_.swap(acc_);
+  lambda_old_.swap(lambda_);
+  g_old_.swap(g_);
+  z_ = z1_;
+  v_ = v_pred_ + sv * zdd1_;
+  if (ga) {
+    const double k = 1 / (1 - alpha_m_);
+    acc_ = k * (alpha_f_ * zdd_old_ - alpha_m_ * acc_h_ + (1 - alpha_f_) * zdd1_);
+  } else {
+    acc_ = zdd1_;
+  }
+  zdd_ = zdd1_;
+  lambda_ = lambda1_;
+  h_old_ = h_last_;
+  h_last_ = h;
+  // g_{n+1} from the converged evaluation (forces and Jacobian at z_{n+1}).
+  g_ = bt_lambda_ - f_;
+  return st;
+}
+
+}  // namespace cablesim

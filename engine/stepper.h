@@ -1,0 +1,76 @@
+#ifndef CABLESIM_ENGINE_STEPPER_H_
+#define CABLESIM_ENGINE_STEPPER_H_
+
+// What the dynamic run loop (simulation.cc) needs from a time stepper:
+// consistent start, one step of size h [s] that either converges or leaves
+// the state unchanged, a local error estimate for adaptive steps, and a way
+// to take back the last accepted step when that estimate rejects it.
+//
+// The state is on the model's unknowns z (MultibodyModel): positions and
+// slopes z, their rates v = dz/dt, accelerations a = d^2z/dt^2 (the
+// physical ones, satisfying the equations of motion) and the Lagrange
+// multipliers lambda.
+//
+// Implementations: ImplicitEulerStepper (the paper's backward Euler) and
+// GeneralizedAlphaStepper (generalized-alpha and HHT). Step() allocates
+// nothing.
+
+#include <memory>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "engine/scene.h"
+
+namespace cablesim {
+
+class MultibodyModel;
+
+class Stepper {
+ public:
+  struct StepStats {
+    bool converged = false;
+    int newton_iterations = 0;
+    int linear_iterations = 0;
+    int factorizations = 0;            // Newton matrices assembled and factored
+    int direct_fallbacks = 0;          // DIRECT solves that had to run MINRES
+    double residual = 0;               // relative momentum residual accepted
+    double max_linear_residual = 0;    // largest true relative residual
+    std::string reason;                // why it did not converge
+  };
+
+  virtual ~Stepper() = default;
+
+  // Consistent initial acceleration from M a + Phi_z^T lambda = f,
+  // Phi_z a = gamma. Returns false (with `reason`) if the solve fails.
+  virtual bool Initialize(std::string* reason) = 0;
+
+  // Advances by h, or leaves the state unchanged and returns !converged.
+  virtual StepStats Step(double h) = 0;
+
+  // Undoes the last converged Step() (once).
+  virtual void Restore() = 0;
+
+  // Estimated local error of the last converged step of size h, in the
+  // weighted max norm max_i |e_i| / (atol + rtol |z_i|): <= 1 means the step
+  // meets the tolerance. Units of e_i are those of z (m for positions).
+  virtual double LocalErrorNorm(double h, double atol, double rtol) const = 0;
+
+  // The power of h in the local error estimate (2 for backward Euler, 3 for
+  // the second-order methods), for the step-size controller.
+  virtual int local_error_order() const = 0;
+  // Global order of accuracy in positions (Richardson extrapolation).
+  virtual int order() const = 0;
+
+  virtual const Eigen::VectorXd& z() const = 0;
+  virtual const Eigen::VectorXd& v() const = 0;
+  virtual const Eigen::VectorXd& a() const = 0;
+  virtual const Eigen::VectorXd& lambda() const = 0;
+};
+
+// The stepper `settings.integrator` names, for `model` (which must outlive it).
+std::unique_ptr<Stepper> MakeStepper(MultibodyModel* model, const SolverSettings& settings);
+
+}  // namespace cablesim
+
+#endif  // CABLESIM_ENGINE_STEPPER_H_
