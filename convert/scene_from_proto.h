@@ -32,10 +32,8 @@ absl::StatusOr<Integrator> IntegratorFromProto(v1::Integrator integrator, std::s
 absl::StatusOr<LinearSolverKind> LinearSolverFromProto(v1::LinearSolver solver,
                                                        std::string_view path);
 
-// The scene-file spelling of an engine enum value, e.g. "DYNAMIC", "MINRES".
-std::string_view AnalysisName(Analysis analysis);
-std::string_view IntegratorName(Integrator integrator);
-std::string_view LinearSolverName(LinearSolverKind solver);
+// The scene-file spelling of an engine enum value (AnalysisName, ...) is
+// declared with the enums in engine/scene.h.
 
 }  // namespace cablesim
 

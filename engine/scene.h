@@ -9,6 +9,7 @@
 // Units are SI: m, kg, s, N, Pa, rad.
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
@@ -24,6 +25,12 @@ enum class Integrator { kImplicitEuler, kGeneralizedAlpha, kHht };
 // kDirect: exact block elimination (skyline LDL^T of the Newton block and a
 // dense Schur complement); kAuto: picked per scene (SaddlePointSolver).
 enum class LinearSolverKind { kMinres, kGmres, kDirect, kAuto };
+
+// The scene-file spelling of an enum value, e.g. "DYNAMIC", "MINRES" (what
+// the summary reports).
+std::string_view AnalysisName(Analysis analysis);
+std::string_view IntegratorName(Integrator integrator);
+std::string_view LinearSolverName(LinearSolverKind solver);
 
 struct CableSpec {
   std::string name;

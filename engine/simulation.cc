@@ -349,32 +349,6 @@ class ProbeRecordingSink : public FrameSink {
   std::vector<Eigen::Vector3d> positions_;
 };
 
-const char* IntegratorLabel(Integrator integrator) {
-  switch (integrator) {
-    case Integrator::kGeneralizedAlpha:
-      return "GENERALIZED_ALPHA";
-    case Integrator::kHht:
-      return "HHT";
-    case Integrator::kImplicitEuler:
-      break;
-  }
-  return "IMPLICIT_EULER";
-}
-
-const char* LinearSolverLabel(LinearSolverKind kind) {
-  switch (kind) {
-    case LinearSolverKind::kGmres:
-      return "GMRES";
-    case LinearSolverKind::kDirect:
-      return "DIRECT";
-    case LinearSolverKind::kAuto:
-      return "AUTO";
-    case LinearSolverKind::kMinres:
-      break;
-  }
-  return "MINRES";
-}
-
 // The error estimate of a DYNAMIC run (solver.error_estimate): a companion
 // run of the same model, with half the step (fixed steps) or tolerances 32
 // times tighter (adaptive steps), compared frame by frame at the probes.
@@ -450,19 +424,17 @@ absl::StatusOr<RunSummary> RunScene(const Scene& scene, FrameSink* sink,
   RunSummary summary;
   summary.info = model.Info();
   const SolverSettings& settings = scene.solver;
-  summary.analysis = settings.analysis == Analysis::kStatic  ? "STATIC"
-                     : settings.analysis == Analysis::kModal ? "MODAL"
-                                                             : "DYNAMIC";
+  summary.analysis = std::string(AnalysisName(settings.analysis));
   int modes = 0;
   if (settings.analysis == Analysis::kModal) {
     absl::StatusOr<int> count = ModalSolver::ModeCount(model, settings);
     if (!count.ok()) return count.status();
     modes = *count;
   }
-  summary.integrator = IntegratorLabel(settings.integrator);
-  summary.linear_solver = LinearSolverLabel(settings.linear_solver);
-  summary.linear_solver_used = LinearSolverLabel(
-      SaddlePointSolver::Resolve(settings.linear_solver, model.dofs(), model.multipliers()));
+  summary.integrator = std::string(IntegratorName(settings.integrator));
+  summary.linear_solver = std::string(LinearSolverName(settings.linear_solver));
+  summary.linear_solver_used = std::string(LinearSolverName(
+      SaddlePointSolver::Resolve(settings.linear_solver, model.dofs(), model.multipliers())));
   summary.adaptive = settings.adaptive;
   if (settings.integrator != Integrator::kImplicitEuler)
     summary.rho_infinity = settings.rho_infinity;

@@ -1,0 +1,43 @@
+#include "engine/scene.h"
+
+namespace cablesim {
+
+std::string_view AnalysisName(Analysis analysis) {
+  switch (analysis) {
+    case Analysis::kDynamic:
+      return "DYNAMIC";
+    case Analysis::kStatic:
+      return "STATIC";
+    case Analysis::kModal:
+      return "MODAL";
+  }
+  return "UNKNOWN";
+}
+
+std::string_view IntegratorName(Integrator integrator) {
+  switch (integrator) {
+    case Integrator::kImplicitEuler:
+      return "IMPLICIT_EULER";
+    case Integrator::kGeneralizedAlpha:
+      return "GENERALIZED_ALPHA";
+    case Integrator::kHht:
+      return "HHT";
+  }
+  return "UNKNOWN";
+}
+
+std::string_view LinearSolverName(LinearSolverKind solver) {
+  switch (solver) {
+    case LinearSolverKind::kMinres:
+      return "MINRES";
+    case LinearSolverKind::kGmres:
+      return "GMRES";
+    case LinearSolverKind::kDirect:
+      return "DIRECT";
+    case LinearSolverKind::kAuto:
+      return "AUTO";
+  }
+  return "UNKNOWN";
+}
+
+}  // namespace cablesim
