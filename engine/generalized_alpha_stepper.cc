@@ -4,12 +4,12 @@
 #include <cmath>
 
 #include "absl/strings/str_format.h"
+#include "engine/newton_convergence.h"
 
 namespace cablesim {
 namespace {
 // A Newton correction below this times (1 + |z|_inf) changes z only in its
 // last few bits (16 machine epsilons).
-constexpr double kRoundingIncrement = 16 * 2.220446049250313e-16;
 }  // namespace
 
 GeneralizedAlphaStepper::GeneralizedAlphaStepper(MultibodyModel* model,
@@ -198,33 +198,23 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
     r += w_ * (bt_lambda_ - f_);
     if (w_ != 1) r += (1 - w_) * g_;
     if (m_ > 0) rhs_.tail(m_) = phi_ / s;
-    const double zscale = 1 + z1_.lpNorm<Eigen::Infinity>();
-    const double res = r.lpNorm<Eigen::Infinity>() / scale;
-    const double viol = m_ > 0 ? phi_.lpNorm<Eigen::Infinity>() : 0.0;
-    if (!std::isfinite(res) || !std::isfinite(viol)) {
+    NewtonIterate iterate;
+    iterate.last_increment = last_increment;
+    iterate.zscale = 1 + z1_.lpNorm<Eigen::Infinity>();
+    iterate.residual = r.lpNorm<Eigen::Infinity>() / scale;
+    iterate.violation = m_ > 0 ? phi_.lpNorm<Eigen::Infinity>() : 0.0;
+    if (!std::isfinite(iterate.residual) || !std::isfinite(iterate.violation)) {
       st.reason = "the residual is not finite (the step diverged)";
       return st;
     }
-    const double floor = w_ * model_->force_roundoff() / scale;
-    // At the rounding floor: the last correction moved z by a few units in
-    // its last place, or by a thousandth of the tolerance, so Newton cannot
-    // usefully improve the state; the residual left is the rounding of the
-    // forces (short, stiff elements far from the origin: eps |x| / l
-    // amplified by EA). Accepted only if that residual is still small
-    // (below sqrt(tol)).
-    const bool at_rounding =
-        last_increment <= std::max(kRoundingIncrement, 1e-3 * tol) * zscale &&
-        res <= std::sqrt(tol);
-    if (checking && (res <= tol + floor || at_rounding) && viol <= tol * zscale) {
+    iterate.floor = w_ * model_->force_roundoff() / scale;
+    if (checking && NewtonConverged(iterate, tol)) {
       st.converged = true;
-      st.residual = res;
+      st.residual = iterate.residual;
       break;
     }
     if (it == settings_.max_newton_iterations) {
-      st.reason = absl::StrFormat(
-          "Newton did not converge in %d iterations (position increment %.3g m, relative "
-          "residual %.3g, constraint violation %.3g)",
-          it, last_increment, res, viol);
+      st.reason = NewtonFailure(it, iterate);
       if (reuse) refresh_ = true;
       return st;
     }
@@ -254,20 +244,15 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
     st.linear_iterations += ls.iterations;
     st.max_linear_residual = std::max(st.max_linear_residual, ls.relative_residual);
     st.direct_fallbacks += ls.fallback ? 1 : 0;
-    if (!(ls.relative_residual <= 1e-6)) {
-      st.reason = absl::StrFormat(
-          "the %s solve did not converge (true relative residual %.3g after %d iterations)",
-          ls.direct                                               ? "direct"
-          : settings_.linear_solver == LinearSolverKind::kGmres ? "GMRES"
-                                                                : "MINRES",
-          ls.relative_residual, ls.iterations);
+    if (!LinearSolveGoodEnough(ls)) {
+      st.reason = LinearSolveFailure(ls, settings_.linear_solver);
       if (reuse) refresh_ = true;
       return st;
     }
     zdd1_ += dx_.head(n_);
     if (m_ > 0) lambda1_ += dx_.tail(m_) / w_;
     const double increment = s * dx_.head(n_).lpNorm<Eigen::Infinity>();
-    if (!std::isfinite(increment) || increment > 1e6 * zscale) {
+    if (!std::isfinite(increment) || increment > 1e6 * iterate.zscale) {
       st.reason = "Newton diverged";
       if (reuse) refresh_ = true;
       return st;

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "absl/strings/str_format.h"
+#include "engine/newton_convergence.h"
 
 namespace cablesim {
 
@@ -111,33 +112,23 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
                                    bt_mu_.lpNorm<Eigen::Infinity>(), 1e-300});
     rv += bt_mu_ - h * f_;
     if (m_ > 0) rhs_.tail(m_) = phi_ / h;
-    const double zscale = 1 + z1_.lpNorm<Eigen::Infinity>();
-    const double res = rv.lpNorm<Eigen::Infinity>() / scale;
-    const double viol = m_ > 0 ? phi_.lpNorm<Eigen::Infinity>() : 0.0;
-    if (!std::isfinite(res) || !std::isfinite(viol)) {
+    NewtonIterate iterate;
+    iterate.last_increment = last_increment;
+    iterate.zscale = 1 + z1_.lpNorm<Eigen::Infinity>();
+    iterate.residual = rv.lpNorm<Eigen::Infinity>() / scale;
+    iterate.violation = m_ > 0 ? phi_.lpNorm<Eigen::Infinity>() : 0.0;
+    if (!std::isfinite(iterate.residual) || !std::isfinite(iterate.violation)) {
       st.reason = "the residual is not finite (the step diverged)";
       return st;
     }
-    // Converged: the last increment was small, and the residual is below
-    // the tolerance or at the rounding floor of the elastic forces.
-    const double floor = h * model_->force_roundoff() / scale;
-    // At the rounding floor: the last correction moved z only in its last
-    // bits (16 eps (1 + |z|)) or by a thousandth of the tolerance, so the
-    // residual left is the rounding of the forces; accepted when below
-    // sqrt(tol).
-    const bool at_rounding =
-        last_increment <= std::max(16 * 2.220446049250313e-16, 1e-3 * tol) * zscale &&
-        res <= std::sqrt(tol);
-    if (checking && (res <= tol + floor || at_rounding) && viol <= tol * zscale) {
+    iterate.floor = h * model_->force_roundoff() / scale;
+    if (checking && NewtonConverged(iterate, tol)) {
       st.converged = true;
-      st.residual = res;
+      st.residual = iterate.residual;
       break;
     }
     if (it == settings_.max_newton_iterations) {
-      st.reason = absl::StrFormat(
-          "Newton did not converge in %d iterations (position increment %.3g m, relative "
-          "residual %.3g, constraint violation %.3g)",
-          it, last_increment, res, viol);
+      st.reason = NewtonFailure(it, iterate);
       return st;
     }
     if (checking) AssembleForces(h);
@@ -154,20 +145,14 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
     st.linear_iterations += ls.iterations;
     st.max_linear_residual = std::max(st.max_linear_residual, ls.relative_residual);
     st.direct_fallbacks += ls.fallback ? 1 : 0;
-    // An inexact solve still gives a descent direction; a bad one does not.
-    if (!(ls.relative_residual <= 1e-6)) {
-      st.reason = absl::StrFormat(
-          "the %s solve did not converge (true relative residual %.3g after %d iterations)",
-          ls.direct                                               ? "direct"
-          : settings_.linear_solver == LinearSolverKind::kGmres ? "GMRES"
-                                                                : "MINRES",
-          ls.relative_residual, ls.iterations);
+    if (!LinearSolveGoodEnough(ls)) {
+      st.reason = LinearSolveFailure(ls, settings_.linear_solver);
       return st;
     }
     v1_ += dx_.head(n_);
     if (m_ > 0) lambda1_ += dx_.tail(m_) / h;
     last_increment = h * dx_.head(n_).lpNorm<Eigen::Infinity>();
-    if (!std::isfinite(last_increment) || last_increment > 1e6 * zscale) {
+    if (!std::isfinite(last_increment) || last_increment > 1e6 * iterate.zscale) {
       st.reason = "Newton diverged";
       return st;
     }
