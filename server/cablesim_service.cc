@@ -202,6 +202,23 @@ void CablesimServiceImpl::Watchdog() {
   }
 }
 
+grpc::Status CablesimServiceImpl::FinishedResult(const std::string& id, v1::Job* job,
+                                                 StoredResult* result) const {
+  if (jobs_ == nullptr) return NoJobs();
+  absl::StatusOr<v1::Job> found = jobs_->Get(id);
+  if (!found.ok()) return ToGrpc(found.status());
+  if (!Finished(found->state()) || !found->has_summary()) {
+    return grpc::Status(
+        grpc::StatusCode::FAILED_PRECONDITION,
+        absl::StrCat("job ", found->id(), " is ", v1::JobState_Name(found->state()), ": no result"));
+  }
+  absl::StatusOr<StoredResult> stored = jobs_->store()->GetResult(found->id());
+  if (!stored.ok()) return ToGrpc(stored.status());
+  *job = *std::move(found);
+  *result = *std::move(stored);
+  return grpc::Status::OK;
+}
+
 grpc::Status CablesimServiceImpl::NoJobs() const {
   return grpc::Status(grpc::StatusCode::UNIMPLEMENTED,
                       "this service has no job store (start cablesim-server with --data-dir)");
@@ -338,38 +355,31 @@ grpc::Status CablesimServiceImpl::WatchJob(grpc::ServerContext* context,
 grpc::Status CablesimServiceImpl::GetJobResult(grpc::ServerContext* context,
                                                const v1::GetJobResultRequest* request,
                                                grpc::ServerWriter<v1::RunEvent>* writer) {
-  if (jobs_ == nullptr) return NoJobs();
-  absl::StatusOr<v1::Job> job = jobs_->Get(request->id());
-  if (!job.ok()) return ToGrpc(job.status());
-  if (!Finished(job->state()) || !job->has_summary()) {
-    return grpc::Status(
-        grpc::StatusCode::FAILED_PRECONDITION,
-        absl::StrCat("job ", job->id(), " is ", v1::JobState_Name(job->state()), ": no result"));
-  }
-  absl::StatusOr<StoredResult> result = jobs_->store()->GetResult(request->id());
-  if (!result.ok()) return ToGrpc(result.status());
+  v1::Job job;
+  StoredResult result;
+  if (grpc::Status s = FinishedResult(request->id(), &job, &result); !s.ok()) return s;
   StreamSlot slot(this, context, /*counted=*/false);
   v1::RunEvent event;
-  *event.mutable_header() = result->header;
-  event.mutable_header()->set_scene_name(job->name());
-  event.mutable_header()->set_end_time_s(job->end_time_s());
+  *event.mutable_header() = result.header;
+  event.mutable_header()->set_scene_name(job.name());
+  event.mutable_header()->set_end_time_s(job.end_time_s());
   if (!TimedWrite(writer, event, slot.watch())) {
     return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
   }
-  const size_t columns = std::max(1, result->header.columns_size());
+  const size_t columns = std::max(1, result.header.columns_size());
   const size_t batch = BatchSize(request->frames_per_batch());
-  const size_t rows = result->values.size() / columns;
+  const size_t rows = result.values.size() / columns;
   const size_t rows_per_message = std::max<size_t>(1, std::min(batch, kMaxBatchValues / columns));
   for (size_t r = 0; r < rows; r += rows_per_message) {
     const size_t n = std::min(rows_per_message, rows - r);
     event.mutable_frames()->set_rows(static_cast<int>(n));
-    event.mutable_frames()->mutable_values()->Assign(result->values.begin() + r * columns,
-                                                     result->values.begin() + (r + n) * columns);
+    event.mutable_frames()->mutable_values()->Assign(result.values.begin() + r * columns,
+                                                     result.values.begin() + (r + n) * columns);
     if (!TimedWrite(writer, event, slot.watch())) {
       return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
     }
   }
-  *event.mutable_summary() = job->summary();
+  *event.mutable_summary() = job.summary();
   if (!TimedWrite(writer, event, slot.watch())) {
     return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
   }
@@ -400,17 +410,10 @@ grpc::Status CablesimServiceImpl::GetEnergy(grpc::ServerContext* context,
   if (request->job_id().empty()) {
     return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, "source: give job_id or scene");
   }
-  if (jobs_ == nullptr) return NoJobs();
-  absl::StatusOr<v1::Job> job = jobs_->Get(request->job_id());
-  if (!job.ok()) return ToGrpc(job.status());
-  if (!Finished(job->state()) || !job->has_summary()) {
-    return grpc::Status(
-        grpc::StatusCode::FAILED_PRECONDITION,
-        absl::StrCat("job ", job->id(), " is ", v1::JobState_Name(job->state()), ": no result"));
-  }
-  absl::StatusOr<StoredResult> result = jobs_->store()->GetResult(job->id());
-  if (!result.ok()) return ToGrpc(result.status());
-  *response = EnergyFromTrajectory(result->header, result->values, job->summary());
+  v1::Job job;
+  StoredResult result;
+  if (grpc::Status s = FinishedResult(request->job_id(), &job, &result); !s.ok()) return s;
+  *response = EnergyFromTrajectory(result.header, result.values, job.summary());
   return grpc::Status::OK;
 }
 

@@ -65,6 +65,9 @@ class CablesimServiceImpl final : public v1::CablesimService::Service {
   };
 
  private:
+  // The stored result of finished job `id` (and the job): NOT_FOUND,
+  // FAILED_PRECONDITION while it has no result, UNIMPLEMENTED without jobs.
+  grpc::Status FinishedResult(const std::string& id, v1::Job* job, StoredResult* result) const;
   grpc::Status NoJobs() const;
   void Watchdog();
 
