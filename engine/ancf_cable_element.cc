@@ -1,5 +1,8 @@
 #include "engine/ancf_cable_element.h"
 
+#include <cmath>
+#include <limits>
+
 namespace cablesim {
 namespace {
 
@@ -124,7 +127,8 @@ typename AncfCableElement<D>::Energy AncfCableElement<D>::StrainEnergy(const Coo
 }
 
 template <int D>
-void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* tangent) const {
+void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* tangent,
+                                       Coords* roundoff) const {
   using Id = Eigen::Matrix<double, D, D>;
   using Block = Eigen::Matrix<double, D, D>;
   for (int g = 0; g < rule_.n; ++g) {
@@ -137,15 +141,19 @@ void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* t
     }
     const double a = u.squaredNorm(), b = u.dot(w), c = w.squaredNorm();
     const double wl = rule_.weight[g] * length_;
+    // Spectral-norm bounds of the Hessian blocks of psi (for `roundoff`).
+    double nuu = 0, nuw = 0, nww = 0;
 
     // Gradient (gu, gw) and Hessian blocks of psi with respect to (u, w).
     const double eps = (a - 1) / 2;
     Point gu = ea_ * eps * u, gw = Point::Zero();
-    Block huu, huw = Block::Zero(), hww = Block::Zero();
+    Block huu = Block::Zero(), huw = Block::Zero(), hww = Block::Zero();
     if (tangent) huu = ea_ * (eps * Id::Identity() + u * u.transpose());
+    if (roundoff) nuu = ea_ * (std::abs(eps) + a);
     if (bending_ == BendingModel::kLinear) {
       gw += ei_ * w;
       if (tangent) hww += ei_ * Id::Identity();
+      nww = ei_;
     } else if (bending_ == BendingModel::kExact) {
       // psi_b = EI/2 f(a, b, c), f = c / a^2 - b^2 / a^3, with
       // da/du = 2u, db/du = w, db/dw = u, dc/dw = 2w.
@@ -156,11 +164,18 @@ void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* t
       const double fc = k * ia2;
       gu += 2 * fa * u + fb * w;
       gw += fb * u + 2 * fc * w;
+      const double faa = k * (6 * c * ia4 - 12 * b * b * ia4 * ia);
+      const double fab = k * (6 * b * ia4);
+      const double fac = k * (-2 * ia3);
+      const double fbb = k * (-2 * ia3);
+      if (roundoff) {
+        const double nu = std::sqrt(a), nw = std::sqrt(c);
+        nuu += 4 * std::abs(faa) * a + 4 * std::abs(fab) * nu * nw + std::abs(fbb) * c +
+               2 * std::abs(fa);
+        nuw = 2 * std::abs(fab) * a + (4 * std::abs(fac) + std::abs(fbb)) * nu * nw + std::abs(fb);
+        nww = std::abs(fbb) * a + 2 * std::abs(fc);
+      }
       if (tangent) {
-        const double faa = k * (6 * c * ia4 - 12 * b * b * ia4 * ia);
-        const double fab = k * (6 * b * ia4);
-        const double fac = k * (-2 * ia3);
-        const double fbb = k * (-2 * ia3);
         // Second derivatives of f through a, b, c, plus f_a, f_b, f_c times
         // the Hessians of a, b, c.
         huu += 4 * faa * u * u.transpose() + 2 * fab * (u * w.transpose() + w * u.transpose()) +
@@ -172,6 +187,23 @@ void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* t
     }
     for (int k = 0; k < 4; ++k)
       force->template segment<D>(k * D) += wl * (s1[k] * gu + s2[k] * gw);
+    if (roundoff) {
+      constexpr double kEps = std::numeric_limits<double>::epsilon();
+      double du = 0, dw = 0;
+      for (int k = 0; k < 4; ++k) {
+        const double ek = e.template segment<D>(k * D).norm();
+        du += std::abs(s1[k]) * ek;
+        dw += std::abs(s2[k]) * ek;
+      }
+      du *= kEps;
+      dw *= kEps;
+      const double dgu = nuu * du + nuw * dw + kEps * gu.norm();
+      const double dgw = nuw * du + nww * dw + kEps * gw.norm();
+      for (int k = 0; k < 4; ++k) {
+        roundoff->template segment<D>(k * D).array() +=
+            wl * (std::abs(s1[k]) * dgu + std::abs(s2[k]) * dgw);
+      }
+    }
     if (tangent) {
       // K += wl B^T H B, block by block: B's node block k is
       // [s_k' I; s_k'' I], so block (k, m) is

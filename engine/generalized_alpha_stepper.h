@@ -131,6 +131,8 @@ class GeneralizedAlphaStepper final : public Stepper {
   Eigen::VectorXd z_old_, v_old_, zdd_old_, acc_old_, lambda_old_, g_old_;
   // Newton work vectors.
   Eigen::VectorXd z_pred_, v_pred_, z1_, zdd1_, lambda1_, q_, f_, phi_, bt_lambda_, rhs_, dx_;
+  // The residual's rounding floor per unknown, and the terms summed into it.
+  Eigen::VectorXd floor_, abs_terms_;
   // The kept factorization: its c = w s, and whether it must be refreshed.
   bool have_factor_ = false;
   double factor_c_ = 0;

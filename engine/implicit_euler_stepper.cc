@@ -27,6 +27,8 @@ ImplicitEulerStepper::ImplicitEulerStepper(MultibodyModel* model, const SolverSe
   rhs_.setZero(n_ + m_);
   dx_.setZero(n_ + m_);
   bt_mu_.setZero(n_);
+  floor_.setZero(n_);
+  abs_terms_.setZero(n_);
   z_old_ = z_;
   v_old_ = v_;
   a_old_ = a_;
@@ -81,9 +83,9 @@ void ImplicitEulerStepper::LoadMass() {
   std::copy(mass.values(), mass.values() + mass.stored(), solver_.a().values());
 }
 
-double ImplicitEulerStepper::AssembleForces(double h) {
+double ImplicitEulerStepper::AssembleForces(double h, Eigen::VectorXd* roundoff) {
   LoadMass();
-  return model_->NetForce(q_, 1.0, &f_, &solver_.a(), h * h);
+  return model_->NetForce(q_, 1.0, &f_, &solver_.a(), h * h, roundoff);
 }
 
 ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
@@ -91,7 +93,7 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
   const double tol = settings_.newton_tolerance;
   v1_ = v_ + h * a_;
   lambda1_ = lambda_;
-  double last_increment = 0;
+  double last_increment = 0, previous_increment = 0;
   SkylineLdlt& a = solver_.a();
   for (int it = 0; it <= settings_.max_newton_iterations; ++it) {
     z1_ = z_ + h * v1_;
@@ -99,7 +101,11 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
     // Newton matrix M + h^2 (K_T + H_lambda), assembled with the forces
     // unless this evaluation is expected to be the converged one.
     const bool checking = it > 0 && last_increment <= tol * (1 + z1_.lpNorm<Eigen::Infinity>());
-    const double force_size = checking ? model_->NetForce(q_, 1.0, &f_) : AssembleForces(h);
+    // The rounding floor is needed where convergence is judged (and for the
+    // message of the last iteration).
+    const bool judge = checking || it == settings_.max_newton_iterations;
+    const double force_size = checking ? model_->NetForce(q_, 1.0, &f_, nullptr, 0, &floor_)
+                                       : AssembleForces(h, judge ? &floor_ : nullptr);
     model_->Constraints(q_, &phi_, &solver_.b());
     // R_v = M (v1 - v0) - h f + Phi_z^T (h lambda).
     mdv_ = v1_ - v_;
@@ -114,6 +120,7 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
     if (m_ > 0) rhs_.tail(m_) = phi_ / h;
     NewtonIterate iterate;
     iterate.last_increment = last_increment;
+    iterate.previous_increment = previous_increment;
     iterate.zscale = 1 + z1_.lpNorm<Eigen::Infinity>();
     iterate.residual = rv.lpNorm<Eigen::Infinity>() / scale;
     iterate.violation = m_ > 0 ? phi_.lpNorm<Eigen::Infinity>() : 0.0;
@@ -121,10 +128,20 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
       st.reason = "the residual is not finite (the step diverged)";
       return st;
     }
-    iterate.floor = h * model_->force_roundoff() / scale;
+    if (judge) {
+      // floor = h roundoff(f) + rounding of the other terms summed into R_v
+      // (M v1, M v0 and h Phi_z^T lambda).
+      abs_terms_.setZero();
+      model_->mass().AddAbsMultiply(v1_.data(), abs_terms_.data());
+      model_->mass().AddAbsMultiply(v_.data(), abs_terms_.data());
+      solver_.b().AddAbsTransposeMultiply(lambda1_.data(), abs_terms_.data(), h);
+      floor_ = h * floor_ + kSumRounding * abs_terms_;
+      MeasureResidual(rv, floor_, scale, &iterate);
+    }
     if (checking && NewtonConverged(iterate, tol)) {
       st.converged = true;
       st.residual = iterate.residual;
+      st.residual_floor = iterate.floor;
       break;
     }
     if (it == settings_.max_newton_iterations) {
@@ -151,6 +168,7 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
     }
     v1_ += dx_.head(n_);
     if (m_ > 0) lambda1_ += dx_.tail(m_) / h;
+    previous_increment = last_increment;
     last_increment = h * dx_.head(n_).lpNorm<Eigen::Infinity>();
     if (!std::isfinite(last_increment) || last_increment > 1e6 * iterate.zscale) {
       st.reason = "Newton diverged";

@@ -526,9 +526,6 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
         const double l = node_s[c][local + 1] - node_s[c][local];
         ElementData<kD> e;
         e.element = AncfCableElement<kD>(l, ea, ei, cable.bending);
-        m.force_roundoff_ =
-            std::max(m.force_roundoff_,
-                     100 * std::numeric_limits<double>::epsilon() * std::max(ea, ei / (l * l)));
         e.first_coord = ns * k;
         e.mass_per_length = mpl;
         e.gravity = e.element.GravityForce(mpl, g);
@@ -651,6 +648,7 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
     }
   }
   m.scratch_full_ = VectorXd::Zero(ncoord);
+  m.scratch_roundoff_ = VectorXd::Zero(ncoord);
   m.ProjectInitialVelocity();
   return m;
 }
@@ -735,10 +733,11 @@ void MultibodyModel::RateToFull(const VectorXd& zdot, VectorXd* qdot) const {
 
 template <int D>
 double MultibodyModel::ElementForces(const VectorXd& q, VectorXd* full, SkylineLdlt* stiffness,
-                                     double stiffness_scale) const {
+                                     double stiffness_scale, VectorXd* roundoff) const {
   constexpr int kN = 4 * D, kN2 = kN * kN;
+  constexpr double kEps = std::numeric_limits<double>::epsilon();
   const auto& elements = Elements<D>();
-  typename AncfCableElement<D>::Coords fe;
+  typename AncfCableElement<D>::Coords fe, re;
   typename AncfCableElement<D>::Matrix ke;
   double size = 0;
   double* values = stiffness ? stiffness->values() : nullptr;
@@ -746,8 +745,12 @@ double MultibodyModel::ElementForces(const VectorXd& q, VectorXd* full, SkylineL
     const ElementData<D>& e = elements[k];
     fe.setZero();
     if (stiffness) ke.setZero();
-    e.element.ElasticForce(q.segment<kN>(e.first_coord), &fe, stiffness ? &ke : nullptr);
+    if (roundoff) re.setZero();
+    e.element.ElasticForce(q.segment<kN>(e.first_coord), &fe, stiffness ? &ke : nullptr,
+                           roundoff ? &re : nullptr);
     full->segment<kN>(e.first_coord) -= fe;
+    // The element's own bound, and the rounding of adding it to the node.
+    if (roundoff) roundoff->segment<kN>(e.first_coord) += re + kEps * fe.cwiseAbs();
     size = std::max(size, fe.template lpNorm<Eigen::Infinity>());
     if (!stiffness) continue;
     const int* slots = &element_slots_[kN2 * k];
@@ -761,7 +764,9 @@ double MultibodyModel::ElementForces(const VectorXd& q, VectorXd* full, SkylineL
 }
 
 double MultibodyModel::NetForce(const VectorXd& q, double load_factor, VectorXd* f,
-                                SkylineLdlt* stiffness, double stiffness_scale) {
+                                SkylineLdlt* stiffness, double stiffness_scale,
+                                VectorXd* roundoff) {
+  constexpr double kEps = std::numeric_limits<double>::epsilon();
   VectorXd& full = scratch_full_;
   full = load_factor * constant_force_;
   // A torque T on a body: its virtual work T . dphi, with de_k = dphi x e_k,
@@ -789,11 +794,25 @@ double MultibodyModel::NetForce(const VectorXd& q, double load_factor, VectorXd*
   const int n = coordinates();
   for (int i = 0; i < n; ++i)
     if (j_[i] >= 0) size = std::max(size, std::abs(full(i)));
-  size = std::max(size, dim_ == 2 ? ElementForces<2>(q, &full, stiffness, stiffness_scale)
-                                  : ElementForces<3>(q, &full, stiffness, stiffness_scale));
+  // Rounding of the applied terms (torques included, through |full|).
+  VectorXd* full_roundoff = nullptr;
+  if (roundoff) {
+    full_roundoff = &scratch_roundoff_;
+    *full_roundoff = kEps * full.cwiseAbs();
+  }
+  size = std::max(size, dim_ == 2 ? ElementForces<2>(q, &full, stiffness, stiffness_scale,
+                                                     full_roundoff)
+                                  : ElementForces<3>(q, &full, stiffness, stiffness_scale,
+                                                     full_roundoff));
   f->setZero();
   for (int i = 0; i < n; ++i)
     if (j_[i] >= 0) (*f)(j_[i]) += s_(i) * full(i);
+  if (roundoff) {
+    roundoff->setZero();
+    for (int i = 0; i < n; ++i)
+      if (j_[i] >= 0)
+        (*roundoff)(j_[i]) += std::abs(s_(i)) * ((*full_roundoff)(i) + kEps * std::abs(full(i)));
+  }
   return size;
 }
 

@@ -97,13 +97,14 @@ class MultibodyModel {
   // Returns the size of the terms that were added, max(|Q_a|_inf, |Q_k|_inf)
   // over the coordinates that move: the scale against which Newton residuals
   // are small (the two nearly cancel at equilibrium).
+  // When `roundoff` is not null, it receives per unknown a bound on the
+  // rounding error of f: the elements' bounds (AncfCableElement::
+  // ElasticForce: coordinates known to eps |q| only, amplified by the
+  // stiffness) plus eps times every term summed into the entry. This is the
+  // floor below which no Newton iteration can push the residual.
   double NetForce(const Eigen::VectorXd& q, double load_factor, Eigen::VectorXd* f,
-                  SkylineLdlt* stiffness = nullptr, double stiffness_scale = 0);
-
-  // The level below which force residuals are rounding error: 100 machine
-  // epsilons of the stiffest element's EA or EI / l^2 [N]. Newton cannot
-  // drive a residual below it, so it is added to the convergence threshold.
-  double force_roundoff() const { return force_roundoff_; }
+                  SkylineLdlt* stiffness = nullptr, double stiffness_scale = 0,
+                  Eigen::VectorXd* roundoff = nullptr);
 
   // Constraint values Phi(q) [multipliers()] and Jacobian dPhi/dz.
   void Constraints(const Eigen::VectorXd& q, Eigen::VectorXd* phi, SparseRows* jac) const;
@@ -181,7 +182,7 @@ class MultibodyModel {
 
   template <int D>
   double ElementForces(const Eigen::VectorXd& q, Eigen::VectorXd* full, SkylineLdlt* stiffness,
-                       double stiffness_scale) const;
+                       double stiffness_scale, Eigen::VectorXd* roundoff) const;
   template <int D>
   void ElementEnergy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
                      EnergySample* en) const;
@@ -221,7 +222,6 @@ class MultibodyModel {
   std::vector<BodyData> bodies_;
   std::vector<TorqueLoad> torques_;
   Eigen::VectorXd constant_force_;  // full: gravity and point loads
-  double force_roundoff_ = 0;
 
   std::vector<Row> rows_;
   std::vector<int> row_coord_;
@@ -252,7 +252,7 @@ class MultibodyModel {
   std::vector<double> element_factors_;
   SparseRows jac_pattern_;
   // Scratch (full size) for NetForce.
-  Eigen::VectorXd scratch_full_;
+  Eigen::VectorXd scratch_full_, scratch_roundoff_;
   // Work done by the torques so far [J].
   double torque_work_ = 0;
 };

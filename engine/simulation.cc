@@ -243,6 +243,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
         summary->min_step_s = std::min(summary->min_step_s, h_try);
         summary->max_step_s = std::max(summary->max_step_s, h_try);
         summary->max_newton_residual = std::max(summary->max_newton_residual, st.residual);
+        summary->max_residual_floor = std::max(summary->max_residual_floor, st.residual_floor);
         summary->end_time_s = t;
         // After a run of good steps, go back up towards the nominal step.
         if (!settings.adaptive && h < h_nominal && ++successes >= 4) {
@@ -288,44 +289,19 @@ void RunStatic(MultibodyModel* model, const SolverSettings& settings, const RunC
                FrameRecorder* rec, RunSummary* summary) {
   StaticSolver solver(model, settings);
   TorqueWork torque_work(model);
-  const int n = settings.load_steps;
-  const double min_increment = std::ldexp(1.0 / n, -settings.max_step_halvings);
-  double alpha = 0;
-  for (int k = 1; k <= n; ++k) {
-    const double target = static_cast<double>(k) / n;
-    double d = target - alpha;
-    while (target - alpha > 1e-12) {
-      if (!MayStep(control, alpha, summary)) return;
-      d = std::min(d, target - alpha);
-      torque_work.Before(solver.z());
-      const auto st = solver.Solve(alpha + d);
-      summary->newton_iterations += st.newton_iterations;
-      summary->linear_iterations += st.linear_iterations;
-      summary->max_linear_residual = std::max(summary->max_linear_residual, st.max_linear_residual);
-      if (st.converged) {
-        alpha += d;
-        torque_work.After(solver.z(), alpha);
-        ++summary->steps;
-        summary->max_newton_residual = std::max(summary->max_newton_residual, st.residual);
-        summary->end_time_s = alpha;
-        continue;
-      }
-      ++summary->rejected_steps;
-      d /= 2;
-      if (d < min_increment * (1 - 1e-12)) {
-        Fail(summary, alpha,
-             absl::StrFormat("load increment from load factor %.6g failed after %d bisections: %s",
-                             alpha, settings.max_step_halvings, st.reason));
-        return;
-      }
-    }
-    alpha = target;
+  auto on_increment = [&](const Eigen::VectorXd& z0, const Eigen::VectorXd& z1, double alpha) {
+    torque_work.Before(z0);
+    torque_work.After(z1, alpha);
+  };
+  auto on_target = [&](double alpha) {
     if (absl::Status s = rec->Emit(alpha, alpha, solver.z(), nullptr, nullptr); !s.ok()) {
       summary->status = "cancelled";
       summary->error = std::string(s.message());
-      return;
+      return false;
     }
-  }
+    return true;
+  };
+  FollowLoadPath(&solver, settings, control, summary, "", on_increment, on_target);
 }
 
 // Forwards frames and keeps every probe position (for the error estimate).

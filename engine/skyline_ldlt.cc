@@ -33,6 +33,20 @@ void SkylineLdlt::Multiply(const double* x, double* y) const {
   }
 }
 
+void SkylineLdlt::AddAbsMultiply(const double* x, double* y) const {
+  for (int i = 0; i < n_; ++i) {
+    const double* row = &values_[start_[i]];
+    const int f = first_[i];
+    double acc = 0;
+    for (int j = f; j < i; ++j) {
+      const double a = std::abs(row[j - f]);
+      acc += a * std::abs(x[j]);
+      y[j] += a * std::abs(x[i]);
+    }
+    y[i] += acc + std::abs(row[i - f] * x[i]);
+  }
+}
+
 bool SkylineLdlt::Factor(double tiny) {
   small_pivots_ = 0;
   negative_pivots_ = 0;

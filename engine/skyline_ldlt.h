@@ -42,6 +42,9 @@ class SkylineLdlt {
 
   // y = A x (the matrix as assembled, not the factor).
   void Multiply(const double* x, double* y) const;
+  // y += |A| |x| (entrywise absolute values): a bound on the terms summed
+  // into A x, for rounding estimates.
+  void AddAbsMultiply(const double* x, double* y) const;
 
   // Factorizes a copy of the assembled values. Returns false if a pivot is
   // not finite. Pivots smaller than `tiny` in magnitude are replaced by
