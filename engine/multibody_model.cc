@@ -526,6 +526,11 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
         const double l = node_s[c][local + 1] - node_s[c][local];
         ElementData<kD> e;
         e.element = AncfCableElement<kD>(l, ea, ei, cable.bending);
+        // Energy the element can hold from coordinates known to 16 eps
+        // (1 + |q0|_inf): a strain of that over l, a curvature of it over l^2.
+        const double strain = 16 * std::numeric_limits<double>::epsilon() *
+                              (1 + q0.lpNorm<Eigen::Infinity>()) / l;
+        m.energy_roundoff_ += (ea + ei / (l * l)) * l * strain * strain;
         e.first_coord = ns * k;
         e.mass_per_length = mpl;
         e.gravity = e.element.GravityForce(mpl, g);

@@ -106,6 +106,13 @@ class MultibodyModel {
                   SkylineLdlt* stiffness = nullptr, double stiffness_scale = 0,
                   Eigen::VectorXd* roundoff = nullptr);
 
+  // The energy [J] below which a change of the total energy is rounding:
+  // sum over elements of (EA + EI / l^2) l d^2, d = 16 eps (1 + |q0|_inf) / l,
+  // the strain energy of the strain (and curvature) that coordinates known
+  // only to their last bits can hold. The energy checks of a dynamic run
+  // ignore rises below it (a cable at rest stays at rest silently).
+  double energy_roundoff() const { return energy_roundoff_; }
+
   // Constraint values Phi(q) [multipliers()] and Jacobian dPhi/dz.
   void Constraints(const Eigen::VectorXd& q, Eigen::VectorXd* phi, SparseRows* jac) const;
   // An empty Jacobian with the constraint pattern (values to be filled).
@@ -222,6 +229,7 @@ class MultibodyModel {
   std::vector<BodyData> bodies_;
   std::vector<TorqueLoad> torques_;
   Eigen::VectorXd constant_force_;  // full: gravity and point loads
+  double energy_roundoff_ = 0;
 
   std::vector<Row> rows_;
   std::vector<int> row_coord_;

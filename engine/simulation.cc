@@ -173,6 +173,8 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   double t = 0;
   double h = h_nominal;
   int successes = 0;
+  // Rises of the total energy below this are rounding (a scene at rest).
+  const double energy_floor = model->energy_roundoff();
   // Backward Euler never raises the energy; the second-order steppers may.
   const bool check_steps = settings.integrator != Integrator::kImplicitEuler;
   summary->min_step_s = settings.adaptive ? std::numeric_limits<double>::infinity() : h_nominal;
@@ -198,7 +200,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
         const double scale =
             std::max({rec->energy_scale(), std::abs(e.kinetic), std::abs(e.potential),
                       std::abs(e.axial) + std::abs(e.bending)});
-        if (e.total - summary->energy_initial > kEnergyRiseLimit * scale) {
+        if (e.total - summary->energy_initial > kEnergyRiseLimit * scale + energy_floor) {
           stepper.Restore();
           ++summary->rejected_steps;
           successes = 0;
@@ -268,7 +270,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     const double rise = e.total - summary->energy_initial;
     const double scale = std::max({rec->energy_scale(), std::abs(e.kinetic),
                                    std::abs(e.potential), std::abs(e.axial) + std::abs(e.bending)});
-    if (rise > kEnergyRiseLimit * scale) {
+    if (rise > kEnergyRiseLimit * scale + energy_floor) {
       Fail(summary, t,
            absl::StrFormat("the total energy rose by %.3g J (more than %g %% of the largest "
                            "energy term, %.3g J) by t = %.9g s: the stepper is unstable at this "

@@ -8,6 +8,9 @@
 #include "engine/newton_convergence.h"
 
 namespace cablesim {
+namespace {
+constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
+}  // namespace
 
 StaticSolver::StaticSolver(MultibodyModel* model, const SolverSettings& settings)
     : model_(model), settings_(settings) {
@@ -26,6 +29,7 @@ StaticSolver::StaticSolver(MultibodyModel* model, const SolverSettings& settings
   bt_l_.setZero(n_);
   floor_.setZero(n_);
   work_.setZero(n_);
+  qdot_zero_.setZero(model->coordinates());
 }
 
 double StaticSolver::FirstShift(const Eigen::VectorXd& r, double zscale) {
@@ -42,6 +46,19 @@ double StaticSolver::FirstShift(const Eigen::VectorXd& r, double zscale) {
   return std::max(move / (kFirstMove * zscale), std::numeric_limits<double>::min());
 }
 
+double StaticSolver::Merit(const Eigen::VectorXd& z, const Eigen::VectorXd& lambda, double alpha,
+                           double gamma) {
+  model_->ToFull(z, &q_);
+  const EnergySample e = model_->Energy(q_, qdot_zero_, alpha);
+  double merit = e.total;
+  if (m_ > 0) {
+    model_->Constraints(q_, &phi_, nullptr);
+    merit += lambda.dot(phi_) + 0.5 * gamma * phi_.squaredNorm();
+  }
+  merit_size_ = std::abs(e.potential) + e.axial + e.bending;
+  return merit;
+}
+
 StaticSolver::IncrementStats StaticSolver::Solve(double alpha, double tolerance) {
   IncrementStats st;
   const double tol = tolerance > 0 ? tolerance : settings_.newton_tolerance;
@@ -49,12 +66,11 @@ StaticSolver::IncrementStats StaticSolver::Solve(double alpha, double tolerance)
   lambda1_ = lambda_;
   const double zscale0 = 1 + z_.lpNorm<Eigen::Infinity>();
   double last_increment = 0, previous_increment = 0;
-  double sigma = 0;             // pseudo-transient shift [1/s^2]; 0: Newton
-  bool transient = false;       // whether the shift is on
-  double last_norm = 0;         // |r|_inf of the previous iterate
-  bool have_last = false;
-  double travel = 0;            // |z1 - z|_inf summed over the steps
+  double sigma = 0;       // shift [1/s^2]; 0: plain Newton
+  double first_sigma = 0; // the first shift switched on
+  double travel = 0;      // sum of the steps' |dz|_inf
   NewtonIterate iterate;
+  const SkylineLdlt& mass = model_->mass();
   for (int it = 0; it <= kMaxIterations; ++it) {
     model_->ToFull(z1_, &q_);
     SkylineLdlt& a = solver_.a();
@@ -95,79 +111,77 @@ StaticSolver::IncrementStats StaticSolver::Solve(double alpha, double tolerance)
           iterate.residual, iterate.floor, iterate.violation);
       return st;
     }
-    const double norm = r.lpNorm<Eigen::Infinity>();
-    if (transient && have_last && !(norm > 10 * last_norm)) {
-      // Switched evolution relaxation: the shift follows the residual.
-      sigma *= norm / last_norm;
-    } else if (have_last && norm > 10 * last_norm) {
-      // The last step made things much worse: take it back, shift harder.
-      z1_ = z_prev_;
-      lambda1_ = lambda_prev_;
-      sigma = transient ? 10 * sigma : FirstShift(r, iterate.zscale);
-      transient = true;
-      have_last = false;
-      last_increment = previous_increment = 0;
-      ++st.newton_iterations;
-      continue;
+    double gamma = 0;
+    if (m_ > 0) {
+      model_->AddConstraintHessian(q_, lambda1_, 1.0, &a);
+      // Bodies have no stiffness: only the constraints hold them, so A
+      // alone is singular. The augmented Lagrangian gamma B^T B, with
+      // gamma the size of A's diagonal, makes it definite without
+      // changing the answer.
+      double diag = 0;
+      for (int j = 0; j < n_; ++j) diag = std::max(diag, std::abs(a.values()[a.Slot(j, j)]));
+      gamma = diag > 0 ? diag : 1.0;
+      solver_.Augment(gamma);
     }
-    if (m_ > 0) model_->AddConstraintHessian(q_, lambda1_, 1.0, &a);
-    // The Newton step, shifted until its matrix is positive definite and
-    // its step is not larger than kMaxMove of the scene.
+    // The step: shifted until its matrix is positive definite, the step is
+    // not longer than kMaxMove of the scene, and (away from the solution)
+    // it lowers the merit, the energy plus the augmented constraint terms.
     double* values = a.values();
-    const SkylineLdlt& mass = model_->mass();
     double added = 0;  // sigma already in `a`
-    bool solved = false;
-    for (int attempt = 0; attempt < 60 && !solved; ++attempt) {
+    bool accepted = false;
+    const double rnorm = r.lpNorm<Eigen::Infinity>();
+    for (int attempt = 0; attempt < 60 && !accepted; ++attempt) {
+      if (attempt > 0) {
+        if (sigma == 0) {
+          sigma = first_sigma > 0 ? first_sigma : FirstShift(r, iterate.zscale);
+          if (first_sigma == 0) first_sigma = sigma;
+        } else {
+          sigma *= 4;
+        }
+      }
       if (sigma != added) {
         const double ds = sigma - added;
         for (int k = 0; k < mass.stored(); ++k) values[k] += ds * mass.values()[k];
         added = sigma;
       }
-      if (m_ > 0 && attempt == 0) {
-        // Bodies have no stiffness: only the constraints hold them, so A
-        // alone is singular. The augmented Lagrangian gamma B^T B, with
-        // gamma the size of A's diagonal, makes it definite without
-        // changing the answer.
-        double diag = 0;
-        for (int j = 0; j < n_; ++j) diag = std::max(diag, std::abs(values[a.Slot(j, j)]));
-        solver_.Augment(diag > 0 ? diag : 1.0);
+      ++st.newton_iterations;
+      if (!solver_.Prepare() || a.negative_pivots() > 0 || a.small_pivots() > 0) continue;
+      rhs_ = -rhs_;
+      const auto ls = solver_.Solve(settings_.linear_solver, rhs_, settings_.linear_tolerance,
+                                    std::max(settings_.max_linear_iterations, 1000), &dx_);
+      rhs_ = -rhs_;
+      st.linear_iterations += ls.iterations;
+      st.max_linear_residual = std::max(st.max_linear_residual, ls.relative_residual);
+      const double step = dx_.head(n_).lpNorm<Eigen::Infinity>();
+      if (!(ls.relative_residual <= kMaxLinearResidual) || !std::isfinite(step) ||
+          step > kMaxMove * iterate.zscale) {
+        continue;
       }
-      const bool factored = solver_.Prepare();
-      const bool definite = factored && a.negative_pivots() == 0 && a.small_pivots() == 0;
-      bool ok = definite;
-      if (ok) {
-        rhs_ = -rhs_;
-        const auto ls = solver_.Solve(settings_.linear_solver, rhs_, settings_.linear_tolerance,
-                                      std::max(settings_.max_linear_iterations, 1000), &dx_);
-        rhs_ = -rhs_;
-        st.linear_iterations += ls.iterations;
-        st.max_linear_residual = std::max(st.max_linear_residual, ls.relative_residual);
-        const double step = dx_.head(n_).lpNorm<Eigen::Infinity>();
-        ok = ls.relative_residual <= kMaxLinearResidual && std::isfinite(step) &&
-             step <= kMaxMove * iterate.zscale;
-      }
-      if (ok) {
-        solved = true;
+      // Near the solution (a short step from a small residual) Newton's
+      // step needs no check, and the merit's change would be rounding.
+      if (step <= 1e-3 * iterate.zscale && rnorm <= std::sqrt(tol) * scale) {
+        accepted = true;
         break;
       }
-      // Not definite, not solved, or too long a step: shift (harder).
-      sigma = transient ? 10 * sigma : FirstShift(r, iterate.zscale);
-      transient = true;
+      trial_z_ = z1_ + dx_.head(n_);
+      trial_lambda_ = lambda1_;
+      if (m_ > 0) trial_lambda_ += dx_.tail(m_);
+      const double before = Merit(z1_, trial_lambda_, alpha, gamma);
+      const double size = merit_size_;
+      const double after = Merit(trial_z_, trial_lambda_, alpha, gamma);
+      accepted = after <= before + 64 * kEpsilon * std::max(size, merit_size_);
     }
-    ++st.newton_iterations;
-    if (!solved) {
-      st.reason = "no shift of the tangent stiffness gave a usable Newton step";
+    if (!accepted) {
+      st.reason = "no shift of the tangent stiffness gave a step that lowers the energy";
       return st;
     }
-    z_prev_ = z1_;
-    lambda_prev_ = lambda1_;
+    // A step that lowered the merit: trust the model more next time.
+    sigma = sigma / 4 < 1e-8 * first_sigma ? 0 : sigma / 4;
     z1_ += dx_.head(n_);
     if (m_ > 0) lambda1_ += dx_.tail(m_);
     previous_increment = last_increment;
     last_increment = dx_.head(n_).lpNorm<Eigen::Infinity>();
     travel += last_increment;
-    last_norm = norm;
-    have_last = true;
   }
   z_ = z1_;
   lambda_ = lambda1_;

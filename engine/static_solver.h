@@ -79,6 +79,11 @@ class StaticSolver {
   // The pseudo-transient shift that moves the scene by kFirstMove of its
   // size in one step under the residual r.
   double FirstShift(const Eigen::VectorXd& r, double zscale);
+  // The merit of a trial state: its potential energy (strain, gravity,
+  // loads) plus lambda . Phi + gamma / 2 |Phi|^2; sets merit_size_ to the
+  // size of the energy terms (for the rounding of a comparison).
+  double Merit(const Eigen::VectorXd& z, const Eigen::VectorXd& lambda, double alpha,
+               double gamma);
 
   MultibodyModel* model_;
   SolverSettings settings_;
@@ -87,7 +92,8 @@ class StaticSolver {
   bool mass_factored_ = false;
   int n_ = 0, m_ = 0;
   Eigen::VectorXd z_, lambda_, z1_, lambda1_, q_, f_, phi_, rhs_, dx_, bt_l_, floor_, work_;
-  Eigen::VectorXd z_prev_, lambda_prev_;
+  Eigen::VectorXd trial_z_, trial_lambda_, qdot_zero_;
+  double merit_size_ = 0;
 };
 
 // Follows the load path 0 -> 1 in settings.load_steps increments (each one
