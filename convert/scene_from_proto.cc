@@ -561,6 +561,21 @@ class SceneConverter {
                                               "solver.relative_tolerance"}}) {
       if (has && !out.adaptive) return Invalid(name, "needs solver.adaptive: true");
     }
+    switch (s.initial_state()) {
+      case v1::Solver::INITIAL_STATE_UNSPECIFIED:
+      case v1::Solver::AS_GIVEN:
+        break;
+      case v1::Solver::STATIC:
+        if (out.analysis != Analysis::kDynamic) {
+          return Invalid("solver.initial_state", "STATIC applies to DYNAMIC analysis only");
+        }
+        out.initial_state = InitialState::kStatic;
+        break;
+      default:
+        return Invalid("solver.initial_state",
+                       absl::StrCat("unknown value ", static_cast<int>(s.initial_state()),
+                                    " (expected AS_GIVEN or STATIC)"));
+    }
     if ((out.adaptive || out.error_estimate) && out.analysis != Analysis::kDynamic) {
       return Invalid(out.adaptive ? "solver.adaptive" : "solver.error_estimate",
                      "applies to DYNAMIC analysis only");

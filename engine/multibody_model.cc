@@ -191,12 +191,8 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
   // ---- Full coordinates and their initial values and rates. ----
   const int ncoord = ns * m.num_nodes_ + bs * num_bodies;
   const int body0 = ns * m.num_nodes_;
-  VectorXd q0 = VectorXd::Zero(ncoord), qd0 = VectorXd::Zero(ncoord);
-  const InitialVelocitySpec& iv = scene.initial_velocity;
-  const Vector3d omega = iv.angular_rad_s;
-  auto rigid_velocity = [&](const Vector3d& r) -> Vector3d {
-    return iv.linear_m_s + omega.cross(r - iv.origin_m);
-  };
+  VectorXd q0 = VectorXd::Zero(ncoord);
+  m.initial_velocity_ = scene.initial_velocity;
   for (int c = 0; c < num_cables; ++c) {
     const CableSpec& cable = scene.cables[c];
     const double stretch = PolylineLength(cable.points) / cable.length_m;
@@ -204,12 +200,9 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
       Vector3d p, t;
       PolylineAt(cable.points, node_s[c][k] / cable.length_m, &p, &t);
       const int i = ns * (first_node[c] + static_cast<int>(k));
-      // Slopes move with the rigid rotation too: d(r_x)/dt = omega x r_x.
       const Vector3d slope = stretch * t;
       q0.segment(i, D) = p.head(D);
       q0.segment(i + D, D) = slope.head(D);
-      qd0.segment(i, D) = rigid_velocity(p).head(D);
-      qd0.segment(i + D, D) = omega.cross(slope).head(D);
     }
   }
   std::vector<Eigen::Matrix3d> frame0(num_bodies);
@@ -218,19 +211,16 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
     const int i = body0 + bs * b;
     frame0[b] = BodyFrame(body.axis);
     q0.segment(i, D) = body.position_m.head(D);
-    qd0.segment(i, D) = rigid_velocity(body.position_m).head(D);
     BodyData data;
     data.coord = i;
     data.mass = body.mass_kg;
     const Vector3d& inertia = body.inertia_kg_m2;
     if (D == 2) {
       q0.segment<2>(i + 2) = frame0[b].col(0).head<2>();
-      qd0.segment<2>(i + 2) = omega.cross(frame0[b].col(0)).head<2>();
       data.jbar = Vector3d(inertia.z(), 0, 0);
     } else {
       for (int k = 0; k < 3; ++k) {
         q0.segment<3>(i + 3 + 3 * k) = frame0[b].col(k);
-        qd0.segment<3>(i + 3 + 3 * k) = omega.cross(frame0[b].col(k));
       }
       data.jbar = Vector3d::Constant(inertia.sum() / 2) - inertia;
       if (!(data.jbar.minCoeff() > 0)) {
@@ -474,23 +464,10 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
   m.dofs_ = next;
 
   // z0 and v0 by least squares through the map (exact for consistent data).
-  m.z0_ = VectorXd::Zero(m.dofs_);
-  m.v0_ = VectorXd::Zero(m.dofs_);
-  {
-    VectorXd norm2 = VectorXd::Zero(m.dofs_);
-    for (int i = 0; i < ncoord; ++i) {
-      if (m.j_[i] < 0) continue;
-      m.z0_(m.j_[i]) += m.s_(i) * q0(i);
-      m.v0_(m.j_[i]) += m.s_(i) * qd0(i);
-      norm2(m.j_[i]) += m.s_(i) * m.s_(i);
-    }
-    for (int j = 0; j < m.dofs_; ++j) {
-      if (norm2(j) > 0) {
-        m.z0_(j) /= norm2(j);
-        m.v0_(j) /= norm2(j);
-      }
-    }
-  }
+  m.z0_ = m.Reduce(q0);
+  VectorXd qd0 = VectorXd::Zero(ncoord);
+  m.RigidVelocity(q0, &qd0);
+  m.v0_ = m.Reduce(qd0);
 
   // A row that no unknown can change (both sides held by ground, say a
   // pinned node and a body pinned at its centre of mass, or the axes of a
@@ -656,6 +633,55 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
   m.scratch_roundoff_ = VectorXd::Zero(ncoord);
   m.ProjectInitialVelocity();
   return m;
+}
+
+VectorXd MultibodyModel::Reduce(const VectorXd& full) const {
+  VectorXd z = VectorXd::Zero(dofs_), norm2 = VectorXd::Zero(dofs_);
+  for (int i = 0; i < coordinates(); ++i) {
+    if (j_[i] < 0) continue;
+    z(j_[i]) += s_(i) * full(i);
+    norm2(j_[i]) += s_(i) * s_(i);
+  }
+  for (int j = 0; j < dofs_; ++j)
+    if (norm2(j) > 0) z(j) /= norm2(j);
+  return z;
+}
+
+void MultibodyModel::RigidVelocity(const VectorXd& q, VectorXd* qdot) const {
+  const InitialVelocitySpec& iv = initial_velocity_;
+  const Vector3d omega = iv.angular_rad_s;
+  const int D = dim_;
+  auto vec = [D](const VectorXd& x, int i) {
+    Vector3d v = Vector3d::Zero();
+    v.head(D) = x.segment(i, D);
+    return v;
+  };
+  // Points move as v + omega x (r - origin); directions (slopes, body axes)
+  // as omega x d.
+  auto point = [&](int i) {
+    qdot->segment(i, D) = (iv.linear_m_s + omega.cross(vec(q, i) - iv.origin_m)).head(D);
+  };
+  auto direction = [&](int i) { qdot->segment(i, D) = omega.cross(vec(q, i)).head(D); };
+  qdot->setZero();
+  for (int node = 0; node < num_nodes_; ++node) {
+    point(node_stride_ * node);
+    direction(node_stride_ * node + D);
+  }
+  for (const BodyData& b : bodies_) {
+    point(b.coord);
+    const int axes = D == 2 ? 1 : 3;
+    for (int k = 0; k < axes; ++k) direction(b.coord + D + D * k);
+  }
+}
+
+void MultibodyModel::SetInitialState(const VectorXd& z) {
+  z0_ = z;
+  VectorXd q(coordinates()), qdot(coordinates());
+  ToFull(z, &q);
+  RigidVelocity(q, &qdot);
+  v0_ = Reduce(qdot);
+  initial_velocity_correction_ = 0;
+  ProjectInitialVelocity();
 }
 
 void MultibodyModel::ProjectInitialVelocity() {

@@ -77,6 +77,11 @@ class MultibodyModel {
   const Eigen::VectorXd& initial_z() const { return z0_; }
   const Eigen::VectorXd& initial_v() const { return v0_; }
 
+  // Starts the motion from unknowns z instead of the scene's layout (its
+  // static equilibrium, say): the scene's rigid initial velocity is taken
+  // at that configuration and projected onto the joints as in Build.
+  void SetInitialState(const Eigen::VectorXd& z);
+
   // q = c + S z, and qdot = S zdot.
   void ToFull(const Eigen::VectorXd& z, Eigen::VectorXd* q) const;
   void RateToFull(const Eigen::VectorXd& zdot, Eigen::VectorXd* qdot) const;
@@ -203,6 +208,13 @@ class MultibodyModel {
   void RowGradient(const Row& row, const Eigen::VectorXd& q, double* grad) const;
   void AddRow(const QuadraticForm& f, Row::Kind kind, int joint, int body);
   void ProjectInitialVelocity();
+  // The scene's rigid initial velocity at full configuration q (all nodes
+  // and bodies; fixed coordinates are dropped by Reduce).
+  void RigidVelocity(const Eigen::VectorXd& q, Eigen::VectorXd* qdot) const;
+  // Unknowns from a full vector, by least squares through q = c + S z
+  // (exact for a full vector the map can produce; c is ignored, so this is
+  // for rates and for positions whose fixed coordinates are c).
+  Eigen::VectorXd Reduce(const Eigen::VectorXd& full) const;
   template <int D>
   const std::vector<ElementData<D>>& Elements() const {
     if constexpr (D == 2) {
@@ -223,6 +235,7 @@ class MultibodyModel {
   int num_nodes_ = 0;
   Eigen::VectorXd z0_, v0_;
   double initial_velocity_correction_ = 0;
+  InitialVelocitySpec initial_velocity_;
 
   std::vector<ElementData<2>> elements2_;
   std::vector<ElementData<3>> elements3_;
