@@ -127,8 +127,19 @@ StaticSolver::IncrementStats StaticSolver::Solve(double alpha, double tolerance)
     // not longer than kMaxMove of the scene, and (away from the solution)
     // it lowers the merit, the energy plus the augmented constraint terms.
     double* values = a.values();
-    double added = 0;  // sigma already in `a`
+    // A floor of the shift, 1e-12 of the stiffness over the mass: it keeps
+    // a motion that nothing resists and nothing drives (a body pinned at its
+    // centre of mass turning about the pin) out of the step, and changes
+    // nothing else measurably.
+    double kdiag = 0, mdiag = 0;
+    for (int j = 0; j < n_; ++j) {
+      kdiag = std::max(kdiag, std::abs(values[a.Slot(j, j)]));
+      mdiag = std::max(mdiag, std::abs(mass.values()[mass.Slot(j, j)]));
+    }
+    const double sigma_floor = mdiag > 0 ? 1e-12 * kdiag / mdiag : 0;
+    double added = 0;  // shift already in `a`
     bool accepted = false;
+    double length = 1;  // of the accepted step, as a fraction of dx
     const double rnorm = r.lpNorm<Eigen::Infinity>();
     for (int attempt = 0; attempt < 60 && !accepted; ++attempt) {
       if (attempt > 0) {
@@ -139,10 +150,11 @@ StaticSolver::IncrementStats StaticSolver::Solve(double alpha, double tolerance)
           sigma *= 4;
         }
       }
-      if (sigma != added) {
-        const double ds = sigma - added;
+      const double shift = std::max(sigma, sigma_floor);
+      if (shift != added) {
+        const double ds = shift - added;
         for (int k = 0; k < mass.stored(); ++k) values[k] += ds * mass.values()[k];
-        added = sigma;
+        added = shift;
       }
       ++st.newton_iterations;
       if (!solver_.Prepare() || a.negative_pivots() > 0 || a.small_pivots() > 0) continue;
@@ -153,34 +165,38 @@ StaticSolver::IncrementStats StaticSolver::Solve(double alpha, double tolerance)
       st.linear_iterations += ls.iterations;
       st.max_linear_residual = std::max(st.max_linear_residual, ls.relative_residual);
       const double step = dx_.head(n_).lpNorm<Eigen::Infinity>();
-      if (!(ls.relative_residual <= kMaxLinearResidual) || !std::isfinite(step) ||
-          step > kMaxMove * iterate.zscale) {
-        continue;
-      }
+      if (!(ls.relative_residual <= kMaxLinearResidual) || !std::isfinite(step)) continue;
       // Near the solution (a short step from a small residual) Newton's
       // step needs no check, and the merit's change would be rounding.
       if (step <= 1e-3 * iterate.zscale && rnorm <= std::sqrt(tol) * scale) {
         accepted = true;
         break;
       }
-      trial_z_ = z1_ + dx_.head(n_);
+      // Backtracking along the step, at most kMaxMove of the scene long,
+      // until the merit falls; a shift (a shorter, more gradient-like step)
+      // only when no length of this one does.
       trial_lambda_ = lambda1_;
       if (m_ > 0) trial_lambda_ += dx_.tail(m_);
       const double before = Merit(z1_, trial_lambda_, alpha, gamma);
       const double size = merit_size_;
-      const double after = Merit(trial_z_, trial_lambda_, alpha, gamma);
-      accepted = after <= before + 64 * kEpsilon * std::max(size, merit_size_);
+      length = std::min(1.0, kMaxMove * iterate.zscale / step);
+      for (int halving = 0; halving < kLineSearchHalvings && !accepted; ++halving) {
+        trial_z_ = z1_ + length * dx_.head(n_);
+        const double after = Merit(trial_z_, trial_lambda_, alpha, gamma);
+        accepted = after <= before + 64 * kEpsilon * std::max(size, merit_size_);
+        if (!accepted) length /= 2;
+      }
     }
     if (!accepted) {
       st.reason = "no shift of the tangent stiffness gave a step that lowers the energy";
       return st;
     }
-    // A step that lowered the merit: trust the model more next time.
-    sigma = sigma / 4 < 1e-8 * first_sigma ? 0 : sigma / 4;
-    z1_ += dx_.head(n_);
-    if (m_ > 0) lambda1_ += dx_.tail(m_);
+    // A full step that lowered the merit: trust the model more next time.
+    if (length == 1) sigma = sigma / 4 < 1e-8 * first_sigma ? 0 : sigma / 4;
+    z1_ += length * dx_.head(n_);
+    if (m_ > 0) lambda1_ += length * dx_.tail(m_);
     previous_increment = last_increment;
-    last_increment = dx_.head(n_).lpNorm<Eigen::Infinity>();
+    last_increment = length * dx_.head(n_).lpNorm<Eigen::Infinity>();
     travel += last_increment;
   }
   z_ = z1_;

@@ -64,6 +64,8 @@ class StaticSolver {
   // Travel [scene sizes] beyond which the scene is taken to have no
   // equilibrium.
   static constexpr double kMaxTravel = 100;
+  // Halvings of a step's length before the shift is raised instead.
+  static constexpr int kLineSearchHalvings = 6;
 
   StaticSolver(MultibodyModel* model, const SolverSettings& settings);
 

@@ -150,14 +150,10 @@ void ExpectCatenary(const std::string& json, double length, double dh,
 
 const char kVPolyline[] = R"([{"x": 0, "y": 0}, {"x": 0.5, "y": -0.33166247903554}, {"x": 1, "y": 0}])";
 
-// Not yet: from a slack polyline with its exact vertex (a 1.66 kJ kink of
-// spurious strain at the corner) the pseudo-transient iteration descends
-// the energy but too slowly to converge in StaticSolver::kMaxIterations
-// with EXACT bending and a negligible EI, supports at different heights, or
-// a body hanging on the cable; bending NONE from a slack start and a
-// compressed straight start fail likewise. Kept disabled, so the gap is
-// visible in every run, until the globalisation handles them (issue 9).
-TEST(CableStaticsTest, DISABLED_SlackPolylineWithNegligibleBendingHangsAsTheCatenary) {
+// From a slack V (its vertex a kink holding 1.7 kJ of spurious strain at
+// the first load increment) to the catenary: the pseudo-transient Newton
+// of StaticSolver, about 350 iterations for the 10 increments.
+TEST(CableStaticsTest, SlackPolylineWithNegligibleBendingHangsAsTheCatenary) {
   ExpectCatenary(CableScene(24, "EXACT", kVPolyline, 1.2), 1.2, 0);
 }
 
@@ -165,7 +161,11 @@ TEST(CableStaticsTest, SlackPolylineWithLinearBendingHangsAsTheCatenary) {
   ExpectCatenary(CableScene(24, "LINEAR", kVPolyline, 1.2), 1.2, 0);
 }
 
-TEST(CableStaticsTest, DISABLED_SupportsAtDifferentHeights) {
+TEST(CableStaticsTest, SlackPolylineWithoutBendingStiffness) {
+  ExpectCatenary(CableScene(24, "NONE", kVPolyline, 1.2), 1.2, 0);
+}
+
+TEST(CableStaticsTest, SupportsAtDifferentHeights) {
   const char pts[] = R"([{"x": 0, "y": 0}, {"x": 0.4, "y": -0.3}, {"x": 1, "y": 0.3}])";
   ExpectCatenary(CableScene(24, "EXACT", pts, 1.2), 1.2, 0.3);
 }
@@ -177,6 +177,14 @@ TEST(CableStaticsTest, TautStraightStartWithoutBendingStiffness) {
   ExpectCatenary(CableScene(24, "EXACT", pts, 0.999), 0.999, 0);
 }
 
+// Not yet: this converges (constraint violation 0, residual at tolerance)
+// to a shape whose sag under the body is 1.5 % short of the catenary with a
+// point weight (0.3258 m against 0.3307 m; the V's own limit is 0.3317 m),
+// likely an element folded at the kinked vertex under the body, which the
+// Green-Lagrange strain does not resist. Kept disabled, so the gap shows in
+// every run, until it is understood (issue 9). A compressed straight start
+// (1.2 m of cable laid straight between pins 1 m apart) does not converge
+// yet either.
 TEST(CableStaticsTest, DISABLED_BodyHangingAtTheMiddle) {
   // A 2 kg point-like body pinned at the midpoint: the catenary with a
   // point weight there.
