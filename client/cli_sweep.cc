@@ -1,7 +1,5 @@
 #include "client/cli_sweep.h"
 
-#include <google/protobuf/util/json_util.h>
-
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -30,15 +28,11 @@ std::string CsvCell(const std::string& text) {
 
 // Reads a sweep file (SweepFile in service.proto, protobuf JSON).
 absl::StatusOr<v1::SubmitSweepRequest> ReadSweepFile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return absl::NotFoundError(absl::StrCat(path, ": cannot open"));
-  std::stringstream text;
-  text << in.rdbuf();
+  const absl::StatusOr<std::string> text = ReadBoundedFile(path, "sweep file");
+  if (!text.ok()) return text.status();
   v1::SweepFile file;
-  google::protobuf::util::JsonParseOptions options;
-  options.ignore_unknown_fields = false;
-  if (auto s = google::protobuf::util::JsonStringToMessage(text.str(), &file, options); !s.ok()) {
-    return absl::InvalidArgumentError(absl::StrCat(path, ": ", s.message().as_string()));
+  if (absl::Status s = ParseStrictJson(*text, "invalid sweep file", &file); !s.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat(path, ": ", s.message()));
   }
   v1::SubmitSweepRequest request;
   request.set_name(file.name());

@@ -49,6 +49,10 @@ inline constexpr double kMaxNominalSteps = 1e10;
 // folds the cable back on itself (at 180 degrees the corner has no tangent).
 inline constexpr double kMaxCornerTurnDegrees = 135;
 
+// Longest name (of the scene, a cable, body or probe, or a name referred
+// to) [bytes]; names are echoed in messages and CSV headers.
+inline constexpr int kMaxNameBytes = 256;
+
 }  // namespace plausible
 }  // namespace cablesim
 

@@ -111,6 +111,15 @@ absl::Status CheckNonNegative(absl::string_view path, double value) {
   return absl::OkStatus();
 }
 
+// Names are echoed in messages: a long one is refused before that.
+absl::Status CheckNameLength(absl::string_view path, absl::string_view name) {
+  if (name.size() > static_cast<size_t>(plausible::kMaxNameBytes)) {
+    return Invalid(path, absl::StrCat("at most ", plausible::kMaxNameBytes, " bytes (got ",
+                                      name.size(), ")"));
+  }
+  return absl::OkStatus();
+}
+
 absl::Status CheckIntRange(absl::string_view path, int value, int lo, int hi) {
   if (value < lo || value > hi) {
     return Invalid(path, absl::StrCat("must be in [", lo, ", ", hi, "] (got ", value, ")"));
@@ -210,6 +219,7 @@ class SceneConverter {
   explicit SceneConverter(const v1::Scene& proto) : proto_(proto) {}
 
   absl::StatusOr<Scene> Convert() {
+    CABLESIM_RETURN_IF_ERROR(CheckNameLength("name", proto_.name()));
     scene_.name = proto_.name();
     switch (proto_.model()) {
       case v1::Scene::MODEL_UNSPECIFIED:
@@ -261,6 +271,7 @@ class SceneConverter {
                                    const std::string& name, int index,
                                    std::map<std::string, int, std::less<>>* names) {
     if (name.empty()) return Invalid(path, "required");
+    CABLESIM_RETURN_IF_ERROR(CheckNameLength(path, name));
     const auto [it, inserted] = names->emplace(name, index);
     if (!inserted) {
       return Invalid(
@@ -452,6 +463,8 @@ class SceneConverter {
     const bool on_cable = !a.cable().empty();
     const bool on_body = !a.body().empty();
     if (on_cable && on_body) return Invalid(path, "names both a cable and a body");
+    CABLESIM_RETURN_IF_ERROR(CheckNameLength(Sub(path, "cable"), a.cable()));
+    CABLESIM_RETURN_IF_ERROR(CheckNameLength(Sub(path, "body"), a.body()));
     if (on_cable) {
       const auto it = cable_index_.find(a.cable());
       if (it == cable_index_.end()) {
@@ -527,6 +540,7 @@ class SceneConverter {
     const v1::Probe& p = proto_.probes(i);
     const std::string path = Indexed("", "probes", i);
     const std::string name_path = Sub(path, "name");
+    CABLESIM_RETURN_IF_ERROR(CheckNameLength(name_path, p.name()));
     if (!p.name().empty() && !std::all_of(p.name().begin(), p.name().end(), IsProbeNameChar)) {
       return Invalid(name_path, absl::StrCat("\"", p.name(),
                                              "\" may contain only letters, digits, '_', '-' "
