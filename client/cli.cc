@@ -51,6 +51,12 @@ const std::set<std::string>& ValueOptions() {
   return *options;
 }
 
+// Options that take no value.
+const std::set<std::string>& FlagOptions() {
+  static const std::set<std::string>* flags = new std::set<std::string>{"allow-outside"};
+  return *flags;
+}
+
 // Parses `args`; returns an error message for a usage error.
 absl::StatusOr<Arguments> ParseArguments(const std::vector<std::string>& args) {
   Arguments parsed;
@@ -76,6 +82,13 @@ absl::StatusOr<Arguments> ParseArguments(const std::vector<std::string>& args) {
       name = name.substr(0, eq);
     }
     if (name == "o") name = "out";
+    if (FlagOptions().count(name)) {
+      if (value.has_value()) {
+        return absl::InvalidArgumentError(absl::StrCat("--", name, " takes no value"));
+      }
+      parsed.options[name] = "";
+      continue;
+    }
     if (name != "out" && name != "server" && !ValueOptions().count(name)) {
       return absl::InvalidArgumentError(absl::StrCat("unknown option ", arg));
     }
@@ -217,10 +230,12 @@ std::string CliUsage() {
       one JSON line with the report; --out writes the time series.
   cablesim sweep SWEEP.json [--out results.csv] [--server HOST:PORT]
                  [--workers N] [--max-energy-drift X] [--max-wall-seconds X]
-                 [--max-constraint-violation X]
+                 [--max-constraint-violation X] [--allow-outside]
       Queue a parameter sweep, wait for every item and write one row per
       item (axis values, summary, final probe values). Without --server the
-      sweep runs in this process on N workers (default: the cores).
+      sweep runs in this process on N workers (default: the cores). The
+      sweep file's base_file must lie under the sweep file's directory
+      unless --allow-outside.
   cablesim help
       Print this text.
 

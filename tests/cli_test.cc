@@ -101,6 +101,18 @@ TEST(CliTest, Help) {
   }
 }
 
+TEST(CliTest, SweepRefusesABaseFileOutsideItsDirectoryUnlessAllowed) {
+  // The sample sweep's base scene is in ../scenes.
+  const std::string sweep = absl::StrCat(CABLESIM_SOURCE_DIR, "/sweeps/pendulum-resolution.json");
+  const CliResult refused = Cli({"sweep", sweep});
+  EXPECT_EQ(refused.code, 2);
+  EXPECT_THAT(refused.err, HasSubstr("base_file: must be under the sweep file's directory"));
+  const CliResult bad_flag = Cli({"sweep", sweep, "--allow-outside=yes"});
+  EXPECT_EQ(bad_flag.code, 2);
+  EXPECT_THAT(bad_flag.err, HasSubstr("--allow-outside takes no value"));
+  EXPECT_EQ(Cli({"run", SampleScene("falling-pendulum.json"), "--allow-outside"}).code, 2);
+}
+
 TEST(CliTest, MissingFileIsBadInput) {
   for (const char* command : {"run", "validate"}) {
     const CliResult r = Cli({command, "/nonexistent/scene.json"});
