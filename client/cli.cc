@@ -10,6 +10,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "cablesim/version.h"
 #include "client/cli_common.h"
 #include "client/cli_jobs.h"
 #include "client/cli_sweep.h"
@@ -73,6 +74,10 @@ absl::StatusOr<Arguments> ParseArguments(const std::vector<std::string>& args) {
     }
     if (arg == "--help" || arg == "-h" || arg == "-help") {
       parsed.help = true;
+      continue;
+    }
+    if (arg == "--version" || arg == "-version") {
+      parsed.version = true;
       continue;
     }
     std::string name = arg.substr(arg[1] == '-' ? 2 : 1);
@@ -236,16 +241,20 @@ std::string CliUsage() {
       sweep runs in this process on N workers (default: the cores). The
       sweep file's base_file must lie under the sweep file's directory
       unless --allow-outside.
-  cablesim help
+  cablesim help | --help
       Print this text.
+  cablesim --version
+      Print the version and the build type.
 
 SCENE is a cablesim.v1.Scene (proto/cablesim/v1/scene.proto) in protobuf
 JSON, or in text format when its name ends in .txtpb, .textproto or .pbtxt.
 SWEEP.json is a cablesim.v1.SweepFile (proto/cablesim/v1/service.proto).
 
-Exit status: 0 success, 1 error writing the output or reaching the server,
-2 bad input (usage, scene file or scene), 3 numerical failure of the run
-(for sweep: an item failed or a threshold was exceeded).
+Exit status: 0 success; 1 error writing the output or reaching the server,
+or the run (watch: the job) was cancelled; 2 bad input (usage, scene or
+sweep file, invalid scene, a server limit); 3 numerical failure of the run
+(for sweep: an item failed or a threshold was exceeded). README.md has the
+table for every command.
 )";
 }
 
@@ -255,6 +264,11 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   const Arguments& a = *parsed;
   if (a.help || (!a.positional.empty() && a.positional[0] == "help")) {
     out << CliUsage();
+    out.flush();
+    return kExitOk;
+  }
+  if (a.version) {
+    out << VersionLine("cablesim") << "\n";
     out.flush();
     return kExitOk;
   }
