@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -427,6 +430,21 @@ INSTANTIATE_TEST_SUITE_P(All, InvalidSceneTest, ::testing::ValuesIn(InvalidCases
                          [](const ::testing::TestParamInfo<InvalidCase>& info) {
                            return std::string(info.param.name);
                          });
+
+// Every invalid scene above is also a seed of the scene fuzz target's corpus
+// (tests/fuzz/corpus/scene/invalid-NAME.json), so the fuzzer starts from
+// each rule. CABLESIM_UPDATE_FUZZ_CORPUS=1 (re)writes the files.
+TEST(FuzzCorpusTest, HoldsEveryInvalidScene) {
+  const std::string dir = std::string(CABLESIM_SOURCE_DIR) + "/tests/fuzz/corpus/scene/";
+  const bool update = std::getenv("CABLESIM_UPDATE_FUZZ_CORPUS") != nullptr;
+  for (const InvalidCase& c : InvalidCases()) {
+    const std::string path = absl::StrCat(dir, "invalid-", c.name, ".json");
+    if (update) std::ofstream(path, std::ios::binary) << c.json;
+    std::ifstream in(path, std::ios::binary);
+    const std::string stored((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(stored, c.json) << path << " is missing or stale";
+  }
+}
 
 // The ranges are wide enough for unusual but real models: a 10 km Kevlar
 // mooring line on a polyline that turns by 90 degrees, a heavy buoy.
