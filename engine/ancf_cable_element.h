@@ -1,7 +1,7 @@
 #ifndef CABLESIM_ENGINE_ANCF_CABLE_ELEMENT_H_
 #define CABLESIM_ENGINE_ANCF_CABLE_ELEMENT_H_
 
-// The gradient-deficient ANCF cable element (MODEL.md sections 1-3), planar
+// The gradient-deficient ANCF cable element (docs/model.md section 1), planar
 // (D = 2, 8 coordinates) or spatial (D = 3, 12 coordinates).
 //
 // Coordinates e = [r_O, r_O,x, r_A, r_A,x] (paper eq. 4, 6, 7 with its typo
@@ -58,7 +58,7 @@ class AncfCableElement {
 
   double length() const { return length_; }
 
-  // Consistent mass matrix (eq. 8-10, MODEL.md section 2) for mass per unit
+  // Consistent mass matrix (eq. 8-10 of the paper, docs/model.md section 1) for mass per unit
   // length rho A [kg/m].
   Matrix MassMatrix(double mass_per_length_kg_m) const;
 

@@ -3,7 +3,7 @@
 
 // Second-order implicit steppers for the index-3 equations of motion
 //
-//   M zdd + Phi_z^T lambda = f(z),   Phi(z) = 0        (MODEL.md section 4)
+//   M zdd + Phi_z^T lambda = f(z),   Phi(z) = 0        (docs/model.md section 3)
 //
 // in two variants that users of other codes know.
 //

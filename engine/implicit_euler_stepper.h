@@ -1,7 +1,7 @@
 #ifndef CABLESIM_ENGINE_IMPLICIT_EULER_STEPPER_H_
 #define CABLESIM_ENGINE_IMPLICIT_EULER_STEPPER_H_
 
-// The paper's stepper (MODEL.md section 5): backward Euler on the index-3
+// The paper's stepper (docs/model.md section 4): backward Euler on the index-3
 // equations of motion,
 //
 //   v1 = v0 + h a1,   z1 = z0 + h v1,
