@@ -20,6 +20,7 @@ absl::StatusOr<std::unique_ptr<CablesimServer>> CablesimServer::Start(
     s->store_ = std::move(*store);
     s->jobs_ =
         std::make_unique<JobManager>(s->store_.get(), options.workers, options.limits, options.log);
+    s->jobs_->set_test_only_gate_dir(options.test_only_job_gate_dir);
   }
   s->service_ = std::make_unique<CablesimServiceImpl>(s->jobs_.get(), options.limits, options.log);
   s->log_ = options.log;

@@ -31,6 +31,8 @@ struct ServerOptions {
   ServerLimits limits;
   // Report jobs, sweeps and shutdown on stderr.
   bool log = true;
+  // TEST ONLY: see JobManager::set_test_only_gate_dir (empty: off).
+  std::string test_only_job_gate_dir;
 };
 
 class CablesimServer {

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <optional>
 #include <string>
 #include <fstream>
@@ -134,6 +135,14 @@ int main(int argc, char** argv) {
   limits.max_streams = absl::GetFlag(FLAGS_max_streams);
   limits.max_message_bytes = absl::GetFlag(FLAGS_max_message_bytes);
   limits.stall_timeout = absl::Seconds(absl::GetFlag(FLAGS_stall_timeout_s));
+  // Only the tests set this (tests/server_test_util.h); no flag, so it is
+  // not offered in --help, and it is announced loudly when present.
+  if (const char* gate = std::getenv("CABLESIM_TEST_ONLY_JOB_GATE"); gate && *gate) {
+    options.test_only_job_gate_dir = gate;
+    std::cerr << "cablesim-server: WARNING: CABLESIM_TEST_ONLY_JOB_GATE is set: jobs named "
+                 "\"gated...\" wait for a file in "
+              << gate << " (for tests only; unset it in any deployment)\n";
+  }
 
   // Block the shutdown signals in every thread; the main thread waits for
   // them below.

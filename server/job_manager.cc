@@ -1,9 +1,11 @@
 #include "server/job_manager.h"
 
+#include <filesystem>
 #include <iostream>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
 #include "convert/run_proto.h"
 #include "convert/scene_from_proto.h"
 
@@ -197,7 +199,12 @@ void JobManager::RunOne(const std::string& id) {
       proto.ok() ? SceneFromProto(*proto) : absl::StatusOr<Scene>(proto.status());
   if (scene.ok()) {
     absl::Time last_report = absl::InfinitePast();
+    bool gated = !gate_dir_.empty() && scene->name.rfind("gated", 0) == 0;
     CollectingSink sink(&result, [&](double t) {
+      if (gated) {
+        gated = false;
+        WaitAtTestGate(id, *running);
+      }
       running->t = t;
       const absl::Time now = absl::Now();
       if (now - last_report > absl::Milliseconds(200)) {
@@ -236,6 +243,15 @@ void JobManager::RunOne(const std::string& id) {
     std::cerr << "cablesim-server: job " << id << " " << v1::JobState_Name(state) << " ("
               << summary.frames << " frames, " << summary.wall_seconds << " s)\n";
   forget();
+}
+
+void JobManager::WaitAtTestGate(const std::string& id, const Running& running) {
+  if (log_) std::cerr << "cablesim-server: TEST ONLY: job " << id << " waits at the gate\n";
+  const std::filesystem::path open = std::filesystem::path(gate_dir_) / id;
+  std::error_code unused;
+  while (running.stop.load() == 0 && !std::filesystem::exists(open, unused)) {
+    absl::SleepFor(absl::Milliseconds(5));
+  }
 }
 
 }  // namespace cablesim

@@ -52,6 +52,15 @@ class JobManager {
   JobStore* store() { return store_; }
   const ServerLimits& limits() const { return limits_; }
 
+  // TEST ONLY (set by cablesim-server from the environment variable
+  // CABLESIM_TEST_ONLY_JOB_GATE, which no deployment sets): a job whose
+  // scene name starts with "gated" stops after its first frame and waits
+  // until the file DIR/<job id> exists (or it is cancelled or shut down),
+  // so a test can choose the moment at which jobs are running and which
+  // have finished. Empty (the default): no job ever waits. Call before
+  // Start().
+  void set_test_only_gate_dir(std::string dir) { gate_dir_ = std::move(dir); }
+
  private:
   struct Running {
     std::atomic<int> stop{0};  // 1 cancel, 2 shutdown
@@ -60,12 +69,14 @@ class JobManager {
   void Enqueue(const std::string& id);
   void Work();
   void RunOne(const std::string& id);
+  void WaitAtTestGate(const std::string& id, const Running& running);
   void Changed();
 
   JobStore* store_;
   const int workers_;
   const ServerLimits limits_;
   const bool log_;
+  std::string gate_dir_;
   absl::Mutex mu_;
   std::deque<std::string> queue_ ABSL_GUARDED_BY(mu_);
   std::map<std::string, std::shared_ptr<Running>> running_ ABSL_GUARDED_BY(mu_);

@@ -49,24 +49,35 @@ class CliServerTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new std::string(testing::FreshDir("cli_server"));
-    server_ = new testing::ServerProcess(*dir_, {"--workers=1"});
+    gate_ = new testing::JobGate(*dir_);
+    server_ = new testing::ServerProcess(*dir_, {"--workers=1"}, {gate_->env()});
   }
   static void TearDownTestSuite() {
     delete server_;
+    delete gate_;
     delete dir_;
   }
-  static std::string Scene(const std::string& name, double duration) {
+  // The falling pendulum with another duration; `scene_name` "gated..."
+  // makes a job of it wait at the server's test-only gate after its first
+  // frame.
+  static std::string Scene(const std::string& name, double duration,
+                           const std::string& scene_name = "falling-pendulum") {
     const std::string path = absl::StrCat(*dir_, "/", name, ".json");
     std::string json = Read(absl::StrCat(CABLESIM_SOURCE_DIR, "/scenes/falling-pendulum.json"));
     const size_t at = json.find("\"duration\": 1.0");
     json.replace(at, 15, absl::StrCat("\"duration\": ", duration));
+    const std::string name_field = "\"name\": \"falling-pendulum\"";
+    json.replace(json.find(name_field), name_field.size(),
+                 absl::StrCat("\"name\": \"", scene_name, "\""));
     std::ofstream(path) << json;
     return path;
   }
   static std::string* dir_;
+  static testing::JobGate* gate_;
   static testing::ServerProcess* server_;
 };
 std::string* CliServerTest::dir_ = nullptr;
+testing::JobGate* CliServerTest::gate_ = nullptr;
 testing::ServerProcess* CliServerTest::server_ = nullptr;
 
 TEST_F(CliServerTest, RunOnTheServerPrintsWhatTheInProcessRunPrints) {
@@ -120,7 +131,9 @@ TEST_F(CliServerTest, SubmitWatchJobsEnergyCancel) {
   EXPECT_THAT(energy.out, HasSubstr(R"("frames":101,)"));
   EXPECT_THAT(energy.out, HasSubstr(R"("relative_drift":-)"));  // dissipation
 
-  const CliResult long_job = Cli({"submit", Scene("long", 19), "--server", address});
+  // Never finishes by itself (its gate stays shut): the cancel cannot come
+  // too late.
+  const CliResult long_job = Cli({"submit", Scene("long", 19, "gated-long"), "--server", address});
   ASSERT_EQ(long_job.code, 0);
   const std::string long_id = long_job.out.substr(7, 8);
   const CliResult cancelled = Cli({"cancel", long_id, "--server", address});

@@ -61,17 +61,24 @@ Streamed RunOnServer(v1::CablesimService::Stub* stub, const v1::Scene& scene, in
 class ServerTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    server_ = new ServerProcess(testing::FreshDir("server_test"),
+    const std::string dir = testing::FreshDir("server_test");
+    gate_ = new testing::JobGate(dir);
+    server_ = new ServerProcess(dir,
                                 {"--workers=1", "--max-elements=200", "--max-frames=20000",
-                                 "--max-streams=40", "--max-trajectory-values=1048576"});
+                                 "--max-streams=40", "--max-trajectory-values=1048576"},
+                                {gate_->env()});
   }
   static void TearDownTestSuite() {
     delete server_;
     server_ = nullptr;
+    delete gate_;
+    gate_ = nullptr;
   }
   static ServerProcess* server_;
+  static testing::JobGate* gate_;  // for jobs named "gated..."
 };
 ServerProcess* ServerTest::server_ = nullptr;
+testing::JobGate* ServerTest::gate_ = nullptr;
 
 TEST_F(ServerTest, RunStreamsTheSameFramesAsTheEngine) {
   // Reference: the engine in this process (no service in between).
@@ -340,19 +347,13 @@ TEST_F(ServerTest, CancelARunningJob) {
   {
     grpc::ClientContext context;
     v1::SubmitJobRequest submit;
-    *submit.mutable_scene() = Pendulum(19, 1e-4, 1e-2);  // minutes of work
+    *submit.mutable_scene() = Pendulum(19, 1e-4, 1e-2);
+    // It stops after its first frame until its gate opens, which it never
+    // does: running, and certain not to finish before the cancel.
+    submit.mutable_scene()->set_name("gated-cancel");
     ASSERT_TRUE(stub->SubmitJob(&context, submit, &job).ok());
   }
-  // Wait until it runs.
-  for (int i = 0; i < 500; ++i) {
-    grpc::ClientContext context;
-    v1::GetJobRequest get;
-    get.set_id(job.id());
-    ASSERT_TRUE(stub->GetJob(&context, get, &job).ok());
-    if (job.state() == v1::RUNNING) break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  ASSERT_EQ(job.state(), v1::RUNNING);
+  ASSERT_TRUE(server_->WaitForLog(absl::StrCat("job ", job.id(), " waits at the gate")));
   grpc::ClientContext context;
   v1::CancelJobRequest cancel;
   cancel.set_id(job.id());
@@ -361,6 +362,7 @@ TEST_F(ServerTest, CancelARunningJob) {
   EXPECT_EQ(testing::WaitForJob(stub.get(), job.id(), &done), v1::CANCELLED);
   EXPECT_EQ(done.summary().status(), "cancelled");
   EXPECT_LT(done.summary().end_time_s(), 19);
+  EXPECT_EQ(done.attempts(), 1);
 }
 
 TEST_F(ServerTest, UnknownJobIsNotFound) {
@@ -484,14 +486,16 @@ TEST(ServerLimitTest, StreamsBeyondTheLimitAreResourceExhausted) {
   while (reader->Read(&event)) {
   }
   reader->Finish();
-  // The slot is free again (the server notices the cancellation within a
-  // step; retry briefly).
+  // The slot is free again once the server has seen the cancellation (at
+  // its next step or write): retry while the slot is still taken (a hang
+  // guard of 60 s, far above the time that takes even on a busy machine).
   grpc::Status status;
-  for (int i = 0; i < 100; ++i) {
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  do {
     status = RunOnServer(other.get(), Pendulum(0.01, 1e-3, 1e-3)).status;
-    if (status.ok()) break;
+    if (status.error_code() != grpc::StatusCode::RESOURCE_EXHAUSTED) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+  } while (std::chrono::steady_clock::now() < give_up);
   EXPECT_TRUE(status.ok()) << status.error_message();
 }
 

@@ -11,12 +11,15 @@
 #include <signal.h>
 #include <sys/types.h>
 #include <sys/wait.h>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
+#include <iterator>
 #include <memory>
 #include <string>
 #include <thread>
@@ -38,15 +41,22 @@ inline std::string FreshDir(const std::string& name) {
 }
 
 // cablesim-server as a child process listening on 127.0.0.1 on a free port
-// (it binds port 0 and writes the port it got to a file).
+// (it binds port 0 and writes the port it got to a file). `env` adds
+// NAME=VALUE entries to the child's environment. The server's stderr goes
+// to DIR/server.log (see WaitForLog), printed when the test has failed.
 class ServerProcess {
  public:
-  ServerProcess(std::string data_dir, std::vector<std::string> flags = {})
-      : data_dir_(std::move(data_dir)), flags_(std::move(flags)) {
+  ServerProcess(std::string data_dir, std::vector<std::string> flags = {},
+                std::vector<std::string> env = {})
+      : data_dir_(std::move(data_dir)), flags_(std::move(flags)), env_(std::move(env)) {
     Start();
   }
   ~ServerProcess() {
     if (pid_ > 0) Kill(SIGKILL);
+    if (::testing::Test::HasFailure()) {
+      std::ifstream in(log_path());
+      std::cerr << "---- " << log_path() << "\n" << in.rdbuf() << "----\n";
+    }
   }
 
   void Start() {
@@ -56,23 +66,53 @@ class ServerProcess {
                                      "--listen=127.0.0.1:0", "--data-dir=" + data_dir_,
                                      "--port-file=" + port_file};
     args.insert(args.end(), flags_.begin(), flags_.end());
+    // Everything the child needs is prepared before fork (after it, only
+    // async-signal-safe calls).
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    std::vector<std::string> env_strings = env_;
+    for (char** e = environ; *e != nullptr; ++e) env_strings.push_back(*e);
+    std::vector<char*> envp;
+    for (std::string& e : env_strings) envp.push_back(e.data());
+    envp.push_back(nullptr);
+    const std::string log = log_path();
     pid_ = fork();
     if (pid_ == 0) {
-      std::vector<char*> argv;
-      for (std::string& a : args) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      execv(argv[0], argv.data());
+      const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0600);
+      if (fd >= 0) ::dup2(fd, STDERR_FILENO);
+      execve(argv[0], argv.data(), envp.data());
       _exit(127);
     }
     ASSERT_GT(pid_, 0);
-    for (int i = 0; i < 300 && port_ == 0; ++i) {
+    // Until the port file appears or the server exits (no time limit that
+    // could decide the verdict: a hung start is ctest's timeout).
+    while (port_ == 0) {
       std::ifstream in(port_file);
-      if (!(in >> port_)) {
-        port_ = 0;
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      if (in >> port_) break;
+      port_ = 0;
+      int status = 0;
+      if (waitpid(pid_, &status, WNOHANG) == pid_) {
+        pid_ = -1;
+        FAIL() << "cablesim-server exited during start-up (status " << status << ")";
       }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
-    ASSERT_GT(port_, 0) << "cablesim-server did not start";
+  }
+
+  // Waits until the server's stderr contains `text`; false if the server
+  // exits first (or after a hang guard of 120 s, which no event the tests
+  // wait for comes near).
+  bool WaitForLog(const std::string& text) const {
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (std::chrono::steady_clock::now() < give_up) {
+      std::ifstream in(log_path());
+      const std::string log((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      if (log.find(text) != std::string::npos) return true;
+      if (pid_ <= 0 || ::kill(pid_, 0) != 0) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return false;
   }
 
   // Sends `signal` and waits for the process; returns its wait status.
@@ -89,6 +129,7 @@ class ServerProcess {
   void Restart() { Start(); }
 
   pid_t pid() const { return pid_; }
+  std::string log_path() const { return absl::StrCat(data_dir_, "/server.log"); }
   int port() const { return port_; }
   std::string address() const { return absl::StrCat("127.0.0.1:", port_); }
   std::shared_ptr<grpc::Channel> Channel() const { return Channel(grpc::ChannelArguments()); }
@@ -105,6 +146,7 @@ class ServerProcess {
  private:
   std::string data_dir_;
   std::vector<std::string> flags_;
+  std::vector<std::string> env_;
   pid_t pid_ = -1;
   int port_ = 0;
 };
@@ -162,6 +204,39 @@ inline v1::Scene Pendulum(double duration_s, double step_s, double output_interv
   scene->mutable_solver()->set_step(step_s);
   scene->mutable_solver()->set_output_interval(output_interval_s);
   return *scene;
+}
+
+// The test-only job gate of cablesim-server (JobManager::
+// set_test_only_gate_dir): jobs whose scene name starts with "gated" stop
+// after their first frame until Open(their id).
+class JobGate {
+ public:
+  explicit JobGate(const std::string& data_dir) : dir_(absl::StrCat(data_dir, "/gate")) {
+    std::filesystem::create_directories(dir_);
+  }
+  // The environment entry that turns the gate on (ServerProcess's `env`).
+  std::string env() const { return absl::StrCat("CABLESIM_TEST_ONLY_JOB_GATE=", dir_); }
+  void Open(const std::string& job_id) const { std::ofstream(absl::StrCat(dir_, "/", job_id)); }
+
+ private:
+  std::string dir_;
+};
+
+// Waits (WatchJob) until job `id` is in `state` or finished; returns the
+// job as last seen.
+inline v1::Job WaitForState(v1::CablesimService::Stub* stub, const std::string& id,
+                            v1::JobState state) {
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(120));
+  v1::WatchJobRequest request;
+  request.set_id(id);
+  auto reader = stub->WatchJob(&context, request);
+  v1::Job job;
+  while (reader->Read(&job) && job.state() != state) {
+  }
+  context.TryCancel();
+  (void)reader->Finish();
+  return job;
 }
 
 inline v1::JobState WaitForJob(v1::CablesimService::Stub* stub, const std::string& id,

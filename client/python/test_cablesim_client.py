@@ -26,9 +26,11 @@ class ClientTest(unittest.TestCase):
         cls.server = subprocess.Popen(
             [os.path.join(BIN, "cablesim-server"), "--listen=127.0.0.1:0",
              "--data-dir=" + cls.tmp.name, "--port-file=" + port_file, "--workers=1"])
-        for _ in range(500):
-            if os.path.exists(port_file):
-                break
+        # Until the server has written its port (or exited): no time limit
+        # that a busy machine could exceed.
+        while not os.path.exists(port_file):
+            if cls.server.poll() is not None:
+                raise RuntimeError("cablesim-server exited with %d" % cls.server.returncode)
             time.sleep(0.01)
         with open(port_file) as f:
             cls.address = "127.0.0.1:" + f.read().strip()
