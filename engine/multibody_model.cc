@@ -490,6 +490,7 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
   }
 
   // ---- Elements. ----
+  const double extent = q0.lpNorm<Eigen::Infinity>();  // scene size [m]
   auto build_elements = [&](auto& elements, auto dim_tag) {
     constexpr int kD = decltype(dim_tag)::value;
     const Eigen::Matrix<double, kD, 1> g = scene.gravity_m_s2.head<kD>();
@@ -505,8 +506,7 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
         e.element = AncfCableElement<kD>(l, ea, ei, cable.bending);
         // Energy the element can hold from coordinates known to 16 eps
         // (1 + |q0|_inf): a strain of that over l, a curvature of it over l^2.
-        const double strain = 16 * std::numeric_limits<double>::epsilon() *
-                              (1 + q0.lpNorm<Eigen::Infinity>()) / l;
+        const double strain = 16 * std::numeric_limits<double>::epsilon() * (1 + extent) / l;
         m.energy_roundoff_ += (ea + ei / (l * l)) * l * strain * strain;
         e.first_coord = ns * k;
         e.mass_per_length = mpl;
