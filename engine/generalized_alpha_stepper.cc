@@ -39,7 +39,8 @@ GeneralizedAlphaStepper::GeneralizedAlphaStepper(MultibodyModel* model,
   acc_h_.setZero(n_);
   lambda_.setZero(m_);
   g_.setZero(n_);
-  for (Eigen::VectorXd* x : {&z_pred_, &v_pred_, &z1_, &zdd1_, &f_, &bt_lambda_, &floor_, &abs_terms_})
+  for (Eigen::VectorXd* x : {&z_pred_, &v_pred_, &z1_, &zdd1_, &f_, &bt_lambda_, &floor_, &abs_terms_,
+                            &f_floor_})
     x->setZero(n_);
   lambda1_.setZero(m_);
   phi_.setZero(m_);
@@ -170,13 +171,14 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
   if (h_last_ > 0) zdd1_ += (h / h_last_) * (zdd_ - zdd_old_);
   lambda1_ = lambda_;
   double last_increment = 0, previous_increment = 0;
+  bool previous_at_floor = false;
   SkylineLdlt& a = solver_.a();
   for (int it = 0; it <= settings_.max_newton_iterations; ++it) {
     z1_ = z_pred_ + s * zdd1_;
     model_->ToFull(z1_, &q_);
     const bool checking = it > 0 && last_increment <= tol * (1 + z1_.lpNorm<Eigen::Infinity>());
     // The rounding floor is needed where convergence is judged (and for the
-    // message of the last iteration).
+    // message of the last iteration), unless the residual is below tol.
     const bool judge = checking || it == settings_.max_newton_iterations;
     // Assemble the Newton matrix with the forces when this iteration will
     // need a fresh one and is not expected to be the converged one.
@@ -184,10 +186,10 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
     double force_size;
     if (fresh && !checking) {
       LoadMass();
-      force_size = model_->NetForce(q_, 1.0, &f_, &a, c, judge ? &floor_ : nullptr);
+      force_size = model_->NetForce(q_, 1.0, &f_, &a, c);
       assembled = true;
     } else {
-      force_size = model_->NetForce(q_, 1.0, &f_, nullptr, 0, judge ? &floor_ : nullptr);
+      force_size = model_->NetForce(q_, 1.0, &f_);
     }
     model_->Constraints(q_, &phi_, &jac_);
     // R = M zdd + w (Phi_z^T lambda - f) + (1 - w) g_n.
@@ -212,13 +214,19 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
       st.reason = "the residual is not finite (the step diverged)";
       return st;
     }
-    if (judge) {
-      // floor = w roundoff(f) + rounding of the other terms summed into R.
+    iterate.previous_at_floor = previous_at_floor;
+    previous_at_floor = false;
+    const bool plain = iterate.residual <= tol && iterate.violation <= tol * iterate.zscale;
+    if (judge && !(checking && plain)) {
+      // floor = w roundoff(f) + rounding of the other terms summed into R
+      // (the forces once more, for their bound: only where it matters).
+      model_->NetForce(q_, 1.0, &f_floor_, nullptr, 0, &floor_);
       abs_terms_.setZero();
       model_->mass().AddAbsMultiply(zdd1_.data(), abs_terms_.data());
       jac_.AddAbsTransposeMultiply(lambda1_.data(), abs_terms_.data(), w_);
       floor_ = w_ * floor_ + kSumRounding * (abs_terms_ + (1 - w_) * g_.cwiseAbs());
       MeasureResidual(r, floor_, scale, &iterate);
+      previous_at_floor = iterate.excess <= tol;
     }
     if (checking && NewtonConverged(iterate, tol)) {
       st.converged = true;

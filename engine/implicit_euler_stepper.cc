@@ -29,6 +29,7 @@ ImplicitEulerStepper::ImplicitEulerStepper(MultibodyModel* model, const SolverSe
   bt_mu_.setZero(n_);
   floor_.setZero(n_);
   abs_terms_.setZero(n_);
+  f_floor_.setZero(n_);
   z_old_ = z_;
   v_old_ = v_;
   a_old_ = a_;
@@ -83,9 +84,9 @@ void ImplicitEulerStepper::LoadMass() {
   std::copy(mass.values(), mass.values() + mass.stored(), solver_.a().values());
 }
 
-double ImplicitEulerStepper::AssembleForces(double h, Eigen::VectorXd* roundoff) {
+double ImplicitEulerStepper::AssembleForces(double h) {
   LoadMass();
-  return model_->NetForce(q_, 1.0, &f_, &solver_.a(), h * h, roundoff);
+  return model_->NetForce(q_, 1.0, &f_, &solver_.a(), h * h);
 }
 
 ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
@@ -94,6 +95,7 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
   v1_ = v_ + h * a_;
   lambda1_ = lambda_;
   double last_increment = 0, previous_increment = 0;
+  bool previous_at_floor = false;
   SkylineLdlt& a = solver_.a();
   for (int it = 0; it <= settings_.max_newton_iterations; ++it) {
     z1_ = z_ + h * v1_;
@@ -104,8 +106,7 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
     // The rounding floor is needed where convergence is judged (and for the
     // message of the last iteration).
     const bool judge = checking || it == settings_.max_newton_iterations;
-    const double force_size = checking ? model_->NetForce(q_, 1.0, &f_, nullptr, 0, &floor_)
-                                       : AssembleForces(h, judge ? &floor_ : nullptr);
+    const double force_size = checking ? model_->NetForce(q_, 1.0, &f_) : AssembleForces(h);
     model_->Constraints(q_, &phi_, &solver_.b());
     // R_v = M (v1 - v0) - h f + Phi_z^T (h lambda).
     mdv_ = v1_ - v_;
@@ -128,15 +129,21 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
       st.reason = "the residual is not finite (the step diverged)";
       return st;
     }
-    if (judge) {
+    iterate.previous_at_floor = previous_at_floor;
+    previous_at_floor = false;
+    const bool plain = iterate.residual <= tol && iterate.violation <= tol * iterate.zscale;
+    if (judge && !(checking && plain)) {
       // floor = h roundoff(f) + rounding of the other terms summed into R_v
-      // (M v1, M v0 and h Phi_z^T lambda).
+      // (M v1, M v0 and h Phi_z^T lambda); the forces once more, for their
+      // bound, only where it matters.
+      model_->NetForce(q_, 1.0, &f_floor_, nullptr, 0, &floor_);
       abs_terms_.setZero();
       model_->mass().AddAbsMultiply(v1_.data(), abs_terms_.data());
       model_->mass().AddAbsMultiply(v_.data(), abs_terms_.data());
       solver_.b().AddAbsTransposeMultiply(lambda1_.data(), abs_terms_.data(), h);
       floor_ = h * floor_ + kSumRounding * abs_terms_;
       MeasureResidual(rv, floor_, scale, &iterate);
+      previous_at_floor = iterate.excess <= tol;
     }
     if (checking && NewtonConverged(iterate, tol)) {
       st.converged = true;

@@ -64,7 +64,7 @@ class ImplicitEulerStepper final : public Stepper {
   // Newton matrix block a = M.
   void LoadMass();
   // a = M + h^2 K_T(q_) and f_ = f(q_) in one pass; returns the force size.
-  double AssembleForces(double h, Eigen::VectorXd* roundoff = nullptr);
+  double AssembleForces(double h);
 
   MultibodyModel* model_;
   SolverSettings settings_;
@@ -75,7 +75,7 @@ class ImplicitEulerStepper final : public Stepper {
   // Newton work vectors.
   Eigen::VectorXd z1_, v1_, lambda1_, q_, f_, phi_, mdv_, rhs_, dx_, bt_mu_;
   // The residual's rounding floor per unknown, and the terms summed into it.
-  Eigen::VectorXd floor_, abs_terms_;
+  Eigen::VectorXd floor_, abs_terms_, f_floor_;
 };
 
 }  // namespace cablesim

@@ -9,9 +9,10 @@
 //   - the momentum residual is below tol times its scale (the largest term
 //     summed into it), or
 //   - Newton can do no more: the last correction moved z only in its last
-//     bits (kRoundingIncrement (1 + |z|_inf)) or was not even half the one
-//     before (Newton converges at least linearly until rounding stops it),
-//     and every entry of the residual is within tol times its scale of its
+//     bits (kRoundingIncrement (1 + |z|_inf)), or was computed from a
+//     residual already at its floor (rounding alone drove it), or was not
+//     even half the one before (Newton converges at least linearly until
+//     rounding stops it), and every entry of the residual is within tol times its scale of its
 //     rounding floor: |r_i| <= tol * scale + floor_i.
 // floor_i bounds what double precision leaves in r_i whatever Newton does:
 // the forces are computed from coordinates known only to eps |q| (for a
@@ -37,6 +38,9 @@ namespace cablesim {
 struct NewtonIterate {
   double last_increment = 0;  // |dz|_inf of the last correction [m]
   double previous_increment = 0;  // and of the one before (0: none)
+  // Whether the previous iterate's residual was already at its floor, so
+  // that the last correction was driven by rounding alone.
+  bool previous_at_floor = false;
   double zscale = 1;          // 1 + |z|_inf
   double residual = 0;        // |r|_inf relative to the residual's scale
   double floor = 0;           // max_i floor_i, relative to the same scale
@@ -69,6 +73,7 @@ constexpr double kRoundingIncrement = 16 * 2.220446049250313e-16;
 
 inline bool NewtonConverged(const NewtonIterate& it, double tol) {
   const bool stalled = it.last_increment <= kRoundingIncrement * it.zscale ||
+                       it.previous_at_floor ||
                        (it.previous_increment > 0 && it.last_increment > 0.5 * it.previous_increment);
   const bool at_floor = stalled && it.excess <= tol;
   return (it.residual <= tol || at_floor) && it.violation <= tol * it.zscale;
