@@ -131,6 +131,12 @@ void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* t
                                        Coords* roundoff) const {
   using Id = Eigen::Matrix<double, D, D>;
   using Block = Eigen::Matrix<double, D, D>;
+  constexpr double kEps = std::numeric_limits<double>::epsilon();
+  // For `roundoff`: |e_k| per node (once per element), and per node the
+  // bound summed over the Gauss points (the same for each of its D entries).
+  double node_size[4] = {0, 0, 0, 0}, node_bound[4] = {0, 0, 0, 0};
+  if (roundoff)
+    for (int k = 0; k < 4; ++k) node_size[k] = e.template segment<D>(k * D).norm();
   for (int g = 0; g < rule_.n; ++g) {
     const double* s1 = d1_[g];
     const double* s2 = d2_[g];
@@ -169,10 +175,10 @@ void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* t
       const double fac = k * (-2 * ia3);
       const double fbb = k * (-2 * ia3);
       if (roundoff) {
-        const double nu = std::sqrt(a), nw = std::sqrt(c);
-        nuu += 4 * std::abs(faa) * a + 4 * std::abs(fab) * nu * nw + std::abs(fbb) * c +
+        const double nunw = std::sqrt(a * c);  // |u| |w|
+        nuu += 4 * std::abs(faa) * a + 4 * std::abs(fab) * nunw + std::abs(fbb) * c +
                2 * std::abs(fa);
-        nuw = 2 * std::abs(fab) * a + (4 * std::abs(fac) + std::abs(fbb)) * nu * nw + std::abs(fb);
+        nuw = 2 * std::abs(fab) * a + (4 * std::abs(fac) + std::abs(fbb)) * nunw + std::abs(fb);
         nww = std::abs(fbb) * a + 2 * std::abs(fc);
       }
       if (tangent) {
@@ -188,21 +194,17 @@ void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* t
     for (int k = 0; k < 4; ++k)
       force->template segment<D>(k * D) += wl * (s1[k] * gu + s2[k] * gw);
     if (roundoff) {
-      constexpr double kEps = std::numeric_limits<double>::epsilon();
       double du = 0, dw = 0;
       for (int k = 0; k < 4; ++k) {
-        const double ek = e.template segment<D>(k * D).norm();
-        du += std::abs(s1[k]) * ek;
-        dw += std::abs(s2[k]) * ek;
+        du += std::abs(s1[k]) * node_size[k];
+        dw += std::abs(s2[k]) * node_size[k];
       }
       du *= kEps;
       dw *= kEps;
-      const double dgu = nuu * du + nuw * dw + kEps * gu.norm();
-      const double dgw = nuw * du + nww * dw + kEps * gw.norm();
-      for (int k = 0; k < 4; ++k) {
-        roundoff->template segment<D>(k * D).array() +=
-            wl * (std::abs(s1[k]) * dgu + std::abs(s2[k]) * dgw);
-      }
+      // |g|_1 >= |g|_2: a bound without a square root.
+      const double dgu = wl * (nuu * du + nuw * dw + kEps * gu.template lpNorm<1>());
+      const double dgw = wl * (nuw * du + nww * dw + kEps * gw.template lpNorm<1>());
+      for (int k = 0; k < 4; ++k) node_bound[k] += std::abs(s1[k]) * dgu + std::abs(s2[k]) * dgw;
     }
     if (tangent) {
       // K += wl B^T H B, block by block: B's node block k is
@@ -218,6 +220,8 @@ void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* t
       }
     }
   }
+  if (roundoff)
+    for (int k = 0; k < 4; ++k) roundoff->template segment<D>(k * D).array() += node_bound[k];
   if (tangent) {
     for (int k = 0; k < 4; ++k)
       for (int m = k + 1; m < 4; ++m)

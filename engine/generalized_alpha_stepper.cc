@@ -182,19 +182,27 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
     const bool judge = checking || it == settings_.max_newton_iterations;
     // Assemble the Newton matrix with the forces when this iteration will
     // need a fresh one and is not expected to be the converged one.
-    bool assembled = false;
+    bool assembled = false, have_floor = false;
     double force_size;
     if (fresh && !checking) {
       LoadMass();
       force_size = model_->NetForce(q_, 1.0, &f_, &a, c);
       assembled = true;
     } else {
-      force_size = model_->NetForce(q_, 1.0, &f_);
+      // The forces' rounding bound in the same pass when the last step was
+      // accepted at its floor: this one most likely will be too.
+      have_floor = judge && floor_expected_;
+      force_size = model_->NetForce(q_, 1.0, &f_, nullptr, 0, have_floor ? &floor_ : nullptr);
     }
     model_->Constraints(q_, &phi_, &jac_);
     // R = M zdd + w (Phi_z^T lambda - f) + (1 - w) g_n.
     auto r = rhs_.head(n_);
-    model_->mass().Multiply(zdd1_.data(), r.data());
+    if (have_floor) {
+      abs_terms_.setZero();
+      model_->mass().MultiplyWithAbs(zdd1_.data(), r.data(), abs_terms_.data());
+    } else {
+      model_->mass().Multiply(zdd1_.data(), r.data());
+    }
     const double inertia = r.lpNorm<Eigen::Infinity>();
     bt_lambda_.setZero();
     jac_.AddTransposeMultiply(lambda1_.data(), bt_lambda_.data());
@@ -219,16 +227,19 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
     const bool plain = iterate.residual <= tol && iterate.violation <= tol * iterate.zscale;
     if (judge && !(checking && plain)) {
       // floor = w roundoff(f) + rounding of the other terms summed into R
-      // (the forces once more, for their bound: only where it matters).
-      model_->NetForce(q_, 1.0, &f_floor_, nullptr, 0, &floor_);
-      abs_terms_.setZero();
-      model_->mass().AddAbsMultiply(zdd1_.data(), abs_terms_.data());
+      // (the forces once more for their bound, unless it came with them).
+      if (!have_floor) {
+        model_->NetForce(q_, 1.0, &f_floor_, nullptr, 0, &floor_);
+        abs_terms_.setZero();
+        model_->mass().AddAbsMultiply(zdd1_.data(), abs_terms_.data());
+      }
       jac_.AddAbsTransposeMultiply(lambda1_.data(), abs_terms_.data(), w_);
       floor_ = w_ * floor_ + kSumRounding * (abs_terms_ + (1 - w_) * g_.cwiseAbs());
       MeasureResidual(r, floor_, scale, &iterate);
       previous_at_floor = iterate.excess <= tol;
     }
     if (checking && NewtonConverged(iterate, tol)) {
+      floor_expected_ = !plain;
       st.converged = true;
       st.residual = iterate.residual;
       st.residual_floor = iterate.floor;

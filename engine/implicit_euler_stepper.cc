@@ -106,7 +106,12 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
     // The rounding floor is needed where convergence is judged (and for the
     // message of the last iteration).
     const bool judge = checking || it == settings_.max_newton_iterations;
-    const double force_size = checking ? model_->NetForce(q_, 1.0, &f_) : AssembleForces(h);
+    // The forces' rounding bound in the same pass when the last step was
+    // accepted at its floor: this one most likely will be too.
+    const bool have_floor = checking && floor_expected_;
+    const double force_size =
+        checking ? model_->NetForce(q_, 1.0, &f_, nullptr, 0, have_floor ? &floor_ : nullptr)
+                 : AssembleForces(h);
     model_->Constraints(q_, &phi_, &solver_.b());
     // R_v = M (v1 - v0) - h f + Phi_z^T (h lambda).
     mdv_ = v1_ - v_;
@@ -135,8 +140,8 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
     if (judge && !(checking && plain)) {
       // floor = h roundoff(f) + rounding of the other terms summed into R_v
       // (M v1, M v0 and h Phi_z^T lambda); the forces once more, for their
-      // bound, only where it matters.
-      model_->NetForce(q_, 1.0, &f_floor_, nullptr, 0, &floor_);
+      // bound, only where it matters, unless it came with them.
+      if (!have_floor) model_->NetForce(q_, 1.0, &f_floor_, nullptr, 0, &floor_);
       abs_terms_.setZero();
       model_->mass().AddAbsMultiply(v1_.data(), abs_terms_.data());
       model_->mass().AddAbsMultiply(v_.data(), abs_terms_.data());
@@ -146,6 +151,7 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
       previous_at_floor = iterate.excess <= tol;
     }
     if (checking && NewtonConverged(iterate, tol)) {
+      floor_expected_ = !plain;
       st.converged = true;
       st.residual = iterate.residual;
       st.residual_floor = iterate.floor;

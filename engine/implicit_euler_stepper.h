@@ -76,6 +76,10 @@ class ImplicitEulerStepper final : public Stepper {
   Eigen::VectorXd z1_, v1_, lambda1_, q_, f_, phi_, mdv_, rhs_, dx_, bt_mu_;
   // The residual's rounding floor per unknown, and the terms summed into it.
   Eigen::VectorXd floor_, abs_terms_, f_floor_;
+  // Whether the last accepted step needed the floor (its residual was above
+  // tol): the next step's checking iteration then bounds the forces'
+  // rounding in the same pass as the forces.
+  bool floor_expected_ = false;
 };
 
 }  // namespace cablesim
