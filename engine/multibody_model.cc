@@ -26,9 +26,10 @@ constexpr double kSnap = 1e-9;
 
 // Arc-length position along a polyline: point and unit tangent at `frac`
 // of its total length. At an interior vertex the tangent is the average of
-// the two segments' directions.
+// the two segments' directions (side 0), or the incoming (side -1) or
+// outgoing (side +1) segment's.
 void PolylineAt(const std::vector<Vector3d>& pts, double frac, Vector3d* point,
-                Vector3d* tangent) {
+                Vector3d* tangent, int side = 0) {
   std::vector<double> cum(pts.size(), 0.0);
   for (size_t i = 1; i < pts.size(); ++i) cum[i] = cum[i - 1] + (pts[i] - pts[i - 1]).norm();
   const double total = cum.back();
@@ -42,9 +43,11 @@ void PolylineAt(const std::vector<Vector3d>& pts, double frac, Vector3d* point,
   Vector3d dir = (b - a).normalized();
   const double tol = kSnap * total;
   if (std::abs(s - cum[seg]) <= tol && seg + 1 < pts.size()) {
-    dir = (dir + (pts[seg + 1] - b).normalized()).normalized();
+    const Vector3d out = (pts[seg + 1] - b).normalized();
+    dir = side < 0 ? dir : side > 0 ? out : (dir + out).normalized();
   } else if (std::abs(s - cum[seg - 1]) <= tol && seg >= 2) {
-    dir = (dir + (a - pts[seg - 2]).normalized()).normalized();
+    const Vector3d in = (a - pts[seg - 2]).normalized();
+    dir = side > 0 ? dir : side < 0 ? in : (dir + in).normalized();
   }
   *tangent = dir;
 }
@@ -167,7 +170,31 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
   for (const JointSpec& j : scene.joints) require(j.a), require(j.b);
   for (const LoadSpec& l : scene.loads) require(l.at);
   for (const ProbeSpec& p : scene.probes) require(p.at);
+  // A cable without bending stiffness kinks where a pin or a point load
+  // acts inside it: the node there is split in two that share their
+  // position unknowns but not their slopes (a C0 node), so the elements on
+  // either side meet at an angle. (Slopes continuous across such a node
+  // round the kink off over an element and shorten the sag at a hung body
+  // at first order in the element length.) Not where a FIXED joint acts:
+  // that joint is about the slope.
+  std::vector<std::vector<double>> kink_s(num_cables), smooth_s(num_cables);
+  auto interior = [&](const Attachment& at) {
+    if (at.cable < 0 || scene.cables[at.cable].bending != BendingModel::kNone) return false;
+    const double len = scene.cables[at.cable].length_m, tol = kSnap * len;
+    return at.s_m > tol && at.s_m < len - tol;
+  };
+  for (const JointSpec& j : scene.joints) {
+    for (const Attachment* at : {&j.a, &j.b}) {
+      if (!interior(*at)) continue;
+      (j.type == JointType::kPin ? kink_s : smooth_s)[at->cable].push_back(at->s_m);
+    }
+  }
+  for (const LoadSpec& l : scene.loads)
+    if (interior(l.at)) kink_s[l.at.cable].push_back(l.at.s_m);
   std::vector<int> first_node(num_cables + 1, 0);
+  // Per node: the node whose position it shares (the first of a split
+  // pair), or -1.
+  std::vector<int> twin_of;
   for (int c = 0; c < num_cables; ++c) {
     auto& s = node_s[c];
     std::sort(s.begin(), s.end());
@@ -177,7 +204,21 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
       if (unique.empty() || v - unique.back() > tol) unique.push_back(v);
     // A point within tol of the end snaps to it.
     unique.back() = scene.cables[c].length_m;
-    s = unique;
+    auto near = [&](const std::vector<double>& list, double v) {
+      for (double x : list)
+        if (std::abs(x - v) <= tol) return true;
+      return false;
+    };
+    s.clear();
+    for (double v : unique) {
+      s.push_back(v);
+      twin_of.push_back(-1);
+      if (near(kink_s[c], v) && !near(smooth_s[c], v)) {
+        s.push_back(v);
+        twin_of.push_back(static_cast<int>(twin_of.size()) - 1);
+        ++m.split_nodes_;
+      }
+    }
     first_node[c + 1] = first_node[c] + static_cast<int>(s.size());
   }
   m.num_nodes_ = first_node[num_cables];
@@ -197,9 +238,14 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
     const CableSpec& cable = scene.cables[c];
     const double stretch = PolylineLength(cable.points) / cable.length_m;
     for (size_t k = 0; k < node_s[c].size(); ++k) {
+      const int node = first_node[c] + static_cast<int>(k);
+      // The two halves of a split node take the tangents of their sides.
+      const int side = twin_of[node] >= 0                                   ? 1
+                       : node + 1 < m.num_nodes_ && twin_of[node + 1] == node ? -1
+                                                                              : 0;
       Vector3d p, t;
-      PolylineAt(cable.points, node_s[c][k] / cable.length_m, &p, &t);
-      const int i = ns * (first_node[c] + static_cast<int>(k));
+      PolylineAt(cable.points, node_s[c][k] / cable.length_m, &p, &t, side);
+      const int i = ns * node;
       const Vector3d slope = stretch * t;
       q0.segment(i, D) = p.head(D);
       q0.segment(i + D, D) = slope.head(D);
@@ -439,7 +485,12 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
   for (int node = 0; node < m.num_nodes_; ++node) {
     const int i = ns * node;
     for (int k = 0; k < D; ++k) {
-      if (state[i + k] == -2) {
+      if (twin_of[node] >= 0) {
+        const int t = ns * twin_of[node] + k;
+        m.j_[i + k] = m.j_[t];
+        m.s_(i + k) = m.s_(t);
+        m.c_(i + k) = m.c_(t);
+      } else if (state[i + k] == -2) {
         m.c_(i + k) = q0(i + k);
       } else {
         m.j_[i + k] = next++;
@@ -500,6 +551,7 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
       const double ei = cable.youngs_modulus_pa * cable.second_moment_m4;
       const double mpl = cable.density_kg_m3 * cable.area_m2;
       for (int k = first_node[c]; k + 1 < first_node[c + 1]; ++k) {
+        if (twin_of[k + 1] == k) continue;  // the two halves of a split node
         const int local = k - first_node[c];
         const double l = node_s[c][local + 1] - node_s[c][local];
         ElementData<kD> e;

@@ -67,7 +67,9 @@ class MultibodyModel {
   int dofs() const { return dofs_; }
   int multipliers() const { return static_cast<int>(rows_.size()); }
   int elements() const { return static_cast<int>(elements2_.size() + elements3_.size()); }
-  int nodes() const { return num_nodes_; }
+  // Nodes of the mesh; a node split where a cable without bending
+  // stiffness kinks (Build) counts once.
+  int nodes() const { return num_nodes_ - split_nodes_; }
   ModelInfo Info() const;
 
   // Initial unknowns and their rates: the scene's rigid initial motion,
@@ -232,7 +234,8 @@ class MultibodyModel {
   Eigen::VectorXd c_, s_;
   std::vector<int> j_;
   int dofs_ = 0;
-  int num_nodes_ = 0;
+  int num_nodes_ = 0;    // including the second half of each split node
+  int split_nodes_ = 0;
   Eigen::VectorXd z0_, v0_;
   double initial_velocity_correction_ = 0;
   InitialVelocitySpec initial_velocity_;

@@ -26,7 +26,7 @@ struct ModelInfo {
   int dofs = 0;            // unknowns after removing ground-fixed ones
   int multipliers = 0;     // Lagrange multipliers (constraint equations)
   int elements = 0;        // cable elements, inserted nodes included
-  int nodes = 0;
+  int nodes = 0;           // cable nodes (a node split where a cable kinks counts once)
   std::vector<std::string> probe_names;
 };
 
