@@ -10,6 +10,7 @@
 #include <iterator>
 #include <string>
 #include <vector>
+#include <unistd.h>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
@@ -512,7 +513,7 @@ TEST(SceneFileTest, MissingFile) {
 }
 
 TEST(SceneFileTest, ParseErrorNamesFileAndField) {
-  const std::string path = ::testing::TempDir() + "/scene_validation_test_bad.json";
+  const std::string path = ::testing::TempDir() + "/scene_validation_test_bad_" + std::to_string(::getpid()) + ".json";
   {
     FILE* f = std::fopen(path.c_str(), "w");
     ASSERT_NE(f, nullptr);
