@@ -177,6 +177,18 @@ TEST(CableStaticsTest, TautStraightStartWithoutBendingStiffness) {
   ExpectCatenary(CableScene(24, "EXACT", pts, 0.999), 0.999, 0);
 }
 
+// Laid straight and compressed (1.2 m of cable on the 1 m chord, 220 kJ of
+// strain): an unstable equilibrium at load factor 0 whose stiffness is
+// negative. StaticSolver leaves it by the flipped-pivot step and reaches the
+// catenary by lengthened Newton steps (about 400 and 510 iterations; before,
+// it failed after 500 iterations at each of 12 bisections of the first
+// increment).
+TEST(CableStaticsTest, CompressedStraightStartHangsAsTheCatenary) {
+  const char pts[] = R"([{"x": 0, "y": 0}, {"x": 1, "y": 0}])";
+  ExpectCatenary(CableScene(24, "NONE", pts, 1.2), 1.2, 0);
+  ExpectCatenary(CableScene(24, "EXACT", pts, 1.2), 1.2, 0);
+}
+
 // A 2 kg point-like body pinned at the midpoint of a cable without bending
 // stiffness: the catenary with a point weight there, kinked under the body.
 // The node under the body is split (multibody_model.cc, Build): with slopes
