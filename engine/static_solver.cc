@@ -157,18 +157,36 @@ StaticSolver::IncrementStats StaticSolver::Solve(double alpha, double tolerance)
         added = shift;
       }
       ++st.newton_iterations;
-      if (!solver_.Prepare() || a.negative_pivots() > 0 || a.small_pivots() > 0) continue;
-      rhs_ = -rhs_;
-      const auto ls = solver_.Solve(settings_.linear_solver, rhs_, settings_.linear_tolerance,
-                                    std::max(settings_.max_linear_iterations, 1000), &dx_);
-      rhs_ = -rhs_;
-      st.linear_iterations += ls.iterations;
-      st.max_linear_residual = std::max(st.max_linear_residual, ls.relative_residual);
+      if (!solver_.Prepare() || a.small_pivots() > 0) continue;
+      // A matrix with negative pivots (a compressed cable: its geometric
+      // stiffness is negative, most of all for the shortest wavelengths)
+      // gives the step of L |D| L^T instead (the pivots' signs flipped: a
+      // modified Newton step, Nocedal and Wright 2006, section 3.4). It
+      // descends along every direction of negative curvature but by
+      // r / |k|, so the short wavelengths that the shift would amplify
+      // most (sigma M - |K| is smallest for them) move least, and the cable
+      // leaves the unstable straight branch in its long, sagging shape
+      // rather than crumpled. With constraints left (m_ > 0) the saddle
+      // point has no such factor: the shift only.
+      const bool flipped = a.negative_pivots() > 0;
+      if (flipped) {
+        if (m_ > 0) continue;
+        dx_.head(n_) = -r;
+        a.SolveAbs(dx_.data());
+      } else {
+        rhs_ = -rhs_;
+        const auto ls = solver_.Solve(settings_.linear_solver, rhs_, settings_.linear_tolerance,
+                                      std::max(settings_.max_linear_iterations, 1000), &dx_);
+        rhs_ = -rhs_;
+        st.linear_iterations += ls.iterations;
+        st.max_linear_residual = std::max(st.max_linear_residual, ls.relative_residual);
+        if (!(ls.relative_residual <= kMaxLinearResidual)) continue;
+      }
       const double step = dx_.head(n_).lpNorm<Eigen::Infinity>();
-      if (!(ls.relative_residual <= kMaxLinearResidual) || !std::isfinite(step)) continue;
+      if (!std::isfinite(step)) continue;
       // Near the solution (a short step from a small residual) Newton's
       // step needs no check, and the merit's change would be rounding.
-      if (step <= 1e-3 * iterate.zscale && rnorm <= std::sqrt(tol) * scale) {
+      if (!flipped && step <= 1e-3 * iterate.zscale && rnorm <= std::sqrt(tol) * scale) {
         accepted = true;
         break;
       }
@@ -184,7 +202,25 @@ StaticSolver::IncrementStats StaticSolver::Solve(double alpha, double tolerance)
         trial_z_ = z1_ + length * dx_.head(n_);
         const double after = Merit(trial_z_, trial_lambda_, alpha, gamma);
         accepted = after <= before + 64 * kEpsilon * std::max(size, merit_size_);
-        if (!accepted) length /= 2;
+        if (!accepted) {
+          length /= 2;
+        } else if (length == 1) {
+          // A full step that lowers the merit is lengthened (doubled, up
+          // to kMaxMove of the scene) while the merit keeps falling: a
+          // slack cable's Newton steps are short and all alike, as its
+          // stiffness changes over the step, and it drifts towards the
+          // catenary in many of them (from a compressed straight start,
+          // over 1,000 iterations at the first load increment).
+          double best = after;
+          const double cap = kMaxMove * iterate.zscale / step;
+          while (2 * length <= cap) {
+            trial_z_ = z1_ + 2 * length * dx_.head(n_);
+            const double further = Merit(trial_z_, trial_lambda_, alpha, gamma);
+            if (!(further < best - 64 * kEpsilon * std::max(size, merit_size_))) break;
+            best = further;
+            length *= 2;
+          }
+        }
       }
     }
     if (!accepted) {
@@ -192,7 +228,7 @@ StaticSolver::IncrementStats StaticSolver::Solve(double alpha, double tolerance)
       return st;
     }
     // A full step that lowered the merit: trust the model more next time.
-    if (length == 1) sigma = sigma / 4 < 1e-8 * first_sigma ? 0 : sigma / 4;
+    if (length >= 1) sigma = sigma / 4 < 1e-8 * first_sigma ? 0 : sigma / 4;
     z1_ += length * dx_.head(n_);
     if (m_ > 0) lambda1_ += length * dx_.tail(m_);
     previous_increment = last_increment;

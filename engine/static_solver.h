@@ -25,6 +25,15 @@
 // (switched evolution relaxation: sigma_k+1 = sigma_k |r_k+1| / |r_k|), so
 // it vanishes as the residual does and the last iterations are Newton's.
 //
+// Two refinements for pure cables started compressed (laid straight on a
+// chord shorter than the cable): a matrix with negative pivots first gives
+// the modified Newton step of L |D| L^T (the pivots' signs flipped), which
+// descends along the negative curvature without amplifying the short
+// wavelengths, so the cable leaves the unstable straight branch in a long
+// sag rather than crumpled; and a full step that lowers the merit is
+// doubled while the merit keeps falling, since a slack cable's Newton steps
+// are short and alike.
+//
 // Convergence is newton_convergence.h's test (per-entry rounding floor).
 // A scene with no equilibrium (a mechanism: a body or cable that the joints
 // do not hold against the loads) never converges: the solve stops after
