@@ -31,6 +31,11 @@ ABSL_FLAG(int64_t, max_frames, 200'000, "limit: output frames per run");
 ABSL_FLAG(int64_t, max_trajectory_values, 32 << 20, "limit: frames x columns kept per run");
 ABSL_FLAG(int, max_sweep_items, 1000, "limit: items per sweep");
 ABSL_FLAG(int, max_streams, 64, "limit: concurrent Run streams");
+ABSL_FLAG(int, max_modes, 200, "limit: MODAL modes per run");
+ABSL_FLAG(int64_t, max_modal_bytes, int64_t{1} << 30,
+          "limit: estimated memory of a MODAL run's modes (8 x dofs x (3 modes + 1) bytes)");
+ABSL_FLAG(int64_t, max_name_bytes, 1024, "limit: bytes of any string in a request (names)");
+ABSL_FLAG(int64_t, max_coordinates, 1'000'000, "limit: coordinates of a scene's model");
 ABSL_FLAG(int, max_message_bytes, 16 << 20, "limit: gRPC message size");
 ABSL_FLAG(double, stall_timeout_s, 30, "cancel a stream whose client reads nothing this long");
 ABSL_FLAG(double, shutdown_grace_s, 2,
@@ -68,6 +73,10 @@ int main(int argc, char** argv) {
   limits.max_sweep_items = absl::GetFlag(FLAGS_max_sweep_items);
   limits.max_streams = absl::GetFlag(FLAGS_max_streams);
   limits.max_message_bytes = absl::GetFlag(FLAGS_max_message_bytes);
+  limits.max_modes = absl::GetFlag(FLAGS_max_modes);
+  limits.max_modal_bytes = absl::GetFlag(FLAGS_max_modal_bytes);
+  limits.max_name_bytes = absl::GetFlag(FLAGS_max_name_bytes);
+  limits.max_coordinates = absl::GetFlag(FLAGS_max_coordinates);
   limits.stall_timeout = absl::Seconds(absl::GetFlag(FLAGS_stall_timeout_s));
   // Only the tests set this (tests/server_test_util.h); no flag, so it is
   // not offered in --help, and it is announced loudly when present.

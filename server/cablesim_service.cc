@@ -226,24 +226,24 @@ grpc::Status CablesimServiceImpl::NoJobs() const {
 
 grpc::Status CablesimServiceImpl::Validate(grpc::ServerContext*, const v1::ValidateRequest* request,
                                            v1::ValidateResponse* response) {
-  // Validation only: the limits are not part of the verdict.
-  ServerLimits unlimited;
-  unlimited.max_elements = std::numeric_limits<int>::max();
-  unlimited.max_steps = std::numeric_limits<int64_t>::max();
-  unlimited.max_frames = std::numeric_limits<int64_t>::max();
-  unlimited.max_trajectory_values = std::numeric_limits<int64_t>::max();
-  absl::StatusOr<CheckedScene> checked = CheckScene(request->scene(), unlimited);
+  // The same checks as Run and SubmitJob, limits included (so a scene the
+  // server would refuse is never called valid, and costs no more to
+  // validate than to refuse).
+  absl::StatusOr<CheckedScene> checked = CheckScene(request->scene(), limits_);
   if (checked.ok()) {
     response->set_valid(true);
     *response->mutable_model() = ModelInfoToProto(checked->info);
     return grpc::Status::OK;
   }
-  if (checked.status().code() != absl::StatusCode::kInvalidArgument) {
+  const absl::StatusCode code = checked.status().code();
+  if (code != absl::StatusCode::kInvalidArgument && code != absl::StatusCode::kResourceExhausted) {
     return ToGrpc(checked.status());
   }
   response->set_valid(false);
   const std::string message(checked.status().message());
   v1::FieldError* error = response->add_errors();
+  error->set_code(code == absl::StatusCode::kInvalidArgument ? "INVALID_ARGUMENT"
+                                                             : "RESOURCE_EXHAUSTED");
   // Messages read `path: rule` (convert/scene_from_proto.h).
   const size_t colon = message.find(": ");
   if (colon != std::string::npos && message.find(' ') >= colon) {

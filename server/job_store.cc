@@ -3,11 +3,15 @@
 #include <fcntl.h>
 #include <sqlite3.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include <cerrno>
 #include <chrono>
+#include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <utility>
 
 #include "absl/strings/numbers.h"
@@ -41,8 +45,56 @@ CREATE INDEX IF NOT EXISTS jobs_by_sweep ON jobs(sweep_seq, sweep_index);
 CREATE TABLE IF NOT EXISTS results (
   job_seq INTEGER PRIMARY KEY REFERENCES jobs(seq),
   header BLOB NOT NULL,         -- cablesim.v1.RunHeader
-  vals BLOB NOT NULL);          -- row-major doubles, native byte order
+  vals BLOB NOT NULL,           -- row-major doubles, native byte order
+  checksum INTEGER);            -- ResultChecksum(header, vals)
+CREATE TABLE IF NOT EXISTS meta (
+  key TEXT PRIMARY KEY,
+  value TEXT NOT NULL);         -- 'store_id': as in DIR/store-id
 )sql";
+
+constexpr char kStoreIdFile[] = "store-id";
+
+// CRC-32 (zlib) of the header blob followed by the values blob.
+int64_t ResultChecksum(const void* header, size_t header_bytes, const void* vals,
+                       size_t vals_bytes) {
+  uLong crc = crc32(0L, Z_NULL, 0);
+  crc = crc32_z(crc, static_cast<const Bytef*>(header), header_bytes);
+  crc = crc32_z(crc, static_cast<const Bytef*>(vals), vals_bytes);
+  return static_cast<int64_t>(crc);
+}
+
+// 128 random bits as 32 hex digits.
+absl::StatusOr<std::string> RandomId() {
+  unsigned char bytes[16];
+  std::ifstream in("/dev/urandom", std::ios::binary);
+  if (!in.read(reinterpret_cast<char*>(bytes), sizeof(bytes))) {
+    return absl::UnavailableError("cannot read /dev/urandom");
+  }
+  std::string id;
+  for (unsigned char b : bytes) absl::StrAppendFormat(&id, "%02x", b);
+  return id;
+}
+
+std::string ReadSmallFile(const std::string& path) {
+  std::ifstream in(path);
+  std::string text;
+  std::getline(in, text);
+  return text;
+}
+
+// Writes `text` to `path` (0600) through a temporary file, synced.
+absl::Status WriteFileDurably(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp";
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+  if (fd < 0) return absl::UnavailableError(absl::StrCat(tmp, ": ", std::strerror(errno)));
+  const bool written = ::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size()) &&
+                       ::fsync(fd) == 0;
+  ::close(fd);
+  if (!written || std::rename(tmp.c_str(), path.c_str()) != 0) {
+    return absl::UnavailableError(absl::StrCat(path, ": ", std::strerror(errno)));
+  }
+  return absl::OkStatus();
+}
 
 // One prepared statement; finalized on destruction.
 class Stmt {
@@ -152,20 +204,32 @@ int64_t NowUnixMs() {
 }
 
 absl::StatusOr<std::unique_ptr<JobStore>> JobStore::Open(const std::string& dir) {
-  const std::string lock_path = absl::StrCat(dir, "/lock");
-  const int lock_fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  // Private: the directory 0700, the database (and so its WAL and shared
+  // memory files, which SQLite creates with the database's mode) 0600.
+  if (::chmod(dir.c_str(), 0700) != 0) {
+    return absl::UnavailableError(absl::StrCat(dir, ": ", std::strerror(errno)));
+  }
+  const std::string path = absl::StrCat(dir, "/cablesim.db");
+  // The single-server lock is held on the database file itself: removing
+  // a file cannot release it, and the kernel drops it when the process
+  // dies, even by kill -9. (flock locks are independent of the POSIX
+  // locks SQLite takes; this descriptor stays open as long as the store,
+  // so closing it never drops SQLite's own locks.)
+  const int lock_fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0600);
   if (lock_fd < 0) {
-    return absl::UnavailableError(absl::StrCat(lock_path, ": ", std::strerror(errno)));
+    return absl::UnavailableError(absl::StrCat(path, ": ", std::strerror(errno)));
   }
   if (::flock(lock_fd, LOCK_EX | LOCK_NB) != 0) {
     ::close(lock_fd);
     return absl::FailedPreconditionError(
-        absl::StrCat(dir, ": in use by another cablesim-server (", lock_path, " is locked)"));
+        absl::StrCat(dir, ": in use by another cablesim-server (", path, " is locked)"));
   }
-  const std::string path = absl::StrCat(dir, "/cablesim.db");
+  ::fchmod(lock_fd, 0600);
+  for (const char* suffix : {"-wal", "-shm"}) {
+    ::chmod(absl::StrCat(path, suffix).c_str(), 0600);  // absent: nothing to do
+  }
   sqlite3* db = nullptr;
-  if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr) !=
-      SQLITE_OK) {
+  if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READWRITE, nullptr) != SQLITE_OK) {
     const std::string message = db ? sqlite3_errmsg(db) : "out of memory";
     sqlite3_close(db);
     ::close(lock_fd);
@@ -173,20 +237,104 @@ absl::StatusOr<std::unique_ptr<JobStore>> JobStore::Open(const std::string& dir)
   }
   std::unique_ptr<JobStore> store(new JobStore(db, lock_fd));
   sqlite3_busy_timeout(db, 5000);
-  // WAL: readers do not block the writer; synchronous=FULL: a committed
-  // transaction is on disk before the call returns.
-  for (const char* sql :
-       {"PRAGMA journal_mode=WAL", "PRAGMA synchronous=FULL", "PRAGMA foreign_keys=ON", kSchema}) {
-    if (absl::Status s = store->Exec(sql); !s.ok()) {
-      return absl::UnavailableError(absl::StrCat(path, ": ", s.message()));
-    }
+  if (absl::Status s = store->CheckAndMigrate(dir); !s.ok()) {
+    return absl::Status(s.code(), absl::StrCat(path, ": ", s.message()));
   }
   return store;
 }
 
+absl::Status JobStore::CheckAndMigrate(const std::string& dir) {
+  // Damage SQLite can see: refuse to serve from a damaged database.
+  {
+    Stmt check(db_, "PRAGMA quick_check");
+    std::string problems;
+    int rc;
+    for (int n = 0; (rc = check.Step()) == SQLITE_ROW && n < 5; ++n) {
+      const std::string line = check.Text(0);
+      if (line == "ok") break;
+      absl::StrAppend(&problems, problems.empty() ? "" : "; ", line);
+    }
+    if (rc != SQLITE_ROW && rc != SQLITE_DONE) {
+      return absl::DataLossError(absl::StrCat("the database is damaged (", sqlite3_errmsg(db_),
+                                              "); restore it from a backup"));
+    }
+    if (!problems.empty()) {
+      return absl::DataLossError(absl::StrCat("the database is damaged (PRAGMA quick_check: ",
+                                              problems, "); restore it from a backup"));
+    }
+  }
+  // Which store this is: DIR/store-id names the database the directory
+  // had. A database that is empty, truncated or replaced while the file
+  // remains is refused rather than silently started afresh (which would
+  // lose every job and reuse their ids).
+  const std::string id_path = absl::StrCat(dir, "/", kStoreIdFile);
+  const std::string expected_id = ReadSmallFile(id_path);
+  bool has_jobs = false, has_meta = false;
+  {
+    Stmt tables(db_, "SELECT name FROM sqlite_schema WHERE type = 'table'");
+    while (tables.Step() == SQLITE_ROW) {
+      const std::string name = tables.Text(0);
+      has_jobs |= name == "jobs";
+      has_meta |= name == "meta";
+    }
+  }
+  std::string stored_id;
+  if (has_meta) {
+    Stmt get(db_, "SELECT value FROM meta WHERE key = 'store_id'");
+    if (get.Step() == SQLITE_ROW) stored_id = get.Text(0);
+  }
+  if (!expected_id.empty() && stored_id != expected_id) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "this is not the database of ", dir, " (", id_path, " names store ", expected_id,
+        has_jobs ? ", the database belongs to another store"
+                 : ", the database has lost its schema and jobs",
+        "); restore the database from a backup, or move the directory aside to start afresh"));
+  }
+  // WAL: readers do not block the writer; synchronous=FULL: a committed
+  // transaction is on disk before the call returns.
+  for (const char* sql :
+       {"PRAGMA journal_mode=WAL", "PRAGMA synchronous=FULL", "PRAGMA foreign_keys=ON", kSchema}) {
+    if (absl::Status s = Exec(sql); !s.ok()) return absl::UnavailableError(s.message());
+  }
+  // Databases from before checksums: add the column and fill it from the
+  // data as it is now.
+  bool has_checksum = false;
+  {
+    Stmt columns(db_, "PRAGMA table_info(results)");
+    while (columns.Step() == SQLITE_ROW) has_checksum |= columns.Text(1) == "checksum";
+  }
+  if (!has_checksum) {
+    if (absl::Status s = Exec("ALTER TABLE results ADD COLUMN checksum INTEGER"); !s.ok()) return s;
+  }
+  {
+    std::vector<std::pair<int64_t, int64_t>> sums;
+    Stmt missing(db_, "SELECT job_seq, header, vals FROM results WHERE checksum IS NULL");
+    while (missing.Step() == SQLITE_ROW) {
+      const std::string header = missing.Blob(1), vals = missing.Blob(2);
+      sums.emplace_back(missing.Int(0),
+                        ResultChecksum(header.data(), header.size(), vals.data(), vals.size()));
+    }
+    for (const auto& [seq, sum] : sums) {
+      Stmt set(db_, "UPDATE results SET checksum = ?1 WHERE job_seq = ?2");
+      if (absl::Status s = set.Bind(1, sum).Bind(2, seq).Done(); !s.ok()) return s;
+    }
+  }
+  if (stored_id.empty()) {
+    absl::StatusOr<std::string> id = RandomId();
+    if (!id.ok()) return id.status();
+    stored_id = *id;
+    Stmt put(db_, "INSERT OR REPLACE INTO meta (key, value) VALUES ('store_id', ?1)");
+    if (absl::Status s = put.Bind(1, stored_id).Done(); !s.ok()) return s;
+  }
+  // The database first, then the file: a crash in between leaves a
+  // database whose id the next start writes again.
+  if (expected_id != stored_id) return WriteFileDurably(id_path, stored_id);
+  return absl::OkStatus();
+}
+
 JobStore::~JobStore() {
   sqlite3_close(db_);
-  ::close(lock_fd_);  // releases the lock
+  ::close(lock_fd_);  // releases the lock (after SQLite has let go of the file)
 }
 
 absl::Status JobStore::Exec(const char* sql) {
@@ -371,10 +519,14 @@ absl::StatusOr<bool> JobStore::Finish(const std::string& id, v1::JobState state,
     Exec("ROLLBACK").IgnoreError();
     return false;
   }
-  Stmt r(db_, "INSERT OR REPLACE INTO results (job_seq, header, vals) VALUES (?1,?2,?3)");
+  Stmt r(db_,
+         "INSERT OR REPLACE INTO results (job_seq, header, vals, checksum) VALUES (?1,?2,?3,?4)");
+  const size_t vals_bytes = result.values.size() * sizeof(double);
   r.Bind(1, seq)
       .BindBlob(2, header_blob.data(), header_blob.size())
-      .BindBlob(3, result.values.data(), result.values.size() * sizeof(double));
+      .BindBlob(3, result.values.data(), vals_bytes)
+      .Bind(4, ResultChecksum(header_blob.data(), header_blob.size(), result.values.data(),
+                              vals_bytes));
   if (absl::Status st = r.Done(); !st.ok()) return rollback(st);
   if (absl::Status st = Exec("COMMIT"); !st.ok()) return rollback(st);
   return true;
@@ -382,14 +534,21 @@ absl::StatusOr<bool> JobStore::Finish(const std::string& id, v1::JobState state,
 
 absl::StatusOr<StoredResult> JobStore::GetResult(const std::string& id) {
   absl::MutexLock lock(&mu_);
-  Stmt s(db_, "SELECT header, vals FROM results WHERE job_seq = ?1");
+  Stmt s(db_, "SELECT header, vals, checksum FROM results WHERE job_seq = ?1");
   s.Bind(1, JobSeq(id));
   const int rc = s.Step();
   if (rc == SQLITE_DONE) return absl::NotFoundError(absl::StrCat("job \"", id, "\" has no result"));
   if (rc != SQLITE_ROW) return SqlError(db_);
+  const std::string header = s.Blob(0), vals = s.Blob(1);
+  // Never serve altered data: the checksum written with the result must
+  // still match.
   StoredResult result;
-  result.header.ParseFromString(s.Blob(0));
-  result.values = DoublesFromBlob(s.Blob(1));
+  if (ResultChecksum(header.data(), header.size(), vals.data(), vals.size()) != s.Int(2) ||
+      vals.size() % sizeof(double) != 0 || !result.header.ParseFromString(header)) {
+    return absl::DataLossError(absl::StrCat(
+        "job ", id, ": the stored result fails its checksum (the database is damaged)"));
+  }
+  result.values = DoublesFromBlob(vals);
   return result;
 }
 

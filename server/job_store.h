@@ -8,9 +8,18 @@
 // accepted job is either finished with its result or runs again, never
 // both. Thread-safe (one connection behind a mutex).
 //
-// One server per directory: Open takes an exclusive lock on DIR/lock (the
-// kernel drops it when the process dies, even by kill -9), so two servers
-// can never run the same job.
+// One server per directory: Open takes an exclusive flock on the database
+// file itself (the kernel drops it when the process dies, even by kill -9;
+// no file can be removed to get around it), so two servers can never run
+// the same job.
+//
+// Integrity: the directory is made 0700 and the database files 0600.
+// Open runs `PRAGMA quick_check` and refuses a damaged database
+// (DATA_LOSS); DIR/store-id names the database the directory belongs to,
+// so a database that was emptied, truncated or replaced is refused
+// (FAILED_PRECONDITION) instead of starting afresh and reusing job ids.
+// Each result is stored with a CRC-32 of its bytes, verified on every
+// read: a mismatch is DATA_LOSS, never altered numbers.
 //
 // Ids: job `j-NNNNNN`, sweep `s-NNNNNN` (the row numbers).
 
@@ -78,6 +87,8 @@ class JobStore {
  private:
   JobStore(sqlite3* db, int lock_fd) : db_(db), lock_fd_(lock_fd) {}
   absl::Status Exec(const char* sql);
+  // Open's checks (quick_check, the store id), the schema and migrations.
+  absl::Status CheckAndMigrate(const std::string& dir);
 
   absl::Mutex mu_;
   sqlite3* db_;

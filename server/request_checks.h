@@ -7,6 +7,7 @@
 // expands to valid items (errors naming `axes[i]`).
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -28,6 +29,17 @@ struct ServerLimits {
   int max_message_bytes = 16 << 20;  // gRPC receive limit
   // A Run stream whose client reads nothing for this long is cancelled.
   absl::Duration stall_timeout = absl::Seconds(30);
+  // Limits added later default to "none" here, so that in-process users
+  // (`cablesim run`) keep the engine's own bounds; cablesim-server sets
+  // them from its flags (README, service section).
+  // MODAL: modes computed per run, and the memory the eigensolver's basis
+  // and the mode shapes take (8 bytes x dofs x (3 modes + 1) estimated).
+  int max_modes = std::numeric_limits<int>::max();
+  int64_t max_modal_bytes = std::numeric_limits<int64_t>::max();
+  // Bytes of any one string in a request (names, references, sweep paths).
+  int64_t max_name_bytes = std::numeric_limits<int64_t>::max();
+  // Coordinates of the model built (nodal and body coordinates).
+  int64_t max_coordinates = std::numeric_limits<int64_t>::max();
 };
 
 struct CheckedScene {
@@ -38,8 +50,18 @@ struct CheckedScene {
   int64_t frames = 0;         // output frames the run will write
 };
 
-// Validates `proto`, builds its model and checks it against `limits`.
+// Validates `proto`, builds its model and checks it against `limits`:
+// every string's length, the steps, frames and numbers kept, the elements
+// summed over all cables before anything is built, then the model's
+// elements and coordinates and, for MODAL, the modes and their memory.
+// The one costing of a scene: Validate, Run, SubmitJob, sweeps and
+// GetEnergy all call it.
 absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimits& limits);
+
+// ResourceExhausted naming the first string field of `message` (its path,
+// after `prefix`) longer than limits.max_name_bytes.
+absl::Status CheckStringLengths(const google::protobuf::Message& message,
+                                const ServerLimits& limits, const std::string& prefix = "");
 
 // The items of a sweep (cartesian product, last axis fastest), each
 // checked with CheckScene; `end_times_s` receives each item's end time.

@@ -37,15 +37,9 @@ std::vector<v1::Job> ListAll(v1::CablesimService::Stub* stub, const std::string&
 }
 
 int64_t ResultFrames(v1::CablesimService::Stub* stub, const std::string& id) {
-  grpc::ClientContext context;
-  v1::GetJobResultRequest request;
-  request.set_id(id);
-  auto reader = stub->GetJobResult(&context, request);
-  v1::RunEvent event;
-  int64_t rows = 0;
-  while (reader->Read(&event)) rows += event.has_frames() ? event.frames().rows() : 0;
-  EXPECT_TRUE(reader->Finish().ok()) << id;
-  return rows;
+  const testing::JobResultRead read = testing::ReadJobResult(stub, id);
+  EXPECT_TRUE(read.status.ok()) << id;
+  return read.rows;
 }
 
 TEST(ServerDurabilityTest, KillNineDuringASweepThenRestart) {

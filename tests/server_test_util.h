@@ -151,6 +151,20 @@ class ServerProcess {
   int port_ = 0;
 };
 
+// Starts a cablesim-server on `data_dir` expected to refuse to start;
+// returns its exit code (124: still running after 60 s, so it did not
+// refuse) and its stderr in `log`.
+inline int StartRefused(const std::string& data_dir, std::string* log) {
+  const std::string log_path = absl::StrCat(data_dir, "/refused.log");
+  const int status = std::system(absl::StrCat("timeout 60 '", CABLESIM_BIN_DIR,
+                                              "/cablesim-server' --listen=127.0.0.1:0 --data-dir='",
+                                              data_dir, "' 2>'", log_path, "'")
+                                     .c_str());
+  std::ifstream in(log_path);
+  log->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
 // One request message and the first response message of `method`, as raw
 // bytes (for services whose .proto is not installed: health, reflection).
 inline grpc::Status RawCall(const std::shared_ptr<grpc::Channel>& channel,
@@ -237,6 +251,23 @@ inline v1::Job WaitForState(v1::CablesimService::Stub* stub, const std::string& 
   context.TryCancel();
   (void)reader->Finish();
   return job;
+}
+
+// GetJobResult of job `id` read to the end: its status and frame rows.
+struct JobResultRead {
+  grpc::Status status;
+  int64_t rows = 0;
+};
+inline JobResultRead ReadJobResult(v1::CablesimService::Stub* stub, const std::string& id) {
+  grpc::ClientContext context;
+  v1::GetJobResultRequest request;
+  request.set_id(id);
+  auto reader = stub->GetJobResult(&context, request);
+  v1::RunEvent event;
+  JobResultRead read;
+  while (reader->Read(&event)) read.rows += event.has_frames() ? event.frames().rows() : 0;
+  read.status = reader->Finish();
+  return read;
 }
 
 inline v1::JobState WaitForJob(v1::CablesimService::Stub* stub, const std::string& id,
