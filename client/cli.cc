@@ -10,6 +10,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "cablesim/version.h"
 #include "client/cli_common.h"
 #include "client/cli_jobs.h"
 #include "client/cli_sweep.h"
@@ -51,6 +52,12 @@ const std::set<std::string>& ValueOptions() {
   return *options;
 }
 
+// Options that take no value.
+const std::set<std::string>& FlagOptions() {
+  static const std::set<std::string>* flags = new std::set<std::string>{"allow-outside"};
+  return *flags;
+}
+
 // Parses `args`; returns an error message for a usage error.
 absl::StatusOr<Arguments> ParseArguments(const std::vector<std::string>& args) {
   Arguments parsed;
@@ -69,6 +76,10 @@ absl::StatusOr<Arguments> ParseArguments(const std::vector<std::string>& args) {
       parsed.help = true;
       continue;
     }
+    if (arg == "--version" || arg == "-version") {
+      parsed.version = true;
+      continue;
+    }
     std::string name = arg.substr(arg[1] == '-' ? 2 : 1);
     std::optional<std::string> value;
     if (const size_t eq = name.find('='); eq != std::string::npos) {
@@ -76,6 +87,13 @@ absl::StatusOr<Arguments> ParseArguments(const std::vector<std::string>& args) {
       name = name.substr(0, eq);
     }
     if (name == "o") name = "out";
+    if (FlagOptions().count(name)) {
+      if (value.has_value()) {
+        return absl::InvalidArgumentError(absl::StrCat("--", name, " takes no value"));
+      }
+      parsed.options[name] = "";
+      continue;
+    }
     if (name != "out" && name != "server" && !ValueOptions().count(name)) {
       return absl::InvalidArgumentError(absl::StrCat("unknown option ", arg));
     }
@@ -217,20 +235,26 @@ std::string CliUsage() {
       one JSON line with the report; --out writes the time series.
   cablesim sweep SWEEP.json [--out results.csv] [--server HOST:PORT]
                  [--workers N] [--max-energy-drift X] [--max-wall-seconds X]
-                 [--max-constraint-violation X]
+                 [--max-constraint-violation X] [--allow-outside]
       Queue a parameter sweep, wait for every item and write one row per
       item (axis values, summary, final probe values). Without --server the
-      sweep runs in this process on N workers (default: the cores).
-  cablesim help
+      sweep runs in this process on N workers (default: the cores). The
+      sweep file's base_file must lie under the sweep file's directory
+      unless --allow-outside.
+  cablesim help | --help
       Print this text.
+  cablesim --version
+      Print the version and the build type.
 
 SCENE is a cablesim.v1.Scene (proto/cablesim/v1/scene.proto) in protobuf
 JSON, or in text format when its name ends in .txtpb, .textproto or .pbtxt.
 SWEEP.json is a cablesim.v1.SweepFile (proto/cablesim/v1/service.proto).
 
-Exit status: 0 success, 1 error writing the output or reaching the server,
-2 bad input (usage, scene file or scene), 3 numerical failure of the run
-(for sweep: an item failed or a threshold was exceeded).
+Exit status: 0 success; 1 error writing the output or reaching the server,
+or the run (watch: the job) was cancelled; 2 bad input (usage, scene or
+sweep file, invalid scene, a server limit); 3 numerical failure of the run
+(for sweep: an item failed or a threshold was exceeded). README.md has the
+table for every command.
 )";
 }
 
@@ -240,6 +264,11 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   const Arguments& a = *parsed;
   if (a.help || (!a.positional.empty() && a.positional[0] == "help")) {
     out << CliUsage();
+    out.flush();
+    return kExitOk;
+  }
+  if (a.version) {
+    out << VersionLine("cablesim") << "\n";
     out.flush();
     return kExitOk;
   }

@@ -29,6 +29,7 @@ struct Arguments {
   std::optional<std::string> server;           // --server
   std::map<std::string, std::string> options;  // the other --name value
   bool help = false;
+  bool version = false;  // --version
 };
 
 // Prints `message` and the usage text; returns the exit code 2.

@@ -6,6 +6,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
 #include "client/json_line.h"
 #include "client/progress.h"
 #include "convert/run_proto.h"
@@ -59,7 +60,8 @@ std::string EnergyJson(const std::string& source, const v1::EnergyResponse& r) {
 absl::Status WriteEnergyCsv(const std::string& path, const v1::EnergyResponse& r) {
   std::ofstream file(path);
   if (!file) return absl::UnavailableError(absl::StrCat(path, ": cannot open for writing"));
-  file << "t,kinetic,potential,axial,bending,total,constraint_violation\n";
+  // The run CSV's names for the same quantities (FrameColumns without probes).
+  file << absl::StrJoin(FrameColumns({}), ",") << "\n";
   for (int i = 0; i < r.t_size(); ++i) {
     file << absl::StrFormat("%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", r.t(i), r.kinetic(i),
                             r.potential(i), r.axial(i), r.bending(i), r.total(i),

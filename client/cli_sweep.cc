@@ -1,7 +1,5 @@
 #include "client/cli_sweep.h"
 
-#include <google/protobuf/util/json_util.h>
-
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -13,7 +11,7 @@
 #include "absl/strings/str_format.h"
 #include "client/json_line.h"
 #include "client/progress.h"
-#include "convert/scene_file.h"
+#include "convert/sweep_file.h"
 
 namespace cablesim::cli_internal {
 namespace {
@@ -26,37 +24,6 @@ std::string CsvCell(const std::string& text) {
     quoted += ch;
   }
   return quoted + "\"";
-}
-
-// Reads a sweep file (SweepFile in service.proto, protobuf JSON).
-absl::StatusOr<v1::SubmitSweepRequest> ReadSweepFile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return absl::NotFoundError(absl::StrCat(path, ": cannot open"));
-  std::stringstream text;
-  text << in.rdbuf();
-  v1::SweepFile file;
-  google::protobuf::util::JsonParseOptions options;
-  options.ignore_unknown_fields = false;
-  if (auto s = google::protobuf::util::JsonStringToMessage(text.str(), &file, options); !s.ok()) {
-    return absl::InvalidArgumentError(absl::StrCat(path, ": ", s.message().as_string()));
-  }
-  v1::SubmitSweepRequest request;
-  request.set_name(file.name());
-  *request.mutable_axes() = file.axes();
-  if (!file.base_file().empty()) {
-    if (file.has_base()) {
-      return absl::InvalidArgumentError(absl::StrCat(path, ": give base or base_file, not both"));
-    }
-    std::filesystem::path base = file.base_file();
-    if (base.is_relative()) base = std::filesystem::path(path).parent_path() / base;
-    absl::StatusOr<v1::Scene> scene = ReadSceneFile(base.string());
-    if (!scene.ok()) return scene.status();
-    *request.mutable_base() = std::move(*scene);
-  } else {
-    *request.mutable_base() = file.base();
-  }
-  if (request.name().empty()) request.set_name(std::filesystem::path(path).stem().string());
-  return request;
 }
 
 absl::StatusOr<double> DoubleOption(const Arguments& a, const std::string& name) {
@@ -85,7 +52,8 @@ int SweepCommand(const Arguments& a, std::ostream& out, std::ostream& err) {
       return UsageError(err, "--workers: a number >= 1");
     }
   }
-  const absl::StatusOr<v1::SubmitSweepRequest> request = ReadSweepFile(path);
+  const absl::StatusOr<v1::SubmitSweepRequest> request =
+      ReadSweepFile(path, a.options.count("allow-outside") > 0);
   if (!request.ok()) {
     err << "cablesim: " << request.status().message() << "\n";
     return kExitBadInput;

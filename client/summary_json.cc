@@ -32,6 +32,7 @@ std::string SummaryToJson(const RunSummary& summary) {
       .Add("energy_max_increase", summary.energy_max_increase)
       .Add("max_constraint_violation", summary.max_constraint_violation)
       .Add("max_newton_residual", summary.max_newton_residual)
+      .Add("max_residual_floor", summary.max_residual_floor)
       .Add("max_linear_residual", summary.max_linear_residual);
   if (summary.analysis == "MODAL") json.Add("frequencies_hz", summary.frequencies_hz);
   if (summary.analysis == "DYNAMIC") {

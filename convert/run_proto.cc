@@ -51,6 +51,7 @@ v1::RunSummary SummaryToProto(const RunSummary& s) {
   p.set_energy_max_increase(s.energy_max_increase);
   p.set_max_constraint_violation(s.max_constraint_violation);
   p.set_max_newton_residual(s.max_newton_residual);
+  p.set_max_residual_floor(s.max_residual_floor);
   p.set_max_linear_residual(s.max_linear_residual);
   for (double f : s.frequencies_hz) p.add_frequencies_hz(f);
   p.set_linear_solver_used(s.linear_solver_used);
@@ -89,6 +90,7 @@ RunSummary SummaryFromProto(const v1::RunSummary& p) {
   s.energy_max_increase = p.energy_max_increase();
   s.max_constraint_violation = p.max_constraint_violation();
   s.max_newton_residual = p.max_newton_residual();
+  s.max_residual_floor = p.max_residual_floor();
   s.max_linear_residual = p.max_linear_residual();
   s.frequencies_hz.assign(p.frequencies_hz().begin(), p.frequencies_hz().end());
   s.linear_solver_used = p.linear_solver_used();

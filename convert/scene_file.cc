@@ -1,15 +1,17 @@
 #include "convert/scene_file.h"
 
 #include <google/protobuf/io/tokenizer.h>
+#include <google/protobuf/struct.pb.h>
 #include <google/protobuf/text_format.h>
 #include <google/protobuf/util/json_util.h>
+
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -17,13 +19,14 @@
 #include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 
 namespace cablesim {
 namespace {
 
-// Largest scene file read [bytes]; a scene is a few kilobytes.
-constexpr std::streamoff kMaxSceneFileBytes = 64 << 20;
+using google::protobuf::Descriptor;
+using google::protobuf::FieldDescriptor;
 
 // Collects the text-format parser's errors instead of logging them.
 class CollectingErrorCollector : public google::protobuf::io::ErrorCollector {
@@ -42,39 +45,253 @@ class CollectingErrorCollector : public google::protobuf::io::ErrorCollector {
   std::vector<std::string> messages_;
 };
 
-// The parser's message on one line.
-std::string OneLine(std::string message) {
-  std::replace(message.begin(), message.end(), '\n', ' ');
-  return std::string(absl::StripAsciiWhitespace(message));
+// Longest parser message passed on [characters]: the parser's messages
+// quote the input, which may be anything.
+constexpr size_t kMaxMessageChars = 160 + kMaxQuotedChars;
+
+// A parser's message made safe to print: on one line, every byte outside
+// printable ASCII escaped as \xNN, cut after kMaxMessageChars.
+std::string Printable(absl::string_view message) {
+  std::string out;
+  for (const char ch : message) {
+    if (out.size() >= kMaxMessageChars) {
+      out += "...";
+      break;
+    }
+    const unsigned char c = static_cast<unsigned char>(ch);
+    if (c == '\n' || c == '\r' || c == '\t') {
+      out += ' ';
+    } else if (c >= 0x20 && c < 0x7f) {
+      out += ch;
+    } else {
+      out += absl::StrFormat("\\x%02x", c);
+    }
+  }
+  return std::string(absl::StripAsciiWhitespace(out));
 }
 
 absl::Status WithPath(const std::string& path, const absl::Status& status) {
   return absl::Status(status.code(), absl::StrCat(path, ": ", status.message()));
 }
 
+absl::Status CheckSize(absl::string_view text, absl::string_view what) {
+  if (text.size() > static_cast<size_t>(kMaxSceneBytes)) {
+    return absl::InvalidArgumentError(absl::StrCat(what, ": ", text.size(),
+                                                   " bytes, more than the limit of ",
+                                                   kMaxSceneBytes));
+  }
+  return absl::OkStatus();
+}
+
+// The nesting of arrays and objects outside strings, checked before any
+// parser recurses into it.
+absl::Status CheckJsonNesting(absl::string_view json, absl::string_view what) {
+  int depth = 0;
+  bool in_string = false, escaped = false;
+  for (size_t i = 0; i < json.size(); ++i) {
+    const char c = json[i];
+    if (in_string) {
+      if (escaped) {
+        escaped = false;
+      } else if (c == '\\') {
+        escaped = true;
+      } else if (c == '"') {
+        in_string = false;
+      }
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxSceneNesting) {
+        return absl::InvalidArgumentError(absl::StrCat(what, ": nested deeper than ",
+                                                       kMaxSceneNesting, " levels (at byte ", i,
+                                                       ")"));
+      }
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return absl::OkStatus();
+}
+
+const char* KindName(const google::protobuf::Value& value) {
+  switch (value.kind_case()) {
+    case google::protobuf::Value::kNullValue:
+      return "null";
+    case google::protobuf::Value::kNumberValue:
+      return "a number";
+    case google::protobuf::Value::kStringValue:
+      return "a string";
+    case google::protobuf::Value::kBoolValue:
+      return "true or false";
+    case google::protobuf::Value::kStructValue:
+      return "an object";
+    case google::protobuf::Value::kListValue:
+      return "a list";
+    default:
+      return "nothing";
+  }
+}
+
+absl::Status CheckObjectKinds(const google::protobuf::Struct& object, const Descriptor& type,
+                              const std::string& path);
+
+// One value (an element, for a repeated field) of `field`.
+absl::Status CheckValueKind(const google::protobuf::Value& value, const FieldDescriptor& field,
+                            const std::string& path) {
+  using V = google::protobuf::Value;
+  const V::KindCase kind = value.kind_case();
+  if (kind == V::kNullValue) return absl::OkStatus();  // the parser's rules apply
+  const char* expected = nullptr;
+  switch (field.cpp_type()) {
+    case FieldDescriptor::CPPTYPE_MESSAGE:
+      if (kind == V::kStructValue) {
+        return CheckObjectKinds(value.struct_value(), *field.message_type(), path);
+      }
+      expected = "an object {...}";
+      break;
+    case FieldDescriptor::CPPTYPE_STRING:
+      if (kind == V::kStringValue) return absl::OkStatus();
+      expected = "a string";
+      break;
+    case FieldDescriptor::CPPTYPE_BOOL:
+      if (kind == V::kBoolValue) return absl::OkStatus();
+      expected = "true or false";
+      break;
+    case FieldDescriptor::CPPTYPE_ENUM:
+      if (kind == V::kStringValue || kind == V::kNumberValue) return absl::OkStatus();
+      expected = "a name (string)";
+      break;
+    default:  // numbers: "NaN", "Infinity" and quoted numbers are strings
+      if (kind == V::kNumberValue || kind == V::kStringValue) return absl::OkStatus();
+      expected = "a number";
+      break;
+  }
+  return absl::InvalidArgumentError(
+      absl::StrCat(path, ": must be ", expected, " (got ", KindName(value), ")"));
+}
+
+absl::Status CheckObjectKinds(const google::protobuf::Struct& object, const Descriptor& type,
+                              const std::string& path) {
+  std::vector<std::string> keys;
+  for (const auto& [key, value] : object.fields()) keys.push_back(key);
+  std::sort(keys.begin(), keys.end());
+  for (const std::string& key : keys) {
+    const FieldDescriptor* field = type.FindFieldByName(key);
+    if (field == nullptr) field = type.FindFieldByCamelcaseName(key);
+    if (field == nullptr) continue;  // the parser names unknown fields
+    const std::string field_path = path.empty() ? key : absl::StrCat(path, ".", key);
+    const google::protobuf::Value& value = object.fields().at(key);
+    if (!field->is_repeated()) {
+      if (absl::Status s = CheckValueKind(value, *field, field_path); !s.ok()) return s;
+      continue;
+    }
+    if (value.kind_case() == google::protobuf::Value::kNullValue) continue;
+    if (value.kind_case() != google::protobuf::Value::kListValue) {
+      return absl::InvalidArgumentError(absl::StrCat(field_path, ": must be a list [...] (got ",
+                                                     KindName(value), ")"));
+    }
+    const auto& items = value.list_value().values();
+    for (int i = 0; i < items.size(); ++i) {
+      const absl::Status s = CheckValueKind(items[i], *field, absl::StrCat(field_path, "[", i, "]"));
+      if (!s.ok()) return s;
+    }
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
-absl::StatusOr<v1::Scene> ParseSceneJson(std::string_view json) {
-  v1::Scene scene;
+absl::Status ParseStrictJson(absl::string_view json, absl::string_view what,
+                             google::protobuf::Message* message) {
+  if (absl::Status s = CheckSize(json, what); !s.ok()) return s;
+  if (absl::Status s = CheckJsonNesting(json, what); !s.ok()) return s;
+  const google::protobuf::StringPiece text(json.data(), json.size());
+  // First the syntax and the kind of every value, on a generic JSON tree.
+  google::protobuf::Value tree;
+  if (const auto s = google::protobuf::util::JsonStringToMessage(text, &tree); !s.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat(what, ": ", Printable(s.message().as_string())));
+  }
+  if (tree.kind_case() != google::protobuf::Value::kStructValue) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(what, ": must be a JSON object {...} (got ", KindName(tree), ")"));
+  }
+  if (absl::Status s = CheckObjectKinds(tree.struct_value(), *message->GetDescriptor(), "");
+      !s.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat(what, ": ", Printable(s.message())));
+  }
+  // Then the message itself: field names and enum names.
   google::protobuf::util::JsonParseOptions options;
   options.ignore_unknown_fields = false;
   options.case_insensitive_enum_parsing = false;
-  const auto status = google::protobuf::util::JsonStringToMessage(
-      google::protobuf::StringPiece(json.data(), json.size()), &scene, options);
-  if (!status.ok()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("invalid JSON scene: ", OneLine(std::string(status.message()))));
+  if (const auto s = google::protobuf::util::JsonStringToMessage(text, message, options);
+      !s.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat(what, ": ", Printable(s.message().as_string())));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<std::string> ReadBoundedFile(const std::string& path, absl::string_view what) {
+  struct stat info;
+  if (::stat(path.c_str(), &info) != 0) {
+    const int error = errno;
+    const std::string message = absl::StrCat(path, ": cannot open ", what, ": ", std::strerror(error));
+    if (error == ENOENT) return absl::NotFoundError(message);
+    return absl::FailedPreconditionError(message);
+  }
+  if (S_ISDIR(info.st_mode)) {
+    return absl::FailedPreconditionError(absl::StrCat(path, ": is a directory, not a ", what));
+  }
+  if (S_ISREG(info.st_mode) && info.st_size > kMaxSceneBytes) {
+    return absl::InvalidArgumentError(absl::StrCat(path, ": ", what, " is ", info.st_size,
+                                                   " bytes, more than the limit of ",
+                                                   kMaxSceneBytes));
+  }
+  errno = 0;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    const int error = errno;
+    return absl::FailedPreconditionError(absl::StrCat(path, ": cannot open ", what, ": ",
+                                                      error != 0 ? std::strerror(error) : "?"));
+  }
+  // Bounded: a device or a pipe has no size to check first.
+  std::string text;
+  char chunk[1 << 16];
+  while (in && text.size() <= static_cast<size_t>(kMaxSceneBytes)) {
+    in.read(chunk, sizeof chunk);
+    text.append(chunk, static_cast<size_t>(in.gcount()));
+  }
+  if (in.bad()) return absl::DataLossError(absl::StrCat(path, ": cannot read ", what));
+  if (text.size() > static_cast<size_t>(kMaxSceneBytes)) {
+    return absl::InvalidArgumentError(absl::StrCat(path, ": ", what, " is more than the limit of ",
+                                                   kMaxSceneBytes, " bytes"));
+  }
+  return text;
+}
+
+absl::StatusOr<v1::Scene> ParseSceneJson(std::string_view json) {
+  v1::Scene scene;
+  if (absl::Status s = ParseStrictJson(absl::string_view(json.data(), json.size()),
+                                       "invalid JSON scene", &scene);
+      !s.ok()) {
+    return s;
   }
   return scene;
 }
 
 absl::StatusOr<v1::Scene> ParseSceneTextFormat(std::string_view text) {
+  if (absl::Status s = CheckSize(absl::string_view(text.data(), text.size()),
+                                 "invalid text-format scene");
+      !s.ok()) {
+    return s;
+  }
   v1::Scene scene;
   CollectingErrorCollector errors;
   google::protobuf::TextFormat::Parser parser;
   parser.RecordErrorsTo(&errors);
+  parser.SetRecursionLimit(kMaxSceneNesting);
   if (!parser.ParseFromString(std::string(text), &scene)) {
-    return absl::InvalidArgumentError(absl::StrCat("invalid text-format scene: ", errors.Joined()));
+    return absl::InvalidArgumentError(
+        absl::StrCat("invalid text-format scene: ", Printable(errors.Joined())));
   }
   return scene;
 }
@@ -86,32 +303,10 @@ bool IsTextFormatScenePath(std::string_view path_std) {
 }
 
 absl::StatusOr<v1::Scene> ReadSceneFile(const std::string& path) {
-  std::error_code ignored;
-  if (std::filesystem::is_directory(path, ignored)) {
-    return absl::FailedPreconditionError(absl::StrCat(path, ": is a directory, not a scene file"));
-  }
-  errno = 0;
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    const int error = errno;
-    const std::string reason = error != 0 ? std::strerror(error) : "cannot open";
-    if (error == ENOENT) {
-      return absl::NotFoundError(absl::StrCat(path, ": cannot open scene file: ", reason));
-    }
-    return absl::FailedPreconditionError(absl::StrCat(path, ": cannot open scene file: ", reason));
-  }
-  std::ostringstream contents;
-  contents << in.rdbuf();
-  if (in.bad()) {
-    return absl::DataLossError(absl::StrCat(path, ": cannot read scene file"));
-  }
-  const std::string text = std::move(contents).str();
-  if (static_cast<std::streamoff>(text.size()) > kMaxSceneFileBytes) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(path, ": scene file is larger than ", kMaxSceneFileBytes, " bytes"));
-  }
+  absl::StatusOr<std::string> text = ReadBoundedFile(path, "scene file");
+  if (!text.ok()) return text.status();
   absl::StatusOr<v1::Scene> scene =
-      IsTextFormatScenePath(path) ? ParseSceneTextFormat(text) : ParseSceneJson(text);
+      IsTextFormatScenePath(path) ? ParseSceneTextFormat(*text) : ParseSceneJson(*text);
   if (!scene.ok()) return WithPath(path, scene.status());
   return scene;
 }

@@ -5,11 +5,14 @@
 #include <map>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "absl/status/status.h"
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/string_view.h"
+#include "convert/plausible_ranges.h"
 
 // Local helpers for early return on error.
 #define CABLESIM_RETURN_IF_ERROR(expr)   \
@@ -66,7 +69,29 @@ std::string Indexed(absl::string_view parent, absl::string_view field, int index
   return absl::StrCat(parent, parent.empty() ? "" : ".", field, "[", index, "]");
 }
 
-std::string Num(double value) { return absl::StrFormat("%.10g", value); }
+// A number as written in messages: 10 significant digits; exponents without
+// '+' or leading zeros, and round numbers of 10,000 and more as exponents
+// (1e-3, 1e6, 2.5e7, 1e308), as users write them.
+std::string Num(double value) {
+  std::string text = absl::StrFormat("%.10g", value);
+  if (text.find_first_of("e.") == std::string::npos && text.size() >= 5 &&
+      absl::EndsWith(text, "0000")) {
+    text = absl::StrFormat("%.9e", value);
+    const size_t e = text.find('e');
+    size_t mantissa_end = e;
+    while (text[mantissa_end - 1] == '0') --mantissa_end;
+    if (text[mantissa_end - 1] == '.') --mantissa_end;
+    text = text.substr(0, mantissa_end) + text.substr(e);
+  }
+  const size_t e = text.find('e');
+  if (e == std::string::npos) return text;
+  size_t digits = e + 1;
+  std::string exponent;
+  if (text[digits] == '-') exponent = "-";
+  if (text[digits] == '-' || text[digits] == '+') ++digits;
+  while (digits + 1 < text.size() && text[digits] == '0') ++digits;
+  return absl::StrCat(text.substr(0, e + 1), exponent, text.substr(digits));
+}
 
 absl::Status CheckFinite(absl::string_view path, double value) {
   if (!std::isfinite(value))
@@ -86,11 +111,37 @@ absl::Status CheckNonNegative(absl::string_view path, double value) {
   return absl::OkStatus();
 }
 
+// Names are echoed in messages: a long one is refused before that.
+absl::Status CheckNameLength(absl::string_view path, absl::string_view name) {
+  if (name.size() > static_cast<size_t>(plausible::kMaxNameBytes)) {
+    return Invalid(path, absl::StrCat("at most ", plausible::kMaxNameBytes, " bytes (got ",
+                                      name.size(), ")"));
+  }
+  return absl::OkStatus();
+}
+
 absl::Status CheckIntRange(absl::string_view path, int value, int lo, int hi) {
   if (value < lo || value > hi) {
     return Invalid(path, absl::StrCat("must be in [", lo, ", ", hi, "] (got ", value, ")"));
   }
   return absl::OkStatus();
+}
+
+// A finite value in `range` (inclusive); the message gives the range.
+absl::Status CheckRange(absl::string_view path, double value, const PlausibleRange& range) {
+  CABLESIM_RETURN_IF_ERROR(CheckFinite(path, value));
+  if (!(value >= range.lo && value <= range.hi)) {
+    return Invalid(path, absl::StrCat("must be in [", Num(range.lo), ", ", Num(range.hi), "] ",
+                                      range.unit, " (got ", Num(value), ")"));
+  }
+  return absl::OkStatus();
+}
+
+// A value > 0 (the message most users meet first) and in `range`.
+absl::Status CheckPositiveInRange(absl::string_view path, double value,
+                                  const PlausibleRange& range) {
+  CABLESIM_RETURN_IF_ERROR(CheckPositive(path, value));
+  return CheckRange(path, value, range);
 }
 
 // A tolerance in (0, kMaxTolerance].
@@ -110,12 +161,50 @@ absl::StatusOr<Eigen::Vector3d> FiniteVector(absl::string_view path, const v1::V
   return Eigen::Vector3d(v.x(), v.y(), v.z());
 }
 
-// A non-zero direction, normalised.
+// A vector whose every component lies in `range`.
+absl::StatusOr<Eigen::Vector3d> VectorInRange(absl::string_view path, const v1::Vec3& v,
+                                              const PlausibleRange& range) {
+  CABLESIM_RETURN_IF_ERROR(CheckRange(Sub(path, "x"), v.x(), range));
+  CABLESIM_RETURN_IF_ERROR(CheckRange(Sub(path, "y"), v.y(), range));
+  CABLESIM_RETURN_IF_ERROR(CheckRange(Sub(path, "z"), v.z(), range));
+  return Eigen::Vector3d(v.x(), v.y(), v.z());
+}
+
+// Smallest norm of a direction that is normalised without losing digits.
+constexpr double kMinDirectionNorm = 1e-100;
+
+// A non-zero direction, normalised. Its size does not matter, but its norm
+// must be a double: components of 1e308 are rejected as overflowing, not
+// called zero.
 absl::StatusOr<Eigen::Vector3d> Direction(absl::string_view path, const v1::Vec3& v) {
   CABLESIM_ASSIGN_OR_RETURN(const Eigen::Vector3d result, FiniteVector(path, v));
   const double norm = result.norm();
-  if (!(norm > 0) || !std::isfinite(norm)) return Invalid(path, "must be non-zero");
+  if (!std::isfinite(norm)) {
+    return Invalid(path, absl::StrCat("norm overflows (largest component ",
+                                      Num(result.cwiseAbs().maxCoeff()),
+                                      "); give a direction of moderate size"));
+  }
+  if (!(norm >= kMinDirectionNorm)) {
+    return Invalid(path, absl::StrCat("must be non-zero (got norm ", Num(norm), ")"));
+  }
   return Eigen::Vector3d(result / norm);
+}
+
+// The polyline's corner at points[corner], between the segment from the
+// point before it and the segment to `next`, must not fold the cable back.
+absl::Status CheckCorner(absl::string_view cable_path, int corner,
+                         const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& next) {
+  const Eigen::Vector3d in = points[corner] - points[corner - 1];
+  const Eigen::Vector3d out = next - points[corner];
+  const double cosine = in.dot(out) / (in.norm() * out.norm());
+  const double turn_degrees = std::acos(std::clamp(cosine, -1.0, 1.0)) * 180 / kPi;
+  if (!(turn_degrees <= plausible::kMaxCornerTurnDegrees)) {
+    return Invalid(Indexed(cable_path, "points", corner),
+                   absl::StrFormat("the polyline folds back at this corner (turns by %.1f "
+                                   "degrees; at most %g)",
+                                   turn_degrees, plausible::kMaxCornerTurnDegrees));
+  }
+  return absl::OkStatus();
 }
 
 bool IsProbeNameChar(char c) {
@@ -130,6 +219,7 @@ class SceneConverter {
   explicit SceneConverter(const v1::Scene& proto) : proto_(proto) {}
 
   absl::StatusOr<Scene> Convert() {
+    CABLESIM_RETURN_IF_ERROR(CheckNameLength("name", proto_.name()));
     scene_.name = proto_.name();
     switch (proto_.model()) {
       case v1::Scene::MODEL_UNSPECIFIED:
@@ -146,7 +236,7 @@ class SceneConverter {
         return Invalid("model", absl::StrCat("unknown value ", static_cast<int>(proto_.model()),
                                              " (expected AUTO, PLANAR or SPATIAL)"));
     }
-    CABLESIM_ASSIGN_OR_RETURN(scene_.gravity_m_s2, FiniteVector("gravity", proto_.gravity()));
+    CABLESIM_ASSIGN_OR_RETURN(scene_.gravity_m_s2, VectorInRange("gravity", proto_.gravity(), plausible::kGravity));
     if (proto_.cables_size() == 0 && proto_.bodies_size() == 0) {
       return Invalid("cables", "a scene needs at least one cable or body");
     }
@@ -181,6 +271,7 @@ class SceneConverter {
                                    const std::string& name, int index,
                                    std::map<std::string, int, std::less<>>* names) {
     if (name.empty()) return Invalid(path, "required");
+    CABLESIM_RETURN_IF_ERROR(CheckNameLength(path, name));
     const auto [it, inserted] = names->emplace(name, index);
     if (!inserted) {
       return Invalid(
@@ -213,7 +304,8 @@ class SceneConverter {
       double polyline_length = 0;
       for (int j = 0; j < c.points_size(); ++j) {
         const std::string point_path = Indexed(path, "points", j);
-        CABLESIM_ASSIGN_OR_RETURN(const Eigen::Vector3d p, FiniteVector(point_path, c.points(j)));
+        CABLESIM_ASSIGN_OR_RETURN(const Eigen::Vector3d p,
+                                  VectorInRange(point_path, c.points(j), plausible::kCoordinate));
         if (j > 0) {
           const Eigen::Vector3d& previous = cable->points.back();
           const double segment = (p - previous).norm();
@@ -222,46 +314,54 @@ class SceneConverter {
             return Invalid(point_path, absl::StrCat("same as points[", j - 1,
                                                     "] (consecutive points must differ)"));
           }
+          if (j > 1) CABLESIM_RETURN_IF_ERROR(CheckCorner(path, j - 1, cable->points, p));
           polyline_length += segment;
         }
         cable->points.push_back(p);
       }
-      if (!std::isfinite(polyline_length)) {
-        return Invalid(Sub(path, "points"), "polyline length overflows");
+      if (!(polyline_length >= plausible::kCableLength.lo &&
+            polyline_length <= plausible::kCableLength.hi)) {
+        return Invalid(Sub(path, "points"),
+                       absl::StrCat("polyline length must be in [", Num(plausible::kCableLength.lo),
+                                    ", ", Num(plausible::kCableLength.hi), "] m (got ",
+                                    Num(polyline_length), ")"));
       }
       if (c.has_length()) {
-        CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(path, "length"), c.length()));
+        CABLESIM_RETURN_IF_ERROR(
+            CheckPositiveInRange(Sub(path, "length"), c.length(), plausible::kCableLength));
         cable->length_m = c.length();
       } else {
         cable->length_m = polyline_length;
       }
     } else {
       CABLESIM_ASSIGN_OR_RETURN(const Eigen::Vector3d start,
-                                FiniteVector(Sub(path, "start"), c.start()));
+                                VectorInRange(Sub(path, "start"), c.start(), plausible::kCoordinate));
       Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
       if (c.has_direction()) {
         CABLESIM_ASSIGN_OR_RETURN(direction,
                                   Direction(Sub(path, "direction"), c.direction()));
       }
       if (!c.has_length()) return Invalid(Sub(path, "length"), "required (or give points)");
-      CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(path, "length"), c.length()));
+      CABLESIM_RETURN_IF_ERROR(
+          CheckPositiveInRange(Sub(path, "length"), c.length(), plausible::kCableLength));
       cable->length_m = c.length();
-      const Eigen::Vector3d end = start + direction * cable->length_m;
-      if (!end.allFinite()) return Invalid(Sub(path, "length"), "end point overflows");
-      cable->points = {start, end};
+      cable->points = {start, Eigen::Vector3d(start + direction * cable->length_m)};
     }
 
-    CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(path, "density"), c.density()));
+    CABLESIM_RETURN_IF_ERROR(
+        CheckPositiveInRange(Sub(path, "density"), c.density(), plausible::kDensity));
     cable->density_kg_m3 = c.density();
-    CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(path, "youngs_modulus"), c.youngs_modulus()));
+    CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange(Sub(path, "youngs_modulus"), c.youngs_modulus(),
+                                                  plausible::kYoungsModulus));
     cable->youngs_modulus_pa = c.youngs_modulus();
 
     if (c.has_diameter()) {
-      CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(path, "diameter"), c.diameter()));
+      CABLESIM_RETURN_IF_ERROR(
+          CheckPositiveInRange(Sub(path, "diameter"), c.diameter(), plausible::kSize));
     }
     const double d = c.diameter();
     if (c.has_area()) {
-      CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(path, "area"), c.area()));
+      CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange(Sub(path, "area"), c.area(), plausible::kArea));
       cable->area_m2 = c.area();
     } else if (c.has_diameter()) {
       cable->area_m2 = kPi * d * d / 4;
@@ -275,6 +375,10 @@ class SceneConverter {
       const std::string moment_path = Sub(path, "second_moment");
       CABLESIM_RETURN_IF_ERROR(no_bending ? CheckNonNegative(moment_path, c.second_moment())
                                           : CheckPositive(moment_path, c.second_moment()));
+      if (c.second_moment() != 0) {
+        CABLESIM_RETURN_IF_ERROR(
+            CheckRange(moment_path, c.second_moment(), plausible::kSecondMoment));
+      }
       cable->second_moment_m4 = c.second_moment();
     } else if (c.has_diameter()) {
       cable->second_moment_m4 = kPi * d * d * d * d / 64;
@@ -309,10 +413,13 @@ class SceneConverter {
       const std::string cylinder_path = Sub(path, "cylinder");
       const double d = b.cylinder().diameter();
       const double h = b.cylinder().height();
-      CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(cylinder_path, "diameter"), d));
-      CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(cylinder_path, "height"), h));
+      CABLESIM_RETURN_IF_ERROR(
+          CheckPositiveInRange(Sub(cylinder_path, "diameter"), d, plausible::kSize));
+      CABLESIM_RETURN_IF_ERROR(
+          CheckPositiveInRange(Sub(cylinder_path, "height"), h, plausible::kSize));
       if (!b.has_density()) return Invalid(Sub(path, "density"), "required with cylinder");
-      CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(path, "density"), b.density()));
+      CABLESIM_RETURN_IF_ERROR(
+          CheckPositiveInRange(Sub(path, "density"), b.density(), plausible::kDensity));
       const double m = b.density() * kPi * d * d / 4 * h;
       const double r = d / 2;
       const double transverse = m * (3 * r * r + h * h) / 12;
@@ -327,20 +434,21 @@ class SceneConverter {
         return Invalid(Sub(path, "density"),
                        "only with cylinder (give either cylinder + density or mass + inertia)");
       }
-      CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(path, "mass"), b.mass()));
+      CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange(Sub(path, "mass"), b.mass(), plausible::kMass));
       body->mass_kg = b.mass();
       const std::string inertia_path = Sub(path, "inertia");
       CABLESIM_ASSIGN_OR_RETURN(body->inertia_kg_m2, FiniteVector(inertia_path, b.inertia()));
       CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(inertia_path, "x"), b.inertia().x()));
       CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(inertia_path, "y"), b.inertia().y()));
       CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(inertia_path, "z"), b.inertia().z()));
+      CABLESIM_RETURN_IF_ERROR(VectorInRange(inertia_path, b.inertia(), plausible::kInertia).status());
     } else if (b.has_density()) {
       return Invalid(Sub(path, "cylinder"), "required with density");
     } else {
       return Invalid(Sub(path, "mass"), "required (give cylinder + density, or mass + inertia)");
     }
 
-    CABLESIM_ASSIGN_OR_RETURN(body->position_m, FiniteVector(Sub(path, "position"), b.position()));
+    CABLESIM_ASSIGN_OR_RETURN(body->position_m, VectorInRange(Sub(path, "position"), b.position(), plausible::kCoordinate));
     body->axis = Eigen::Vector3d::UnitX();
     if (b.has_axis()) {
       CABLESIM_ASSIGN_OR_RETURN(body->axis, Direction(Sub(path, "axis"), b.axis()));
@@ -355,6 +463,8 @@ class SceneConverter {
     const bool on_cable = !a.cable().empty();
     const bool on_body = !a.body().empty();
     if (on_cable && on_body) return Invalid(path, "names both a cable and a body");
+    CABLESIM_RETURN_IF_ERROR(CheckNameLength(Sub(path, "cable"), a.cable()));
+    CABLESIM_RETURN_IF_ERROR(CheckNameLength(Sub(path, "body"), a.body()));
     if (on_cable) {
       const auto it = cable_index_.find(a.cable());
       if (it == cable_index_.end()) {
@@ -380,7 +490,7 @@ class SceneConverter {
       }
       if (a.s() != 0) return Invalid(Sub(path, "s"), "only with cable");
       result.body = it->second;
-      CABLESIM_ASSIGN_OR_RETURN(result.point_body_m, FiniteVector(Sub(path, "point"), a.point()));
+      CABLESIM_ASSIGN_OR_RETURN(result.point_body_m, VectorInRange(Sub(path, "point"), a.point(), plausible::kCoordinate));
       return result;
     }
     if (!allow_ground) return Invalid(path, "must name a cable or a body");
@@ -416,9 +526,9 @@ class SceneConverter {
     const v1::Load& l = proto_.loads(i);
     const std::string path = Indexed("", "loads", i);
     CABLESIM_ASSIGN_OR_RETURN(load->at, ConvertAttachment(Sub(path, "at"), l.at(), false));
-    CABLESIM_ASSIGN_OR_RETURN(load->force_n, FiniteVector(Sub(path, "force"), l.force()));
+    CABLESIM_ASSIGN_OR_RETURN(load->force_n, VectorInRange(Sub(path, "force"), l.force(), plausible::kForce));
     const std::string torque_path = Sub(path, "torque");
-    CABLESIM_ASSIGN_OR_RETURN(load->torque_nm, FiniteVector(torque_path, l.torque()));
+    CABLESIM_ASSIGN_OR_RETURN(load->torque_nm, VectorInRange(torque_path, l.torque(), plausible::kTorque));
     if (load->at.cable >= 0) {
       if (!load->torque_nm.isZero(0)) return Invalid(torque_path, "allowed on bodies only");
     } else {
@@ -430,6 +540,7 @@ class SceneConverter {
     const v1::Probe& p = proto_.probes(i);
     const std::string path = Indexed("", "probes", i);
     const std::string name_path = Sub(path, "name");
+    CABLESIM_RETURN_IF_ERROR(CheckNameLength(name_path, p.name()));
     if (!p.name().empty() && !std::all_of(p.name().begin(), p.name().end(), IsProbeNameChar)) {
       return Invalid(name_path, absl::StrCat("\"", p.name(),
                                              "\" may contain only letters, digits, '_', '-' "
@@ -449,10 +560,14 @@ class SceneConverter {
   absl::Status ConvertInitialVelocity() {
     const v1::InitialVelocity& v = proto_.initial_velocity();
     InitialVelocitySpec& spec = scene_.initial_velocity;
-    CABLESIM_ASSIGN_OR_RETURN(spec.linear_m_s, FiniteVector("initial_velocity.linear", v.linear()));
-    CABLESIM_ASSIGN_OR_RETURN(spec.angular_rad_s,
-                              FiniteVector("initial_velocity.angular", v.angular()));
-    CABLESIM_ASSIGN_OR_RETURN(spec.origin_m, FiniteVector("initial_velocity.origin", v.origin()));
+    CABLESIM_ASSIGN_OR_RETURN(
+        spec.linear_m_s,
+        VectorInRange("initial_velocity.linear", v.linear(), plausible::kVelocity));
+    CABLESIM_ASSIGN_OR_RETURN(
+        spec.angular_rad_s,
+        VectorInRange("initial_velocity.angular", v.angular(), plausible::kAngularVelocity));
+    CABLESIM_ASSIGN_OR_RETURN(
+        spec.origin_m, VectorInRange("initial_velocity.origin", v.origin(), plausible::kCoordinate));
     return absl::OkStatus();
   }
 
@@ -469,7 +584,7 @@ class SceneConverter {
     CABLESIM_RETURN_IF_ERROR(CheckFinite("solver.step", s.step()));
     CABLESIM_RETURN_IF_ERROR(CheckFinite("solver.output_interval", s.output_interval()));
     out.step_s = s.has_step() ? s.step() : kDefaultStep;
-    CABLESIM_RETURN_IF_ERROR(CheckPositive("solver.step", out.step_s));
+    CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange("solver.step", out.step_s, plausible::kStep));
     out.output_interval_s = s.has_output_interval() ? s.output_interval() : out.step_s;
     CABLESIM_RETURN_IF_ERROR(CheckPositive("solver.output_interval", out.output_interval_s));
     if (out.output_interval_s < out.step_s * (1 - kTimeTolerance)) {
@@ -478,10 +593,17 @@ class SceneConverter {
                                   Num(out.output_interval_s), ")"));
     }
     out.duration_s = s.duration();
+    CABLESIM_RETURN_IF_ERROR(CheckRange("solver.duration", s.duration(), plausible::kDuration));
     if (out.analysis == Analysis::kDynamic) {
       if (!(s.duration() > 0)) {
         return Invalid("solver.duration", absl::StrCat("must be > 0 for DYNAMIC analysis (got ",
                                                        Num(s.duration()), ")"));
+      }
+      if (out.duration_s / out.step_s > plausible::kMaxNominalSteps) {
+        return Invalid("solver.step",
+                       absl::StrCat("solver.duration / solver.step is ",
+                                    Num(out.duration_s / out.step_s), " steps (at most ",
+                                    Num(plausible::kMaxNominalSteps), ")"));
       }
       if (out.step_s > out.duration_s * (1 + kTimeTolerance)) {
         return Invalid("solver.step",
@@ -561,13 +683,28 @@ class SceneConverter {
                                               "solver.relative_tolerance"}}) {
       if (has && !out.adaptive) return Invalid(name, "needs solver.adaptive: true");
     }
+    switch (s.initial_state()) {
+      case v1::Solver::INITIAL_STATE_UNSPECIFIED:
+      case v1::Solver::AS_GIVEN:
+        break;
+      case v1::Solver::STATIC:
+        if (out.analysis != Analysis::kDynamic) {
+          return Invalid("solver.initial_state", "STATIC applies to DYNAMIC analysis only");
+        }
+        out.initial_state = InitialState::kStatic;
+        break;
+      default:
+        return Invalid("solver.initial_state",
+                       absl::StrCat("unknown value ", static_cast<int>(s.initial_state()),
+                                    " (expected AS_GIVEN or STATIC)"));
+    }
     if ((out.adaptive || out.error_estimate) && out.analysis != Analysis::kDynamic) {
       return Invalid(out.adaptive ? "solver.adaptive" : "solver.error_estimate",
                      "applies to DYNAMIC analysis only");
     }
     if (s.has_tolerance()) {
-      CABLESIM_RETURN_IF_ERROR(CheckFinite("solver.tolerance", s.tolerance()));
-      CABLESIM_RETURN_IF_ERROR(CheckPositive("solver.tolerance", s.tolerance()));
+      CABLESIM_RETURN_IF_ERROR(
+          CheckPositiveInRange("solver.tolerance", s.tolerance(), plausible::kErrorTolerance));
       out.tolerance_m = s.tolerance();
     }
     if (s.has_relative_tolerance()) {

@@ -1,5 +1,8 @@
 #include "engine/ancf_cable_element.h"
 
+#include <cmath>
+#include <limits>
+
 namespace cablesim {
 namespace {
 
@@ -124,9 +127,16 @@ typename AncfCableElement<D>::Energy AncfCableElement<D>::StrainEnergy(const Coo
 }
 
 template <int D>
-void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* tangent) const {
+void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* tangent,
+                                       Coords* roundoff) const {
   using Id = Eigen::Matrix<double, D, D>;
   using Block = Eigen::Matrix<double, D, D>;
+  constexpr double kEps = std::numeric_limits<double>::epsilon();
+  // For `roundoff`: |e_k| per node (once per element), and per node the
+  // bound summed over the Gauss points (the same for each of its D entries).
+  double node_size[4] = {0, 0, 0, 0}, node_bound[4] = {0, 0, 0, 0};
+  if (roundoff)
+    for (int k = 0; k < 4; ++k) node_size[k] = e.template segment<D>(k * D).norm();
   for (int g = 0; g < rule_.n; ++g) {
     const double* s1 = d1_[g];
     const double* s2 = d2_[g];
@@ -137,15 +147,19 @@ void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* t
     }
     const double a = u.squaredNorm(), b = u.dot(w), c = w.squaredNorm();
     const double wl = rule_.weight[g] * length_;
+    // Spectral-norm bounds of the Hessian blocks of psi (for `roundoff`).
+    double nuu = 0, nuw = 0, nww = 0;
 
     // Gradient (gu, gw) and Hessian blocks of psi with respect to (u, w).
     const double eps = (a - 1) / 2;
     Point gu = ea_ * eps * u, gw = Point::Zero();
-    Block huu, huw = Block::Zero(), hww = Block::Zero();
+    Block huu = Block::Zero(), huw = Block::Zero(), hww = Block::Zero();
     if (tangent) huu = ea_ * (eps * Id::Identity() + u * u.transpose());
+    if (roundoff) nuu = ea_ * (std::abs(eps) + a);
     if (bending_ == BendingModel::kLinear) {
       gw += ei_ * w;
       if (tangent) hww += ei_ * Id::Identity();
+      nww = ei_;
     } else if (bending_ == BendingModel::kExact) {
       // psi_b = EI/2 f(a, b, c), f = c / a^2 - b^2 / a^3, with
       // da/du = 2u, db/du = w, db/dw = u, dc/dw = 2w.
@@ -156,11 +170,18 @@ void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* t
       const double fc = k * ia2;
       gu += 2 * fa * u + fb * w;
       gw += fb * u + 2 * fc * w;
+      const double faa = k * (6 * c * ia4 - 12 * b * b * ia4 * ia);
+      const double fab = k * (6 * b * ia4);
+      const double fac = k * (-2 * ia3);
+      const double fbb = k * (-2 * ia3);
+      if (roundoff) {
+        const double nunw = std::sqrt(a * c);  // |u| |w|
+        nuu += 4 * std::abs(faa) * a + 4 * std::abs(fab) * nunw + std::abs(fbb) * c +
+               2 * std::abs(fa);
+        nuw = 2 * std::abs(fab) * a + (4 * std::abs(fac) + std::abs(fbb)) * nunw + std::abs(fb);
+        nww = std::abs(fbb) * a + 2 * std::abs(fc);
+      }
       if (tangent) {
-        const double faa = k * (6 * c * ia4 - 12 * b * b * ia4 * ia);
-        const double fab = k * (6 * b * ia4);
-        const double fac = k * (-2 * ia3);
-        const double fbb = k * (-2 * ia3);
         // Second derivatives of f through a, b, c, plus f_a, f_b, f_c times
         // the Hessians of a, b, c.
         huu += 4 * faa * u * u.transpose() + 2 * fab * (u * w.transpose() + w * u.transpose()) +
@@ -172,6 +193,19 @@ void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* t
     }
     for (int k = 0; k < 4; ++k)
       force->template segment<D>(k * D) += wl * (s1[k] * gu + s2[k] * gw);
+    if (roundoff) {
+      double du = 0, dw = 0;
+      for (int k = 0; k < 4; ++k) {
+        du += std::abs(s1[k]) * node_size[k];
+        dw += std::abs(s2[k]) * node_size[k];
+      }
+      du *= kEps;
+      dw *= kEps;
+      // |g|_1 >= |g|_2: a bound without a square root.
+      const double dgu = wl * (nuu * du + nuw * dw + kEps * gu.template lpNorm<1>());
+      const double dgw = wl * (nuw * du + nww * dw + kEps * gw.template lpNorm<1>());
+      for (int k = 0; k < 4; ++k) node_bound[k] += std::abs(s1[k]) * dgu + std::abs(s2[k]) * dgw;
+    }
     if (tangent) {
       // K += wl B^T H B, block by block: B's node block k is
       // [s_k' I; s_k'' I], so block (k, m) is
@@ -186,6 +220,8 @@ void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* t
       }
     }
   }
+  if (roundoff)
+    for (int k = 0; k < 4; ++k) roundoff->template segment<D>(k * D).array() += node_bound[k];
   if (tangent) {
     for (int k = 0; k < 4; ++k)
       for (int m = k + 1; m < 4; ++m)

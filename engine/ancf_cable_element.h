@@ -1,7 +1,7 @@
 #ifndef CABLESIM_ENGINE_ANCF_CABLE_ELEMENT_H_
 #define CABLESIM_ENGINE_ANCF_CABLE_ELEMENT_H_
 
-// The gradient-deficient ANCF cable element (MODEL.md sections 1-3), planar
+// The gradient-deficient ANCF cable element (docs/model.md section 1), planar
 // (D = 2, 8 coordinates) or spatial (D = 3, 12 coordinates).
 //
 // Coordinates e = [r_O, r_O,x, r_A, r_A,x] (paper eq. 4, 6, 7 with its typo
@@ -58,7 +58,7 @@ class AncfCableElement {
 
   double length() const { return length_; }
 
-  // Consistent mass matrix (eq. 8-10, MODEL.md section 2) for mass per unit
+  // Consistent mass matrix (eq. 8-10 of the paper, docs/model.md section 1) for mass per unit
   // length rho A [kg/m].
   Matrix MassMatrix(double mass_per_length_kg_m) const;
 
@@ -75,7 +75,22 @@ class AncfCableElement {
   // Adds the elastic force Q_k = dU/de to `force` and, when `tangent` is not
   // null, the tangent K_T = dQ_k/de to `tangent` (which must be symmetric on
   // entry, usually zero). Allocates nothing.
-  void ElasticForce(const Coords& e, Coords* force, Matrix* tangent) const;
+  //
+  // When `roundoff` is not null, also adds to it a bound on the rounding
+  // error of each force entry [N, or N m for slopes]: the force computed in
+  // double precision from coordinates that are themselves only known to
+  // machine precision. At a Gauss point u = sum_k s_k' e_k is off by up to
+  // du = eps sum_k |s_k'| |e_k| (and w by dw likewise with s_k''): for a
+  // short element far from the origin that is eps |r| / l, far above eps.
+  // The gradient (g_u, g_w) of psi then moves by at most
+  // |H_uu| du + |H_uw| dw and |H_uw| du + |H_ww| dw (spectral-norm bounds of
+  // the Hessian blocks of psi), plus eps |g| for its own evaluation, and the
+  // force entry k by l w_g (|s_k'| dg_u + |s_k''| dg_w). Newton cannot drive
+  // a residual below this level: it is the floor of its acceptance test
+  // (newton_convergence.h). An EA of 1.6e7 N, a 1 mm element and |r| = 10 m
+  // give about 3e-5 N, while 100 eps EA (the older global floor) is 3.5e-7 N.
+  void ElasticForce(const Coords& e, Coords* force, Matrix* tangent,
+                    Coords* roundoff = nullptr) const;
 
  private:
   // B maps e to (u, w) at Gauss point g: rows 0..D-1 are S', rows D..2D-1

@@ -39,7 +39,9 @@ GeneralizedAlphaStepper::GeneralizedAlphaStepper(MultibodyModel* model,
   acc_h_.setZero(n_);
   lambda_.setZero(m_);
   g_.setZero(n_);
-  for (Eigen::VectorXd* x : {&z_pred_, &v_pred_, &z1_, &zdd1_, &f_, &bt_lambda_}) x->setZero(n_);
+  for (Eigen::VectorXd* x : {&z_pred_, &v_pred_, &z1_, &zdd1_, &f_, &bt_lambda_, &floor_, &abs_terms_,
+                            &f_floor_})
+    x->setZero(n_);
   lambda1_.setZero(m_);
   phi_.setZero(m_);
   q_.setZero(model->coordinates());
@@ -168,27 +170,39 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
   zdd1_ = zdd_;
   if (h_last_ > 0) zdd1_ += (h / h_last_) * (zdd_ - zdd_old_);
   lambda1_ = lambda_;
-  double last_increment = 0;
+  double last_increment = 0, previous_increment = 0;
+  bool previous_at_floor = false;
   SkylineLdlt& a = solver_.a();
   for (int it = 0; it <= settings_.max_newton_iterations; ++it) {
     z1_ = z_pred_ + s * zdd1_;
     model_->ToFull(z1_, &q_);
     const bool checking = it > 0 && last_increment <= tol * (1 + z1_.lpNorm<Eigen::Infinity>());
+    // The rounding floor is needed where convergence is judged (and for the
+    // message of the last iteration), unless the residual is below tol.
+    const bool judge = checking || it == settings_.max_newton_iterations;
     // Assemble the Newton matrix with the forces when this iteration will
     // need a fresh one and is not expected to be the converged one.
-    bool assembled = false;
+    bool assembled = false, have_floor = false;
     double force_size;
     if (fresh && !checking) {
       LoadMass();
       force_size = model_->NetForce(q_, 1.0, &f_, &a, c);
       assembled = true;
     } else {
-      force_size = model_->NetForce(q_, 1.0, &f_);
+      // The forces' rounding bound in the same pass when the last step was
+      // accepted at its floor: this one most likely will be too.
+      have_floor = judge && floor_expected_;
+      force_size = model_->NetForce(q_, 1.0, &f_, nullptr, 0, have_floor ? &floor_ : nullptr);
     }
     model_->Constraints(q_, &phi_, &jac_);
     // R = M zdd + w (Phi_z^T lambda - f) + (1 - w) g_n.
     auto r = rhs_.head(n_);
-    model_->mass().Multiply(zdd1_.data(), r.data());
+    if (have_floor) {
+      abs_terms_.setZero();
+      model_->mass().MultiplyWithAbs(zdd1_.data(), r.data(), abs_terms_.data());
+    } else {
+      model_->mass().Multiply(zdd1_.data(), r.data());
+    }
     const double inertia = r.lpNorm<Eigen::Infinity>();
     bt_lambda_.setZero();
     jac_.AddTransposeMultiply(lambda1_.data(), bt_lambda_.data());
@@ -200,6 +214,7 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
     if (m_ > 0) rhs_.tail(m_) = phi_ / s;
     NewtonIterate iterate;
     iterate.last_increment = last_increment;
+    iterate.previous_increment = previous_increment;
     iterate.zscale = 1 + z1_.lpNorm<Eigen::Infinity>();
     iterate.residual = r.lpNorm<Eigen::Infinity>() / scale;
     iterate.violation = m_ > 0 ? phi_.lpNorm<Eigen::Infinity>() : 0.0;
@@ -207,10 +222,27 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
       st.reason = "the residual is not finite (the step diverged)";
       return st;
     }
-    iterate.floor = w_ * model_->force_roundoff() / scale;
+    iterate.previous_at_floor = previous_at_floor;
+    previous_at_floor = false;
+    const bool plain = iterate.residual <= tol && iterate.violation <= tol * iterate.zscale;
+    if (judge && !(checking && plain)) {
+      // floor = w roundoff(f) + rounding of the other terms summed into R
+      // (the forces once more for their bound, unless it came with them).
+      if (!have_floor) {
+        model_->NetForce(q_, 1.0, &f_floor_, nullptr, 0, &floor_);
+        abs_terms_.setZero();
+        model_->mass().AddAbsMultiply(zdd1_.data(), abs_terms_.data());
+      }
+      jac_.AddAbsTransposeMultiply(lambda1_.data(), abs_terms_.data(), w_);
+      floor_ = w_ * floor_ + kSumRounding * (abs_terms_ + (1 - w_) * g_.cwiseAbs());
+      MeasureResidual(r, floor_, scale, &iterate);
+      previous_at_floor = iterate.excess <= tol;
+    }
     if (checking && NewtonConverged(iterate, tol)) {
+      floor_expected_ = !plain;
       st.converged = true;
       st.residual = iterate.residual;
+      st.residual_floor = iterate.floor;
       break;
     }
     if (it == settings_.max_newton_iterations) {
@@ -259,6 +291,7 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
     }
     // Safeguard of the kept matrix: slow contraction asks for a fresh one.
     if (reuse && it > 0 && increment > 0.5 * last_increment) fresh = true;
+    previous_increment = last_increment;
     last_increment = increment;
   }
   z_old_.swap(z_);

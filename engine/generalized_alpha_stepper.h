@@ -3,7 +3,7 @@
 
 // Second-order implicit steppers for the index-3 equations of motion
 //
-//   M zdd + Phi_z^T lambda = f(z),   Phi(z) = 0        (MODEL.md section 4)
+//   M zdd + Phi_z^T lambda = f(z),   Phi(z) = 0        (docs/model.md section 3)
 //
 // in two variants that users of other codes know.
 //
@@ -131,6 +131,12 @@ class GeneralizedAlphaStepper final : public Stepper {
   Eigen::VectorXd z_old_, v_old_, zdd_old_, acc_old_, lambda_old_, g_old_;
   // Newton work vectors.
   Eigen::VectorXd z_pred_, v_pred_, z1_, zdd1_, lambda1_, q_, f_, phi_, bt_lambda_, rhs_, dx_;
+  // The residual's rounding floor per unknown, and the terms summed into it.
+  Eigen::VectorXd floor_, abs_terms_, f_floor_;
+  // Whether the last accepted step needed the floor (its residual was above
+  // tol): the next step's checking iteration then bounds the forces'
+  // rounding in the same pass as the forces.
+  bool floor_expected_ = false;
   // The kept factorization: its c = w s, and whether it must be refreshed.
   bool have_factor_ = false;
   double factor_c_ = 0;

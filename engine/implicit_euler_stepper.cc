@@ -27,6 +27,9 @@ ImplicitEulerStepper::ImplicitEulerStepper(MultibodyModel* model, const SolverSe
   rhs_.setZero(n_ + m_);
   dx_.setZero(n_ + m_);
   bt_mu_.setZero(n_);
+  floor_.setZero(n_);
+  abs_terms_.setZero(n_);
+  f_floor_.setZero(n_);
   z_old_ = z_;
   v_old_ = v_;
   a_old_ = a_;
@@ -91,7 +94,8 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
   const double tol = settings_.newton_tolerance;
   v1_ = v_ + h * a_;
   lambda1_ = lambda_;
-  double last_increment = 0;
+  double last_increment = 0, previous_increment = 0;
+  bool previous_at_floor = false;
   SkylineLdlt& a = solver_.a();
   for (int it = 0; it <= settings_.max_newton_iterations; ++it) {
     z1_ = z_ + h * v1_;
@@ -99,7 +103,15 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
     // Newton matrix M + h^2 (K_T + H_lambda), assembled with the forces
     // unless this evaluation is expected to be the converged one.
     const bool checking = it > 0 && last_increment <= tol * (1 + z1_.lpNorm<Eigen::Infinity>());
-    const double force_size = checking ? model_->NetForce(q_, 1.0, &f_) : AssembleForces(h);
+    // The rounding floor is needed where convergence is judged (and for the
+    // message of the last iteration).
+    const bool judge = checking || it == settings_.max_newton_iterations;
+    // The forces' rounding bound in the same pass when the last step was
+    // accepted at its floor: this one most likely will be too.
+    const bool have_floor = checking && floor_expected_;
+    const double force_size =
+        checking ? model_->NetForce(q_, 1.0, &f_, nullptr, 0, have_floor ? &floor_ : nullptr)
+                 : AssembleForces(h);
     model_->Constraints(q_, &phi_, &solver_.b());
     // R_v = M (v1 - v0) - h f + Phi_z^T (h lambda).
     mdv_ = v1_ - v_;
@@ -114,6 +126,7 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
     if (m_ > 0) rhs_.tail(m_) = phi_ / h;
     NewtonIterate iterate;
     iterate.last_increment = last_increment;
+    iterate.previous_increment = previous_increment;
     iterate.zscale = 1 + z1_.lpNorm<Eigen::Infinity>();
     iterate.residual = rv.lpNorm<Eigen::Infinity>() / scale;
     iterate.violation = m_ > 0 ? phi_.lpNorm<Eigen::Infinity>() : 0.0;
@@ -121,10 +134,27 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
       st.reason = "the residual is not finite (the step diverged)";
       return st;
     }
-    iterate.floor = h * model_->force_roundoff() / scale;
+    iterate.previous_at_floor = previous_at_floor;
+    previous_at_floor = false;
+    const bool plain = iterate.residual <= tol && iterate.violation <= tol * iterate.zscale;
+    if (judge && !(checking && plain)) {
+      // floor = h roundoff(f) + rounding of the other terms summed into R_v
+      // (M v1, M v0 and h Phi_z^T lambda); the forces once more, for their
+      // bound, only where it matters, unless it came with them.
+      if (!have_floor) model_->NetForce(q_, 1.0, &f_floor_, nullptr, 0, &floor_);
+      abs_terms_.setZero();
+      model_->mass().AddAbsMultiply(v1_.data(), abs_terms_.data());
+      model_->mass().AddAbsMultiply(v_.data(), abs_terms_.data());
+      solver_.b().AddAbsTransposeMultiply(lambda1_.data(), abs_terms_.data(), h);
+      floor_ = h * floor_ + kSumRounding * abs_terms_;
+      MeasureResidual(rv, floor_, scale, &iterate);
+      previous_at_floor = iterate.excess <= tol;
+    }
     if (checking && NewtonConverged(iterate, tol)) {
+      floor_expected_ = !plain;
       st.converged = true;
       st.residual = iterate.residual;
+      st.residual_floor = iterate.floor;
       break;
     }
     if (it == settings_.max_newton_iterations) {
@@ -151,6 +181,7 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
     }
     v1_ += dx_.head(n_);
     if (m_ > 0) lambda1_ += dx_.tail(m_) / h;
+    previous_increment = last_increment;
     last_increment = h * dx_.head(n_).lpNorm<Eigen::Infinity>();
     if (!std::isfinite(last_increment) || last_increment > 1e6 * iterate.zscale) {
       st.reason = "Newton diverged";

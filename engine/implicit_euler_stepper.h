@@ -1,7 +1,7 @@
 #ifndef CABLESIM_ENGINE_IMPLICIT_EULER_STEPPER_H_
 #define CABLESIM_ENGINE_IMPLICIT_EULER_STEPPER_H_
 
-// The paper's stepper (MODEL.md section 5): backward Euler on the index-3
+// The paper's stepper (docs/model.md section 4): backward Euler on the index-3
 // equations of motion,
 //
 //   v1 = v0 + h a1,   z1 = z0 + h v1,
@@ -74,6 +74,12 @@ class ImplicitEulerStepper final : public Stepper {
   Eigen::VectorXd z_old_, v_old_, a_old_, lambda_old_;  // before the last step
   // Newton work vectors.
   Eigen::VectorXd z1_, v1_, lambda1_, q_, f_, phi_, mdv_, rhs_, dx_, bt_mu_;
+  // The residual's rounding floor per unknown, and the terms summed into it.
+  Eigen::VectorXd floor_, abs_terms_, f_floor_;
+  // Whether the last accepted step needed the floor (its residual was above
+  // tol): the next step's checking iteration then bounds the forces'
+  // rounding in the same pass as the forces.
+  bool floor_expected_ = false;
 };
 
 }  // namespace cablesim

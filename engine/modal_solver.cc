@@ -11,6 +11,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "engine/newton_convergence.h"
 #include "engine/skyline_ldlt.h"
 #include "engine/sparse_rows.h"
 #include "engine/static_solver.h"
@@ -72,32 +73,33 @@ Balance ForceBalance(MultibodyModel* model, const Eigen::VectorXd& z, SkylineLdl
   return bal;
 }
 
-// Whether z balances the full loads: the residual f - Phi_z^T lambda is
-// below `tolerance` times the forces' size, or at the rounding level of
-// forces computed from positions, 100 machine epsilons of the stiffest
-// diagonal entry of K_T times (1 + |z|) (the model's force_roundoff, an
-// EA-sized bound, is too small for short stiff elements, whose K_T ~ EA / l).
+// Whether z balances the full loads: every entry of the residual
+// f - Phi_z^T lambda is within `tolerance` times the forces' size of its
+// rounding floor (NetForce's roundoff; newton_convergence.h).
 bool IsEquilibrium(MultibodyModel* model, const Eigen::VectorXd& z, double tolerance) {
-  SkylineLdlt stiffness;
-  stiffness.SetPattern(model->envelope());
-  stiffness.SetZero();
-  Balance bal = ForceBalance(model, z, &stiffness);
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(model->coordinates());
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(model->dofs());
+  Eigen::VectorXd floor = Eigen::VectorXd::Zero(model->dofs());
+  model->ToFull(z, &q);
+  const double force_size = model->NetForce(q, 1.0, &f, nullptr, 0, &floor);
   Eigen::VectorXd bt_lambda = Eigen::VectorXd::Zero(model->dofs());
+  double violation = 0;
   if (model->multipliers() > 0) {
-    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(bal.b.transpose());
-    bal.lambda = qr.solve(bal.f);
-    bt_lambda = bal.b.transpose() * bal.lambda;
+    Eigen::VectorXd phi = Eigen::VectorXd::Zero(model->multipliers());
+    SparseRows jac = model->jacobian_pattern();
+    model->Constraints(q, &phi, &jac);
+    violation = phi.lpNorm<Eigen::Infinity>();
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Dense(jac).transpose());
+    const Eigen::VectorXd lambda = qr.solve(f);
+    jac.AddTransposeMultiply(lambda.data(), bt_lambda.data());
+    jac.AddAbsTransposeMultiply(lambda.data(), floor.data(), kSumRounding);
   }
-  double diag = 0;
-  for (int j = 0; j < model->dofs(); ++j)
-    diag = std::max(diag, std::abs(stiffness.values()[stiffness.Slot(j, j)]));
-  const double zscale = 1 + z.lpNorm<Eigen::Infinity>();
-  const double scale = std::max(bal.force_size, bt_lambda.lpNorm<Eigen::Infinity>());
-  const double rounding = std::max(model->force_roundoff(),
-                                   100 * std::numeric_limits<double>::epsilon() * diag * zscale);
-  const double residual = (bal.f - bt_lambda).lpNorm<Eigen::Infinity>();
-  const double violation = bal.phi.size() ? bal.phi.lpNorm<Eigen::Infinity>() : 0.0;
-  return residual <= tolerance * scale + rounding && violation <= tolerance * zscale;
+  NewtonIterate it;
+  it.zscale = 1 + z.lpNorm<Eigen::Infinity>();
+  it.violation = violation;
+  const double scale = std::max({force_size, bt_lambda.lpNorm<Eigen::Infinity>(), 1e-300});
+  MeasureResidual(f - bt_lambda, floor, scale, &it);
+  return NewtonConverged(it, tolerance);
 }
 
 void Fail(RunSummary* s, double at, const std::string& reason) {
@@ -116,51 +118,16 @@ bool StopRequested(const RunControl& control, RunSummary* s) {
 }
 
 // The equilibrium under the full loads by the load increments of STATIC
-// analysis (each bisected on failure); false (summary filled in) on failure.
+// analysis (FollowLoadPath); false (summary filled in) on failure.
 bool FindEquilibrium(MultibodyModel* model, const SolverSettings& settings,
                      const RunControl& control, RunSummary* summary, Eigen::VectorXd* z) {
   StaticSolver solver(model, settings);
-  const int n = settings.load_steps;
-  const double min_increment = std::ldexp(1.0 / n, -settings.max_step_halvings);
-  double alpha = 0;
-  for (int k = 1; k <= n; ++k) {
-    const double target = static_cast<double>(k) / n;
-    double d = target - alpha;
-    while (target - alpha > 1e-12) {
-      if (StopRequested(control, summary)) return false;
-      if (control.max_steps > 0 && summary->steps + summary->rejected_steps >= control.max_steps) {
-        Fail(summary, alpha,
-             absl::StrFormat("step limit of %d load increments reached at load factor %.6g",
-                             control.max_steps, alpha));
-        return false;
-      }
-      d = std::min(d, target - alpha);
-      const auto st = solver.Solve(alpha + d);
-      summary->newton_iterations += st.newton_iterations;
-      summary->linear_iterations += st.linear_iterations;
-      summary->max_linear_residual = std::max(summary->max_linear_residual, st.max_linear_residual);
-      if (st.converged) {
-        alpha += d;
-        ++summary->steps;
-        summary->max_newton_residual = std::max(summary->max_newton_residual, st.residual);
-        continue;
-      }
-      ++summary->rejected_steps;
-      d /= 2;
-      if (d < min_increment * (1 - 1e-12)) {
-        Fail(summary, alpha,
-             absl::StrFormat("MODAL: no static equilibrium: the load increment from load factor "
-                             "%.6g failed after %d bisections: %s",
-                             alpha, settings.max_step_halvings, st.reason));
-        return false;
-      }
-    }
-    alpha = target;
+  if (!FollowLoadPath(&solver, settings, control, summary, "MODAL: ", nullptr, nullptr)) {
+    return false;
   }
   *z = solver.z();
   return true;
 }
-
 
 // y = M x, for the Lanczos iteration's M-inner product.
 class MassProduct {

@@ -2,7 +2,7 @@
 #define CABLESIM_ENGINE_MODAL_SOLVER_H_
 
 // MODAL analysis: natural frequencies and mode shapes of small vibrations
-// about a static equilibrium z* (MODEL.md section 4 linearised).
+// about a static equilibrium z* (docs/model.md section 3, linearised).
 //
 // Linearising M z'' - f(z) + Phi_z^T lambda = 0, Phi(z) = 0 about z* (where
 // f(z*) = Phi_z^T lambda*) gives the constrained generalized symmetric

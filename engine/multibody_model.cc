@@ -26,9 +26,10 @@ constexpr double kSnap = 1e-9;
 
 // Arc-length position along a polyline: point and unit tangent at `frac`
 // of its total length. At an interior vertex the tangent is the average of
-// the two segments' directions.
+// the two segments' directions (side 0), or the incoming (side -1) or
+// outgoing (side +1) segment's.
 void PolylineAt(const std::vector<Vector3d>& pts, double frac, Vector3d* point,
-                Vector3d* tangent) {
+                Vector3d* tangent, int side = 0) {
   std::vector<double> cum(pts.size(), 0.0);
   for (size_t i = 1; i < pts.size(); ++i) cum[i] = cum[i - 1] + (pts[i] - pts[i - 1]).norm();
   const double total = cum.back();
@@ -42,9 +43,11 @@ void PolylineAt(const std::vector<Vector3d>& pts, double frac, Vector3d* point,
   Vector3d dir = (b - a).normalized();
   const double tol = kSnap * total;
   if (std::abs(s - cum[seg]) <= tol && seg + 1 < pts.size()) {
-    dir = (dir + (pts[seg + 1] - b).normalized()).normalized();
+    const Vector3d out = (pts[seg + 1] - b).normalized();
+    dir = side < 0 ? dir : side > 0 ? out : (dir + out).normalized();
   } else if (std::abs(s - cum[seg - 1]) <= tol && seg >= 2) {
-    dir = (dir + (a - pts[seg - 2]).normalized()).normalized();
+    const Vector3d in = (a - pts[seg - 2]).normalized();
+    dir = side > 0 ? dir : side < 0 ? in : (dir + in).normalized();
   }
   *tangent = dir;
 }
@@ -167,7 +170,31 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
   for (const JointSpec& j : scene.joints) require(j.a), require(j.b);
   for (const LoadSpec& l : scene.loads) require(l.at);
   for (const ProbeSpec& p : scene.probes) require(p.at);
+  // A cable without bending stiffness kinks where a pin or a point load
+  // acts inside it: the node there is split in two that share their
+  // position unknowns but not their slopes (a C0 node), so the elements on
+  // either side meet at an angle. (Slopes continuous across such a node
+  // round the kink off over an element and shorten the sag at a hung body
+  // at first order in the element length.) Not where a FIXED joint acts:
+  // that joint is about the slope.
+  std::vector<std::vector<double>> kink_s(num_cables), smooth_s(num_cables);
+  auto interior = [&](const Attachment& at) {
+    if (at.cable < 0 || scene.cables[at.cable].bending != BendingModel::kNone) return false;
+    const double len = scene.cables[at.cable].length_m, tol = kSnap * len;
+    return at.s_m > tol && at.s_m < len - tol;
+  };
+  for (const JointSpec& j : scene.joints) {
+    for (const Attachment* at : {&j.a, &j.b}) {
+      if (!interior(*at)) continue;
+      (j.type == JointType::kPin ? kink_s : smooth_s)[at->cable].push_back(at->s_m);
+    }
+  }
+  for (const LoadSpec& l : scene.loads)
+    if (interior(l.at)) kink_s[l.at.cable].push_back(l.at.s_m);
   std::vector<int> first_node(num_cables + 1, 0);
+  // Per node: the node whose position it shares (the first of a split
+  // pair), or -1.
+  std::vector<int> twin_of;
   for (int c = 0; c < num_cables; ++c) {
     auto& s = node_s[c];
     std::sort(s.begin(), s.end());
@@ -177,7 +204,21 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
       if (unique.empty() || v - unique.back() > tol) unique.push_back(v);
     // A point within tol of the end snaps to it.
     unique.back() = scene.cables[c].length_m;
-    s = unique;
+    auto near = [&](const std::vector<double>& list, double v) {
+      for (double x : list)
+        if (std::abs(x - v) <= tol) return true;
+      return false;
+    };
+    s.clear();
+    for (double v : unique) {
+      s.push_back(v);
+      twin_of.push_back(-1);
+      if (near(kink_s[c], v) && !near(smooth_s[c], v)) {
+        s.push_back(v);
+        twin_of.push_back(static_cast<int>(twin_of.size()) - 1);
+        ++m.split_nodes_;
+      }
+    }
     first_node[c + 1] = first_node[c] + static_cast<int>(s.size());
   }
   m.num_nodes_ = first_node[num_cables];
@@ -191,25 +232,23 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
   // ---- Full coordinates and their initial values and rates. ----
   const int ncoord = ns * m.num_nodes_ + bs * num_bodies;
   const int body0 = ns * m.num_nodes_;
-  VectorXd q0 = VectorXd::Zero(ncoord), qd0 = VectorXd::Zero(ncoord);
-  const InitialVelocitySpec& iv = scene.initial_velocity;
-  const Vector3d omega = iv.angular_rad_s;
-  auto rigid_velocity = [&](const Vector3d& r) -> Vector3d {
-    return iv.linear_m_s + omega.cross(r - iv.origin_m);
-  };
+  VectorXd q0 = VectorXd::Zero(ncoord);
+  m.initial_velocity_ = scene.initial_velocity;
   for (int c = 0; c < num_cables; ++c) {
     const CableSpec& cable = scene.cables[c];
     const double stretch = PolylineLength(cable.points) / cable.length_m;
     for (size_t k = 0; k < node_s[c].size(); ++k) {
+      const int node = first_node[c] + static_cast<int>(k);
+      // The two halves of a split node take the tangents of their sides.
+      const int side = twin_of[node] >= 0                                   ? 1
+                       : node + 1 < m.num_nodes_ && twin_of[node + 1] == node ? -1
+                                                                              : 0;
       Vector3d p, t;
-      PolylineAt(cable.points, node_s[c][k] / cable.length_m, &p, &t);
-      const int i = ns * (first_node[c] + static_cast<int>(k));
-      // Slopes move with the rigid rotation too: d(r_x)/dt = omega x r_x.
+      PolylineAt(cable.points, node_s[c][k] / cable.length_m, &p, &t, side);
+      const int i = ns * node;
       const Vector3d slope = stretch * t;
       q0.segment(i, D) = p.head(D);
       q0.segment(i + D, D) = slope.head(D);
-      qd0.segment(i, D) = rigid_velocity(p).head(D);
-      qd0.segment(i + D, D) = omega.cross(slope).head(D);
     }
   }
   std::vector<Eigen::Matrix3d> frame0(num_bodies);
@@ -218,19 +257,16 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
     const int i = body0 + bs * b;
     frame0[b] = BodyFrame(body.axis);
     q0.segment(i, D) = body.position_m.head(D);
-    qd0.segment(i, D) = rigid_velocity(body.position_m).head(D);
     BodyData data;
     data.coord = i;
     data.mass = body.mass_kg;
     const Vector3d& inertia = body.inertia_kg_m2;
     if (D == 2) {
       q0.segment<2>(i + 2) = frame0[b].col(0).head<2>();
-      qd0.segment<2>(i + 2) = omega.cross(frame0[b].col(0)).head<2>();
       data.jbar = Vector3d(inertia.z(), 0, 0);
     } else {
       for (int k = 0; k < 3; ++k) {
         q0.segment<3>(i + 3 + 3 * k) = frame0[b].col(k);
-        qd0.segment<3>(i + 3 + 3 * k) = omega.cross(frame0[b].col(k));
       }
       data.jbar = Vector3d::Constant(inertia.sum() / 2) - inertia;
       if (!(data.jbar.minCoeff() > 0)) {
@@ -449,7 +485,12 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
   for (int node = 0; node < m.num_nodes_; ++node) {
     const int i = ns * node;
     for (int k = 0; k < D; ++k) {
-      if (state[i + k] == -2) {
+      if (twin_of[node] >= 0) {
+        const int t = ns * twin_of[node] + k;
+        m.j_[i + k] = m.j_[t];
+        m.s_(i + k) = m.s_(t);
+        m.c_(i + k) = m.c_(t);
+      } else if (state[i + k] == -2) {
         m.c_(i + k) = q0(i + k);
       } else {
         m.j_[i + k] = next++;
@@ -474,23 +515,10 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
   m.dofs_ = next;
 
   // z0 and v0 by least squares through the map (exact for consistent data).
-  m.z0_ = VectorXd::Zero(m.dofs_);
-  m.v0_ = VectorXd::Zero(m.dofs_);
-  {
-    VectorXd norm2 = VectorXd::Zero(m.dofs_);
-    for (int i = 0; i < ncoord; ++i) {
-      if (m.j_[i] < 0) continue;
-      m.z0_(m.j_[i]) += m.s_(i) * q0(i);
-      m.v0_(m.j_[i]) += m.s_(i) * qd0(i);
-      norm2(m.j_[i]) += m.s_(i) * m.s_(i);
-    }
-    for (int j = 0; j < m.dofs_; ++j) {
-      if (norm2(j) > 0) {
-        m.z0_(j) /= norm2(j);
-        m.v0_(j) /= norm2(j);
-      }
-    }
-  }
+  m.z0_ = m.Reduce(q0);
+  VectorXd qd0 = VectorXd::Zero(ncoord);
+  m.RigidVelocity(q0, &qd0);
+  m.v0_ = m.Reduce(qd0);
 
   // A row that no unknown can change (both sides held by ground, say a
   // pinned node and a body pinned at its centre of mass, or the axes of a
@@ -513,6 +541,7 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
   }
 
   // ---- Elements. ----
+  const double extent = q0.lpNorm<Eigen::Infinity>();  // scene size [m]
   auto build_elements = [&](auto& elements, auto dim_tag) {
     constexpr int kD = decltype(dim_tag)::value;
     const Eigen::Matrix<double, kD, 1> g = scene.gravity_m_s2.head<kD>();
@@ -522,13 +551,15 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
       const double ei = cable.youngs_modulus_pa * cable.second_moment_m4;
       const double mpl = cable.density_kg_m3 * cable.area_m2;
       for (int k = first_node[c]; k + 1 < first_node[c + 1]; ++k) {
+        if (twin_of[k + 1] == k) continue;  // the two halves of a split node
         const int local = k - first_node[c];
         const double l = node_s[c][local + 1] - node_s[c][local];
         ElementData<kD> e;
         e.element = AncfCableElement<kD>(l, ea, ei, cable.bending);
-        m.force_roundoff_ =
-            std::max(m.force_roundoff_,
-                     100 * std::numeric_limits<double>::epsilon() * std::max(ea, ei / (l * l)));
+        // Energy the element can hold from coordinates known to 16 eps
+        // (1 + |q0|_inf): a strain of that over l, a curvature of it over l^2.
+        const double strain = 16 * std::numeric_limits<double>::epsilon() * (1 + extent) / l;
+        m.energy_roundoff_ += (ea + ei / (l * l)) * l * strain * strain;
         e.first_coord = ns * k;
         e.mass_per_length = mpl;
         e.gravity = e.element.GravityForce(mpl, g);
@@ -651,8 +682,58 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
     }
   }
   m.scratch_full_ = VectorXd::Zero(ncoord);
+  m.scratch_roundoff_ = VectorXd::Zero(ncoord);
   m.ProjectInitialVelocity();
   return m;
+}
+
+VectorXd MultibodyModel::Reduce(const VectorXd& full) const {
+  VectorXd z = VectorXd::Zero(dofs_), norm2 = VectorXd::Zero(dofs_);
+  for (int i = 0; i < coordinates(); ++i) {
+    if (j_[i] < 0) continue;
+    z(j_[i]) += s_(i) * full(i);
+    norm2(j_[i]) += s_(i) * s_(i);
+  }
+  for (int j = 0; j < dofs_; ++j)
+    if (norm2(j) > 0) z(j) /= norm2(j);
+  return z;
+}
+
+void MultibodyModel::RigidVelocity(const VectorXd& q, VectorXd* qdot) const {
+  const InitialVelocitySpec& iv = initial_velocity_;
+  const Vector3d omega = iv.angular_rad_s;
+  const int D = dim_;
+  auto vec = [D](const VectorXd& x, int i) {
+    Vector3d v = Vector3d::Zero();
+    v.head(D) = x.segment(i, D);
+    return v;
+  };
+  // Points move as v + omega x (r - origin); directions (slopes, body axes)
+  // as omega x d.
+  auto point = [&](int i) {
+    qdot->segment(i, D) = (iv.linear_m_s + omega.cross(vec(q, i) - iv.origin_m)).head(D);
+  };
+  auto direction = [&](int i) { qdot->segment(i, D) = omega.cross(vec(q, i)).head(D); };
+  qdot->setZero();
+  for (int node = 0; node < num_nodes_; ++node) {
+    point(node_stride_ * node);
+    direction(node_stride_ * node + D);
+  }
+  for (const BodyData& b : bodies_) {
+    point(b.coord);
+    const int axes = D == 2 ? 1 : 3;
+    for (int k = 0; k < axes; ++k) direction(b.coord + D + D * k);
+  }
+}
+
+void MultibodyModel::SetInitialState(const VectorXd& z) {
+  z0_ = z;
+  VectorXd q(coordinates()), qdot(coordinates());
+  ToFull(z, &q);
+  RigidVelocity(q, &qdot);
+  v0_ = Reduce(qdot);
+  initial_velocity_correction_ = 0;
+  ProjectInitialVelocity();
 }
 
 void MultibodyModel::ProjectInitialVelocity() {
@@ -735,10 +816,11 @@ void MultibodyModel::RateToFull(const VectorXd& zdot, VectorXd* qdot) const {
 
 template <int D>
 double MultibodyModel::ElementForces(const VectorXd& q, VectorXd* full, SkylineLdlt* stiffness,
-                                     double stiffness_scale) const {
+                                     double stiffness_scale, VectorXd* roundoff) const {
   constexpr int kN = 4 * D, kN2 = kN * kN;
+  constexpr double kEps = std::numeric_limits<double>::epsilon();
   const auto& elements = Elements<D>();
-  typename AncfCableElement<D>::Coords fe;
+  typename AncfCableElement<D>::Coords fe, re;
   typename AncfCableElement<D>::Matrix ke;
   double size = 0;
   double* values = stiffness ? stiffness->values() : nullptr;
@@ -746,8 +828,12 @@ double MultibodyModel::ElementForces(const VectorXd& q, VectorXd* full, SkylineL
     const ElementData<D>& e = elements[k];
     fe.setZero();
     if (stiffness) ke.setZero();
-    e.element.ElasticForce(q.segment<kN>(e.first_coord), &fe, stiffness ? &ke : nullptr);
+    if (roundoff) re.setZero();
+    e.element.ElasticForce(q.segment<kN>(e.first_coord), &fe, stiffness ? &ke : nullptr,
+                           roundoff ? &re : nullptr);
     full->segment<kN>(e.first_coord) -= fe;
+    // The element's own bound, and the rounding of adding it to the node.
+    if (roundoff) roundoff->segment<kN>(e.first_coord) += re + kEps * fe.cwiseAbs();
     size = std::max(size, fe.template lpNorm<Eigen::Infinity>());
     if (!stiffness) continue;
     const int* slots = &element_slots_[kN2 * k];
@@ -761,7 +847,9 @@ double MultibodyModel::ElementForces(const VectorXd& q, VectorXd* full, SkylineL
 }
 
 double MultibodyModel::NetForce(const VectorXd& q, double load_factor, VectorXd* f,
-                                SkylineLdlt* stiffness, double stiffness_scale) {
+                                SkylineLdlt* stiffness, double stiffness_scale,
+                                VectorXd* roundoff) {
+  constexpr double kEps = std::numeric_limits<double>::epsilon();
   VectorXd& full = scratch_full_;
   full = load_factor * constant_force_;
   // A torque T on a body: its virtual work T . dphi, with de_k = dphi x e_k,
@@ -789,11 +877,25 @@ double MultibodyModel::NetForce(const VectorXd& q, double load_factor, VectorXd*
   const int n = coordinates();
   for (int i = 0; i < n; ++i)
     if (j_[i] >= 0) size = std::max(size, std::abs(full(i)));
-  size = std::max(size, dim_ == 2 ? ElementForces<2>(q, &full, stiffness, stiffness_scale)
-                                  : ElementForces<3>(q, &full, stiffness, stiffness_scale));
+  // Rounding of the applied terms (torques included, through |full|).
+  VectorXd* full_roundoff = nullptr;
+  if (roundoff) {
+    full_roundoff = &scratch_roundoff_;
+    *full_roundoff = kEps * full.cwiseAbs();
+  }
+  size = std::max(size, dim_ == 2 ? ElementForces<2>(q, &full, stiffness, stiffness_scale,
+                                                     full_roundoff)
+                                  : ElementForces<3>(q, &full, stiffness, stiffness_scale,
+                                                     full_roundoff));
   f->setZero();
   for (int i = 0; i < n; ++i)
     if (j_[i] >= 0) (*f)(j_[i]) += s_(i) * full(i);
+  if (roundoff) {
+    roundoff->setZero();
+    for (int i = 0; i < n; ++i)
+      if (j_[i] >= 0)
+        (*roundoff)(j_[i]) += std::abs(s_(i)) * ((*full_roundoff)(i) + kEps * std::abs(full(i)));
+  }
   return size;
 }
 

@@ -67,7 +67,9 @@ class MultibodyModel {
   int dofs() const { return dofs_; }
   int multipliers() const { return static_cast<int>(rows_.size()); }
   int elements() const { return static_cast<int>(elements2_.size() + elements3_.size()); }
-  int nodes() const { return num_nodes_; }
+  // Nodes of the mesh; a node split where a cable without bending
+  // stiffness kinks (Build) counts once.
+  int nodes() const { return num_nodes_ - split_nodes_; }
   ModelInfo Info() const;
 
   // Initial unknowns and their rates: the scene's rigid initial motion,
@@ -76,6 +78,11 @@ class MultibodyModel {
   double initial_velocity_correction() const { return initial_velocity_correction_; }
   const Eigen::VectorXd& initial_z() const { return z0_; }
   const Eigen::VectorXd& initial_v() const { return v0_; }
+
+  // Starts the motion from unknowns z instead of the scene's layout (its
+  // static equilibrium, say): the scene's rigid initial velocity is taken
+  // at that configuration and projected onto the joints as in Build.
+  void SetInitialState(const Eigen::VectorXd& z);
 
   // q = c + S z, and qdot = S zdot.
   void ToFull(const Eigen::VectorXd& z, Eigen::VectorXd* q) const;
@@ -97,13 +104,21 @@ class MultibodyModel {
   // Returns the size of the terms that were added, max(|Q_a|_inf, |Q_k|_inf)
   // over the coordinates that move: the scale against which Newton residuals
   // are small (the two nearly cancel at equilibrium).
+  // When `roundoff` is not null, it receives per unknown a bound on the
+  // rounding error of f: the elements' bounds (AncfCableElement::
+  // ElasticForce: coordinates known to eps |q| only, amplified by the
+  // stiffness) plus eps times every term summed into the entry. This is the
+  // floor below which no Newton iteration can push the residual.
   double NetForce(const Eigen::VectorXd& q, double load_factor, Eigen::VectorXd* f,
-                  SkylineLdlt* stiffness = nullptr, double stiffness_scale = 0);
+                  SkylineLdlt* stiffness = nullptr, double stiffness_scale = 0,
+                  Eigen::VectorXd* roundoff = nullptr);
 
-  // The level below which force residuals are rounding error: 100 machine
-  // epsilons of the stiffest element's EA or EI / l^2 [N]. Newton cannot
-  // drive a residual below it, so it is added to the convergence threshold.
-  double force_roundoff() const { return force_roundoff_; }
+  // The energy [J] below which a change of the total energy is rounding:
+  // sum over elements of (EA + EI / l^2) l d^2, d = 16 eps (1 + |q0|_inf) / l,
+  // the strain energy of the strain (and curvature) that coordinates known
+  // only to their last bits can hold. The energy checks of a dynamic run
+  // ignore rises below it (a cable at rest stays at rest silently).
+  double energy_roundoff() const { return energy_roundoff_; }
 
   // Constraint values Phi(q) [multipliers()] and Jacobian dPhi/dz.
   void Constraints(const Eigen::VectorXd& q, Eigen::VectorXd* phi, SparseRows* jac) const;
@@ -181,7 +196,7 @@ class MultibodyModel {
 
   template <int D>
   double ElementForces(const Eigen::VectorXd& q, Eigen::VectorXd* full, SkylineLdlt* stiffness,
-                       double stiffness_scale) const;
+                       double stiffness_scale, Eigen::VectorXd* roundoff) const;
   template <int D>
   void ElementEnergy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
                      EnergySample* en) const;
@@ -195,6 +210,13 @@ class MultibodyModel {
   void RowGradient(const Row& row, const Eigen::VectorXd& q, double* grad) const;
   void AddRow(const QuadraticForm& f, Row::Kind kind, int joint, int body);
   void ProjectInitialVelocity();
+  // The scene's rigid initial velocity at full configuration q (all nodes
+  // and bodies; fixed coordinates are dropped by Reduce).
+  void RigidVelocity(const Eigen::VectorXd& q, Eigen::VectorXd* qdot) const;
+  // Unknowns from a full vector, by least squares through q = c + S z
+  // (exact for a full vector the map can produce; c is ignored, so this is
+  // for rates and for positions whose fixed coordinates are c).
+  Eigen::VectorXd Reduce(const Eigen::VectorXd& full) const;
   template <int D>
   const std::vector<ElementData<D>>& Elements() const {
     if constexpr (D == 2) {
@@ -212,16 +234,18 @@ class MultibodyModel {
   Eigen::VectorXd c_, s_;
   std::vector<int> j_;
   int dofs_ = 0;
-  int num_nodes_ = 0;
+  int num_nodes_ = 0;    // including the second half of each split node
+  int split_nodes_ = 0;
   Eigen::VectorXd z0_, v0_;
   double initial_velocity_correction_ = 0;
+  InitialVelocitySpec initial_velocity_;
 
   std::vector<ElementData<2>> elements2_;
   std::vector<ElementData<3>> elements3_;
   std::vector<BodyData> bodies_;
   std::vector<TorqueLoad> torques_;
   Eigen::VectorXd constant_force_;  // full: gravity and point loads
-  double force_roundoff_ = 0;
+  double energy_roundoff_ = 0;
 
   std::vector<Row> rows_;
   std::vector<int> row_coord_;
@@ -252,7 +276,7 @@ class MultibodyModel {
   std::vector<double> element_factors_;
   SparseRows jac_pattern_;
   // Scratch (full size) for NetForce.
-  Eigen::VectorXd scratch_full_;
+  Eigen::VectorXd scratch_full_, scratch_roundoff_;
   // Work done by the torques so far [J].
   double torque_work_ = 0;
 };

@@ -8,7 +8,7 @@
 //   [ B   0   ] [x2] = [r2],
 //
 // A = M + h^2 (K_T + H_lambda) (dynamics) or K_T + H_lambda (statics) on the
-// unknowns, B = Phi_q (MODEL.md section 5), with MINRES or GMRES under the
+// unknowns, B = Phi_q (docs/model.md section 5), with MINRES or GMRES under the
 // block-diagonal preconditioner
 //
 //   P = diag( L|D|L^T , B (L|D|L^T)^{-1} B^T ),

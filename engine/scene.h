@@ -25,6 +25,9 @@ enum class Integrator { kImplicitEuler, kGeneralizedAlpha, kHht };
 // kDirect: exact block elimination (skyline LDL^T of the Newton block and a
 // dense Schur complement); kAuto: picked per scene (SaddlePointSolver).
 enum class LinearSolverKind { kMinres, kGmres, kDirect, kAuto };
+// Where a DYNAMIC run starts: the scene as laid out, or its static
+// equilibrium under gravity and loads (StaticSolver).
+enum class InitialState { kAsGiven, kStatic };
 
 // The scene-file spelling of an enum value, e.g. "DYNAMIC", "MINRES" (what
 // the summary reports).
@@ -122,6 +125,7 @@ struct SolverSettings {
   // Newton economy: keep the factorized Newton matrix across iterations and
   // steps while Newton contracts fast enough (a fresh one otherwise).
   bool reuse_factorization = true;  // GENERALIZED_ALPHA and HHT only
+  InitialState initial_state = InitialState::kAsGiven;  // DYNAMIC only
 };
 
 struct Scene {

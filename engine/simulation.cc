@@ -173,6 +173,8 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   double t = 0;
   double h = h_nominal;
   int successes = 0;
+  // Rises of the total energy below this are rounding (a scene at rest).
+  const double energy_floor = model->energy_roundoff();
   // Backward Euler never raises the energy; the second-order steppers may.
   const bool check_steps = settings.integrator != Integrator::kImplicitEuler;
   summary->min_step_s = settings.adaptive ? std::numeric_limits<double>::infinity() : h_nominal;
@@ -198,7 +200,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
         const double scale =
             std::max({rec->energy_scale(), std::abs(e.kinetic), std::abs(e.potential),
                       std::abs(e.axial) + std::abs(e.bending)});
-        if (e.total - summary->energy_initial > kEnergyRiseLimit * scale) {
+        if (e.total - summary->energy_initial > kEnergyRiseLimit * scale + energy_floor) {
           stepper.Restore();
           ++summary->rejected_steps;
           successes = 0;
@@ -243,6 +245,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
         summary->min_step_s = std::min(summary->min_step_s, h_try);
         summary->max_step_s = std::max(summary->max_step_s, h_try);
         summary->max_newton_residual = std::max(summary->max_newton_residual, st.residual);
+        summary->max_residual_floor = std::max(summary->max_residual_floor, st.residual_floor);
         summary->end_time_s = t;
         // After a run of good steps, go back up towards the nominal step.
         if (!settings.adaptive && h < h_nominal && ++successes >= 4) {
@@ -267,7 +270,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     const double rise = e.total - summary->energy_initial;
     const double scale = std::max({rec->energy_scale(), std::abs(e.kinetic),
                                    std::abs(e.potential), std::abs(e.axial) + std::abs(e.bending)});
-    if (rise > kEnergyRiseLimit * scale) {
+    if (rise > kEnergyRiseLimit * scale + energy_floor) {
       Fail(summary, t,
            absl::StrFormat("the total energy rose by %.3g J (more than %g %% of the largest "
                            "energy term, %.3g J) by t = %.9g s: the stepper is unstable at this "
@@ -288,44 +291,19 @@ void RunStatic(MultibodyModel* model, const SolverSettings& settings, const RunC
                FrameRecorder* rec, RunSummary* summary) {
   StaticSolver solver(model, settings);
   TorqueWork torque_work(model);
-  const int n = settings.load_steps;
-  const double min_increment = std::ldexp(1.0 / n, -settings.max_step_halvings);
-  double alpha = 0;
-  for (int k = 1; k <= n; ++k) {
-    const double target = static_cast<double>(k) / n;
-    double d = target - alpha;
-    while (target - alpha > 1e-12) {
-      if (!MayStep(control, alpha, summary)) return;
-      d = std::min(d, target - alpha);
-      torque_work.Before(solver.z());
-      const auto st = solver.Solve(alpha + d);
-      summary->newton_iterations += st.newton_iterations;
-      summary->linear_iterations += st.linear_iterations;
-      summary->max_linear_residual = std::max(summary->max_linear_residual, st.max_linear_residual);
-      if (st.converged) {
-        alpha += d;
-        torque_work.After(solver.z(), alpha);
-        ++summary->steps;
-        summary->max_newton_residual = std::max(summary->max_newton_residual, st.residual);
-        summary->end_time_s = alpha;
-        continue;
-      }
-      ++summary->rejected_steps;
-      d /= 2;
-      if (d < min_increment * (1 - 1e-12)) {
-        Fail(summary, alpha,
-             absl::StrFormat("load increment from load factor %.6g failed after %d bisections: %s",
-                             alpha, settings.max_step_halvings, st.reason));
-        return;
-      }
-    }
-    alpha = target;
+  auto on_increment = [&](const Eigen::VectorXd& z0, const Eigen::VectorXd& z1, double alpha) {
+    torque_work.Before(z0);
+    torque_work.After(z1, alpha);
+  };
+  auto on_target = [&](double alpha) {
     if (absl::Status s = rec->Emit(alpha, alpha, solver.z(), nullptr, nullptr); !s.ok()) {
       summary->status = "cancelled";
       summary->error = std::string(s.message());
-      return;
+      return false;
     }
-  }
+    return true;
+  };
+  FollowLoadPath(&solver, settings, control, summary, "", on_increment, on_target);
 }
 
 // Forwards frames and keeps every probe position (for the error estimate).
@@ -403,6 +381,35 @@ void EstimateError(MultibodyModel* model, const SolverSettings& settings,
   summary->error_estimate_m = factor * worst;
 }
 
+// solver.initial_state STATIC: moves the model's initial state to the
+// static equilibrium under the full gravity and loads (the load path of
+// STATIC analysis, without its frames), solved to the rounding floor of the
+// forces (newton_tolerance 1e-12) so that the motion starting there stays
+// at rest to about a nanometre. Its Newton iterations count in the run's.
+// False, with the summary failed at t = 0, when there is no equilibrium.
+bool StartFromEquilibrium(MultibodyModel* model, const SolverSettings& settings,
+                          const RunControl& control, RunSummary* summary) {
+  SolverSettings statics = settings;
+  statics.analysis = Analysis::kStatic;
+  statics.newton_tolerance = std::min(settings.newton_tolerance, 1e-12);
+  StaticSolver solver(model, statics);
+  RunSummary path;
+  const bool ok = FollowLoadPath(&solver, statics, control, &path,
+                                 "solver.initial_state STATIC: ", nullptr, nullptr);
+  summary->newton_iterations += path.newton_iterations;
+  summary->linear_iterations += path.linear_iterations;
+  summary->max_linear_residual = std::max(summary->max_linear_residual, path.max_linear_residual);
+  summary->max_residual_floor = std::max(summary->max_residual_floor, path.max_residual_floor);
+  if (!ok) {
+    summary->status = path.status;
+    summary->error = path.error;
+    summary->failure_time_s = 0;
+    return false;
+  }
+  model->SetInitialState(solver.z());
+  return true;
+}
+
 }  // namespace
 
 absl::StatusOr<ModelInfo> DescribeModel(const Scene& scene) {
@@ -447,6 +454,9 @@ absl::StatusOr<RunSummary> RunScene(const Scene& scene, FrameSink* sink,
     RunStatic(&model, settings, control, &recorder, &summary);
   } else if (settings.analysis == Analysis::kModal) {
     RunModalAnalysis(&model, settings, modes, control, sink, &summary);
+  } else if (settings.initial_state == InitialState::kStatic &&
+             !StartFromEquilibrium(&model, settings, control, &summary)) {
+    // The summary says why; no frame was delivered.
   } else {
     RunDynamic(&model, settings, control, &recorder, &summary);
     if (!std::isfinite(summary.min_step_s)) summary.min_step_s = 0;

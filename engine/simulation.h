@@ -26,7 +26,7 @@ struct ModelInfo {
   int dofs = 0;            // unknowns after removing ground-fixed ones
   int multipliers = 0;     // Lagrange multipliers (constraint equations)
   int elements = 0;        // cable elements, inserted nodes included
-  int nodes = 0;
+  int nodes = 0;           // cable nodes (a node split where a cable kinks counts once)
   std::vector<std::string> probe_names;
 };
 
@@ -93,6 +93,10 @@ struct RunSummary {
   double energy_max_increase = 0;  // largest rise of the total above its start
   double max_constraint_violation = 0;
   double max_newton_residual = 0;  // largest accepted Newton residual norm
+  // The largest rounding floor of an accepted Newton residual, relative as
+  // max_newton_residual (engine/newton_convergence.h): what double
+  // precision cannot resolve in these coordinates.
+  double max_residual_floor = 0;
   double max_linear_residual = 0;  // largest true relative residual of a solve
   // MODAL: the natural frequencies [Hz], ascending (engine/modal_solver.h).
   std::vector<double> frequencies_hz;

@@ -33,6 +33,39 @@ void SkylineLdlt::Multiply(const double* x, double* y) const {
   }
 }
 
+void SkylineLdlt::AddAbsMultiply(const double* x, double* y) const {
+  for (int i = 0; i < n_; ++i) {
+    const double* row = &values_[start_[i]];
+    const int f = first_[i];
+    double acc = 0;
+    for (int j = f; j < i; ++j) {
+      const double a = std::abs(row[j - f]);
+      acc += a * std::abs(x[j]);
+      y[j] += a * std::abs(x[i]);
+    }
+    y[i] += acc + std::abs(row[i - f] * x[i]);
+  }
+}
+
+void SkylineLdlt::MultiplyWithAbs(const double* x, double* y, double* abs_y) const {
+  for (int i = 0; i < n_; ++i) y[i] = 0;
+  for (int i = 0; i < n_; ++i) {
+    const double* row = &values_[start_[i]];
+    const int f = first_[i];
+    const double xi = x[i], axi = std::abs(xi);
+    double acc = 0, abs_acc = 0;
+    for (int j = f; j < i; ++j) {
+      const double a = row[j - f], aa = std::abs(a);
+      acc += a * x[j];
+      abs_acc += aa * std::abs(x[j]);
+      y[j] += a * xi;
+      abs_y[j] += aa * axi;
+    }
+    y[i] += acc + row[i - f] * xi;
+    abs_y[i] += abs_acc + std::abs(row[i - f]) * axi;
+  }
+}
+
 bool SkylineLdlt::Factor(double tiny) {
   small_pivots_ = 0;
   negative_pivots_ = 0;

@@ -42,6 +42,11 @@ class SkylineLdlt {
 
   // y = A x (the matrix as assembled, not the factor).
   void Multiply(const double* x, double* y) const;
+  // y += |A| |x| (entrywise absolute values): a bound on the terms summed
+  // into A x, for rounding estimates.
+  void AddAbsMultiply(const double* x, double* y) const;
+  // Both in one pass over the matrix: y = A x and abs_y += |A| |x|.
+  void MultiplyWithAbs(const double* x, double* y, double* abs_y) const;
 
   // Factorizes a copy of the assembled values. Returns false if a pivot is
   // not finite. Pivots smaller than `tiny` in magnitude are replaced by

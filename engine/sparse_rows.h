@@ -6,6 +6,7 @@
 // model is built and whose values change every Newton iteration. Repeated
 // column indices in a row are allowed and add up.
 
+#include <cmath>
 #include <vector>
 
 #include <Eigen/Core>
@@ -32,6 +33,13 @@ struct SparseRows {
   void AddTransposeMultiply(const double* x, double* y) const {
     for (int r = 0; r < rows(); ++r)
       for (int k = row_start[r]; k < row_start[r + 1]; ++k) y[col[k]] += value[k] * x[r];
+  }
+  // y += s |J|^T |x| (entrywise absolute values): a bound on the terms
+  // summed into s J^T x, for rounding estimates.
+  void AddAbsTransposeMultiply(const double* x, double* y, double s = 1.0) const {
+    for (int r = 0; r < rows(); ++r)
+      for (int k = row_start[r]; k < row_start[r + 1]; ++k)
+        y[col[k]] += std::abs(s * value[k] * x[r]);
   }
 };
 

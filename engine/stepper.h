@@ -35,6 +35,7 @@ class Stepper {
     int factorizations = 0;            // Newton matrices assembled and factored
     int direct_fallbacks = 0;          // DIRECT solves that had to run MINRES
     double residual = 0;               // relative momentum residual accepted
+    double residual_floor = 0;         // its rounding floor (newton_convergence.h)
     double max_linear_residual = 0;    // largest true relative residual
     std::string reason;                // why it did not converge
   };

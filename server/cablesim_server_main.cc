@@ -9,16 +9,21 @@
 
 #include <signal.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
+#include <string>
 #include <fstream>
 #include <iostream>
 #include <thread>
 #include <vector>
 
 #include "absl/flags/flag.h"
-#include "absl/flags/parse.h"
-#include "absl/flags/usage.h"
+#include "absl/flags/reflection.h"
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "cablesim/version.h"
 #include "server/cablesim_server.h"
 
 ABSL_FLAG(std::string, listen, "127.0.0.1:50051", "host:port to listen on (port 0: any free)");
@@ -41,28 +46,89 @@ ABSL_FLAG(double, stall_timeout_s, 30, "cancel a stream whose client reads nothi
 ABSL_FLAG(double, shutdown_grace_s, 2,
           "on SIGTERM, wait this long for calls (and idle client connections) to end");
 
-int main(int argc, char** argv) {
-  absl::SetProgramUsageMessage("cablesim-server --listen HOST:PORT --data-dir DIR [--workers N]");
-  // Accept --data-dir as well as absl's --data_dir spelling.
-  std::vector<std::string> args(argv, argv + argc);
-  for (size_t i = 1; i < args.size(); ++i) {
-    std::string& a = args[i];
-    if (a.rfind("--", 0) != 0) continue;
-    const size_t end = std::min(a.find('='), a.size());
-    for (size_t k = 2; k < end; ++k) {
-      if (a[k] == '-') a[k] = '_';
+namespace {
+
+constexpr char kUsage[] =
+    "Usage: cablesim-server --listen HOST:PORT --data-dir DIR [--workers N] [--LIMIT N ...]\n"
+    "\n"
+    "The cablesim gRPC service (proto/cablesim/v1/service.proto): runs, durable jobs\n"
+    "and sweeps, with the jobs in SQLite under DIR. Flags may be written --data-dir\n"
+    "or --data_dir, --flag=value or --flag value.\n"
+    "\n"
+    "Exit status: 0 after SIGTERM or SIGINT (running jobs stay queued) and for\n"
+    "--help and --version, 1 when the server cannot start (address in use, data\n"
+    "directory unusable), 2 for a usage error.\n";
+
+// The flags of this file, sorted, as --help lists them.
+void PrintHelp(std::ostream& out) {
+  out << kUsage << "\nFlags:\n";
+  std::vector<const absl::CommandLineFlag*> flags;
+  for (const auto& [name, flag] : absl::GetAllFlags()) {
+    if (absl::StrContains(flag->Filename(), "cablesim_server_main")) flags.push_back(flag);
+  }
+  std::sort(flags.begin(), flags.end(),
+            [](const auto* a, const auto* b) { return a->Name() < b->Name(); });
+  for (const absl::CommandLineFlag* flag : flags) {
+    std::string name(flag->Name());
+    std::replace(name.begin(), name.end(), '_', '-');
+    out << "  --" << name << "  " << flag->Help() << " (default: " << flag->DefaultValue()
+        << ")\n";
+  }
+}
+
+int UsageError(const std::string& message) {
+  std::cerr << "cablesim-server: " << message << "\n" << kUsage;
+  return 2;
+}
+
+// Sets the flags from the command line. Done here rather than with
+// absl::ParseCommandLine, which exits with status 1 for --help and for a
+// usage error alike. Returns the exit code when the program should stop.
+std::optional<int> ParseFlags(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h" || arg == "-help" || arg == "--helpfull") {
+      PrintHelp(std::cout);
+      return 0;
+    }
+    if (arg == "--version" || arg == "-version") {
+      std::cout << cablesim::VersionLine("cablesim-server") << "\n";
+      return 0;
+    }
+    if (arg.size() < 3 || arg.rfind("--", 0) != 0) {
+      return UsageError(absl::StrCat("unexpected argument \"", arg, "\""));
+    }
+    std::string name = arg.substr(2);
+    std::optional<std::string> value;
+    if (const size_t eq = name.find('='); eq != std::string::npos) {
+      value = name.substr(eq + 1);
+      name.resize(eq);
+    }
+    std::replace(name.begin(), name.end(), '-', '_');  // --data-dir is --data_dir
+    absl::CommandLineFlag* flag = absl::FindCommandLineFlag(name);
+    if (flag == nullptr || !absl::StrContains(flag->Filename(), "cablesim_server_main")) {
+      return UsageError(absl::StrCat("unknown flag ", arg));
+    }
+    if (!value.has_value()) {
+      if (i + 1 >= argc) return UsageError(absl::StrCat(arg, " needs a value"));
+      value = argv[++i];
+    }
+    std::string error;
+    if (!flag->ParseFrom(*value, &error)) {
+      return UsageError(absl::StrCat("--", name, ": ", error));
     }
   }
-  std::vector<char*> arg_ptrs;
-  for (std::string& a : args) arg_ptrs.push_back(a.data());
-  absl::ParseCommandLine(static_cast<int>(arg_ptrs.size()), arg_ptrs.data());
+  return std::nullopt;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (const std::optional<int> exit_code = ParseFlags(argc, argv)) return *exit_code;
   cablesim::ServerOptions options;
   options.listen = absl::GetFlag(FLAGS_listen);
   options.data_dir = absl::GetFlag(FLAGS_data_dir);
-  if (options.data_dir.empty()) {
-    std::cerr << "cablesim-server: --data-dir is required\n";
-    return 2;
-  }
+  if (options.data_dir.empty()) return UsageError("--data-dir is required");
   options.workers = absl::GetFlag(FLAGS_workers);
   if (options.workers <= 0) options.workers = std::max(1u, std::thread::hardware_concurrency());
   cablesim::ServerLimits& limits = options.limits;

@@ -7,7 +7,10 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "cablesim/version.h"
+#include "convert/plausible_ranges.h"
 #include "convert/run_proto.h"
+#include "convert/scene_file.h"
 #include "server/energy_report.h"
 
 namespace cablesim {
@@ -229,7 +232,10 @@ grpc::Status CablesimServiceImpl::Validate(grpc::ServerContext*, const v1::Valid
   // The same checks as Run and SubmitJob, limits included (so a scene the
   // server would refuse is never called valid, and costs no more to
   // validate than to refuse).
-  absl::StatusOr<CheckedScene> checked = CheckScene(request->scene(), limits_);
+  const absl::StatusOr<v1::Scene> scene =
+      SceneOfRequest(request->has_scene(), request->scene(), request->scene_json());
+  absl::StatusOr<CheckedScene> checked =
+      scene.ok() ? CheckScene(*scene, limits_) : absl::StatusOr<CheckedScene>(scene.status());
   if (checked.ok()) {
     response->set_valid(true);
     *response->mutable_model() = ModelInfoToProto(checked->info);
@@ -263,7 +269,10 @@ grpc::Status CablesimServiceImpl::Run(grpc::ServerContext* context, const v1::Ru
                         absl::StrCat("the server already runs ", limits_.max_streams,
                                      " streams (max_streams); try again later"));
   }
-  absl::StatusOr<CheckedScene> checked = CheckScene(request->scene(), limits_);
+  const absl::StatusOr<v1::Scene> scene =
+      SceneOfRequest(request->has_scene(), request->scene(), request->scene_json());
+  if (!scene.ok()) return ToGrpc(scene.status());
+  absl::StatusOr<CheckedScene> checked = CheckScene(*scene, limits_);
   if (!checked.ok()) return ToGrpc(checked.status());
   StreamingSink sink(writer, slot.watch(), BatchSize(request->frames_per_batch()),
                      checked->scene.name, checked->end_time_s);
@@ -286,7 +295,10 @@ grpc::Status CablesimServiceImpl::SubmitJob(grpc::ServerContext*,
                                             const v1::SubmitJobRequest* request,
                                             v1::Job* response) {
   if (jobs_ == nullptr) return NoJobs();
-  absl::StatusOr<v1::Job> job = jobs_->Submit(request->scene());
+  const absl::StatusOr<v1::Scene> scene =
+      SceneOfRequest(request->has_scene(), request->scene(), request->scene_json());
+  if (!scene.ok()) return ToGrpc(scene.status());
+  absl::StatusOr<v1::Job> job = jobs_->Submit(*scene);
   if (!job.ok()) return ToGrpc(job.status());
   *response = std::move(*job);
   if (log_) std::cerr << "cablesim-server: job " << response->id() << " queued\n";
@@ -421,7 +433,15 @@ grpc::Status CablesimServiceImpl::SubmitSweep(grpc::ServerContext*,
                                               const v1::SubmitSweepRequest* request,
                                               v1::Sweep* response) {
   if (jobs_ == nullptr) return NoJobs();
-  absl::StatusOr<v1::Sweep> sweep = jobs_->SubmitSweep(*request);
+  v1::SubmitSweepRequest submitted = *request;
+  if (!request->base_json().empty()) {
+    absl::StatusOr<v1::Scene> base =
+        SceneOfRequest(request->has_base(), request->base(), request->base_json(), "base_json");
+    if (!base.ok()) return ToGrpc(base.status());
+    *submitted.mutable_base() = std::move(*base);
+    submitted.clear_base_json();
+  }
+  absl::StatusOr<v1::Sweep> sweep = jobs_->SubmitSweep(submitted);
   if (!sweep.ok()) return ToGrpc(sweep.status());
   *response = std::move(*sweep);
   if (log_)
@@ -514,6 +534,27 @@ grpc::Status CablesimServiceImpl::GetSweepResults(grpc::ServerContext*,
       if (result.ok()) *response->mutable_final_columns() = result->header.columns();
     }
   }
+  return grpc::Status::OK;
+}
+
+grpc::Status CablesimServiceImpl::GetServerInfo(grpc::ServerContext*,
+                                                const v1::GetServerInfoRequest*,
+                                                v1::ServerInfo* response) {
+  response->set_version(CABLESIM_VERSION);
+  response->set_build_type(CABLESIM_BUILD_TYPE);
+  response->set_sanitizers(CABLESIM_SANITIZERS);
+  response->set_max_elements(limits_.max_elements);
+  response->set_max_steps(limits_.max_steps);
+  response->set_max_frames(limits_.max_frames);
+  response->set_max_trajectory_values(limits_.max_trajectory_values);
+  response->set_max_sweep_items(limits_.max_sweep_items);
+  response->set_max_streams(limits_.max_streams);
+  response->set_max_message_bytes(limits_.max_message_bytes);
+  response->set_stall_timeout_s(absl::ToDoubleSeconds(limits_.stall_timeout));
+  response->set_max_scene_bytes(kMaxSceneBytes);
+  response->set_max_scene_nesting(kMaxSceneNesting);
+  response->set_max_name_bytes(plausible::kMaxNameBytes);
+  response->set_jobs(jobs_ != nullptr);
   return grpc::Status::OK;
 }
 

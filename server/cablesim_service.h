@@ -57,6 +57,9 @@ class CablesimServiceImpl final : public v1::CablesimService::Service {
   grpc::Status GetSweepResults(grpc::ServerContext* context,
                                const v1::GetSweepResultsRequest* request,
                                v1::SweepResults* response) override;
+  grpc::Status GetServerInfo(grpc::ServerContext* context,
+                             const v1::GetServerInfoRequest* request,
+                             v1::ServerInfo* response) override;
 
   // Tracks one stream's writes for the stall watchdog.
   struct StreamWatch {

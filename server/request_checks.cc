@@ -6,6 +6,7 @@
 #include "absl/strings/str_format.h"
 #include "convert/run_proto.h"
 #include "convert/scene_field_path.h"
+#include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
 
 namespace cablesim {
@@ -42,6 +43,20 @@ absl::Status CheckStringLengths(const google::protobuf::Message& message,
     }
   }
   return absl::OkStatus();
+}
+
+absl::StatusOr<v1::Scene> SceneOfRequest(bool has_scene, const v1::Scene& scene,
+                                         const std::string& json, absl::string_view json_field) {
+  if (json.empty()) return scene;
+  if (has_scene) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(json_field, ": give the scene either as a message or as JSON text, not both"));
+  }
+  absl::StatusOr<v1::Scene> parsed = ParseSceneJson(json);
+  if (!parsed.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat(json_field, ": ", parsed.status().message()));
+  }
+  return parsed;
 }
 
 absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimits& limits) {

@@ -8,9 +8,11 @@
 
 #include <cstdint>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 #include "absl/time/time.h"
 #include "cablesim/v1/service.pb.h"
 #include "engine/simulation.h"
@@ -49,6 +51,14 @@ struct CheckedScene {
   int64_t nominal_steps = 0;  // duration / step, or load steps
   int64_t frames = 0;         // output frames the run will write
 };
+
+// The scene a request carries: `scene`, or `json` (its JSON text, the
+// request field `json_field`) parsed with the strict scene-file parser
+// (convert/scene_file.h). InvalidArgument, starting with `json_field: `,
+// when both are given or the text does not parse.
+absl::StatusOr<v1::Scene> SceneOfRequest(bool has_scene, const v1::Scene& scene,
+                                         const std::string& json,
+                                         absl::string_view json_field = "scene_json");
 
 // Validates `proto`, builds its model and checks it against `limits`:
 // every string's length, the steps, frames and numbers kept, the elements

@@ -14,6 +14,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
+#include "cablesim/version.h"
 
 namespace cablesim {
 namespace {
@@ -139,6 +140,26 @@ TEST(CliEndToEndTest, SpatialPendulum) {
   double zmax = 0;
   for (const auto& row : csv.rows) zmax = std::max(zmax, std::abs(row[3]));
   EXPECT_GT(zmax, 0.5);
+}
+
+// Both binaries say their version and build type (from CMake) and print
+// their usage with exit code 0; a usage error exits with 2.
+TEST(CliEndToEndTest, VersionAndHelpOfBothBinaries) {
+  const std::string bin = CABLESIM_BIN_DIR;
+  for (const std::string program : {"cablesim", "cablesim-server"}) {
+    const Process version = RunCommand(absl::StrCat(bin, "/", program, " --version"));
+    EXPECT_EQ(version.exit_code, 0) << program;
+    EXPECT_EQ(version.out, VersionLine(program) + "\n");
+    EXPECT_THAT(version.out, HasSubstr(absl::StrCat("(", CABLESIM_BUILD_TYPE, " build")));
+    const Process help = RunCommand(absl::StrCat(bin, "/", program, " --help"));
+    EXPECT_EQ(help.exit_code, 0) << program;
+    EXPECT_THAT(help.out, HasSubstr("Exit status: 0"));
+    const Process bad = RunCommand(absl::StrCat(bin, "/", program, " --no-such-flag 2>/dev/null"));
+    EXPECT_EQ(bad.exit_code, 2) << program;
+  }
+  const Process help = RunCommand(bin + "/cablesim-server --help");
+  EXPECT_THAT(help.out, HasSubstr("--data-dir  directory of the job database"));
+  EXPECT_THAT(help.out, HasSubstr("--max-message-bytes"));
 }
 
 }  // namespace

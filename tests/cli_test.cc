@@ -101,6 +101,31 @@ TEST(CliTest, Help) {
   }
 }
 
+TEST(CliTest, SweepRefusesABaseFileOutsideItsDirectoryUnlessAllowed) {
+  // The sample sweep's base scene is in ../scenes.
+  const std::string sweep = absl::StrCat(CABLESIM_SOURCE_DIR, "/sweeps/pendulum-resolution.json");
+  const CliResult refused = Cli({"sweep", sweep});
+  EXPECT_EQ(refused.code, 2);
+  EXPECT_THAT(refused.err, HasSubstr("base_file: must be under the sweep file's directory"));
+  const CliResult bad_flag = Cli({"sweep", sweep, "--allow-outside=yes"});
+  EXPECT_EQ(bad_flag.code, 2);
+  EXPECT_THAT(bad_flag.err, HasSubstr("--allow-outside takes no value"));
+  EXPECT_EQ(Cli({"run", SampleScene("falling-pendulum.json"), "--allow-outside"}).code, 2);
+}
+
+// `energy --out` names its columns as the run CSV does.
+TEST(CliTest, EnergyCsvUsesTheRunCsvColumnNames) {
+  const std::string scene = WriteTempFile("energy_scene.json", kTinyScene);
+  const std::string csv = absl::StrCat(::testing::TempDir(), "/cli_test_energy.csv");
+  const CliResult r = Cli({"energy", scene, "--out", csv});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::vector<std::string> lines = ReadLines(csv);
+  ASSERT_EQ(lines.size(), 4u);  // header and 3 frames
+  EXPECT_EQ(lines[0],
+            "t,energy.kinetic,energy.potential,energy.axial,energy.bending,energy.total,"
+            "constraint.violation");
+}
+
 TEST(CliTest, MissingFileIsBadInput) {
   for (const char* command : {"run", "validate"}) {
     const CliResult r = Cli({command, "/nonexistent/scene.json"});

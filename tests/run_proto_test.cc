@@ -43,6 +43,7 @@ RunSummary EveryFieldSet() {
   s.max_constraint_violation = 23;
   s.max_newton_residual = 24;
   s.max_linear_residual = 25;
+  s.max_residual_floor = 0.034;
   s.frequencies_hz = {26, 27};
   s.linear_solver_used = "DIRECT";
   s.factorizations = 28;

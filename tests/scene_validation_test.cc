@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -341,6 +344,73 @@ std::vector<InvalidCase> InvalidCases() {
        absl::StrCat(R"({"cables": [)", kCable,
                     R"(], "solver": {"duration": 1, "linear_solver": 9}})"),
        "solver.linear_solver: ", "MINRES, GMRES, DIRECT or AUTO"},
+      // Physical plausibility: finite but absurd values are refused before
+      // the engine starts, naming the field and the range.
+      {"HugeDensity",
+       R"({"cables": [{"name": "c", "length": 1, "density": 1e308, "youngs_modulus": 1e7,
+                       "diameter": 0.01}], "solver": {"duration": 1}})",
+       "cables[0].density: ", "must be in [1e-6, 1e6] kg/m^3 (got 1e308)"},
+      {"StartFarAway",
+       R"({"cables": [{"name": "c", "length": 1, "start": {"y": 1e20}, "density": 1000,
+                       "youngs_modulus": 1e7, "diameter": 0.01}], "solver": {"duration": 1}})",
+       "cables[0].start.y: ", "must be in [-1e6, 1e6] m (got 1e20)"},
+      {"DenormalStep",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"duration": 1, "step": 1e-310, "output_interval": 1}})"),
+       "solver.step: ", "must be in [1e-9, 1e4] s"},
+      {"TooManySteps",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"duration": 1e6, "step": 1e-6, "output_interval": 1}})"),
+       "solver.step: ", "steps (at most 1e10)"},
+      {"HugeDirection",
+       R"({"cables": [{"name": "c", "length": 1, "direction": {"x": 1e308, "y": 1e308},
+                       "density": 1000, "youngs_modulus": 1e7, "diameter": 0.01}],
+           "solver": {"duration": 1}})",
+       "cables[0].direction: ", "norm overflows"},
+      {"HugeBodyAxis",
+       Scene1(R"("bodies": [{"name": "b", "mass": 2, "inertia": {"z": 1},
+                             "axis": {"x": -1e308, "y": 1e308}}], )"),
+       "bodies[0].axis: ", "norm overflows"},
+      {"PolylinePointsHuge",
+       R"({"cables": [{"name": "c", "points": [{"x": -1e308}, {"x": 1e308}], "density": 1000,
+                       "youngs_modulus": 1e7, "diameter": 0.01}], "solver": {"duration": 1}})",
+       "cables[0].points[0].x: ", "must be in [-1e6, 1e6] m (got -1e308)"},
+      {"PolylineFoldsBack",
+       R"({"cables": [{"name": "c", "points": [{"x": 0}, {"x": 1}, {"x": 0.5}], "density": 1000,
+                       "youngs_modulus": 1e7, "diameter": 0.01}], "solver": {"duration": 1}})",
+       "cables[0].points[1]: ", "folds back at this corner (turns by 180.0 degrees"},
+      {"PolylineLongerThanRange",
+       R"({"cables": [{"name": "c", "points": [{"x": -1e6}, {"x": 1e6}], "density": 1000,
+                       "youngs_modulus": 1e7, "diameter": 0.01}], "solver": {"duration": 1}})",
+       "cables[0].points: ", "polyline length must be in [1e-6, 1e5] m (got 2e6)"},
+      {"TinyModulus",
+       R"({"cables": [{"name": "c", "length": 1, "density": 1000, "youngs_modulus": 1e-3,
+                       "diameter": 0.01}], "solver": {"duration": 1}})",
+       "cables[0].youngs_modulus: ", "must be in [1, 1e13] Pa"},
+      {"HugeDiameter",
+       R"({"cables": [{"name": "c", "length": 1, "density": 1000, "youngs_modulus": 1e7,
+                       "diameter": 1e200}], "solver": {"duration": 1}})",
+       "cables[0].diameter: ", "must be in [1e-6, 1000] m"},
+      {"HugeSecondMoment",
+       R"({"cables": [{"name": "c", "length": 1, "density": 1000, "youngs_modulus": 1e7,
+                       "area": 1e-4, "second_moment": 1e300}], "solver": {"duration": 1}})",
+       "cables[0].second_moment: ", "must be in [1e-30, 1e12] m^4"},
+      {"HugeBodyMass",
+       Scene1(R"("bodies": [{"name": "b", "mass": 1e30, "inertia": {"z": 1}}], )"),
+       "bodies[0].mass: ", "must be in [1e-9, 1e9] kg"},
+      {"HugeForce",
+       Scene1(R"("loads": [{"at": {"cable": "c", "s": 1}, "force": {"y": -1e300}}], )"),
+       "loads[0].force.y: ", "must be in [-1e12, 1e12] N"},
+      {"HugeInitialVelocity",
+       Scene1(R"("initial_velocity": {"linear": {"x": 3e8}}, )"),
+       "initial_velocity.linear.x: ", "must be in [-1e5, 1e5] m/s"},
+      {"HugeGravity",
+       R"({"gravity": {"y": -1e100}, "cables": [)" + std::string(kCable) + "], " + kSolver + "}",
+       "gravity.y: ", "must be in [-1e6, 1e6] m/s^2"},
+      {"HugeDuration",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"analysis": "STATIC", "duration": 1e300}})"),
+       "solver.duration: ", "must be in [0, 1e9] s"},
   };
 }
 
@@ -360,6 +430,38 @@ INSTANTIATE_TEST_SUITE_P(All, InvalidSceneTest, ::testing::ValuesIn(InvalidCases
                          [](const ::testing::TestParamInfo<InvalidCase>& info) {
                            return std::string(info.param.name);
                          });
+
+// Every invalid scene above is also a seed of the scene fuzz target's corpus
+// (tests/fuzz/corpus/scene/invalid-NAME.json), so the fuzzer starts from
+// each rule. CABLESIM_UPDATE_FUZZ_CORPUS=1 (re)writes the files.
+TEST(FuzzCorpusTest, HoldsEveryInvalidScene) {
+  const std::string dir = std::string(CABLESIM_SOURCE_DIR) + "/tests/fuzz/corpus/scene/";
+  const bool update = std::getenv("CABLESIM_UPDATE_FUZZ_CORPUS") != nullptr;
+  for (const InvalidCase& c : InvalidCases()) {
+    const std::string path = absl::StrCat(dir, "invalid-", c.name, ".json");
+    if (update) std::ofstream(path, std::ios::binary) << c.json;
+    std::ifstream in(path, std::ios::binary);
+    const std::string stored((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(stored, c.json) << path << " is missing or stale";
+  }
+}
+
+// The ranges are wide enough for unusual but real models: a 10 km Kevlar
+// mooring line on a polyline that turns by 90 degrees, a heavy buoy.
+TEST(ScenePlausibilityTest, AcceptsAKevlarMooringTenKilometresLong) {
+  const absl::StatusOr<Scene> scene = ValidateJson(R"({
+    "gravity": {"y": -9.81},
+    "cables": [{"name": "tether", "elements": 200,
+                "points": [{"x": 0}, {"x": 5000}, {"x": 5000, "y": -5000}],
+                "density": 1440, "youngs_modulus": 1.3e11, "diameter": 0.05}],
+    "bodies": [{"name": "buoy", "mass": 5e4, "inertia": {"x": 1e5, "y": 1e5, "z": 1e5},
+                "position": {"x": 5000, "y": -5000}}],
+    "joints": [{"type": "PIN", "a": {"cable": "tether", "s": 0}},
+               {"type": "PIN", "a": {"cable": "tether", "s": 10000}, "b": {"body": "buoy"}}],
+    "solver": {"duration": 3600, "step": 0.5}})");
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  EXPECT_DOUBLE_EQ(scene->cables[0].length_m, 10000);
+}
 
 TEST(SceneParseTest, UnknownJsonFieldIsNamed) {
   const absl::StatusOr<v1::Scene> scene =

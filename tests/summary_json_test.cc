@@ -69,6 +69,7 @@ TEST(SummaryJsonTest, OkSummary) {
                           "energy_dissipated",
                           "energy_max_increase",
                           "max_newton_residual",
+                          "max_residual_floor",
                           "max_linear_residual"}) {
     EXPECT_THAT(json, HasSubstr(std::string("\"") + key + "\":")) << key;
   }

@@ -12,6 +12,8 @@
 #include <vector>
 
 #include <gmock/gmock.h>
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include "absl/strings/str_cat.h"
@@ -79,7 +81,10 @@ constexpr char kConfig[] = R"({"repeats": 1,
              "elements": [10, 20], "linear_solvers": ["MINRES"], "repeats": 1}})";
 
 TEST(WorkPrecisionSmokeTest, TinyReport) {
-  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "work_precision";
+  // A directory of this process's own: another checkout's tests may run
+  // the same test at the same time.
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) /
+                                    ("work_precision_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   const std::filesystem::path config = dir / "config.json";
