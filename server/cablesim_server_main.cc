@@ -36,12 +36,23 @@ ABSL_FLAG(int64_t, max_frames, 200'000, "limit: output frames per run");
 ABSL_FLAG(int64_t, max_trajectory_values, 32 << 20, "limit: frames x columns kept per run");
 ABSL_FLAG(int, max_sweep_items, 1000, "limit: items per sweep");
 ABSL_FLAG(int, max_streams, 64, "limit: concurrent Run streams");
+ABSL_FLAG(int, max_streams_per_peer, 16,
+          "limit: concurrent Run streams of one client address");
+ABSL_FLAG(int64_t, max_queued_jobs_per_peer, 1000,
+          "limit: jobs (sweep items included) one client address has queued or running");
 ABSL_FLAG(int, max_modes, 200, "limit: MODAL modes per run");
 ABSL_FLAG(int64_t, max_modal_bytes, int64_t{1} << 30,
           "limit: estimated memory of a MODAL run's modes (8 x dofs x (3 modes + 1) bytes)");
-ABSL_FLAG(int64_t, max_name_bytes, 1024, "limit: bytes of any string in a request (names)");
+ABSL_FLAG(int64_t, max_name_bytes, 256,
+          "limit: bytes of any string in a request (names, sweep paths); names are also "
+          "bounded by the scene format (256)");
 ABSL_FLAG(int64_t, max_coordinates, 1'000'000, "limit: coordinates of a scene's model");
 ABSL_FLAG(int, max_message_bytes, 16 << 20, "limit: gRPC message size");
+ABSL_FLAG(double, retention_max_age_s, 0,
+          "delete finished jobs and sweeps this many seconds after they finished (0: keep)");
+ABSL_FLAG(int64_t, retention_max_bytes, 0,
+          "delete the oldest finished jobs and sweeps while stored results take more bytes "
+          "than this (0: no limit)");
 ABSL_FLAG(double, stall_timeout_s, 30, "cancel a stream whose client reads nothing this long");
 ABSL_FLAG(double, shutdown_grace_s, 2,
           "on SIGTERM, wait this long for calls (and idle client connections) to end");
@@ -143,6 +154,18 @@ int main(int argc, char** argv) {
   limits.max_modal_bytes = absl::GetFlag(FLAGS_max_modal_bytes);
   limits.max_name_bytes = absl::GetFlag(FLAGS_max_name_bytes);
   limits.max_coordinates = absl::GetFlag(FLAGS_max_coordinates);
+  limits.max_streams_per_peer = absl::GetFlag(FLAGS_max_streams_per_peer);
+  limits.max_queued_jobs_per_peer = absl::GetFlag(FLAGS_max_queued_jobs_per_peer);
+  if (const double age = absl::GetFlag(FLAGS_retention_max_age_s); age > 0) {
+    limits.retention_max_age = absl::Seconds(age);
+  } else if (age < 0) {
+    return UsageError("--retention-max-age-s: must be >= 0");
+  }
+  if (const int64_t bytes = absl::GetFlag(FLAGS_retention_max_bytes); bytes > 0) {
+    limits.retention_max_bytes = bytes;
+  } else if (bytes < 0) {
+    return UsageError("--retention-max-bytes: must be >= 0");
+  }
   limits.stall_timeout = absl::Seconds(absl::GetFlag(FLAGS_stall_timeout_s));
   // Only the tests set this (tests/server_test_util.h); no flag, so it is
   // not offered in --help, and it is announced loudly when present.

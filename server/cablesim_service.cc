@@ -1,7 +1,9 @@
 #include "server/cablesim_service.h"
 
+#include <algorithm>
 #include <chrono>
 #include <iostream>
+#include <limits>
 #include <set>
 #include <utility>
 
@@ -12,6 +14,7 @@
 #include "convert/run_proto.h"
 #include "convert/scene_file.h"
 #include "server/energy_report.h"
+#include "server/job_store.h"
 
 namespace cablesim {
 
@@ -21,18 +24,57 @@ class StreamSlot {
  public:
   // `counted`: the stream takes one of the max_streams slots (runs do;
   // watchers and result downloads only register with the watchdog).
+  // A counted stream also takes one of its peer's max_streams_per_peer
+  // slots (the peer: the client's address without its port), so that one
+  // client cannot hold every slot.
   StreamSlot(CablesimServiceImpl* service, grpc::ServerContext* context, bool counted = true)
       : service_(service), watch_{context}, counted_(counted) {
-    acquired_ = !counted_ || service_->streams_.fetch_add(1) < service_->limits_.max_streams;
+    if (counted_) peer_ = PeerOf(context);
     absl::MutexLock lock(&service_->mu_);
+    if (counted_) {
+      const ServerLimits& limits = service_->limits_;
+      int& mine = service_->peer_streams_[peer_];
+      if (service_->streams_ >= limits.max_streams) {
+        refusal_ = absl::StrCat("the server already runs ", limits.max_streams,
+                                " streams (max_streams); try again later");
+      } else if (mine >= limits.max_streams_per_peer) {
+        refusal_ = absl::StrCat("this client (", peer_, ") already runs ", mine,
+                                " streams, the server's limit is ", limits.max_streams_per_peer,
+                                " (max_streams_per_peer); try again later");
+      }
+      acquired_ = refusal_.empty();
+      if (acquired_) {
+        ++service_->streams_;
+        ++mine;
+      } else if (mine == 0) {
+        service_->peer_streams_.erase(peer_);
+      }
+    } else {
+      acquired_ = true;
+    }
     service_->watched_[&watch_] = true;
   }
   ~StreamSlot() {
-    if (counted_) service_->streams_.fetch_sub(1);
     absl::MutexLock lock(&service_->mu_);
+    if (counted_ && acquired_) {
+      --service_->streams_;
+      if (--service_->peer_streams_[peer_] == 0) service_->peer_streams_.erase(peer_);
+    }
     service_->watched_.erase(&watch_);
   }
   bool acquired() const { return acquired_; }
+  // Why not acquired (names the limit).
+  const std::string& refusal() const { return refusal_; }
+
+  // "ipv4:127.0.0.1:5555" -> "ipv4:127.0.0.1", "ipv6:[::1]:5555" -> "ipv6:[::1]".
+  static std::string PeerOf(const grpc::ServerContext* context) {
+    std::string peer = context->peer();
+    const size_t colon = peer.rfind(':');
+    if ((peer.rfind("ipv4:", 0) == 0 || peer.rfind("ipv6:", 0) == 0) && colon > 5) {
+      peer.resize(colon);
+    }
+    return peer;
+  }
   CablesimServiceImpl::StreamWatch* watch() { return &watch_; }
 
  private:
@@ -40,6 +82,8 @@ class StreamSlot {
   CablesimServiceImpl::StreamWatch watch_;
   const bool counted_;
   bool acquired_ = false;
+  std::string peer_;
+  std::string refusal_;
 };
 
 namespace {
@@ -265,9 +309,7 @@ grpc::Status CablesimServiceImpl::Run(grpc::ServerContext* context, const v1::Ru
                                       grpc::ServerWriter<v1::RunEvent>* writer) {
   StreamSlot slot(this, context);
   if (!slot.acquired()) {
-    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
-                        absl::StrCat("the server already runs ", limits_.max_streams,
-                                     " streams (max_streams); try again later"));
+    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, slot.refusal());
   }
   const absl::StatusOr<v1::Scene> scene =
       SceneOfRequest(request->has_scene(), request->scene(), request->scene_json());
@@ -291,14 +333,14 @@ grpc::Status CablesimServiceImpl::Run(grpc::ServerContext* context, const v1::Ru
   return grpc::Status::OK;
 }
 
-grpc::Status CablesimServiceImpl::SubmitJob(grpc::ServerContext*,
+grpc::Status CablesimServiceImpl::SubmitJob(grpc::ServerContext* context,
                                             const v1::SubmitJobRequest* request,
                                             v1::Job* response) {
   if (jobs_ == nullptr) return NoJobs();
   const absl::StatusOr<v1::Scene> scene =
       SceneOfRequest(request->has_scene(), request->scene(), request->scene_json());
   if (!scene.ok()) return ToGrpc(scene.status());
-  absl::StatusOr<v1::Job> job = jobs_->Submit(*scene);
+  absl::StatusOr<v1::Job> job = jobs_->Submit(*scene, StreamSlot::PeerOf(context));
   if (!job.ok()) return ToGrpc(job.status());
   *response = std::move(*job);
   if (log_) std::cerr << "cablesim-server: job " << response->id() << " queued\n";
@@ -317,12 +359,34 @@ grpc::Status CablesimServiceImpl::GetJob(grpc::ServerContext*, const v1::GetJobR
 grpc::Status CablesimServiceImpl::ListJobs(grpc::ServerContext*, const v1::ListJobsRequest* request,
                                            v1::ListJobsResponse* response) {
   if (jobs_ == nullptr) return NoJobs();
-  const int limit = request->limit() <= 0 ? 100 : std::min(request->limit(), 10000);
+  const int asked = request->page_size() > 0 ? request->page_size() : request->limit();
+  const int limit = asked <= 0 ? 100 : std::min(asked, 10000);
+  // The page token is the id of the last job of the previous page.
+  int64_t before = std::numeric_limits<int64_t>::max();
+  if (!request->page_token().empty()) {
+    before = JobSeq(request->page_token());
+    if (before <= 0) {
+      return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                          "page_token: not a token from a previous ListJobs response");
+    }
+  }
+  // One more than asked, to know whether another page follows.
   absl::StatusOr<std::vector<v1::Job>> jobs =
-      jobs_->store()->ListJobs(request->state(), request->sweep_id(), limit);
+      jobs_->store()->ListJobs(request->state(), request->sweep_id(), limit + 1, before);
   if (!jobs.ok()) return ToGrpc(jobs.status());
-  for (v1::Job& job : *jobs) {
+  // Never a response over the message limit: stop at half of it.
+  const size_t budget = static_cast<size_t>(limits_.max_message_bytes) / 2;
+  size_t bytes = 0;
+  for (size_t i = 0; i < jobs->size(); ++i) {
+    v1::Job& job = (*jobs)[i];
     jobs_->AddProgress(&job);
+    const size_t size = job.ByteSizeLong() + 8;
+    const bool full = static_cast<int>(i) == limit || (i > 0 && bytes + size > budget);
+    if (full) {
+      response->set_next_page_token(response->jobs(response->jobs_size() - 1).id());
+      break;
+    }
+    bytes += size;
     *response->add_jobs() = std::move(job);
   }
   return grpc::Status::OK;
@@ -335,6 +399,28 @@ grpc::Status CablesimServiceImpl::CancelJob(grpc::ServerContext*,
   absl::StatusOr<v1::Job> job = jobs_->Cancel(request->id());
   if (!job.ok()) return ToGrpc(job.status());
   *response = std::move(*job);
+  return grpc::Status::OK;
+}
+
+grpc::Status CablesimServiceImpl::DeleteJob(grpc::ServerContext*,
+                                            const v1::DeleteJobRequest* request,
+                                            v1::DeleteResponse* response) {
+  if (jobs_ == nullptr) return NoJobs();
+  absl::StatusOr<int64_t> freed = jobs_->DeleteJob(request->id());
+  if (!freed.ok()) return ToGrpc(freed.status());
+  response->set_freed_bytes(*freed);
+  if (log_) std::cerr << "cablesim-server: job " << request->id() << " deleted\n";
+  return grpc::Status::OK;
+}
+
+grpc::Status CablesimServiceImpl::DeleteSweep(grpc::ServerContext*,
+                                              const v1::DeleteSweepRequest* request,
+                                              v1::DeleteResponse* response) {
+  if (jobs_ == nullptr) return NoJobs();
+  absl::StatusOr<int64_t> freed = jobs_->DeleteSweep(request->id());
+  if (!freed.ok()) return ToGrpc(freed.status());
+  response->set_freed_bytes(*freed);
+  if (log_) std::cerr << "cablesim-server: sweep " << request->id() << " deleted\n";
   return grpc::Status::OK;
 }
 
@@ -404,9 +490,7 @@ grpc::Status CablesimServiceImpl::GetEnergy(grpc::ServerContext* context,
   if (request->has_scene()) {
     StreamSlot slot(this, context);
     if (!slot.acquired()) {
-      return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
-                          absl::StrCat("the server already runs ", limits_.max_streams,
-                                       " streams (max_streams); try again later"));
+      return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, slot.refusal());
     }
     absl::StatusOr<CheckedScene> checked = CheckScene(request->scene(), limits_);
     if (!checked.ok()) return ToGrpc(checked.status());
@@ -429,7 +513,7 @@ grpc::Status CablesimServiceImpl::GetEnergy(grpc::ServerContext* context,
   return grpc::Status::OK;
 }
 
-grpc::Status CablesimServiceImpl::SubmitSweep(grpc::ServerContext*,
+grpc::Status CablesimServiceImpl::SubmitSweep(grpc::ServerContext* context,
                                               const v1::SubmitSweepRequest* request,
                                               v1::Sweep* response) {
   if (jobs_ == nullptr) return NoJobs();
@@ -441,7 +525,7 @@ grpc::Status CablesimServiceImpl::SubmitSweep(grpc::ServerContext*,
     *submitted.mutable_base() = std::move(*base);
     submitted.clear_base_json();
   }
-  absl::StatusOr<v1::Sweep> sweep = jobs_->SubmitSweep(submitted);
+  absl::StatusOr<v1::Sweep> sweep = jobs_->SubmitSweep(submitted, StreamSlot::PeerOf(context));
   if (!sweep.ok()) return ToGrpc(sweep.status());
   *response = std::move(*sweep);
   if (log_)
@@ -553,8 +637,22 @@ grpc::Status CablesimServiceImpl::GetServerInfo(grpc::ServerContext*,
   response->set_stall_timeout_s(absl::ToDoubleSeconds(limits_.stall_timeout));
   response->set_max_scene_bytes(kMaxSceneBytes);
   response->set_max_scene_nesting(kMaxSceneNesting);
-  response->set_max_name_bytes(plausible::kMaxNameBytes);
+  // The converter's bound on names, or the server's own on every string
+  // of a request (--max-name-bytes) when that is lower.
+  response->set_max_name_bytes(static_cast<int32_t>(
+      std::min<int64_t>(plausible::kMaxNameBytes, limits_.max_name_bytes)));
   response->set_jobs(jobs_ != nullptr);
+  response->set_max_modes(limits_.max_modes);
+  response->set_max_modal_bytes(limits_.max_modal_bytes);
+  response->set_max_coordinates(limits_.max_coordinates);
+  response->set_max_streams_per_peer(limits_.max_streams_per_peer);
+  response->set_max_queued_jobs_per_peer(limits_.max_queued_jobs_per_peer);
+  if (limits_.retention_max_age != absl::InfiniteDuration()) {
+    response->set_retention_max_age_s(absl::ToDoubleSeconds(limits_.retention_max_age));
+  }
+  if (limits_.retention_max_bytes != std::numeric_limits<int64_t>::max()) {
+    response->set_retention_max_bytes(limits_.retention_max_bytes);
+  }
   return grpc::Status::OK;
 }
 

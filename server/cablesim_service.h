@@ -15,6 +15,7 @@
 #include <atomic>
 #include <map>
 #include <memory>
+#include <string>
 #include <thread>
 
 #include "absl/synchronization/mutex.h"
@@ -54,6 +55,10 @@ class CablesimServiceImpl final : public v1::CablesimService::Service {
                            v1::Sweep* response) override;
   grpc::Status WatchSweep(grpc::ServerContext* context, const v1::WatchSweepRequest* request,
                           grpc::ServerWriter<v1::SweepEvent>* writer) override;
+  grpc::Status DeleteJob(grpc::ServerContext* context, const v1::DeleteJobRequest* request,
+                         v1::DeleteResponse* response) override;
+  grpc::Status DeleteSweep(grpc::ServerContext* context, const v1::DeleteSweepRequest* request,
+                           v1::DeleteResponse* response) override;
   grpc::Status GetSweepResults(grpc::ServerContext* context,
                                const v1::GetSweepResultsRequest* request,
                                v1::SweepResults* response) override;
@@ -77,8 +82,10 @@ class CablesimServiceImpl final : public v1::CablesimService::Service {
   JobManager* jobs_;
   const ServerLimits limits_;
   const bool log_;
-  std::atomic<int> streams_{0};
   absl::Mutex mu_;
+  // Counted streams, in all and per peer (StreamSlot).
+  int streams_ ABSL_GUARDED_BY(mu_) = 0;
+  std::map<std::string, int> peer_streams_ ABSL_GUARDED_BY(mu_);
   std::map<StreamWatch*, bool> watched_ ABSL_GUARDED_BY(mu_);
   bool stop_ ABSL_GUARDED_BY(mu_) = false;
   std::thread watchdog_;

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -64,6 +65,7 @@ absl::Status JobManager::Start() {
     absl::MutexLock lock(&mu_);
     for (const std::string& id : *queued) queue_.push_back(id);
   }
+  ApplyRetention();
   for (int i = 0; i < workers_; ++i) threads_.emplace_back([this] { Work(); });
   return absl::OkStatus();
 }
@@ -107,20 +109,23 @@ void JobManager::Enqueue(const std::string& id) {
   ++version_;
 }
 
-absl::StatusOr<v1::Job> JobManager::Submit(const v1::Scene& scene) {
+absl::StatusOr<v1::Job> JobManager::Submit(const v1::Scene& scene, const std::string& peer) {
   absl::StatusOr<CheckedScene> checked = CheckScene(scene, limits_);
   if (!checked.ok()) return checked.status();
-  absl::StatusOr<v1::Job> job = store_->InsertJob(scene, checked->end_time_s);
+  absl::StatusOr<v1::Job> job =
+      store_->InsertJob(scene, checked->end_time_s, peer, limits_.max_queued_jobs_per_peer);
   if (!job.ok()) return job.status();
   Enqueue(job->id());
   return job;
 }
 
-absl::StatusOr<v1::Sweep> JobManager::SubmitSweep(const v1::SubmitSweepRequest& request) {
+absl::StatusOr<v1::Sweep> JobManager::SubmitSweep(const v1::SubmitSweepRequest& request,
+                                                  const std::string& peer) {
   std::vector<double> end_times;
   absl::StatusOr<std::vector<v1::Scene>> items = ExpandSweep(request, limits_, &end_times);
   if (!items.ok()) return items.status();
-  absl::StatusOr<v1::Sweep> sweep = store_->InsertSweep(request, *items, end_times);
+  absl::StatusOr<v1::Sweep> sweep = store_->InsertSweep(request, *items, end_times, peer,
+                                                        limits_.max_queued_jobs_per_peer);
   if (!sweep.ok()) return sweep.status();
   absl::MutexLock lock(&mu_);
   for (const std::string& id : sweep->job_ids()) queue_.push_back(id);
@@ -137,6 +142,39 @@ absl::StatusOr<v1::Job> JobManager::Cancel(const std::string& id) {
   if (!cancelled.ok()) return cancelled.status();
   Changed();
   return Get(id);
+}
+
+absl::StatusOr<int64_t> JobManager::DeleteJob(const std::string& id) {
+  absl::StatusOr<int64_t> freed = store_->DeleteJob(id);
+  if (freed.ok()) Changed();
+  return freed;
+}
+
+absl::StatusOr<int64_t> JobManager::DeleteSweep(const std::string& id) {
+  absl::StatusOr<int64_t> freed = store_->DeleteSweep(id);
+  if (freed.ok()) Changed();
+  return freed;
+}
+
+void JobManager::ApplyRetention() {
+  const bool by_age = limits_.retention_max_age != absl::InfiniteDuration();
+  if (!by_age && limits_.retention_max_bytes == std::numeric_limits<int64_t>::max()) return;
+  const int64_t older_than =
+      by_age ? NowUnixMs() - absl::ToInt64Milliseconds(limits_.retention_max_age)
+             : std::numeric_limits<int64_t>::min();
+  absl::StatusOr<RetentionReport> report =
+      store_->ApplyRetention(older_than, limits_.retention_max_bytes);
+  if (!report.ok()) {
+    if (log_) std::cerr << "cablesim-server: retention: " << report.status() << "\n";
+    return;
+  }
+  if (report->jobs > 0) {
+    if (log_) {
+      std::cerr << "cablesim-server: retention deleted " << report->jobs << " jobs ("
+                << report->sweeps << " sweeps), " << report->bytes << " bytes of results\n";
+    }
+    Changed();
+  }
 }
 
 absl::StatusOr<v1::Job> JobManager::Get(const std::string& id) {
@@ -243,6 +281,7 @@ void JobManager::RunOne(const std::string& id) {
     std::cerr << "cablesim-server: job " << id << " " << v1::JobState_Name(state) << " ("
               << summary.frames << " frames, " << summary.wall_seconds << " s)\n";
   forget();
+  ApplyRetention();
 }
 
 void JobManager::WaitAtTestGate(const std::string& id, const Running& running) {

@@ -39,7 +39,8 @@ CREATE TABLE IF NOT EXISTS jobs (
   attempts INTEGER NOT NULL DEFAULT 0,
   summary BLOB,                 -- cablesim.v1.RunSummary once finished
   sweep_seq INTEGER NOT NULL DEFAULT 0,
-  sweep_index INTEGER NOT NULL DEFAULT 0);
+  sweep_index INTEGER NOT NULL DEFAULT 0,
+  peer TEXT NOT NULL DEFAULT '');  -- the client address that submitted it
 CREATE INDEX IF NOT EXISTS jobs_by_state ON jobs(state, seq);
 CREATE INDEX IF NOT EXISTS jobs_by_sweep ON jobs(sweep_seq, sweep_index);
 CREATE TABLE IF NOT EXISTS results (
@@ -153,9 +154,11 @@ absl::Status SqlError(sqlite3* db) {
   return absl::InternalError(absl::StrCat("sqlite: ", sqlite3_errmsg(db)));
 }
 
+// The last column: bytes of the job's stored result (0 without one).
 constexpr char kJobColumns[] =
     "seq, state, name, created_ms, started_ms, finished_ms, attempts, end_time_s, summary, "
-    "sweep_seq, sweep_index";
+    "sweep_seq, sweep_index, "
+    "(SELECT length(header) + length(vals) FROM results WHERE job_seq = jobs.seq)";
 
 v1::Job JobFromRow(Stmt& s) {
   v1::Job job;
@@ -173,6 +176,7 @@ v1::Job JobFromRow(Stmt& s) {
     job.set_sweep_id(SweepId(s.Int(9)));
     job.set_sweep_index(static_cast<int>(s.Int(10)));
   }
+  job.set_stored_bytes(s.Int(11));
   return job;
 }
 
@@ -283,6 +287,12 @@ absl::Status JobStore::CheckAndMigrate(const std::string& dir) {
     Stmt get(db_, "SELECT value FROM meta WHERE key = 'store_id'");
     if (get.Step() == SQLITE_ROW) stored_id = get.Text(0);
   }
+  if (!stored_id.empty() && !has_jobs) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "the database has lost its schema and jobs (it names store ", stored_id,
+        " but has no jobs table); restore it from a backup, or move the directory aside to "
+        "start afresh"));
+  }
   if (!expected_id.empty() && stored_id != expected_id) {
     return absl::FailedPreconditionError(absl::StrCat(
         "this is not the database of ", dir, " (", id_path, " names store ", expected_id,
@@ -305,6 +315,18 @@ absl::Status JobStore::CheckAndMigrate(const std::string& dir) {
   }
   if (!has_checksum) {
     if (absl::Status s = Exec("ALTER TABLE results ADD COLUMN checksum INTEGER"); !s.ok()) return s;
+  }
+  // Databases from before per-client limits: jobs of no known client.
+  bool has_peer = false;
+  {
+    Stmt columns(db_, "PRAGMA table_info(jobs)");
+    while (columns.Step() == SQLITE_ROW) has_peer |= columns.Text(1) == "peer";
+  }
+  if (!has_peer) {
+    if (absl::Status s = Exec("ALTER TABLE jobs ADD COLUMN peer TEXT NOT NULL DEFAULT ''");
+        !s.ok()) {
+      return s;
+    }
   }
   {
     std::vector<std::pair<int64_t, int64_t>> sums;
@@ -355,18 +377,38 @@ absl::StatusOr<int> JobStore::RequeueRunning() {
   return sqlite3_changes(db_);
 }
 
-absl::StatusOr<v1::Job> JobStore::InsertJob(const v1::Scene& scene, double end_time_s) {
+absl::Status JobStore::CheckPeerRoom(const std::string& peer, int64_t adding,
+                                     int64_t max_unfinished) {
+  if (max_unfinished == std::numeric_limits<int64_t>::max()) return absl::OkStatus();
+  Stmt c(db_, "SELECT COUNT(*) FROM jobs WHERE peer = ?1 AND state IN (?2, ?3)");
+  c.Bind(1, peer).Bind(2, int64_t{v1::QUEUED}).Bind(3, int64_t{v1::RUNNING});
+  if (c.Step() != SQLITE_ROW) return SqlError(db_);
+  const int64_t unfinished = c.Int(0);
+  if (unfinished + adding > max_unfinished) {
+    return absl::ResourceExhaustedError(absl::StrFormat(
+        "this client (%s) has %d jobs queued or running and asks for %d more, the server's "
+        "limit is %d (max_queued_jobs_per_peer); try again when some have finished",
+        peer, unfinished, adding, max_unfinished));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<v1::Job> JobStore::InsertJob(const v1::Scene& scene, double end_time_s,
+                                            const std::string& peer, int64_t max_unfinished) {
   int64_t seq;
   {
     absl::MutexLock lock(&mu_);
+    if (absl::Status st = CheckPeerRoom(peer, 1, max_unfinished); !st.ok()) return st;
     Stmt s(db_,
-           "INSERT INTO jobs (state, name, scene, end_time_s, created_ms) VALUES (?1,?2,?3,?4,?5)");
+           "INSERT INTO jobs (state, name, scene, end_time_s, created_ms, peer) "
+           "VALUES (?1,?2,?3,?4,?5,?6)");
     const std::string blob = scene.SerializeAsString();
     s.Bind(1, int64_t{v1::QUEUED})
         .Bind(2, scene.name())
         .BindBlob(3, blob.data(), blob.size())
         .Bind(4, end_time_s)
-        .Bind(5, NowUnixMs());
+        .Bind(5, NowUnixMs())
+        .Bind(6, peer);
     if (absl::Status st = s.Done(); !st.ok()) return st;
     seq = sqlite3_last_insert_rowid(db_);
   }
@@ -375,10 +417,16 @@ absl::StatusOr<v1::Job> JobStore::InsertJob(const v1::Scene& scene, double end_t
 
 absl::StatusOr<v1::Sweep> JobStore::InsertSweep(const v1::SubmitSweepRequest& request,
                                                 const std::vector<v1::Scene>& items,
-                                                const std::vector<double>& end_times_s) {
+                                                const std::vector<double>& end_times_s,
+                                                const std::string& peer,
+                                                int64_t max_unfinished) {
   int64_t sweep_seq;
   {
     absl::MutexLock lock(&mu_);
+    if (absl::Status st = CheckPeerRoom(peer, static_cast<int64_t>(items.size()), max_unfinished);
+        !st.ok()) {
+      return st;
+    }
     if (absl::Status st = Exec("BEGIN IMMEDIATE"); !st.ok()) return st;
     auto rollback = [&](absl::Status st) {
       Exec("ROLLBACK").IgnoreError();
@@ -397,7 +445,7 @@ absl::StatusOr<v1::Sweep> JobStore::InsertSweep(const v1::SubmitSweepRequest& re
     for (size_t i = 0; i < items.size(); ++i) {
       Stmt s(db_,
              "INSERT INTO jobs (state, name, scene, end_time_s, created_ms, sweep_seq, "
-             "sweep_index) VALUES (?1,?2,?3,?4,?5,?6,?7)");
+             "sweep_index, peer) VALUES (?1,?2,?3,?4,?5,?6,?7,?8)");
       const std::string blob = items[i].SerializeAsString();
       s.Bind(1, int64_t{v1::QUEUED})
           .Bind(2, items[i].name())
@@ -405,7 +453,8 @@ absl::StatusOr<v1::Sweep> JobStore::InsertSweep(const v1::SubmitSweepRequest& re
           .Bind(4, end_times_s[i])
           .Bind(5, now)
           .Bind(6, sweep_seq)
-          .Bind(7, static_cast<int64_t>(i));
+          .Bind(7, static_cast<int64_t>(i))
+          .Bind(8, peer);
       if (absl::Status st = s.Done(); !st.ok()) return rollback(st);
     }
     if (absl::Status st = Exec("COMMIT"); !st.ok()) return rollback(st);
@@ -437,15 +486,17 @@ absl::StatusOr<v1::Scene> JobStore::GetScene(const std::string& id) {
 }
 
 absl::StatusOr<std::vector<v1::Job>> JobStore::ListJobs(v1::JobState state,
-                                                        const std::string& sweep_id, int limit) {
+                                                        const std::string& sweep_id, int limit,
+                                                        int64_t before_seq) {
   absl::MutexLock lock(&mu_);
   Stmt s(db_, absl::StrCat("SELECT ", kJobColumns,
                            " FROM jobs WHERE (?1 = 0 OR state = ?1) AND (?2 = 0 OR sweep_seq = ?2)"
-                           " ORDER BY seq DESC LIMIT ?3")
+                           " AND seq < ?4 ORDER BY seq DESC LIMIT ?3")
                   .c_str());
   s.Bind(1, int64_t{state})
       .Bind(2, sweep_id.empty() ? 0 : SweepSeq(sweep_id))
-      .Bind(3, int64_t{limit});
+      .Bind(3, int64_t{limit})
+      .Bind(4, before_seq);
   std::vector<v1::Job> jobs;
   int rc;
   while ((rc = s.Step()) == SQLITE_ROW) jobs.push_back(JobFromRow(s));
@@ -583,6 +634,158 @@ absl::StatusOr<v1::Sweep> JobStore::GetSweep(const std::string& id) {
   sweep.set_finished(finished);
   sweep.set_failed(failed);
   return sweep;
+}
+
+namespace {
+
+bool IsFinished(v1::JobState state) {
+  return state == v1::SUCCEEDED || state == v1::FAILED || state == v1::CANCELLED;
+}
+
+constexpr char kResultBytes[] = "length(header) + length(vals)";
+
+}  // namespace
+
+absl::Status JobStore::DeleteJobRows(const std::string& where, int64_t key) {
+  Stmt r(db_, absl::StrCat("DELETE FROM results WHERE job_seq IN (SELECT seq FROM jobs WHERE ",
+                           where, ")")
+                  .c_str());
+  if (absl::Status st = r.Bind(1, key).Done(); !st.ok()) return st;
+  Stmt j(db_, absl::StrCat("DELETE FROM jobs WHERE ", where).c_str());
+  return j.Bind(1, key).Done();
+}
+
+absl::StatusOr<int64_t> JobStore::DeleteJob(const std::string& id) {
+  const int64_t seq = JobSeq(id);
+  absl::MutexLock lock(&mu_);
+  if (absl::Status st = Exec("BEGIN IMMEDIATE"); !st.ok()) return st;
+  auto rollback = [&](absl::Status st) {
+    Exec("ROLLBACK").IgnoreError();
+    return st;
+  };
+  Stmt s(db_, absl::StrCat("SELECT state, sweep_seq, (SELECT ", kResultBytes,
+                           " FROM results WHERE job_seq = jobs.seq) FROM jobs WHERE seq = ?1")
+                  .c_str());
+  s.Bind(1, seq);
+  const int rc = s.Step();
+  if (rc == SQLITE_DONE) return rollback(absl::NotFoundError(absl::StrCat("no job \"", id, "\"")));
+  if (rc != SQLITE_ROW) return rollback(SqlError(db_));
+  const auto state = static_cast<v1::JobState>(s.Int(0));
+  const int64_t sweep_seq = s.Int(1), bytes = s.Int(2);
+  if (!IsFinished(state)) {
+    return rollback(absl::FailedPreconditionError(absl::StrCat(
+        "job \"", id, "\" is ", v1::JobState_Name(state), "; cancel it before deleting it")));
+  }
+  if (sweep_seq > 0) {
+    return rollback(absl::FailedPreconditionError(
+        absl::StrCat("job \"", id, "\" is an item of sweep \"", SweepId(sweep_seq),
+                     "\"; delete the sweep (DeleteSweep) instead")));
+  }
+  if (absl::Status st = DeleteJobRows("seq = ?1", seq); !st.ok()) return rollback(st);
+  if (absl::Status st = Exec("COMMIT"); !st.ok()) return rollback(st);
+  return bytes;
+}
+
+absl::StatusOr<int64_t> JobStore::DeleteSweep(const std::string& id) {
+  const int64_t seq = SweepSeq(id);
+  absl::MutexLock lock(&mu_);
+  if (absl::Status st = Exec("BEGIN IMMEDIATE"); !st.ok()) return st;
+  auto rollback = [&](absl::Status st) {
+    Exec("ROLLBACK").IgnoreError();
+    return st;
+  };
+  {
+    Stmt s(db_, "SELECT 1 FROM sweeps WHERE seq = ?1");
+    s.Bind(1, seq);
+    const int rc = s.Step();
+    if (rc == SQLITE_DONE) {
+      return rollback(absl::NotFoundError(absl::StrCat("no sweep \"", id, "\"")));
+    }
+    if (rc != SQLITE_ROW) return rollback(SqlError(db_));
+  }
+  int64_t bytes = 0, unfinished = 0;
+  {
+    Stmt s(db_, absl::StrCat("SELECT state, (SELECT ", kResultBytes,
+                             " FROM results WHERE job_seq = jobs.seq) FROM jobs WHERE "
+                             "sweep_seq = ?1")
+                    .c_str());
+    s.Bind(1, seq);
+    int rc;
+    while ((rc = s.Step()) == SQLITE_ROW) {
+      unfinished += IsFinished(static_cast<v1::JobState>(s.Int(0))) ? 0 : 1;
+      bytes += s.Int(1);
+    }
+    if (rc != SQLITE_DONE) return rollback(SqlError(db_));
+  }
+  if (unfinished > 0) {
+    return rollback(absl::FailedPreconditionError(
+        absl::StrCat("sweep \"", id, "\" has ", unfinished,
+                     " unfinished items; cancel them before deleting it")));
+  }
+  if (absl::Status st = DeleteJobRows("sweep_seq = ?1", seq); !st.ok()) return rollback(st);
+  Stmt d(db_, "DELETE FROM sweeps WHERE seq = ?1");
+  if (absl::Status st = d.Bind(1, seq).Done(); !st.ok()) return rollback(st);
+  if (absl::Status st = Exec("COMMIT"); !st.ok()) return rollback(st);
+  return bytes;
+}
+
+absl::StatusOr<RetentionReport> JobStore::ApplyRetention(int64_t older_than_unix_ms,
+                                                         int64_t max_bytes) {
+  // What can go: finished jobs outside sweeps, and sweeps whose items have
+  // all finished (a sweep goes as a whole), oldest finished first.
+  struct Candidate {
+    bool sweep;
+    int64_t seq, finished_ms, bytes;
+  };
+  std::vector<Candidate> candidates;
+  int64_t total = 0;
+  absl::MutexLock lock(&mu_);
+  {
+    Stmt t(db_, absl::StrCat("SELECT COALESCE(SUM(", kResultBytes, "), 0) FROM results").c_str());
+    if (t.Step() != SQLITE_ROW) return SqlError(db_);
+    total = t.Int(0);
+  }
+  {
+    Stmt s(db_, absl::StrCat(
+                    "SELECT 0, seq, finished_ms, COALESCE((SELECT ", kResultBytes,
+                    " FROM results WHERE job_seq = jobs.seq), 0) FROM jobs "
+                    "WHERE sweep_seq = 0 AND state IN (?1, ?2, ?3) "
+                    "UNION ALL "
+                    "SELECT 1, sweep_seq, MAX(finished_ms), COALESCE(SUM((SELECT ",
+                    kResultBytes,
+                    " FROM results WHERE job_seq = jobs.seq)), 0) FROM jobs "
+                    "WHERE sweep_seq > 0 GROUP BY sweep_seq "
+                    "HAVING SUM(state NOT IN (?1, ?2, ?3)) = 0 "
+                    "ORDER BY 3")
+                    .c_str());
+    s.Bind(1, int64_t{v1::SUCCEEDED}).Bind(2, int64_t{v1::FAILED}).Bind(3, int64_t{v1::CANCELLED});
+    int rc;
+    while ((rc = s.Step()) == SQLITE_ROW) {
+      candidates.push_back({s.Int(0) != 0, s.Int(1), s.Int(2), s.Int(3)});
+    }
+    if (rc != SQLITE_DONE) return SqlError(db_);
+  }
+  RetentionReport report;
+  for (const Candidate& c : candidates) {
+    if (c.finished_ms >= older_than_unix_ms && total <= max_bytes) break;
+    if (absl::Status st = Exec("BEGIN IMMEDIATE"); !st.ok()) return st;
+    absl::Status st = DeleteJobRows(c.sweep ? "sweep_seq = ?1" : "seq = ?1", c.seq);
+    int64_t jobs = sqlite3_changes(db_);
+    if (st.ok() && c.sweep) {
+      Stmt d(db_, "DELETE FROM sweeps WHERE seq = ?1");
+      st = d.Bind(1, c.seq).Done();
+    }
+    if (st.ok()) st = Exec("COMMIT");
+    if (!st.ok()) {
+      Exec("ROLLBACK").IgnoreError();
+      return st;
+    }
+    total -= c.bytes;
+    report.jobs += jobs;
+    report.sweeps += c.sweep ? 1 : 0;
+    report.bytes += c.bytes;
+  }
+  return report;
 }
 
 }  // namespace cablesim

@@ -40,8 +40,18 @@ struct ServerLimits {
   int64_t max_modal_bytes = std::numeric_limits<int64_t>::max();
   // Bytes of any one string in a request (names, references, sweep paths).
   int64_t max_name_bytes = std::numeric_limits<int64_t>::max();
+  // Counted streams (Run, GetEnergy of a scene) of one client address.
+  int max_streams_per_peer = std::numeric_limits<int>::max();
+  // Jobs queued or running that one client address submitted (sweep
+  // items included).
+  int64_t max_queued_jobs_per_peer = std::numeric_limits<int64_t>::max();
   // Coordinates of the model built (nodal and body coordinates).
   int64_t max_coordinates = std::numeric_limits<int64_t>::max();
+  // Retention of finished jobs and sweeps: deleted once finished longer
+  // ago than this, or, oldest first, while the stored results take more
+  // than max_bytes. Infinite / max: kept.
+  absl::Duration retention_max_age = absl::InfiniteDuration();
+  int64_t retention_max_bytes = std::numeric_limits<int64_t>::max();
 };
 
 struct CheckedScene {

@@ -66,7 +66,7 @@ class ServerTest : public ::testing::Test {
     server_ = new ServerProcess(dir,
                                 {"--workers=1", "--max-elements=200", "--max-frames=20000",
                                  "--max-streams=40", "--max-trajectory-values=1048576",
-                                 "--max-modes=6", "--max-name-bytes=64"},
+                                 "--max-modes=6", "--max-name-bytes=64", "--max-streams-per-peer=40"},
                                 {gate_->env()});
   }
   static void TearDownTestSuite() {
