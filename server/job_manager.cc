@@ -254,7 +254,7 @@ void JobManager::RunOne(const std::string& id) {
     control.should_stop = [&] { return running->stop.load() != 0; };
     // Rejected steps count too: allow the nominal limit twice over.
     control.max_steps = 2 * limits_.max_steps;
-    absl::StatusOr<RunSummary> ran = RunScene(*scene, &sink, control);
+    absl::StatusOr<RunSummary> ran = RunSceneWithinMemory(*scene, &sink, control);
     if (ran.ok()) {
       summary = std::move(*ran);
     } else {

@@ -1,6 +1,7 @@
 #include "server/request_checks.h"
 
 #include <cmath>
+#include <new>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -43,6 +44,24 @@ absl::Status CheckStringLengths(const google::protobuf::Message& message,
     }
   }
   return absl::OkStatus();
+}
+
+absl::StatusOr<RunSummary> RunSceneWithinMemory(const Scene& scene, FrameSink* sink,
+                                                const RunControl& control) {
+  try {
+    return RunScene(scene, sink, control);
+  } catch (const std::bad_alloc&) {
+    int64_t elements = 0;
+    for (const CableSpec& cable : scene.cables) elements += cable.elements;
+    std::string what = absl::StrFormat("%d cable elements", elements);
+    if (scene.solver.analysis == Analysis::kModal) {
+      absl::StrAppendFormat(&what, ", %d modes", scene.solver.modes);
+    }
+    return absl::ResourceExhaustedError(absl::StrFormat(
+        "cables, solver: the run needs more memory than the server could allocate (%s); "
+        "ask for fewer elements, frames or modes",
+        what));
+  }
 }
 
 absl::StatusOr<v1::Scene> SceneOfRequest(bool has_scene, const v1::Scene& scene,

@@ -78,6 +78,13 @@ absl::StatusOr<v1::Scene> SceneOfRequest(bool has_scene, const v1::Scene& scene,
 // GetEnergy all call it.
 absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimits& limits);
 
+// RunScene, with an allocation that fails (std::bad_alloc: the run needs
+// more memory than the server can get) answered as ResourceExhausted
+// naming the scene's size, instead of an exception that the RPC would
+// report as UNKNOWN (or that would end a job's worker thread).
+absl::StatusOr<RunSummary> RunSceneWithinMemory(const Scene& scene, FrameSink* sink,
+                                                const RunControl& control);
+
 // ResourceExhausted naming the first string field of `message` (its path,
 // after `prefix`) longer than limits.max_name_bytes.
 absl::Status CheckStringLengths(const google::protobuf::Message& message,

@@ -9,6 +9,7 @@
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <fcntl.h>
@@ -46,9 +47,14 @@ inline std::string FreshDir(const std::string& name) {
 // to DIR/server.log (see WaitForLog), printed when the test has failed.
 class ServerProcess {
  public:
+  // `address_space_bytes` > 0: the child's RLIMIT_AS (so that a large
+  // allocation fails inside the server).
   ServerProcess(std::string data_dir, std::vector<std::string> flags = {},
-                std::vector<std::string> env = {})
-      : data_dir_(std::move(data_dir)), flags_(std::move(flags)), env_(std::move(env)) {
+                std::vector<std::string> env = {}, uint64_t address_space_bytes = 0)
+      : data_dir_(std::move(data_dir)),
+        flags_(std::move(flags)),
+        env_(std::move(env)),
+        address_space_bytes_(address_space_bytes) {
     Start();
   }
   ~ServerProcess() {
@@ -81,6 +87,10 @@ class ServerProcess {
     if (pid_ == 0) {
       const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0600);
       if (fd >= 0) ::dup2(fd, STDERR_FILENO);
+      if (address_space_bytes_ > 0) {
+        const struct rlimit limit = {address_space_bytes_, address_space_bytes_};
+        ::setrlimit(RLIMIT_AS, &limit);
+      }
       execve(argv[0], argv.data(), envp.data());
       _exit(127);
     }
@@ -147,6 +157,7 @@ class ServerProcess {
   std::string data_dir_;
   std::vector<std::string> flags_;
   std::vector<std::string> env_;
+  uint64_t address_space_bytes_ = 0;
   pid_t pid_ = -1;
   int port_ = 0;
 };
