@@ -7,6 +7,7 @@
 #include <set>
 #include <utility>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "cablesim/version.h"
@@ -213,8 +214,28 @@ RunControl ControlFor(grpc::ServerContext* context, const ServerLimits& limits) 
 
 }  // namespace
 
-CablesimServiceImpl::CablesimServiceImpl(JobManager* jobs, ServerLimits limits, bool log)
-    : jobs_(jobs), limits_(limits), log_(log) {
+grpc::Status CablesimServiceImpl::Authorize(grpc::ServerContext* context) const {
+  if (tokens_.empty()) return grpc::Status::OK;
+  const auto& metadata = context->client_metadata();
+  const auto it = metadata.find("authorization");
+  if (it == metadata.end()) {
+    return grpc::Status(grpc::StatusCode::UNAUTHENTICATED,
+                        "authorization: this server needs a bearer token (metadata "
+                        "\"authorization: Bearer TOKEN\")");
+  }
+  const absl::string_view value(it->second.data(), it->second.size());
+  constexpr absl::string_view kBearer = "Bearer ";
+  if (!absl::StartsWith(value, kBearer) ||
+      tokens_.find(std::string(value.substr(kBearer.size()))) == tokens_.end()) {
+    return grpc::Status(grpc::StatusCode::UNAUTHENTICATED,
+                        "authorization: not a token this server knows");
+  }
+  return grpc::Status::OK;
+}
+
+CablesimServiceImpl::CablesimServiceImpl(JobManager* jobs, ServerLimits limits, bool log,
+                                         std::map<std::string, std::string> tokens)
+    : jobs_(jobs), limits_(limits), log_(log), tokens_(std::move(tokens)) {
   watchdog_ = std::thread([this] { Watchdog(); });
 }
 
@@ -271,8 +292,10 @@ grpc::Status CablesimServiceImpl::NoJobs() const {
                       "this service has no job store (start cablesim-server with --data-dir)");
 }
 
-grpc::Status CablesimServiceImpl::Validate(grpc::ServerContext*, const v1::ValidateRequest* request,
+grpc::Status CablesimServiceImpl::Validate(grpc::ServerContext* context,
+                                           const v1::ValidateRequest* request,
                                            v1::ValidateResponse* response) {
+  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
   // The same checks as Run and SubmitJob, limits included (so a scene the
   // server would refuse is never called valid, and costs no more to
   // validate than to refuse).
@@ -307,6 +330,7 @@ grpc::Status CablesimServiceImpl::Validate(grpc::ServerContext*, const v1::Valid
 
 grpc::Status CablesimServiceImpl::Run(grpc::ServerContext* context, const v1::RunRequest* request,
                                       grpc::ServerWriter<v1::RunEvent>* writer) {
+  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
   StreamSlot slot(this, context);
   if (!slot.acquired()) {
     return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, slot.refusal());
@@ -336,6 +360,7 @@ grpc::Status CablesimServiceImpl::Run(grpc::ServerContext* context, const v1::Ru
 grpc::Status CablesimServiceImpl::SubmitJob(grpc::ServerContext* context,
                                             const v1::SubmitJobRequest* request,
                                             v1::Job* response) {
+  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
   const absl::StatusOr<v1::Scene> scene =
       SceneOfRequest(request->has_scene(), request->scene(), request->scene_json());
@@ -347,8 +372,10 @@ grpc::Status CablesimServiceImpl::SubmitJob(grpc::ServerContext* context,
   return grpc::Status::OK;
 }
 
-grpc::Status CablesimServiceImpl::GetJob(grpc::ServerContext*, const v1::GetJobRequest* request,
+grpc::Status CablesimServiceImpl::GetJob(grpc::ServerContext* context,
+                                         const v1::GetJobRequest* request,
                                          v1::Job* response) {
+  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
   absl::StatusOr<v1::Job> job = jobs_->Get(request->id());
   if (!job.ok()) return ToGrpc(job.status());
@@ -356,8 +383,10 @@ grpc::Status CablesimServiceImpl::GetJob(grpc::ServerContext*, const v1::GetJobR
   return grpc::Status::OK;
 }
 
-grpc::Status CablesimServiceImpl::ListJobs(grpc::ServerContext*, const v1::ListJobsRequest* request,
+grpc::Status CablesimServiceImpl::ListJobs(grpc::ServerContext* context,
+                                           const v1::ListJobsRequest* request,
                                            v1::ListJobsResponse* response) {
+  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
   const int asked = request->page_size() > 0 ? request->page_size() : request->limit();
   const int limit = asked <= 0 ? 100 : std::min(asked, 10000);
@@ -392,9 +421,10 @@ grpc::Status CablesimServiceImpl::ListJobs(grpc::ServerContext*, const v1::ListJ
   return grpc::Status::OK;
 }
 
-grpc::Status CablesimServiceImpl::CancelJob(grpc::ServerContext*,
+grpc::Status CablesimServiceImpl::CancelJob(grpc::ServerContext* context,
                                             const v1::CancelJobRequest* request,
                                             v1::Job* response) {
+  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
   absl::StatusOr<v1::Job> job = jobs_->Cancel(request->id());
   if (!job.ok()) return ToGrpc(job.status());
@@ -402,9 +432,10 @@ grpc::Status CablesimServiceImpl::CancelJob(grpc::ServerContext*,
   return grpc::Status::OK;
 }
 
-grpc::Status CablesimServiceImpl::DeleteJob(grpc::ServerContext*,
+grpc::Status CablesimServiceImpl::DeleteJob(grpc::ServerContext* context,
                                             const v1::DeleteJobRequest* request,
                                             v1::DeleteResponse* response) {
+  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
   absl::StatusOr<int64_t> freed = jobs_->DeleteJob(request->id());
   if (!freed.ok()) return ToGrpc(freed.status());
@@ -413,9 +444,10 @@ grpc::Status CablesimServiceImpl::DeleteJob(grpc::ServerContext*,
   return grpc::Status::OK;
 }
 
-grpc::Status CablesimServiceImpl::DeleteSweep(grpc::ServerContext*,
+grpc::Status CablesimServiceImpl::DeleteSweep(grpc::ServerContext* context,
                                               const v1::DeleteSweepRequest* request,
                                               v1::DeleteResponse* response) {
+  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
   absl::StatusOr<int64_t> freed = jobs_->DeleteSweep(request->id());
   if (!freed.ok()) return ToGrpc(freed.status());
@@ -427,6 +459,7 @@ grpc::Status CablesimServiceImpl::DeleteSweep(grpc::ServerContext*,
 grpc::Status CablesimServiceImpl::WatchJob(grpc::ServerContext* context,
                                            const v1::WatchJobRequest* request,
                                            grpc::ServerWriter<v1::Job>* writer) {
+  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
   StreamSlot slot(this, context, /*counted=*/false);
   std::string last;
@@ -453,6 +486,7 @@ grpc::Status CablesimServiceImpl::WatchJob(grpc::ServerContext* context,
 grpc::Status CablesimServiceImpl::GetJobResult(grpc::ServerContext* context,
                                                const v1::GetJobResultRequest* request,
                                                grpc::ServerWriter<v1::RunEvent>* writer) {
+  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
   v1::Job job;
   StoredResult result;
   if (grpc::Status s = FinishedResult(request->id(), &job, &result); !s.ok()) return s;
@@ -487,6 +521,7 @@ grpc::Status CablesimServiceImpl::GetJobResult(grpc::ServerContext* context,
 grpc::Status CablesimServiceImpl::GetEnergy(grpc::ServerContext* context,
                                             const v1::EnergyRequest* request,
                                             v1::EnergyResponse* response) {
+  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
   if (request->has_scene()) {
     StreamSlot slot(this, context);
     if (!slot.acquired()) {
@@ -516,6 +551,7 @@ grpc::Status CablesimServiceImpl::GetEnergy(grpc::ServerContext* context,
 grpc::Status CablesimServiceImpl::SubmitSweep(grpc::ServerContext* context,
                                               const v1::SubmitSweepRequest* request,
                                               v1::Sweep* response) {
+  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
   v1::SubmitSweepRequest submitted = *request;
   if (!request->base_json().empty()) {
@@ -562,6 +598,7 @@ v1::SweepItem ItemOf(JobManager* jobs, const v1::Sweep& sweep, const v1::Job& jo
 grpc::Status CablesimServiceImpl::WatchSweep(grpc::ServerContext* context,
                                              const v1::WatchSweepRequest* request,
                                              grpc::ServerWriter<v1::SweepEvent>* writer) {
+  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
   StreamSlot slot(this, context, /*counted=*/false);
   std::set<std::string> reported;
@@ -601,9 +638,10 @@ grpc::Status CablesimServiceImpl::WatchSweep(grpc::ServerContext* context,
   }
 }
 
-grpc::Status CablesimServiceImpl::GetSweepResults(grpc::ServerContext*,
+grpc::Status CablesimServiceImpl::GetSweepResults(grpc::ServerContext* context,
                                                   const v1::GetSweepResultsRequest* request,
                                                   v1::SweepResults* response) {
+  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
   absl::StatusOr<v1::Sweep> sweep = jobs_->store()->GetSweep(request->id());
   if (!sweep.ok()) return ToGrpc(sweep.status());
@@ -621,9 +659,10 @@ grpc::Status CablesimServiceImpl::GetSweepResults(grpc::ServerContext*,
   return grpc::Status::OK;
 }
 
-grpc::Status CablesimServiceImpl::GetServerInfo(grpc::ServerContext*,
+grpc::Status CablesimServiceImpl::GetServerInfo(grpc::ServerContext* context,
                                                 const v1::GetServerInfoRequest*,
                                                 v1::ServerInfo* response) {
+  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
   response->set_version(CABLESIM_VERSION);
   response->set_build_type(CABLESIM_BUILD_TYPE);
   response->set_sanitizers(CABLESIM_SANITIZERS);

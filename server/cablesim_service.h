@@ -30,7 +30,9 @@ class CablesimServiceImpl final : public v1::CablesimService::Service {
   // `jobs` may be null (an in-process service for `cablesim run`): the job
   // and sweep calls then answer UNIMPLEMENTED.
   // `log`: report on stderr.
-  CablesimServiceImpl(JobManager* jobs, ServerLimits limits, bool log = true);
+  // `tokens`: bearer token -> tenant; empty: no authentication.
+  CablesimServiceImpl(JobManager* jobs, ServerLimits limits, bool log = true,
+                      std::map<std::string, std::string> tokens = {});
   ~CablesimServiceImpl() override;
 
   grpc::Status Validate(grpc::ServerContext* context, const v1::ValidateRequest* request,
@@ -77,11 +79,15 @@ class CablesimServiceImpl final : public v1::CablesimService::Service {
   // FAILED_PRECONDITION while it has no result, UNIMPLEMENTED without jobs.
   grpc::Status FinishedResult(const std::string& id, v1::Job* job, StoredResult* result) const;
   grpc::Status NoJobs() const;
+  // UNAUTHENTICATED unless the call carries `authorization: Bearer T` with
+  // T one of tokens_ (OK when there are none).
+  grpc::Status Authorize(grpc::ServerContext* context) const;
   void Watchdog();
 
   JobManager* jobs_;
   const ServerLimits limits_;
   const bool log_;
+  const std::map<std::string, std::string> tokens_;
   absl::Mutex mu_;
   // Counted streams, in all and per peer (StreamSlot).
   int streams_ ABSL_GUARDED_BY(mu_) = 0;
