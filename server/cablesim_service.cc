@@ -214,7 +214,20 @@ RunControl ControlFor(grpc::ServerContext* context, const ServerLimits& limits) 
 
 }  // namespace
 
-grpc::Status CablesimServiceImpl::Authorize(grpc::ServerContext* context) const {
+grpc::Status CablesimServiceImpl::Owned(const std::string& id, const std::string& tenant) const {
+  if (tokens_.empty() || jobs_ == nullptr) return grpc::Status::OK;
+  absl::StatusOr<std::string> owner = jobs_->store()->Tenant(id);
+  if (!owner.ok()) return ToGrpc(owner.status());
+  if (*owner != tenant) {
+    // As if it did not exist: another tenant learns nothing about it.
+    return grpc::Status(grpc::StatusCode::NOT_FOUND,
+                        absl::StrCat("no ", SweepSeq(id) > 0 ? "sweep" : "job", " \"", id, "\""));
+  }
+  return grpc::Status::OK;
+}
+
+grpc::Status CablesimServiceImpl::Authorize(grpc::ServerContext* context,
+                                            std::string* tenant) const {
   if (tokens_.empty()) return grpc::Status::OK;
   const auto& metadata = context->client_metadata();
   const auto it = metadata.find("authorization");
@@ -225,11 +238,14 @@ grpc::Status CablesimServiceImpl::Authorize(grpc::ServerContext* context) const 
   }
   const absl::string_view value(it->second.data(), it->second.size());
   constexpr absl::string_view kBearer = "Bearer ";
-  if (!absl::StartsWith(value, kBearer) ||
-      tokens_.find(std::string(value.substr(kBearer.size()))) == tokens_.end()) {
+  const auto token = absl::StartsWith(value, kBearer)
+                         ? tokens_.find(std::string(value.substr(kBearer.size())))
+                         : tokens_.end();
+  if (token == tokens_.end()) {
     return grpc::Status(grpc::StatusCode::UNAUTHENTICATED,
                         "authorization: not a token this server knows");
   }
+  *tenant = token->second;
   return grpc::Status::OK;
 }
 
@@ -295,7 +311,8 @@ grpc::Status CablesimServiceImpl::NoJobs() const {
 grpc::Status CablesimServiceImpl::Validate(grpc::ServerContext* context,
                                            const v1::ValidateRequest* request,
                                            v1::ValidateResponse* response) {
-  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   // The same checks as Run and SubmitJob, limits included (so a scene the
   // server would refuse is never called valid, and costs no more to
   // validate than to refuse).
@@ -330,7 +347,8 @@ grpc::Status CablesimServiceImpl::Validate(grpc::ServerContext* context,
 
 grpc::Status CablesimServiceImpl::Run(grpc::ServerContext* context, const v1::RunRequest* request,
                                       grpc::ServerWriter<v1::RunEvent>* writer) {
-  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   StreamSlot slot(this, context);
   if (!slot.acquired()) {
     return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, slot.refusal());
@@ -360,12 +378,13 @@ grpc::Status CablesimServiceImpl::Run(grpc::ServerContext* context, const v1::Ru
 grpc::Status CablesimServiceImpl::SubmitJob(grpc::ServerContext* context,
                                             const v1::SubmitJobRequest* request,
                                             v1::Job* response) {
-  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
   const absl::StatusOr<v1::Scene> scene =
       SceneOfRequest(request->has_scene(), request->scene(), request->scene_json());
   if (!scene.ok()) return ToGrpc(scene.status());
-  absl::StatusOr<v1::Job> job = jobs_->Submit(*scene, StreamSlot::PeerOf(context));
+  absl::StatusOr<v1::Job> job = jobs_->Submit(*scene, StreamSlot::PeerOf(context), tenant);
   if (!job.ok()) return ToGrpc(job.status());
   *response = std::move(*job);
   if (log_) std::cerr << "cablesim-server: job " << response->id() << " queued\n";
@@ -375,8 +394,10 @@ grpc::Status CablesimServiceImpl::SubmitJob(grpc::ServerContext* context,
 grpc::Status CablesimServiceImpl::GetJob(grpc::ServerContext* context,
                                          const v1::GetJobRequest* request,
                                          v1::Job* response) {
-  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
+  if (grpc::Status s = Owned(request->id(), tenant); !s.ok()) return s;
   absl::StatusOr<v1::Job> job = jobs_->Get(request->id());
   if (!job.ok()) return ToGrpc(job.status());
   *response = std::move(*job);
@@ -386,7 +407,8 @@ grpc::Status CablesimServiceImpl::GetJob(grpc::ServerContext* context,
 grpc::Status CablesimServiceImpl::ListJobs(grpc::ServerContext* context,
                                            const v1::ListJobsRequest* request,
                                            v1::ListJobsResponse* response) {
-  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
   const int asked = request->page_size() > 0 ? request->page_size() : request->limit();
   const int limit = asked <= 0 ? 100 : std::min(asked, 10000);
@@ -401,7 +423,8 @@ grpc::Status CablesimServiceImpl::ListJobs(grpc::ServerContext* context,
   }
   // One more than asked, to know whether another page follows.
   absl::StatusOr<std::vector<v1::Job>> jobs =
-      jobs_->store()->ListJobs(request->state(), request->sweep_id(), limit + 1, before);
+      jobs_->store()->ListJobs(request->state(), request->sweep_id(), limit + 1, before,
+                               tokens_.empty() ? nullptr : &tenant);
   if (!jobs.ok()) return ToGrpc(jobs.status());
   // Never a response over the message limit: stop at half of it.
   const size_t budget = static_cast<size_t>(limits_.max_message_bytes) / 2;
@@ -424,8 +447,10 @@ grpc::Status CablesimServiceImpl::ListJobs(grpc::ServerContext* context,
 grpc::Status CablesimServiceImpl::CancelJob(grpc::ServerContext* context,
                                             const v1::CancelJobRequest* request,
                                             v1::Job* response) {
-  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
+  if (grpc::Status s = Owned(request->id(), tenant); !s.ok()) return s;
   absl::StatusOr<v1::Job> job = jobs_->Cancel(request->id());
   if (!job.ok()) return ToGrpc(job.status());
   *response = std::move(*job);
@@ -435,8 +460,10 @@ grpc::Status CablesimServiceImpl::CancelJob(grpc::ServerContext* context,
 grpc::Status CablesimServiceImpl::DeleteJob(grpc::ServerContext* context,
                                             const v1::DeleteJobRequest* request,
                                             v1::DeleteResponse* response) {
-  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
+  if (grpc::Status s = Owned(request->id(), tenant); !s.ok()) return s;
   absl::StatusOr<int64_t> freed = jobs_->DeleteJob(request->id());
   if (!freed.ok()) return ToGrpc(freed.status());
   response->set_freed_bytes(*freed);
@@ -447,8 +474,10 @@ grpc::Status CablesimServiceImpl::DeleteJob(grpc::ServerContext* context,
 grpc::Status CablesimServiceImpl::DeleteSweep(grpc::ServerContext* context,
                                               const v1::DeleteSweepRequest* request,
                                               v1::DeleteResponse* response) {
-  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
+  if (grpc::Status s = Owned(request->id(), tenant); !s.ok()) return s;
   absl::StatusOr<int64_t> freed = jobs_->DeleteSweep(request->id());
   if (!freed.ok()) return ToGrpc(freed.status());
   response->set_freed_bytes(*freed);
@@ -459,9 +488,11 @@ grpc::Status CablesimServiceImpl::DeleteSweep(grpc::ServerContext* context,
 grpc::Status CablesimServiceImpl::WatchJob(grpc::ServerContext* context,
                                            const v1::WatchJobRequest* request,
                                            grpc::ServerWriter<v1::Job>* writer) {
-  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
   StreamSlot slot(this, context, /*counted=*/false);
+  if (grpc::Status s = Owned(request->id(), tenant); !s.ok()) return s;
   std::string last;
   while (true) {
     const uint64_t seen = jobs_->version();
@@ -486,9 +517,11 @@ grpc::Status CablesimServiceImpl::WatchJob(grpc::ServerContext* context,
 grpc::Status CablesimServiceImpl::GetJobResult(grpc::ServerContext* context,
                                                const v1::GetJobResultRequest* request,
                                                grpc::ServerWriter<v1::RunEvent>* writer) {
-  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   v1::Job job;
   StoredResult result;
+  if (grpc::Status s = Owned(request->id(), tenant); !s.ok()) return s;
   if (grpc::Status s = FinishedResult(request->id(), &job, &result); !s.ok()) return s;
   StreamSlot slot(this, context, /*counted=*/false);
   v1::RunEvent event;
@@ -521,7 +554,8 @@ grpc::Status CablesimServiceImpl::GetJobResult(grpc::ServerContext* context,
 grpc::Status CablesimServiceImpl::GetEnergy(grpc::ServerContext* context,
                                             const v1::EnergyRequest* request,
                                             v1::EnergyResponse* response) {
-  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   if (request->has_scene()) {
     StreamSlot slot(this, context);
     if (!slot.acquired()) {
@@ -543,6 +577,7 @@ grpc::Status CablesimServiceImpl::GetEnergy(grpc::ServerContext* context,
   }
   v1::Job job;
   StoredResult result;
+  if (grpc::Status s = Owned(request->job_id(), tenant); !s.ok()) return s;
   if (grpc::Status s = FinishedResult(request->job_id(), &job, &result); !s.ok()) return s;
   *response = EnergyFromTrajectory(result.header, result.values, job.summary());
   return grpc::Status::OK;
@@ -551,7 +586,8 @@ grpc::Status CablesimServiceImpl::GetEnergy(grpc::ServerContext* context,
 grpc::Status CablesimServiceImpl::SubmitSweep(grpc::ServerContext* context,
                                               const v1::SubmitSweepRequest* request,
                                               v1::Sweep* response) {
-  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
   v1::SubmitSweepRequest submitted = *request;
   if (!request->base_json().empty()) {
@@ -561,7 +597,8 @@ grpc::Status CablesimServiceImpl::SubmitSweep(grpc::ServerContext* context,
     *submitted.mutable_base() = std::move(*base);
     submitted.clear_base_json();
   }
-  absl::StatusOr<v1::Sweep> sweep = jobs_->SubmitSweep(submitted, StreamSlot::PeerOf(context));
+  absl::StatusOr<v1::Sweep> sweep =
+      jobs_->SubmitSweep(submitted, StreamSlot::PeerOf(context), tenant);
   if (!sweep.ok()) return ToGrpc(sweep.status());
   *response = std::move(*sweep);
   if (log_)
@@ -598,10 +635,12 @@ v1::SweepItem ItemOf(JobManager* jobs, const v1::Sweep& sweep, const v1::Job& jo
 grpc::Status CablesimServiceImpl::WatchSweep(grpc::ServerContext* context,
                                              const v1::WatchSweepRequest* request,
                                              grpc::ServerWriter<v1::SweepEvent>* writer) {
-  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
   StreamSlot slot(this, context, /*counted=*/false);
   std::set<std::string> reported;
+  if (grpc::Status s = Owned(request->id(), tenant); !s.ok()) return s;
   bool first = true;
   while (true) {
     const uint64_t seen = jobs_->version();
@@ -641,8 +680,10 @@ grpc::Status CablesimServiceImpl::WatchSweep(grpc::ServerContext* context,
 grpc::Status CablesimServiceImpl::GetSweepResults(grpc::ServerContext* context,
                                                   const v1::GetSweepResultsRequest* request,
                                                   v1::SweepResults* response) {
-  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
+  if (grpc::Status s = Owned(request->id(), tenant); !s.ok()) return s;
   absl::StatusOr<v1::Sweep> sweep = jobs_->store()->GetSweep(request->id());
   if (!sweep.ok()) return ToGrpc(sweep.status());
   absl::StatusOr<std::vector<v1::Job>> jobs =
@@ -662,7 +703,8 @@ grpc::Status CablesimServiceImpl::GetSweepResults(grpc::ServerContext* context,
 grpc::Status CablesimServiceImpl::GetServerInfo(grpc::ServerContext* context,
                                                 const v1::GetServerInfoRequest*,
                                                 v1::ServerInfo* response) {
-  if (grpc::Status auth = Authorize(context); !auth.ok()) return auth;
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   response->set_version(CABLESIM_VERSION);
   response->set_build_type(CABLESIM_BUILD_TYPE);
   response->set_sanitizers(CABLESIM_SANITIZERS);

@@ -81,7 +81,11 @@ class CablesimServiceImpl final : public v1::CablesimService::Service {
   grpc::Status NoJobs() const;
   // UNAUTHENTICATED unless the call carries `authorization: Bearer T` with
   // T one of tokens_ (OK when there are none).
-  grpc::Status Authorize(grpc::ServerContext* context) const;
+  // `tenant`: the token's tenant.
+  grpc::Status Authorize(grpc::ServerContext* context, std::string* tenant) const;
+  // NOT_FOUND unless job or sweep `id` exists and, with tokens, belongs to
+  // `tenant`.
+  grpc::Status Owned(const std::string& id, const std::string& tenant) const;
   void Watchdog();
 
   JobManager* jobs_;

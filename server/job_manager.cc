@@ -109,23 +109,26 @@ void JobManager::Enqueue(const std::string& id) {
   ++version_;
 }
 
-absl::StatusOr<v1::Job> JobManager::Submit(const v1::Scene& scene, const std::string& peer) {
+absl::StatusOr<v1::Job> JobManager::Submit(const v1::Scene& scene, const std::string& peer,
+                                           const std::string& tenant) {
   absl::StatusOr<CheckedScene> checked = CheckScene(scene, limits_);
   if (!checked.ok()) return checked.status();
   absl::StatusOr<v1::Job> job =
-      store_->InsertJob(scene, checked->end_time_s, peer, limits_.max_queued_jobs_per_peer);
+      store_->InsertJob(scene, checked->end_time_s, peer, limits_.max_queued_jobs_per_peer,
+                        tenant);
   if (!job.ok()) return job.status();
   Enqueue(job->id());
   return job;
 }
 
 absl::StatusOr<v1::Sweep> JobManager::SubmitSweep(const v1::SubmitSweepRequest& request,
-                                                  const std::string& peer) {
+                                                  const std::string& peer,
+                                                  const std::string& tenant) {
   std::vector<double> end_times;
   absl::StatusOr<std::vector<v1::Scene>> items = ExpandSweep(request, limits_, &end_times);
   if (!items.ok()) return items.status();
-  absl::StatusOr<v1::Sweep> sweep = store_->InsertSweep(request, *items, end_times, peer,
-                                                        limits_.max_queued_jobs_per_peer);
+  absl::StatusOr<v1::Sweep> sweep = store_->InsertSweep(
+      request, *items, end_times, peer, limits_.max_queued_jobs_per_peer, tenant);
   if (!sweep.ok()) return sweep.status();
   absl::MutexLock lock(&mu_);
   for (const std::string& id : sweep->job_ids()) queue_.push_back(id);

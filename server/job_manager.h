@@ -38,9 +38,12 @@ class JobManager {
 
   // `peer`: the submitting client's address, for
   // limits().max_queued_jobs_per_peer.
-  absl::StatusOr<v1::Job> Submit(const v1::Scene& scene, const std::string& peer = "");
+  // `tenant`: the owner (JobStore::InsertJob).
+  absl::StatusOr<v1::Job> Submit(const v1::Scene& scene, const std::string& peer = "",
+                                 const std::string& tenant = "");
   absl::StatusOr<v1::Sweep> SubmitSweep(const v1::SubmitSweepRequest& request,
-                                        const std::string& peer = "");
+                                        const std::string& peer = "",
+                                        const std::string& tenant = "");
   absl::StatusOr<v1::Job> Cancel(const std::string& id);
   // JobStore::DeleteJob / DeleteSweep (watchers see the change).
   absl::StatusOr<int64_t> DeleteJob(const std::string& id);

@@ -26,7 +26,8 @@ CREATE TABLE IF NOT EXISTS sweeps (
   seq INTEGER PRIMARY KEY AUTOINCREMENT,
   name TEXT NOT NULL,
   axes BLOB NOT NULL,           -- cablesim.v1.Sweep with only the axes
-  created_ms INTEGER NOT NULL);
+  created_ms INTEGER NOT NULL,
+  tenant TEXT NOT NULL DEFAULT '');  -- the token's tenant that made it
 CREATE TABLE IF NOT EXISTS jobs (
   seq INTEGER PRIMARY KEY AUTOINCREMENT,
   state INTEGER NOT NULL,       -- cablesim.v1.JobState
@@ -40,7 +41,8 @@ CREATE TABLE IF NOT EXISTS jobs (
   summary BLOB,                 -- cablesim.v1.RunSummary once finished
   sweep_seq INTEGER NOT NULL DEFAULT 0,
   sweep_index INTEGER NOT NULL DEFAULT 0,
-  peer TEXT NOT NULL DEFAULT '');  -- the client address that submitted it
+  peer TEXT NOT NULL DEFAULT '',   -- the client address that submitted it
+  tenant TEXT NOT NULL DEFAULT '');  -- the token's tenant that made it
 CREATE INDEX IF NOT EXISTS jobs_by_state ON jobs(state, seq);
 CREATE INDEX IF NOT EXISTS jobs_by_sweep ON jobs(sweep_seq, sweep_index);
 CREATE TABLE IF NOT EXISTS results (
@@ -316,14 +318,17 @@ absl::Status JobStore::CheckAndMigrate(const std::string& dir) {
   if (!has_checksum) {
     if (absl::Status s = Exec("ALTER TABLE results ADD COLUMN checksum INTEGER"); !s.ok()) return s;
   }
-  // Databases from before per-client limits: jobs of no known client.
-  bool has_peer = false;
-  {
-    Stmt columns(db_, "PRAGMA table_info(jobs)");
-    while (columns.Step() == SQLITE_ROW) has_peer |= columns.Text(1) == "peer";
-  }
-  if (!has_peer) {
-    if (absl::Status s = Exec("ALTER TABLE jobs ADD COLUMN peer TEXT NOT NULL DEFAULT ''");
+  // Databases from before per-client limits and tenants: jobs and sweeps
+  // of no known client and no tenant.
+  for (const auto& [table, column] : {std::pair{"jobs", "peer"}, std::pair{"jobs", "tenant"},
+                                      std::pair{"sweeps", "tenant"}}) {
+    bool has = false;
+    Stmt columns(db_, absl::StrCat("PRAGMA table_info(", table, ")").c_str());
+    while (columns.Step() == SQLITE_ROW) has |= columns.Text(1) == column;
+    if (has) continue;
+    if (absl::Status s = Exec(absl::StrCat("ALTER TABLE ", table, " ADD COLUMN ", column,
+                                           " TEXT NOT NULL DEFAULT ''")
+                                  .c_str());
         !s.ok()) {
       return s;
     }
@@ -394,21 +399,23 @@ absl::Status JobStore::CheckPeerRoom(const std::string& peer, int64_t adding,
 }
 
 absl::StatusOr<v1::Job> JobStore::InsertJob(const v1::Scene& scene, double end_time_s,
-                                            const std::string& peer, int64_t max_unfinished) {
+                                            const std::string& peer, int64_t max_unfinished,
+                                            const std::string& tenant) {
   int64_t seq;
   {
     absl::MutexLock lock(&mu_);
     if (absl::Status st = CheckPeerRoom(peer, 1, max_unfinished); !st.ok()) return st;
     Stmt s(db_,
-           "INSERT INTO jobs (state, name, scene, end_time_s, created_ms, peer) "
-           "VALUES (?1,?2,?3,?4,?5,?6)");
+           "INSERT INTO jobs (state, name, scene, end_time_s, created_ms, peer, tenant) "
+           "VALUES (?1,?2,?3,?4,?5,?6,?7)");
     const std::string blob = scene.SerializeAsString();
     s.Bind(1, int64_t{v1::QUEUED})
         .Bind(2, scene.name())
         .BindBlob(3, blob.data(), blob.size())
         .Bind(4, end_time_s)
         .Bind(5, NowUnixMs())
-        .Bind(6, peer);
+        .Bind(6, peer)
+        .Bind(7, tenant);
     if (absl::Status st = s.Done(); !st.ok()) return st;
     seq = sqlite3_last_insert_rowid(db_);
   }
@@ -419,7 +426,8 @@ absl::StatusOr<v1::Sweep> JobStore::InsertSweep(const v1::SubmitSweepRequest& re
                                                 const std::vector<v1::Scene>& items,
                                                 const std::vector<double>& end_times_s,
                                                 const std::string& peer,
-                                                int64_t max_unfinished) {
+                                                int64_t max_unfinished,
+                                                const std::string& tenant) {
   int64_t sweep_seq;
   {
     absl::MutexLock lock(&mu_);
@@ -437,15 +445,18 @@ absl::StatusOr<v1::Sweep> JobStore::InsertSweep(const v1::SubmitSweepRequest& re
     const std::string axes_blob = axes.SerializeAsString();
     const int64_t now = NowUnixMs();
     {
-      Stmt s(db_, "INSERT INTO sweeps (name, axes, created_ms) VALUES (?1, ?2, ?3)");
-      s.Bind(1, request.name()).BindBlob(2, axes_blob.data(), axes_blob.size()).Bind(3, now);
+      Stmt s(db_, "INSERT INTO sweeps (name, axes, created_ms, tenant) VALUES (?1, ?2, ?3, ?4)");
+      s.Bind(1, request.name())
+          .BindBlob(2, axes_blob.data(), axes_blob.size())
+          .Bind(3, now)
+          .Bind(4, tenant);
       if (absl::Status st = s.Done(); !st.ok()) return rollback(st);
       sweep_seq = sqlite3_last_insert_rowid(db_);
     }
     for (size_t i = 0; i < items.size(); ++i) {
       Stmt s(db_,
              "INSERT INTO jobs (state, name, scene, end_time_s, created_ms, sweep_seq, "
-             "sweep_index, peer) VALUES (?1,?2,?3,?4,?5,?6,?7,?8)");
+             "sweep_index, peer, tenant) VALUES (?1,?2,?3,?4,?5,?6,?7,?8,?9)");
       const std::string blob = items[i].SerializeAsString();
       s.Bind(1, int64_t{v1::QUEUED})
           .Bind(2, items[i].name())
@@ -454,7 +465,8 @@ absl::StatusOr<v1::Sweep> JobStore::InsertSweep(const v1::SubmitSweepRequest& re
           .Bind(5, now)
           .Bind(6, sweep_seq)
           .Bind(7, static_cast<int64_t>(i))
-          .Bind(8, peer);
+          .Bind(8, peer)
+          .Bind(9, tenant);
       if (absl::Status st = s.Done(); !st.ok()) return rollback(st);
     }
     if (absl::Status st = Exec("COMMIT"); !st.ok()) return rollback(st);
@@ -487,12 +499,14 @@ absl::StatusOr<v1::Scene> JobStore::GetScene(const std::string& id) {
 
 absl::StatusOr<std::vector<v1::Job>> JobStore::ListJobs(v1::JobState state,
                                                         const std::string& sweep_id, int limit,
-                                                        int64_t before_seq) {
+                                                        int64_t before_seq,
+                                                        const std::string* tenant) {
   absl::MutexLock lock(&mu_);
   Stmt s(db_, absl::StrCat("SELECT ", kJobColumns,
                            " FROM jobs WHERE (?1 = 0 OR state = ?1) AND (?2 = 0 OR sweep_seq = ?2)"
-                           " AND seq < ?4 ORDER BY seq DESC LIMIT ?3")
+                           " AND seq < ?4 AND (?5 = 0 OR tenant = ?6) ORDER BY seq DESC LIMIT ?3")
                   .c_str());
+  s.Bind(5, int64_t{tenant != nullptr}).Bind(6, tenant != nullptr ? *tenant : std::string());
   s.Bind(1, int64_t{state})
       .Bind(2, sweep_id.empty() ? 0 : SweepSeq(sweep_id))
       .Bind(3, int64_t{limit})
@@ -786,6 +800,20 @@ absl::StatusOr<RetentionReport> JobStore::ApplyRetention(int64_t older_than_unix
     report.bytes += c.bytes;
   }
   return report;
+}
+
+absl::StatusOr<std::string> JobStore::Tenant(const std::string& id) {
+  const bool sweep = SweepSeq(id) > 0;
+  absl::MutexLock lock(&mu_);
+  Stmt s(db_, sweep ? "SELECT tenant FROM sweeps WHERE seq = ?1"
+                    : "SELECT tenant FROM jobs WHERE seq = ?1");
+  s.Bind(1, sweep ? SweepSeq(id) : JobSeq(id));
+  const int rc = s.Step();
+  if (rc == SQLITE_ROW) return s.Text(0);
+  if (rc == SQLITE_DONE) {
+    return absl::NotFoundError(absl::StrCat("no ", sweep ? "sweep" : "job", " \"", id, "\""));
+  }
+  return SqlError(db_);
 }
 
 }  // namespace cablesim

@@ -65,23 +65,29 @@ class JobStore {
   // submitted by client address `peer`; ResourceExhausted (naming
   // max_queued_jobs_per_peer) when that peer would have more than
   // `max_unfinished` jobs queued or running.
+  // `tenant`: the token's tenant that owns it ("" without tokens).
   absl::StatusOr<v1::Job> InsertJob(
       const v1::Scene& scene, double end_time_s, const std::string& peer = "",
-      int64_t max_unfinished = std::numeric_limits<int64_t>::max());
+      int64_t max_unfinished = std::numeric_limits<int64_t>::max(),
+      const std::string& tenant = "");
   // Stores the sweep and its item jobs in one transaction (the items count
   // against `max_unfinished` as InsertJob).
   absl::StatusOr<v1::Sweep> InsertSweep(
       const v1::SubmitSweepRequest& request, const std::vector<v1::Scene>& items,
       const std::vector<double>& end_times_s, const std::string& peer = "",
-      int64_t max_unfinished = std::numeric_limits<int64_t>::max());
+      int64_t max_unfinished = std::numeric_limits<int64_t>::max(),
+      const std::string& tenant = "");
 
   absl::StatusOr<v1::Job> GetJob(const std::string& id);
   absl::StatusOr<v1::Scene> GetScene(const std::string& id);
   // Newest first, at most `limit`, only jobs older than row `before_seq`
-  // (paging).
+  // (paging), and with `tenant`, only that tenant's.
   absl::StatusOr<std::vector<v1::Job>> ListJobs(
       v1::JobState state, const std::string& sweep_id, int limit,
-      int64_t before_seq = std::numeric_limits<int64_t>::max());
+      int64_t before_seq = std::numeric_limits<int64_t>::max(),
+      const std::string* tenant = nullptr);
+  // The tenant that owns job or sweep `id` (by its prefix); NotFound.
+  absl::StatusOr<std::string> Tenant(const std::string& id);
   // Ids of QUEUED jobs, oldest first.
   absl::StatusOr<std::vector<std::string>> QueuedJobIds();
 

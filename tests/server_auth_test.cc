@@ -57,6 +57,99 @@ TEST(ServerAuthTest, ACallWithoutAKnownTokenIsUnauthenticated) {
   EXPECT_TRUE(Info(stub.get(), kToken).ok());
 }
 
+TEST(ServerAuthTest, ATenantSeesOnlyItsOwnJobsAndSweeps) {
+  const std::string dir = testing::FreshDir("auth_tenants");
+  const std::string tokens = dir + "/tokens";
+  const std::string alice = kToken, bob = "tok-bob-0123456789ab";
+  std::ofstream(tokens) << alice << " alice\n" << bob << " bob\n";
+  ServerProcess server(dir, {"--token-file=" + tokens, "--workers=1"});
+  auto stub = server.Stub();
+  auto as = [](grpc::ClientContext* context, const std::string& token) {
+    context->AddMetadata("authorization", "Bearer " + token);
+  };
+  v1::Job job;
+  {
+    grpc::ClientContext context;
+    as(&context, alice);
+    v1::SubmitJobRequest request;
+    *request.mutable_scene() = testing::Pendulum(0.02, 1e-3, 1e-2);
+    ASSERT_TRUE(stub->SubmitJob(&context, request, &job).ok());
+  }
+  v1::Sweep sweep;
+  {
+    grpc::ClientContext context;
+    as(&context, alice);
+    v1::SubmitSweepRequest request;
+    *request.mutable_base() = testing::Pendulum(0.02, 1e-3, 1e-2);
+    request.add_axes()->set_path("gravity.y");
+    request.mutable_axes(0)->add_values(-9.81);
+    ASSERT_TRUE(stub->SubmitSweep(&context, request, &sweep).ok());
+  }
+  // Bob: as if neither existed.
+  {
+    grpc::ClientContext context;
+    as(&context, bob);
+    v1::GetJobRequest request;
+    request.set_id(job.id());
+    v1::Job seen;
+    const grpc::Status s = stub->GetJob(&context, request, &seen);
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::NOT_FOUND);
+  }
+  {
+    grpc::ClientContext context;
+    as(&context, bob);
+    v1::CancelJobRequest request;
+    request.set_id(job.id());
+    v1::Job seen;
+    EXPECT_EQ(stub->CancelJob(&context, request, &seen).error_code(), grpc::StatusCode::NOT_FOUND);
+  }
+  {
+    grpc::ClientContext context;
+    as(&context, bob);
+    v1::GetJobResultRequest request;
+    request.set_id(job.id());
+    auto reader = stub->GetJobResult(&context, request);
+    v1::RunEvent event;
+    while (reader->Read(&event)) {
+    }
+    EXPECT_EQ(reader->Finish().error_code(), grpc::StatusCode::NOT_FOUND);
+  }
+  {
+    grpc::ClientContext context;
+    as(&context, bob);
+    v1::GetSweepResultsRequest request;
+    request.set_id(sweep.id());
+    v1::SweepResults results;
+    EXPECT_EQ(stub->GetSweepResults(&context, request, &results).error_code(),
+              grpc::StatusCode::NOT_FOUND);
+  }
+  {
+    grpc::ClientContext context;
+    as(&context, bob);
+    v1::DeleteSweepRequest request;
+    request.set_id(sweep.id());
+    v1::DeleteResponse response;
+    EXPECT_EQ(stub->DeleteSweep(&context, request, &response).error_code(),
+              grpc::StatusCode::NOT_FOUND);
+  }
+  auto list = [&](const std::string& token) {
+    grpc::ClientContext context;
+    as(&context, token);
+    v1::ListJobsResponse response;
+    EXPECT_TRUE(stub->ListJobs(&context, v1::ListJobsRequest(), &response).ok());
+    return response.jobs_size();
+  };
+  EXPECT_EQ(list(bob), 0);
+  EXPECT_EQ(list(alice), 2);
+  // Alice sees hers.
+  grpc::ClientContext context;
+  as(&context, alice);
+  v1::GetJobRequest request;
+  request.set_id(job.id());
+  v1::Job seen;
+  EXPECT_TRUE(stub->GetJob(&context, request, &seen).ok());
+}
+
 // Runs `command` with /bin/sh; true on exit 0.
 bool Shell(const std::string& command) { return std::system(command.c_str()) == 0; }
 
