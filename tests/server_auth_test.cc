@@ -9,8 +9,10 @@
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
 
+#include "client/cli.h"
 #include "server_test_util.h"
 
 namespace cablesim {
@@ -205,6 +207,35 @@ TEST(ServerAuthTest, MutualTlsNeedsAClientCertificate) {
                              "--tls-client-ca=" + dir + "/ca.pem"});
   EXPECT_FALSE(Info(TlsStub(server, dir, false).get()).ok());
   EXPECT_TRUE(Info(TlsStub(server, dir, true).get()).ok());
+}
+
+// `cablesim ARGS...` in this process: its exit code, stderr in `err`.
+int Cli(const std::vector<std::string>& args, std::string* err) {
+  std::ostringstream out, error;
+  const int code = RunCli(args, out, error);
+  *err = error.str();
+  return code;
+}
+
+TEST(ServerAuthTest, TheCommandLineTakesTlsCaAndTokenFile) {
+  const std::string dir = testing::FreshDir("auth_cli");
+  MakeCertificates(dir);
+  const std::string tokens = dir + "/tokens", mine = dir + "/my-token";
+  std::ofstream(tokens) << kToken << " alice\n";
+  std::ofstream(mine) << "# issued to alice\n" << kToken << "\n";
+  ServerProcess server(dir, {"--tls-cert=" + dir + "/server.pem",
+                             "--tls-key=" + dir + "/server.key", "--token-file=" + tokens});
+  // The certificate names localhost.
+  const std::string address = absl::StrCat("localhost:", server.port());
+  std::string err;
+  EXPECT_EQ(Cli({"jobs", "--server", address, "--tls-ca", dir + "/ca.pem", "--token-file", mine},
+                &err),
+            0)
+      << err;
+  EXPECT_EQ(Cli({"jobs", "--server", address, "--tls-ca", dir + "/ca.pem"}, &err), 1);
+  EXPECT_THAT(err, HasSubstr("UNAUTHENTICATED"));
+  EXPECT_EQ(Cli({"jobs", "--server", address, "--token-file", mine}, &err), 1);  // no TLS
+  EXPECT_EQ(Cli({"jobs", "--token-file", mine}, &err), 2);  // only with --server
 }
 
 TEST(ServerAuthTest, BeyondLoopbackOnlyWithTlsAndTokensOrInsecure) {
