@@ -221,7 +221,7 @@ grpc::Status CablesimServiceImpl::Owned(const std::string& id, const std::string
   if (*owner != tenant) {
     // As if it did not exist: another tenant learns nothing about it.
     return grpc::Status(grpc::StatusCode::NOT_FOUND,
-                        absl::StrCat("no ", SweepSeq(id) > 0 ? "sweep" : "job", " \"", id, "\""));
+                        absl::StrCat("no ", IsSweepId(id) ? "sweep" : "job", " \"", id, "\""));
   }
   return grpc::Status::OK;
 }
@@ -413,17 +413,10 @@ grpc::Status CablesimServiceImpl::ListJobs(grpc::ServerContext* context,
   const int asked = request->page_size() > 0 ? request->page_size() : request->limit();
   const int limit = asked <= 0 ? 100 : std::min(asked, 10000);
   // The page token is the id of the last job of the previous page.
-  int64_t before = std::numeric_limits<int64_t>::max();
-  if (!request->page_token().empty()) {
-    before = JobSeq(request->page_token());
-    if (before <= 0) {
-      return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                          "page_token: not a token from a previous ListJobs response");
-    }
-  }
   // One more than asked, to know whether another page follows.
   absl::StatusOr<std::vector<v1::Job>> jobs =
-      jobs_->store()->ListJobs(request->state(), request->sweep_id(), limit + 1, before,
+      jobs_->store()->ListJobs(request->state(), request->sweep_id(), limit + 1,
+                               request->page_token(),
                                tokens_.empty() ? nullptr : &tenant);
   if (!jobs.ok()) return ToGrpc(jobs.status());
   // Never a response over the message limit: stop at half of it.

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <sqlite3.h>
 #include <sys/file.h>
+#include <sys/random.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <zlib.h>
@@ -14,6 +15,8 @@
 #include <fstream>
 #include <utility>
 
+#include "absl/strings/escaping.h"
+#include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -24,12 +27,14 @@ namespace {
 constexpr char kSchema[] = R"sql(
 CREATE TABLE IF NOT EXISTS sweeps (
   seq INTEGER PRIMARY KEY AUTOINCREMENT,
+  pid TEXT,                     -- the public id, `s-` and 128 random bits
   name TEXT NOT NULL,
   axes BLOB NOT NULL,           -- cablesim.v1.Sweep with only the axes
   created_ms INTEGER NOT NULL,
   tenant TEXT NOT NULL DEFAULT '');  -- the token's tenant that made it
 CREATE TABLE IF NOT EXISTS jobs (
   seq INTEGER PRIMARY KEY AUTOINCREMENT,
+  pid TEXT,                     -- the public id, `j-` and 128 random bits
   state INTEGER NOT NULL,       -- cablesim.v1.JobState
   name TEXT NOT NULL,
   scene BLOB NOT NULL,          -- cablesim.v1.Scene
@@ -160,11 +165,12 @@ absl::Status SqlError(sqlite3* db) {
 constexpr char kJobColumns[] =
     "seq, state, name, created_ms, started_ms, finished_ms, attempts, end_time_s, summary, "
     "sweep_seq, sweep_index, "
-    "(SELECT length(header) + length(vals) FROM results WHERE job_seq = jobs.seq)";
+    "(SELECT length(header) + length(vals) FROM results WHERE job_seq = jobs.seq), pid, "
+    "(SELECT pid FROM sweeps WHERE sweeps.seq = jobs.sweep_seq)";
 
 v1::Job JobFromRow(Stmt& s) {
   v1::Job job;
-  job.set_id(JobId(s.Int(0)));
+  job.set_id(s.Text(12));
   job.set_state(static_cast<v1::JobState>(s.Int(1)));
   job.set_name(s.Text(2));
   job.set_created_unix_ms(s.Int(3));
@@ -175,7 +181,7 @@ v1::Job JobFromRow(Stmt& s) {
   const std::string summary = s.Blob(8);
   if (!summary.empty()) job.mutable_summary()->ParseFromString(summary);
   if (s.Int(9) > 0) {
-    job.set_sweep_id(SweepId(s.Int(9)));
+    job.set_sweep_id(s.Text(13));
     job.set_sweep_index(static_cast<int>(s.Int(10)));
   }
   job.set_stored_bytes(s.Int(11));
@@ -188,21 +194,30 @@ std::vector<double> DoublesFromBlob(const std::string& blob) {
   return v;
 }
 
-int64_t SeqFromId(const std::string& id, char prefix) {
-  int64_t seq = -1;
-  if (id.size() < 3 || id[0] != prefix || id[1] != '-' ||
-      !absl::SimpleAtoi(absl::string_view(id).substr(2), &seq) || seq <= 0) {
-    return -1;
-  }
-  return seq;
-}
 
 }  // namespace
 
 std::string JobId(int64_t seq) { return absl::StrFormat("j-%06d", seq); }
-int64_t JobSeq(const std::string& id) { return SeqFromId(id, 'j'); }
 std::string SweepId(int64_t seq) { return absl::StrFormat("s-%06d", seq); }
-int64_t SweepSeq(const std::string& id) { return SeqFromId(id, 's'); }
+
+bool IsSweepId(const std::string& id) { return absl::StartsWith(id, "s-"); }
+
+absl::StatusOr<std::string> NewPublicId(char prefix) {
+  unsigned char bytes[16];
+  if (::getrandom(bytes, sizeof(bytes), 0) != static_cast<ssize_t>(sizeof(bytes))) {
+    return absl::UnavailableError(absl::StrCat("getrandom: ", std::strerror(errno)));
+  }
+  return absl::StrCat(std::string(1, prefix), "-",
+                      absl::WebSafeBase64Escape(absl::string_view(
+                          reinterpret_cast<const char*>(bytes), sizeof(bytes))));
+}
+
+int64_t JobStore::LookUpSeq(const std::string& id) {
+  Stmt s(db_, IsSweepId(id) ? "SELECT seq FROM sweeps WHERE pid = ?1"
+                            : "SELECT seq FROM jobs WHERE pid = ?1");
+  s.Bind(1, id);
+  return s.Step() == SQLITE_ROW ? s.Int(0) : -1;
+}
 int64_t NowUnixMs() {
   return std::chrono::duration_cast<std::chrono::milliseconds>(
              std::chrono::system_clock::now().time_since_epoch())
@@ -318,6 +333,28 @@ absl::Status JobStore::CheckAndMigrate(const std::string& dir) {
   if (!has_checksum) {
     if (absl::Status s = Exec("ALTER TABLE results ADD COLUMN checksum INTEGER"); !s.ok()) return s;
   }
+  // Databases from before random ids: their rows keep the ids they had.
+  for (const auto& [table, prefix] : {std::pair{"jobs", "j"}, std::pair{"sweeps", "s"}}) {
+    bool has = false;
+    {
+      Stmt columns(db_, absl::StrCat("PRAGMA table_info(", table, ")").c_str());
+      while (columns.Step() == SQLITE_ROW) has |= columns.Text(1) == "pid";
+    }
+    if (!has) {
+      if (absl::Status s = Exec(absl::StrCat("ALTER TABLE ", table, " ADD COLUMN pid TEXT").c_str());
+          !s.ok()) {
+        return s;
+      }
+    }
+    if (absl::Status s = Exec(absl::StrCat("UPDATE ", table, " SET pid = printf('", prefix,
+                                           "-%06d', seq) WHERE pid IS NULL; ",
+                                           "CREATE UNIQUE INDEX IF NOT EXISTS ", table,
+                                           "_by_pid ON ", table, "(pid)")
+                                  .c_str());
+        !s.ok()) {
+      return s;
+    }
+  }
   // Databases from before per-client limits and tenants: jobs and sweeps
   // of no known client and no tenant.
   for (const auto& [table, column] : {std::pair{"jobs", "peer"}, std::pair{"jobs", "tenant"},
@@ -401,13 +438,14 @@ absl::Status JobStore::CheckPeerRoom(const std::string& peer, int64_t adding,
 absl::StatusOr<v1::Job> JobStore::InsertJob(const v1::Scene& scene, double end_time_s,
                                             const std::string& peer, int64_t max_unfinished,
                                             const std::string& tenant) {
-  int64_t seq;
+  absl::StatusOr<std::string> pid = NewPublicId('j');
+  if (!pid.ok()) return pid.status();
   {
     absl::MutexLock lock(&mu_);
     if (absl::Status st = CheckPeerRoom(peer, 1, max_unfinished); !st.ok()) return st;
     Stmt s(db_,
-           "INSERT INTO jobs (state, name, scene, end_time_s, created_ms, peer, tenant) "
-           "VALUES (?1,?2,?3,?4,?5,?6,?7)");
+           "INSERT INTO jobs (state, name, scene, end_time_s, created_ms, peer, tenant, pid) "
+           "VALUES (?1,?2,?3,?4,?5,?6,?7,?8)");
     const std::string blob = scene.SerializeAsString();
     s.Bind(1, int64_t{v1::QUEUED})
         .Bind(2, scene.name())
@@ -415,11 +453,11 @@ absl::StatusOr<v1::Job> JobStore::InsertJob(const v1::Scene& scene, double end_t
         .Bind(4, end_time_s)
         .Bind(5, NowUnixMs())
         .Bind(6, peer)
-        .Bind(7, tenant);
+        .Bind(7, tenant)
+        .Bind(8, *pid);
     if (absl::Status st = s.Done(); !st.ok()) return st;
-    seq = sqlite3_last_insert_rowid(db_);
   }
-  return GetJob(JobId(seq));
+  return GetJob(*pid);
 }
 
 absl::StatusOr<v1::Sweep> JobStore::InsertSweep(const v1::SubmitSweepRequest& request,
@@ -429,6 +467,7 @@ absl::StatusOr<v1::Sweep> JobStore::InsertSweep(const v1::SubmitSweepRequest& re
                                                 int64_t max_unfinished,
                                                 const std::string& tenant) {
   int64_t sweep_seq;
+  absl::StatusOr<std::string> sweep_pid;
   {
     absl::MutexLock lock(&mu_);
     if (absl::Status st = CheckPeerRoom(peer, static_cast<int64_t>(items.size()), max_unfinished);
@@ -440,23 +479,27 @@ absl::StatusOr<v1::Sweep> JobStore::InsertSweep(const v1::SubmitSweepRequest& re
       Exec("ROLLBACK").IgnoreError();
       return st;
     };
+    sweep_pid = NewPublicId('s');
+    if (!sweep_pid.ok()) return rollback(sweep_pid.status());
     v1::Sweep axes;
     *axes.mutable_axes() = request.axes();
     const std::string axes_blob = axes.SerializeAsString();
     const int64_t now = NowUnixMs();
     {
-      Stmt s(db_, "INSERT INTO sweeps (name, axes, created_ms, tenant) VALUES (?1, ?2, ?3, ?4)");
+      Stmt s(db_,
+             "INSERT INTO sweeps (name, axes, created_ms, tenant, pid) VALUES (?1,?2,?3,?4,?5)");
       s.Bind(1, request.name())
           .BindBlob(2, axes_blob.data(), axes_blob.size())
           .Bind(3, now)
-          .Bind(4, tenant);
+          .Bind(4, tenant)
+          .Bind(5, *sweep_pid);
       if (absl::Status st = s.Done(); !st.ok()) return rollback(st);
       sweep_seq = sqlite3_last_insert_rowid(db_);
     }
     for (size_t i = 0; i < items.size(); ++i) {
       Stmt s(db_,
              "INSERT INTO jobs (state, name, scene, end_time_s, created_ms, sweep_seq, "
-             "sweep_index, peer, tenant) VALUES (?1,?2,?3,?4,?5,?6,?7,?8,?9)");
+             "sweep_index, peer, tenant, pid) VALUES (?1,?2,?3,?4,?5,?6,?7,?8,?9,?10)");
       const std::string blob = items[i].SerializeAsString();
       s.Bind(1, int64_t{v1::QUEUED})
           .Bind(2, items[i].name())
@@ -467,18 +510,21 @@ absl::StatusOr<v1::Sweep> JobStore::InsertSweep(const v1::SubmitSweepRequest& re
           .Bind(7, static_cast<int64_t>(i))
           .Bind(8, peer)
           .Bind(9, tenant);
+      absl::StatusOr<std::string> item_pid = NewPublicId('j');
+      if (!item_pid.ok()) return rollback(item_pid.status());
+      s.Bind(10, *item_pid);
       if (absl::Status st = s.Done(); !st.ok()) return rollback(st);
     }
     if (absl::Status st = Exec("COMMIT"); !st.ok()) return rollback(st);
   }
-  return GetSweep(SweepId(sweep_seq));
+  (void)sweep_seq;
+  return GetSweep(*sweep_pid);
 }
 
 absl::StatusOr<v1::Job> JobStore::GetJob(const std::string& id) {
-  const int64_t seq = JobSeq(id);
   absl::MutexLock lock(&mu_);
-  Stmt s(db_, absl::StrCat("SELECT ", kJobColumns, " FROM jobs WHERE seq = ?1").c_str());
-  s.Bind(1, seq);
+  Stmt s(db_, absl::StrCat("SELECT ", kJobColumns, " FROM jobs WHERE pid = ?1").c_str());
+  s.Bind(1, id);
   const int rc = s.Step();
   if (rc == SQLITE_ROW) return JobFromRow(s);
   if (rc == SQLITE_DONE) return absl::NotFoundError(absl::StrCat("no job \"", id, "\""));
@@ -487,8 +533,8 @@ absl::StatusOr<v1::Job> JobStore::GetJob(const std::string& id) {
 
 absl::StatusOr<v1::Scene> JobStore::GetScene(const std::string& id) {
   absl::MutexLock lock(&mu_);
-  Stmt s(db_, "SELECT scene FROM jobs WHERE seq = ?1");
-  s.Bind(1, JobSeq(id));
+  Stmt s(db_, "SELECT scene FROM jobs WHERE pid = ?1");
+  s.Bind(1, id);
   const int rc = s.Step();
   if (rc == SQLITE_DONE) return absl::NotFoundError(absl::StrCat("no job \"", id, "\""));
   if (rc != SQLITE_ROW) return SqlError(db_);
@@ -499,16 +545,24 @@ absl::StatusOr<v1::Scene> JobStore::GetScene(const std::string& id) {
 
 absl::StatusOr<std::vector<v1::Job>> JobStore::ListJobs(v1::JobState state,
                                                         const std::string& sweep_id, int limit,
-                                                        int64_t before_seq,
+                                                        const std::string& after_id,
                                                         const std::string* tenant) {
   absl::MutexLock lock(&mu_);
+  int64_t before_seq = std::numeric_limits<int64_t>::max();
+  if (!after_id.empty()) {
+    before_seq = IsSweepId(after_id) ? -1 : LookUpSeq(after_id);
+    if (before_seq < 0) {
+      return absl::InvalidArgumentError(
+          "page_token: not a token from a previous ListJobs response (or its job was deleted)");
+    }
+  }
   Stmt s(db_, absl::StrCat("SELECT ", kJobColumns,
                            " FROM jobs WHERE (?1 = 0 OR state = ?1) AND (?2 = 0 OR sweep_seq = ?2)"
                            " AND seq < ?4 AND (?5 = 0 OR tenant = ?6) ORDER BY seq DESC LIMIT ?3")
                   .c_str());
   s.Bind(5, int64_t{tenant != nullptr}).Bind(6, tenant != nullptr ? *tenant : std::string());
   s.Bind(1, int64_t{state})
-      .Bind(2, sweep_id.empty() ? 0 : SweepSeq(sweep_id))
+      .Bind(2, sweep_id.empty() ? 0 : (IsSweepId(sweep_id) ? LookUpSeq(sweep_id) : -1))
       .Bind(3, int64_t{limit})
       .Bind(4, before_seq);
   std::vector<v1::Job> jobs;
@@ -520,11 +574,11 @@ absl::StatusOr<std::vector<v1::Job>> JobStore::ListJobs(v1::JobState state,
 
 absl::StatusOr<std::vector<std::string>> JobStore::QueuedJobIds() {
   absl::MutexLock lock(&mu_);
-  Stmt s(db_, "SELECT seq FROM jobs WHERE state = ?1 ORDER BY seq");
+  Stmt s(db_, "SELECT pid FROM jobs WHERE state = ?1 ORDER BY seq");
   s.Bind(1, int64_t{v1::QUEUED});
   std::vector<std::string> ids;
   int rc;
-  while ((rc = s.Step()) == SQLITE_ROW) ids.push_back(JobId(s.Int(0)));
+  while ((rc = s.Step()) == SQLITE_ROW) ids.push_back(s.Text(0));
   if (rc != SQLITE_DONE) return SqlError(db_);
   return ids;
 }
@@ -536,7 +590,7 @@ absl::StatusOr<bool> JobStore::MarkRunning(const std::string& id) {
          "WHERE seq = ?3 AND state = ?4");
   s.Bind(1, int64_t{v1::RUNNING})
       .Bind(2, NowUnixMs())
-      .Bind(3, JobSeq(id))
+      .Bind(3, LookUpSeq(id))
       .Bind(4, int64_t{v1::QUEUED});
   if (absl::Status st = s.Done(); !st.ok()) return st;
   return sqlite3_changes(db_) == 1;
@@ -545,7 +599,7 @@ absl::StatusOr<bool> JobStore::MarkRunning(const std::string& id) {
 absl::Status JobStore::Requeue(const std::string& id) {
   absl::MutexLock lock(&mu_);
   Stmt s(db_, "UPDATE jobs SET state = ?1 WHERE seq = ?2 AND state = ?3");
-  s.Bind(1, int64_t{v1::QUEUED}).Bind(2, JobSeq(id)).Bind(3, int64_t{v1::RUNNING});
+  s.Bind(1, int64_t{v1::QUEUED}).Bind(2, LookUpSeq(id)).Bind(3, int64_t{v1::RUNNING});
   return s.Done();
 }
 
@@ -554,7 +608,7 @@ absl::StatusOr<bool> JobStore::CancelQueued(const std::string& id) {
   Stmt s(db_, "UPDATE jobs SET state = ?1, finished_ms = ?2 WHERE seq = ?3 AND state = ?4");
   s.Bind(1, int64_t{v1::CANCELLED})
       .Bind(2, NowUnixMs())
-      .Bind(3, JobSeq(id))
+      .Bind(3, LookUpSeq(id))
       .Bind(4, int64_t{v1::QUEUED});
   if (absl::Status st = s.Done(); !st.ok()) return st;
   return sqlite3_changes(db_) == 1;
@@ -562,10 +616,10 @@ absl::StatusOr<bool> JobStore::CancelQueued(const std::string& id) {
 
 absl::StatusOr<bool> JobStore::Finish(const std::string& id, v1::JobState state,
                                       const v1::RunSummary& summary, const StoredResult& result) {
-  const int64_t seq = JobSeq(id);
   const std::string summary_blob = summary.SerializeAsString();
   const std::string header_blob = result.header.SerializeAsString();
   absl::MutexLock lock(&mu_);
+  const int64_t seq = LookUpSeq(id);
   if (absl::Status st = Exec("BEGIN IMMEDIATE"); !st.ok()) return st;
   auto rollback = [&](absl::Status st) {
     Exec("ROLLBACK").IgnoreError();
@@ -600,7 +654,7 @@ absl::StatusOr<bool> JobStore::Finish(const std::string& id, v1::JobState state,
 absl::StatusOr<StoredResult> JobStore::GetResult(const std::string& id) {
   absl::MutexLock lock(&mu_);
   Stmt s(db_, "SELECT header, vals, checksum FROM results WHERE job_seq = ?1");
-  s.Bind(1, JobSeq(id));
+  s.Bind(1, LookUpSeq(id));
   const int rc = s.Step();
   if (rc == SQLITE_DONE) return absl::NotFoundError(absl::StrCat("job \"", id, "\" has no result"));
   if (rc != SQLITE_ROW) return SqlError(db_);
@@ -618,8 +672,8 @@ absl::StatusOr<StoredResult> JobStore::GetResult(const std::string& id) {
 }
 
 absl::StatusOr<v1::Sweep> JobStore::GetSweep(const std::string& id) {
-  const int64_t seq = SweepSeq(id);
   absl::MutexLock lock(&mu_);
+  const int64_t seq = IsSweepId(id) ? LookUpSeq(id) : -1;
   v1::Sweep sweep;
   {
     Stmt s(db_, "SELECT name, axes, created_ms FROM sweeps WHERE seq = ?1");
@@ -632,13 +686,13 @@ absl::StatusOr<v1::Sweep> JobStore::GetSweep(const std::string& id) {
     sweep.set_name(s.Text(0));
     sweep.set_created_unix_ms(s.Int(2));
   }
-  Stmt s(db_, "SELECT seq, state FROM jobs WHERE sweep_seq = ?1 ORDER BY sweep_index");
+  Stmt s(db_, "SELECT pid, state FROM jobs WHERE sweep_seq = ?1 ORDER BY sweep_index");
   s.Bind(1, seq);
   int rc;
   int items = 0, finished = 0, failed = 0;
   while ((rc = s.Step()) == SQLITE_ROW) {
     ++items;
-    sweep.add_job_ids(JobId(s.Int(0)));
+    sweep.add_job_ids(s.Text(0));
     const auto state = static_cast<v1::JobState>(s.Int(1));
     if (state == v1::SUCCEEDED || state == v1::FAILED || state == v1::CANCELLED) ++finished;
     if (state == v1::FAILED || state == v1::CANCELLED) ++failed;
@@ -670,15 +724,17 @@ absl::Status JobStore::DeleteJobRows(const std::string& where, int64_t key) {
 }
 
 absl::StatusOr<int64_t> JobStore::DeleteJob(const std::string& id) {
-  const int64_t seq = JobSeq(id);
   absl::MutexLock lock(&mu_);
+  const int64_t seq = IsSweepId(id) ? -1 : LookUpSeq(id);
   if (absl::Status st = Exec("BEGIN IMMEDIATE"); !st.ok()) return st;
   auto rollback = [&](absl::Status st) {
     Exec("ROLLBACK").IgnoreError();
     return st;
   };
   Stmt s(db_, absl::StrCat("SELECT state, sweep_seq, (SELECT ", kResultBytes,
-                           " FROM results WHERE job_seq = jobs.seq) FROM jobs WHERE seq = ?1")
+                           " FROM results WHERE job_seq = jobs.seq), "
+                           "(SELECT pid FROM sweeps WHERE sweeps.seq = jobs.sweep_seq) "
+                           "FROM jobs WHERE seq = ?1")
                   .c_str());
   s.Bind(1, seq);
   const int rc = s.Step();
@@ -686,13 +742,14 @@ absl::StatusOr<int64_t> JobStore::DeleteJob(const std::string& id) {
   if (rc != SQLITE_ROW) return rollback(SqlError(db_));
   const auto state = static_cast<v1::JobState>(s.Int(0));
   const int64_t sweep_seq = s.Int(1), bytes = s.Int(2);
+  const std::string sweep_id = s.Text(3);
   if (!IsFinished(state)) {
     return rollback(absl::FailedPreconditionError(absl::StrCat(
         "job \"", id, "\" is ", v1::JobState_Name(state), "; cancel it before deleting it")));
   }
   if (sweep_seq > 0) {
     return rollback(absl::FailedPreconditionError(
-        absl::StrCat("job \"", id, "\" is an item of sweep \"", SweepId(sweep_seq),
+        absl::StrCat("job \"", id, "\" is an item of sweep \"", sweep_id,
                      "\"; delete the sweep (DeleteSweep) instead")));
   }
   if (absl::Status st = DeleteJobRows("seq = ?1", seq); !st.ok()) return rollback(st);
@@ -701,8 +758,8 @@ absl::StatusOr<int64_t> JobStore::DeleteJob(const std::string& id) {
 }
 
 absl::StatusOr<int64_t> JobStore::DeleteSweep(const std::string& id) {
-  const int64_t seq = SweepSeq(id);
   absl::MutexLock lock(&mu_);
+  const int64_t seq = IsSweepId(id) ? LookUpSeq(id) : -1;
   if (absl::Status st = Exec("BEGIN IMMEDIATE"); !st.ok()) return st;
   auto rollback = [&](absl::Status st) {
     Exec("ROLLBACK").IgnoreError();
@@ -803,11 +860,11 @@ absl::StatusOr<RetentionReport> JobStore::ApplyRetention(int64_t older_than_unix
 }
 
 absl::StatusOr<std::string> JobStore::Tenant(const std::string& id) {
-  const bool sweep = SweepSeq(id) > 0;
+  const bool sweep = IsSweepId(id);
   absl::MutexLock lock(&mu_);
-  Stmt s(db_, sweep ? "SELECT tenant FROM sweeps WHERE seq = ?1"
-                    : "SELECT tenant FROM jobs WHERE seq = ?1");
-  s.Bind(1, sweep ? SweepSeq(id) : JobSeq(id));
+  Stmt s(db_, sweep ? "SELECT tenant FROM sweeps WHERE pid = ?1"
+                    : "SELECT tenant FROM jobs WHERE pid = ?1");
+  s.Bind(1, id);
   const int rc = s.Step();
   if (rc == SQLITE_ROW) return s.Text(0);
   if (rc == SQLITE_DONE) {

@@ -21,8 +21,10 @@
 // Each result is stored with a CRC-32 of its bytes, verified on every
 // read: a mismatch is DATA_LOSS, never altered numbers.
 //
-// Ids: job `j-NNNNNN`, sweep `s-NNNNNN` (the row numbers, never reused:
-// a deleted job's id names no other job).
+// Ids: job `j-` and sweep `s-` followed by 128 random bits (22 URL-safe
+// base64 characters), so that they cannot be guessed; rows stored before
+// random ids keep theirs (`j-000042`). Rows are numbered internally
+// (AUTOINCREMENT, never reused).
 
 #include <cstdint>
 #include <limits>
@@ -80,12 +82,12 @@ class JobStore {
 
   absl::StatusOr<v1::Job> GetJob(const std::string& id);
   absl::StatusOr<v1::Scene> GetScene(const std::string& id);
-  // Newest first, at most `limit`, only jobs older than row `before_seq`
-  // (paging), and with `tenant`, only that tenant's.
-  absl::StatusOr<std::vector<v1::Job>> ListJobs(
-      v1::JobState state, const std::string& sweep_id, int limit,
-      int64_t before_seq = std::numeric_limits<int64_t>::max(),
-      const std::string* tenant = nullptr);
+  // Newest first, at most `limit`, and with `tenant`, only that tenant's.
+  // Paging: only jobs older than job `after_id` (InvalidArgument when no
+  // such job).
+  absl::StatusOr<std::vector<v1::Job>> ListJobs(v1::JobState state, const std::string& sweep_id,
+                                                int limit, const std::string& after_id = "",
+                                                const std::string* tenant = nullptr);
   // The tenant that owns job or sweep `id` (by its prefix); NotFound.
   absl::StatusOr<std::string> Tenant(const std::string& id);
   // Ids of QUEUED jobs, oldest first.
@@ -126,6 +128,8 @@ class JobStore {
   absl::Status Exec(const char* sql);
   // Open's checks (quick_check, the store id), the schema and migrations.
   absl::Status CheckAndMigrate(const std::string& dir);
+  // The row of job or sweep `id` (by its prefix), -1 when none; mu_ held.
+  int64_t LookUpSeq(const std::string& id);
   // Deletes the jobs matching `where` (with ?1 bound to `key`) and their
   // results; in the caller's transaction, mu_ held.
   absl::Status DeleteJobRows(const std::string& where, int64_t key);
@@ -138,11 +142,12 @@ class JobStore {
   int lock_fd_;
 };
 
-// Job id <-> row number; -1 for a malformed id.
+// The ids of rows made before ids were random (`j-000042`), which such
+// rows keep.
 std::string JobId(int64_t seq);
-int64_t JobSeq(const std::string& id);
 std::string SweepId(int64_t seq);
-int64_t SweepSeq(const std::string& id);
+// Whether `id` names a sweep (`s-...`) rather than a job (`j-...`).
+bool IsSweepId(const std::string& id);
 int64_t NowUnixMs();
 
 }  // namespace cablesim

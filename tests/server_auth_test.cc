@@ -152,6 +152,29 @@ TEST(ServerAuthTest, ATenantSeesOnlyItsOwnJobsAndSweeps) {
   EXPECT_TRUE(stub->GetJob(&context, request, &seen).ok());
 }
 
+TEST(ServerAuthTest, IdsCannotBeGuessed) {
+  const std::string dir = testing::FreshDir("auth_ids");
+  ServerProcess server(dir, {"--workers=1"});
+  auto stub = server.Stub();
+  std::vector<std::string> ids;
+  for (int i = 0; i < 2; ++i) {
+    grpc::ClientContext context;
+    v1::SubmitJobRequest request;
+    *request.mutable_scene() = testing::Pendulum(0.01, 1e-3, 1e-3);
+    v1::Job job;
+    ASSERT_TRUE(stub->SubmitJob(&context, request, &job).ok());
+    EXPECT_THAT(job.id(), ::testing::MatchesRegex("j-[A-Za-z0-9_-]{22}"));
+    ids.push_back(job.id());
+  }
+  EXPECT_NE(ids[0], ids[1]);
+  // The sequential ids of before name nothing.
+  grpc::ClientContext context;
+  v1::GetJobRequest request;
+  request.set_id("j-000001");
+  v1::Job job;
+  EXPECT_EQ(stub->GetJob(&context, request, &job).error_code(), grpc::StatusCode::NOT_FOUND);
+}
+
 // Runs `command` with /bin/sh; true on exit 0.
 bool Shell(const std::string& command) { return std::system(command.c_str()) == 0; }
 
