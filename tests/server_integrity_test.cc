@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "absl/strings/escaping.h"
 #include "server_test_util.h"
 
 namespace cablesim {
@@ -142,6 +143,64 @@ TEST(ServerIntegrityTest, TheSingleServerLockCannotBeRemoved) {
   std::string log;
   EXPECT_EQ(testing::StartRefused(dir, &log), 1);
   EXPECT_THAT(log, HasSubstr("in use by another cablesim-server"));
+}
+
+TEST(ServerIntegrityTest, ADatabaseFromBeforeIsUpgradedAndKeepsItsIds) {
+  // The schema of the last release (no checksums, peers, tenants or
+  // random ids) with one finished job and its two-row result.
+  const std::string dir = testing::FreshDir("integrity_upgrade");
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open((dir + "/cablesim.db").c_str(), &db), SQLITE_OK);
+  v1::RunHeader header;
+  header.add_columns("t");
+  header.add_columns("x");
+  const std::string header_blob = header.SerializeAsString();
+  v1::RunSummary summary;
+  summary.set_status("ok");
+  const std::string summary_blob = summary.SerializeAsString();
+  const double vals[] = {0.0, 1.0, 0.5, 2.0};
+  const std::string sql = absl::StrCat(R"sql(
+CREATE TABLE sweeps (seq INTEGER PRIMARY KEY AUTOINCREMENT, name TEXT NOT NULL,
+  axes BLOB NOT NULL, created_ms INTEGER NOT NULL);
+CREATE TABLE jobs (seq INTEGER PRIMARY KEY AUTOINCREMENT, state INTEGER NOT NULL,
+  name TEXT NOT NULL, scene BLOB NOT NULL, end_time_s REAL NOT NULL, created_ms INTEGER NOT NULL,
+  started_ms INTEGER NOT NULL DEFAULT 0, finished_ms INTEGER NOT NULL DEFAULT 0,
+  attempts INTEGER NOT NULL DEFAULT 0, summary BLOB, sweep_seq INTEGER NOT NULL DEFAULT 0,
+  sweep_index INTEGER NOT NULL DEFAULT 0);
+CREATE TABLE results (job_seq INTEGER PRIMARY KEY REFERENCES jobs(seq), header BLOB NOT NULL,
+  vals BLOB NOT NULL);
+INSERT INTO jobs (state, name, scene, end_time_s, created_ms, finished_ms, attempts, summary)
+  VALUES (3, 'old', x'', 1.0, 1, 2, 1, x')sql",
+                                       absl::BytesToHexString(summary_blob), R"sql(');
+INSERT INTO results (job_seq, header, vals) VALUES (1, x')sql",
+                                       absl::BytesToHexString(header_blob), "', x'",
+                                       absl::BytesToHexString(absl::string_view(
+                                           reinterpret_cast<const char*>(vals), sizeof(vals))),
+                                       "');");
+  char* error = nullptr;
+  ASSERT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &error), SQLITE_OK) << error;
+  sqlite3_close(db);
+
+  ServerProcess server(dir);
+  auto stub = server.Stub();
+  grpc::ClientContext context;
+  v1::GetJobRequest get;
+  get.set_id("j-000001");
+  v1::Job job;
+  const grpc::Status s = stub->GetJob(&context, get, &job);
+  ASSERT_TRUE(s.ok()) << s.error_message();
+  EXPECT_EQ(job.state(), v1::SUCCEEDED);
+  EXPECT_EQ(job.name(), "old");
+  const testing::JobResultRead read = testing::ReadJobResult(stub.get(), "j-000001");
+  EXPECT_TRUE(read.status.ok()) << read.status.error_message();
+  EXPECT_EQ(read.rows, 2);
+  // New jobs get random ids beside it.
+  grpc::ClientContext submit_context;
+  v1::SubmitJobRequest submit;
+  *submit.mutable_scene() = Pendulum(0.01, 1e-3, 1e-3);
+  v1::Job fresh;
+  ASSERT_TRUE(stub->SubmitJob(&submit_context, submit, &fresh).ok());
+  EXPECT_THAT(fresh.id(), ::testing::MatchesRegex("j-[A-Za-z0-9_-]{22}"));
 }
 
 TEST(ServerIntegrityTest, TheDataIsPrivate) {
