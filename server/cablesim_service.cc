@@ -25,12 +25,12 @@ class StreamSlot {
  public:
   // `counted`: the stream takes one of the max_streams slots (runs do;
   // watchers and result downloads only register with the watchdog).
-  // A counted stream also takes one of its peer's max_streams_per_peer
-  // slots (the peer: the client's address without its port), so that one
-  // client cannot hold every slot.
-  StreamSlot(CablesimServiceImpl* service, grpc::ServerContext* context, bool counted = true)
+  // A counted stream also takes one of its client's max_streams_per_peer
+  // slots (`client`: ClientKey), so that one client cannot hold every slot.
+  StreamSlot(CablesimServiceImpl* service, grpc::ServerContext* context, bool counted = true,
+             const std::string& client = "")
       : service_(service), watch_{context}, counted_(counted) {
-    if (counted_) peer_ = PeerOf(context);
+    if (counted_) peer_ = client.empty() ? PeerOf(context) : client;
     absl::MutexLock lock(&service_->mu_);
     if (counted_) {
       const ServerLimits& limits = service_->limits_;
@@ -226,6 +226,11 @@ grpc::Status CablesimServiceImpl::Owned(const std::string& id, const std::string
   return grpc::Status::OK;
 }
 
+std::string CablesimServiceImpl::ClientKey(const grpc::ServerContext* context,
+                                           const std::string& tenant) const {
+  return tokens_.empty() ? StreamSlot::PeerOf(context) : absl::StrCat("tenant ", tenant);
+}
+
 grpc::Status CablesimServiceImpl::Authorize(grpc::ServerContext* context,
                                             std::string* tenant) const {
   if (tokens_.empty()) return grpc::Status::OK;
@@ -349,7 +354,7 @@ grpc::Status CablesimServiceImpl::Run(grpc::ServerContext* context, const v1::Ru
                                       grpc::ServerWriter<v1::RunEvent>* writer) {
   std::string tenant;
   if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
-  StreamSlot slot(this, context);
+  StreamSlot slot(this, context, /*counted=*/true, ClientKey(context, tenant));
   if (!slot.acquired()) {
     return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, slot.refusal());
   }
@@ -384,7 +389,7 @@ grpc::Status CablesimServiceImpl::SubmitJob(grpc::ServerContext* context,
   const absl::StatusOr<v1::Scene> scene =
       SceneOfRequest(request->has_scene(), request->scene(), request->scene_json());
   if (!scene.ok()) return ToGrpc(scene.status());
-  absl::StatusOr<v1::Job> job = jobs_->Submit(*scene, StreamSlot::PeerOf(context), tenant);
+  absl::StatusOr<v1::Job> job = jobs_->Submit(*scene, ClientKey(context, tenant), tenant);
   if (!job.ok()) return ToGrpc(job.status());
   *response = std::move(*job);
   if (log_) std::cerr << "cablesim-server: job " << response->id() << " queued\n";
@@ -550,7 +555,7 @@ grpc::Status CablesimServiceImpl::GetEnergy(grpc::ServerContext* context,
   std::string tenant;
   if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   if (request->has_scene()) {
-    StreamSlot slot(this, context);
+    StreamSlot slot(this, context, /*counted=*/true, ClientKey(context, tenant));
     if (!slot.acquired()) {
       return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, slot.refusal());
     }
@@ -591,7 +596,7 @@ grpc::Status CablesimServiceImpl::SubmitSweep(grpc::ServerContext* context,
     submitted.clear_base_json();
   }
   absl::StatusOr<v1::Sweep> sweep =
-      jobs_->SubmitSweep(submitted, StreamSlot::PeerOf(context), tenant);
+      jobs_->SubmitSweep(submitted, ClientKey(context, tenant), tenant);
   if (!sweep.ok()) return ToGrpc(sweep.status());
   *response = std::move(*sweep);
   if (log_)

@@ -86,6 +86,10 @@ class CablesimServiceImpl final : public v1::CablesimService::Service {
   // NOT_FOUND unless job or sweep `id` exists and, with tokens, belongs to
   // `tenant`.
   grpc::Status Owned(const std::string& id, const std::string& tenant) const;
+  // Whose share a call counts against (max_streams_per_peer,
+  // max_queued_jobs_per_peer): the tenant with tokens, else the client's
+  // address without its port.
+  std::string ClientKey(const grpc::ServerContext* context, const std::string& tenant) const;
   void Watchdog();
 
   JobManager* jobs_;

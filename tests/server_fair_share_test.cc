@@ -6,6 +6,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -88,6 +89,36 @@ TEST(ServerFairShareTest, OneClientCannotFillTheQueue) {
   ASSERT_EQ(testing::WaitForJob(stub.get(), queued.id()), v1::SUCCEEDED);
   s = submit(Pendulum(0.05, 1e-3, 1e-2), &refused);
   EXPECT_TRUE(s.ok()) << s.error_message();
+}
+
+TEST(ServerFairShareTest, WithTokensTheShareIsPerTenant) {
+  // Two tenants behind one address: each has its own share of the queue.
+  const std::string dir = testing::FreshDir("fair_tenants");
+  testing::JobGate gate(dir);
+  const std::string tokens = dir + "/tokens";
+  const std::string alice = "tok-alice-0123456789", bob = "tok-bob-0123456789ab";
+  std::ofstream(tokens) << alice << " alice\n" << bob << " bob\n";
+  ServerProcess server(dir,
+                       {"--workers=1", "--max-queued-jobs-per-peer=1", "--token-file=" + tokens},
+                       {gate.env()});
+  auto stub = server.Stub();
+  auto submit = [&](const std::string& token, const std::string& name, v1::Job* job) {
+    grpc::ClientContext context;
+    context.AddMetadata("authorization", "Bearer " + token);
+    v1::SubmitJobRequest request;
+    *request.mutable_scene() = Pendulum(0.05, 1e-3, 1e-2);
+    request.mutable_scene()->set_name(name);
+    return stub->SubmitJob(&context, request, job);
+  };
+  v1::Job a, refused, b;
+  ASSERT_TRUE(submit(alice, "gated alice", &a).ok());
+  grpc::Status s = submit(alice, "alice again", &refused);
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(s.error_message(), HasSubstr("tenant alice"));
+  s = submit(bob, "gated bob", &b);
+  EXPECT_TRUE(s.ok()) << s.error_message();
+  gate.Open(a.id());
+  gate.Open(b.id());
 }
 
 }  // namespace
