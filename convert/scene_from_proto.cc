@@ -587,11 +587,6 @@ class SceneConverter {
     CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange("solver.step", out.step_s, plausible::kStep));
     out.output_interval_s = s.has_output_interval() ? s.output_interval() : out.step_s;
     CABLESIM_RETURN_IF_ERROR(CheckPositive("solver.output_interval", out.output_interval_s));
-    if (out.output_interval_s < out.step_s * (1 - kTimeTolerance)) {
-      return Invalid("solver.output_interval",
-                     absl::StrCat("must be >= solver.step (", Num(out.step_s), "; got ",
-                                  Num(out.output_interval_s), ")"));
-    }
     out.duration_s = s.duration();
     CABLESIM_RETURN_IF_ERROR(CheckRange("solver.duration", s.duration(), plausible::kDuration));
     if (out.analysis == Analysis::kDynamic) {

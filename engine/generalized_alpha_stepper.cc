@@ -160,8 +160,8 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
     sv = h * gamma_;
   }
   const double c = w_ * s;
-  // A kept matrix serves while c is within 20 % of its own (steps shortened
-  // to land on output times, or resized by the error controller): Newton
+  // A kept matrix serves while c is within 20 % of its own (the last steps
+  // shortened to end on the duration, or resized by the error controller): Newton
   // then still contracts by about that fraction, and the safeguard below
   // catches it when it does not.
   if (!have_factor_ || !(std::abs(c - factor_c_) <= 0.2 * factor_c_)) fresh = true;

@@ -53,10 +53,13 @@
 
 namespace cablesim {
 
+class ModelBuilder;
+
 class MultibodyModel {
  public:
   // Builds the mesh (a node wherever a joint, load or probe sits), the
-  // coordinate map, and the constraint pattern. InvalidArgument names the
+  // coordinate map, and the constraint pattern, by the steps of
+  // ModelBuilder (model_builder.h), in order. InvalidArgument names the
   // scene field when the scene cannot be assembled (for example joint sides
   // that do not coincide at t = 0).
   static absl::StatusOr<MultibodyModel> Build(const Scene& scene);
@@ -68,7 +71,7 @@ class MultibodyModel {
   int multipliers() const { return static_cast<int>(rows_.size()); }
   int elements() const { return static_cast<int>(elements2_.size() + elements3_.size()); }
   // Nodes of the mesh; a node split where a cable without bending
-  // stiffness kinks (Build) counts once.
+  // stiffness kinks (ModelBuilder::MeshCables) counts once.
   int nodes() const { return num_nodes_ - split_nodes_; }
   ModelInfo Info() const;
 
@@ -163,6 +166,9 @@ class MultibodyModel {
   int RowJoint(int row) const { return rows_[row].joint; }
 
  private:
+  // Build's steps fill in the members below.
+  friend class ModelBuilder;
+
   template <int D>
   struct ElementData {
     AncfCableElement<D> element;
@@ -203,8 +209,6 @@ class MultibodyModel {
   template <int D>
   Eigen::Vector3d ElementAngularMomentum(const Eigen::VectorXd& q,
                                          const Eigen::VectorXd& qdot) const;
-  template <int D>
-  void SetupElementSlots(const std::vector<ElementData<D>>& elements);
   double RowValue(const Row& row, const Eigen::VectorXd& q) const;
   // Local gradient of a row: grad[k] for coordinate row_coord_[begin + k].
   void RowGradient(const Row& row, const Eigen::VectorXd& q, double* grad) const;

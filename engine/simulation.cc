@@ -178,110 +178,161 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   // Backward Euler never raises the energy; the second-order steppers may.
   const bool check_steps = settings.integrator != Integrator::kImplicitEuler;
   summary->min_step_s = settings.adaptive ? std::numeric_limits<double>::infinity() : h_nominal;
-  for (long k = 1; k <= frames; ++k) {
-    const double t_frame = std::min(duration, k * interval);
-    while (t_frame - t > 1e-12 * std::max(1.0, t_frame)) {
-      if (!MayStep(control, t, summary)) return;
-      const double remaining = t_frame - t;
-      const double substeps = std::ceil(remaining / h - 1e-9);
-      const double h_try = remaining / substeps;
-      torque_work.Before(stepper.z());
-      const auto st = stepper.Step(h_try);
-      summary->newton_iterations += st.newton_iterations;
-      summary->linear_iterations += st.linear_iterations;
-      summary->factorizations += st.factorizations;
-      summary->direct_fallbacks += st.direct_fallbacks;
-      summary->max_linear_residual = std::max(summary->max_linear_residual, st.max_linear_residual);
-      if (st.converged && check_steps && st.newton_iterations >= kEnergyCheckNewton) {
-        // A step Newton found hard may have landed on a spurious root (an
-        // element folded through itself: Green-Lagrange strain does not see
-        // it); its energy says so. Take it back and halve the step.
-        const EnergySample e = rec->StateEnergy(stepper.z(), stepper.v());
-        const double scale =
-            std::max({rec->energy_scale(), std::abs(e.kinetic), std::abs(e.potential),
-                      std::abs(e.axial) + std::abs(e.bending)});
-        if (e.total - summary->energy_initial > kEnergyRiseLimit * scale + energy_floor) {
-          stepper.Restore();
-          ++summary->rejected_steps;
-          successes = 0;
-          h = h_try / 2;
-          if (h < h_min * (1 - 1e-12)) {
-            Fail(summary, t + h_try,
-                 absl::StrFormat("step from t = %.9g s raises the total energy by %.3g J down to "
-                                 "h = %.3g s: the stepper is unstable here; use a smaller "
-                                 "rho_infinity",
-                                 t, e.total - summary->energy_initial, h_try));
-            return;
-          }
-          continue;
-        }
-      }
-      if (st.converged && settings.adaptive) {
-        // Adaptive steps: accept when the local error estimate meets the
-        // tolerance, and choose the next step from it either way.
-        const double err = stepper.LocalErrorNorm(h_try, settings.tolerance_m,
-                                                  settings.relative_tolerance);
-        const double factor = StepFactor(err, stepper.local_error_order());
-        if (!(err <= 1)) {
-          stepper.Restore();
-          ++summary->rejected_steps;
-          h = h_try * factor;
-          if (h < h_min * (1 - 1e-12)) {
-            Fail(summary, t + h_try,
-                 absl::StrFormat("step from t = %.9g s cannot meet the tolerance: the local "
-                                 "error estimate is %.3g times the tolerance at h = %.3g s, the "
-                                 "smallest step allowed is %.3g s",
-                                 t, err, h_try, h_min));
-            return;
-          }
-          continue;
-        }
-        h = h_try * factor;
-      }
-      if (st.converged) {
-        t += h_try;
-        torque_work.After(stepper.z(), 1);
-        ++summary->steps;
-        summary->min_step_s = std::min(summary->min_step_s, h_try);
-        summary->max_step_s = std::max(summary->max_step_s, h_try);
-        summary->max_newton_residual = std::max(summary->max_newton_residual, st.residual);
-        summary->max_residual_floor = std::max(summary->max_residual_floor, st.residual_floor);
-        summary->end_time_s = t;
-        // After a run of good steps, go back up towards the nominal step.
-        if (!settings.adaptive && h < h_nominal && ++successes >= 4) {
-          h = std::min(h_nominal, 2 * h);
-          successes = 0;
-        }
-        continue;
-      }
-      ++summary->rejected_steps;
-      successes = 0;
-      h = h_try / 2;
-      if (h < h_min * (1 - 1e-12)) {
-        Fail(summary, t + h_try,
-             absl::StrFormat("step from t = %.9g s failed %d times down to h = %.3g s: %s", t,
-                             settings.max_step_halvings + 1, h_try, st.reason));
-        return;
-      }
-    }
-    t = t_frame;
-    rec->Evaluate(t, 1, stepper.z(), &stepper.v(), &stepper.a());
+  // Steps of h (the last one or two shortened to end on the duration);
+  // frames between step ends are interpolated (dense output), so asking
+  // for frames never changes the steps. Over a step from (z0, v0, a0) to
+  // (z1, v1, a1) of length d, at theta = (t - t0) / d: positions by the
+  // cubic Hermite interpolant of z0, v0, z1, v1 (its error, O(d^4), is
+  // below the second-order steppers' O(d^2)), velocities by its
+  // derivative, accelerations linearly between a0 and a1. A frame's
+  // energies and constraint violation are those of that interpolated state.
+  const int n = static_cast<int>(stepper.z().size());
+  Eigen::VectorXd z_0 = stepper.z(), v_0 = stepper.v(), a_0 = stepper.a();
+  Eigen::VectorXd z_i(n), v_i(n), a_i(n);
+  auto frame_time = [&](long k) { return std::min(duration, k * interval); };
+  auto Interpolate = [&](double th, double d, const Stepper& s) {
+    const double th2 = th * th, th3 = th2 * th;
+    const double h00 = 2 * th3 - 3 * th2 + 1, h10 = th3 - 2 * th2 + th, h01 = -2 * th3 + 3 * th2,
+                 h11 = th3 - th2;
+    const double d00 = 6 * th2 - 6 * th, d10 = 3 * th2 - 4 * th + 1, d01 = -d00,
+                 d11 = 3 * th2 - 2 * th;
+    z_i = h00 * z_0 + (h10 * d) * v_0 + h01 * s.z() + (h11 * d) * s.v();
+    v_i = (d00 / d) * z_0 + d10 * v_0 + (d01 / d) * s.z() + d11 * s.v();
+    a_i = (1 - th) * a_0 + th * s.a();
+  };
+  auto CheckAndDeliver = [&](double tf) {
     const EnergySample& e = rec->frame().energy;
     const double rise = e.total - summary->energy_initial;
     const double scale = std::max({rec->energy_scale(), std::abs(e.kinetic),
                                    std::abs(e.potential), std::abs(e.axial) + std::abs(e.bending)});
     if (rise > kEnergyRiseLimit * scale + energy_floor) {
-      Fail(summary, t,
+      Fail(summary, tf,
            absl::StrFormat("the total energy rose by %.3g J (more than %g %% of the largest "
                            "energy term, %.3g J) by t = %.9g s: the stepper is unstable at this "
                            "step; use a smaller solver.step, adaptive steps or a smaller "
                            "rho_infinity",
-                           rise, 100 * kEnergyRiseLimit, scale, t));
-      return;
+                           rise, 100 * kEnergyRiseLimit, scale, tf));
+      return false;
     }
-    if (absl::Status s = rec->Deliver(); !s.ok()) {
+    if (absl::Status st = rec->Deliver(); !st.ok()) {
       summary->status = "cancelled";
-      summary->error = std::string(s.message());
+      summary->error = std::string(st.message());
+      return false;
+    }
+    return true;
+  };
+  long next_frame = 1;
+  while (next_frame <= frames) {
+    // A frame already reached (a duration within rounding of the last).
+    if (const double tf = frame_time(next_frame); tf - t <= 1e-12 * std::max(1.0, tf)) {
+      rec->Evaluate(tf, 1, stepper.z(), &stepper.v(), &stepper.a());
+      if (!CheckAndDeliver(tf)) return;
+      ++next_frame;
+      continue;
+    }
+    if (!MayStep(control, t, summary)) return;
+    const double remaining = duration - t;
+    // The last steps: one or two equal ones that end on the duration.
+    const double h_try =
+        remaining < 2 * h ? remaining / std::ceil(remaining / h - 1e-9) : h;
+    z_0 = stepper.z();
+    v_0 = stepper.v();
+    a_0 = stepper.a();
+    torque_work.Before(stepper.z());
+    const auto st = stepper.Step(h_try);
+    summary->newton_iterations += st.newton_iterations;
+    summary->linear_iterations += st.linear_iterations;
+    summary->factorizations += st.factorizations;
+    summary->direct_fallbacks += st.direct_fallbacks;
+    summary->max_linear_residual = std::max(summary->max_linear_residual, st.max_linear_residual);
+    if (st.converged && check_steps && st.newton_iterations >= kEnergyCheckNewton) {
+      // A step Newton found hard may have landed on a spurious root (an
+      // element folded through itself: Green-Lagrange strain does not see
+      // it); its energy says so. Take it back and halve the step.
+      const EnergySample e = rec->StateEnergy(stepper.z(), stepper.v());
+      const double scale =
+          std::max({rec->energy_scale(), std::abs(e.kinetic), std::abs(e.potential),
+                    std::abs(e.axial) + std::abs(e.bending)});
+      if (e.total - summary->energy_initial > kEnergyRiseLimit * scale + energy_floor) {
+        stepper.Restore();
+        ++summary->rejected_steps;
+        successes = 0;
+        h = h_try / 2;
+        if (h < h_min * (1 - 1e-12)) {
+          Fail(summary, t + h_try,
+               absl::StrFormat("step from t = %.9g s raises the total energy by %.3g J down to "
+                               "h = %.3g s: the stepper is unstable here; use a smaller "
+                               "rho_infinity",
+                               t, e.total - summary->energy_initial, h_try));
+          return;
+        }
+        continue;
+      }
+    }
+    if (st.converged && settings.adaptive) {
+      // Adaptive steps: accept when the local error estimate meets the
+      // tolerance, and choose the next step from it either way.
+      const double err = stepper.LocalErrorNorm(h_try, settings.tolerance_m,
+                                                settings.relative_tolerance);
+      const double factor = StepFactor(err, stepper.local_error_order());
+      if (!(err <= 1)) {
+        stepper.Restore();
+        ++summary->rejected_steps;
+        h = h_try * factor;
+        if (h < h_min * (1 - 1e-12)) {
+          Fail(summary, t + h_try,
+               absl::StrFormat("step from t = %.9g s cannot meet the tolerance: the local "
+                               "error estimate is %.3g times the tolerance at h = %.3g s, the "
+                               "smallest step allowed is %.3g s",
+                               t, err, h_try, h_min));
+          return;
+        }
+        continue;
+      }
+      h = h_try * factor;
+    }
+    if (st.converged) {
+      const double t0 = t;
+      t += h_try;
+      torque_work.After(stepper.z(), 1);
+      ++summary->steps;
+      summary->min_step_s = std::min(summary->min_step_s, h_try);
+      summary->max_step_s = std::max(summary->max_step_s, h_try);
+      summary->max_newton_residual = std::max(summary->max_newton_residual, st.residual);
+      summary->max_residual_floor = std::max(summary->max_residual_floor, st.residual_floor);
+      summary->end_time_s = t;
+      // After a run of good steps, go back up towards the nominal step.
+      if (!settings.adaptive && h < h_nominal && ++successes >= 4) {
+        h = std::min(h_nominal, 2 * h);
+        successes = 0;
+      }
+      // Every frame this step reached: the step's end state where the
+      // frame is its end (within 1e-6 of the step, which also keeps t on
+      // the frames' grid), otherwise interpolated (dense output).
+      while (next_frame <= frames) {
+        const double tf = frame_time(next_frame);
+        const bool at_end = std::abs(tf - t) <= 1e-6 * h_try;
+        if (!at_end && tf > t) break;
+        if (at_end) {
+          t = tf;
+          rec->Evaluate(tf, 1, stepper.z(), &stepper.v(), &stepper.a());
+        } else {
+          Interpolate((tf - t0) / h_try, h_try, stepper);
+          rec->Evaluate(tf, 1, z_i, &v_i, &a_i);
+        }
+        if (!CheckAndDeliver(tf)) return;
+        ++next_frame;
+      }
+      summary->end_time_s = t;
+      continue;
+    }
+    ++summary->rejected_steps;
+    successes = 0;
+    h = h_try / 2;
+    if (h < h_min * (1 - 1e-12)) {
+      Fail(summary, t + h_try,
+           absl::StrFormat("step from t = %.9g s failed %d times down to h = %.3g s: %s", t,
+                           settings.max_step_halvings + 1, h_try, st.reason));
       return;
     }
   }

@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <iostream>
 #include <limits>
+#include <set>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -62,8 +63,13 @@ absl::Status JobManager::Start() {
               << " interrupted and requeued)\n";
   }
   {
+    // A job submitted between the server's start of listening and this
+    // call is in queue_ already: queue each id once.
     absl::MutexLock lock(&mu_);
-    for (const std::string& id : *queued) queue_.push_back(id);
+    const std::set<std::string> present(queue_.begin(), queue_.end());
+    for (const std::string& id : *queued) {
+      if (!present.count(id)) queue_.push_back(id);
+    }
   }
   ApplyRetention();
   for (int i = 0; i < workers_; ++i) threads_.emplace_back([this] { Work(); });
@@ -137,12 +143,17 @@ absl::StatusOr<v1::Sweep> JobManager::SubmitSweep(const v1::SubmitSweepRequest& 
 }
 
 absl::StatusOr<v1::Job> JobManager::Cancel(const std::string& id) {
+  // The store first, then the running jobs: a worker registers a job in
+  // running_ before it claims it (QUEUED -> RUNNING), so a job that is no
+  // longer QUEUED here is either finished or already in running_. (Asked in
+  // the other order, a worker could claim the job between the two looks and
+  // the cancel would be acknowledged but never carried out.)
+  absl::StatusOr<bool> cancelled = store_->CancelQueued(id);
+  if (!cancelled.ok()) return cancelled.status();
   {
     absl::MutexLock lock(&mu_);
     if (auto it = running_.find(id); it != running_.end()) it->second->stop = 1;
   }
-  absl::StatusOr<bool> cancelled = store_->CancelQueued(id);
-  if (!cancelled.ok()) return cancelled.status();
   Changed();
   return Get(id);
 }
@@ -218,7 +229,9 @@ void JobManager::RunOne(const std::string& id) {
   {
     absl::MutexLock lock(&mu_);
     if (stopping_) return;
-    running_[id] = running;
+    // Another worker has this job (an id queued twice): leave its entry,
+    // which cancel and shutdown need, alone.
+    if (!running_.emplace(id, running).second) return;
   }
   auto forget = [&] {
     absl::MutexLock lock(&mu_);

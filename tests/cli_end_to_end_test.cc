@@ -10,6 +10,7 @@
 #include <fstream>
 #include <string>
 #include <vector>
+#include <unistd.h>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
@@ -76,7 +77,7 @@ Csv ReadCsv(const std::string& path) {
 Csv RunSample(const std::string& scene) {
   const std::string binary = absl::StrCat(CABLESIM_BIN_DIR, "/cablesim");
   EXPECT_TRUE(std::ifstream(binary).good()) << "build the cablesim target first: " << binary;
-  const std::string csv = absl::StrCat(::testing::TempDir(), "/cli_end_to_end_", scene, ".csv");
+  const std::string csv = absl::StrCat(::testing::TempDir(), "/cli_end_to_end_", ::getpid(), "_", scene, ".csv");
   std::remove(csv.c_str());
   const Process p = RunCommand(absl::StrCat("'", binary, "' run '", CABLESIM_SOURCE_DIR, "/scenes/",
                                             scene, "' --out '", csv, "'"));

@@ -131,16 +131,29 @@ TEST_F(CliServerTest, SubmitWatchJobsEnergyCancel) {
   EXPECT_THAT(energy.out, HasSubstr(R"("frames":101,)"));
   EXPECT_THAT(energy.out, HasSubstr(R"("relative_drift":-)"));  // dissipation
 
-  // Never finishes by itself (its gate stays shut): the cancel cannot come
-  // too late.
+  // Cancel, both ways, each chosen by the test, not by when the worker
+  // takes the job: `long` never finishes by itself (its gate stays shut)
+  // and is cancelled once it is running at its gate; `queued`, submitted
+  // while `long` holds the only worker, is cancelled before it ever runs.
   const CliResult long_job = Cli({"submit", Scene("long", 19, "gated-long"), "--server", address});
   ASSERT_EQ(long_job.code, 0);
   const std::string long_id = long_job.out.substr(7, long_job.out.find('"', 7) - 7);
-  const CliResult cancelled = Cli({"cancel", long_id, "--server", address});
-  ASSERT_EQ(cancelled.code, 0) << cancelled.err;
-  const CliResult after = Cli({"watch", long_id, "--server", address});
-  EXPECT_EQ(after.code, 1);  // cancelled is not success
-  EXPECT_THAT(after.out, HasSubstr("\"cancel"));
+  ASSERT_TRUE(server_->WaitForLog(absl::StrCat("job ", long_id, " waits at the gate")));
+  const CliResult queued_job =
+      Cli({"submit", Scene("queued", 19, "gated-queued"), "--server", address});
+  ASSERT_EQ(queued_job.code, 0);
+  const std::string queued_id = queued_job.out.substr(7, queued_job.out.find('"', 7) - 7);
+  for (const std::string& job : {queued_id, long_id}) {
+    const CliResult cancelled = Cli({"cancel", job, "--server", address});
+    ASSERT_EQ(cancelled.code, 0) << cancelled.err;
+  }
+  const CliResult after_queued = Cli({"watch", queued_id, "--server", address});
+  EXPECT_EQ(after_queued.code, 1);  // cancelled is not success
+  EXPECT_THAT(after_queued.out, HasSubstr(R"("state":"CANCELLED")"));
+  EXPECT_THAT(after_queued.out, HasSubstr(R"("attempts":0,)"));  // never ran
+  const CliResult after_running = Cli({"watch", long_id, "--server", address});
+  EXPECT_EQ(after_running.code, 1);
+  EXPECT_THAT(after_running.out, HasSubstr(R"("status":"cancelled")"));  // stopped mid-run
 
   EXPECT_EQ(Cli({"submit", Scene("x", 0.1)}).code, 2);  // needs --server
 }

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include <unistd.h>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
@@ -41,7 +42,7 @@ std::string SampleScene(const char* name) {
 }
 
 std::string WriteTempFile(const std::string& name, const std::string& contents) {
-  const std::string path = absl::StrCat(::testing::TempDir(), "/cli_test_", name);
+  const std::string path = absl::StrCat(::testing::TempDir(), "/cli_test_", ::getpid(), "_", name);
   std::ofstream(path) << contents;
   return path;
 }
@@ -116,7 +117,7 @@ TEST(CliTest, SweepRefusesABaseFileOutsideItsDirectoryUnlessAllowed) {
 // `energy --out` names its columns as the run CSV does.
 TEST(CliTest, EnergyCsvUsesTheRunCsvColumnNames) {
   const std::string scene = WriteTempFile("energy_scene.json", kTinyScene);
-  const std::string csv = absl::StrCat(::testing::TempDir(), "/cli_test_energy.csv");
+  const std::string csv = absl::StrCat(::testing::TempDir(), "/cli_test_", ::getpid(), "_energy.csv");
   const CliResult r = Cli({"energy", scene, "--out", csv});
   ASSERT_EQ(r.code, 0) << r.err;
   const std::vector<std::string> lines = ReadLines(csv);
@@ -203,7 +204,7 @@ TEST(CliTest, ValidateTakesNoOut) {
 
 TEST(CliTest, RunWritesSummaryAndCsv) {
   const std::string scene = WriteTempFile("tiny.json", kTinyScene);
-  const std::string csv = absl::StrCat(::testing::TempDir(), "/cli_test_tiny.csv");
+  const std::string csv = absl::StrCat(::testing::TempDir(), "/cli_test_", ::getpid(), "_tiny.csv");
   // Twice, with both spellings of --out: RunCli keeps no state.
   for (const std::string& out_flag : {std::string("--out=") + csv, std::string("--out")}) {
     std::vector<std::string> args = {"run", scene, out_flag};
@@ -260,7 +261,7 @@ TEST(CliTest, NumericalFailureExitsWith3AndKeepsTheCsv) {
     "joints": [{"type": "PIN", "a": {"cable": "c", "s": 0}}],
     "solver": {"duration": 1, "step": 0.5, "max_newton_iterations": 1,
                "max_step_halvings": 0}})");
-  const std::string csv = absl::StrCat(::testing::TempDir(), "/cli_test_failing.csv");
+  const std::string csv = absl::StrCat(::testing::TempDir(), "/cli_test_", ::getpid(), "_failing.csv");
   const CliResult r = Cli({"run", scene, "--out", csv});
   EXPECT_EQ(r.code, 3) << r.err;
   EXPECT_THAT(r.out, StartsWith(R"({"status":"failed","error":")"));

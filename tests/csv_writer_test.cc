@@ -12,6 +12,7 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include <unistd.h>
 
 #include "absl/strings/str_split.h"
 
@@ -96,7 +97,7 @@ TEST(CsvWriterTest, WrongProbeCountIsAnError) {
 }
 
 TEST(CsvWriterTest, FileIsCompleteAfterFinish) {
-  const std::string path = ::testing::TempDir() + "/csv_writer_test.csv";
+  const std::string path = ::testing::TempDir() + "/csv_writer_test_" + std::to_string(::getpid()) + ".csv";
   auto writer = CsvWriter::Create(path);
   ASSERT_TRUE(writer.ok()) << writer.status();
   ASSERT_TRUE((*writer)->OnStart(InfoWithProbes({"p"})).ok());
@@ -111,7 +112,7 @@ TEST(CsvWriterTest, FileIsCompleteAfterFinish) {
 }
 
 TEST(CsvWriterTest, FileIsFlushedOnDestruction) {
-  const std::string path = ::testing::TempDir() + "/csv_writer_test_destroyed.csv";
+  const std::string path = ::testing::TempDir() + "/csv_writer_test_destroyed_" + std::to_string(::getpid()) + ".csv";
   {
     auto writer = CsvWriter::Create(path);
     ASSERT_TRUE(writer.ok()) << writer.status();

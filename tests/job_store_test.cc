@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <unistd.h>
 
 #include "absl/strings/str_cat.h"
 
@@ -15,7 +16,7 @@ namespace cablesim {
 namespace {
 
 std::string FreshDir(const std::string& name) {
-  const std::string dir = absl::StrCat(::testing::TempDir(), "/job_store_test_", name);
+  const std::string dir = absl::StrCat(::testing::TempDir(), "/job_store_test_", name, "_", ::getpid());
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;

@@ -11,6 +11,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include "absl/strings/str_cat.h"
 #include "client/json_line.h"
@@ -322,7 +323,7 @@ TEST(ModalTest, ModesFieldIsValidated) {
 // The sample scene through the command line: exit code 0, the frequencies
 // in the summary line, the equilibrium and one row per mode in the CSV.
 TEST(ModalTest, SampleSceneThroughTheCommandLine) {
-  const std::string csv = absl::StrCat(::testing::TempDir(), "/hanging_chain_modes.csv");
+  const std::string csv = absl::StrCat(::testing::TempDir(), "/hanging_chain_modes_", ::getpid(), ".csv");
   const std::string command =
       absl::StrCat(CABLESIM_BIN_DIR, "/cablesim run ", CABLESIM_SOURCE_DIR,
                    "/scenes/hanging-chain-modes.json --out ", csv);

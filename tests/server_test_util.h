@@ -9,6 +9,7 @@
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/types.h>
 #include <sys/wait.h>
@@ -83,8 +84,14 @@ class ServerProcess {
     for (std::string& e : env_strings) envp.push_back(e.data());
     envp.push_back(nullptr);
     const std::string log = log_path();
+    const pid_t parent = ::getpid();
     pid_ = fork();
     if (pid_ == 0) {
+      // The server dies with the test process: a test killed by CTest's
+      // timeout (or a crash) leaves no server behind, parked at a gate or
+      // holding a port, for later tests to trip over.
+      ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+      if (::getppid() != parent) _exit(127);  // the test died before prctl
       const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0600);
       if (fd >= 0) ::dup2(fd, STDERR_FILENO);
       if (address_space_bytes_ > 0) {

@@ -22,12 +22,17 @@ try {
 const SOURCE = process.env.CABLESIM_SOURCE_DIR;
 const BIN = process.env.CABLESIM_BIN_DIR;
 
-async function waitForFile(file) {
-  for (let i = 0; i < 1000; ++i) {
-    if (fs.existsSync(file) && fs.readFileSync(file, 'utf8').trim()) return;
+// Until the server has written its port file (it writes it whole, by a
+// rename) or has exited: no time limit that a busy machine could exceed (a
+// hung start is CTest's timeout).
+async function waitForPortFile(file, server) {
+  while (!(fs.existsSync(file) && fs.readFileSync(file, 'utf8').trim())) {
+    if (server.exitCode !== null || server.signalCode !== null) {
+      throw new Error(`cablesim-server exited (${server.exitCode ?? server.signalCode}) ` +
+                      `before writing ${file}`);
+    }
     await new Promise((r) => setTimeout(r, 10));
   }
-  throw new Error(`${file}: the server did not start`);
 }
 
 async function main() {
@@ -38,7 +43,7 @@ async function main() {
       ['--listen=127.0.0.1:0', `--data-dir=${dir}`, `--port-file=${portFile}`, '--workers=1'],
       {stdio: ['ignore', 'inherit', 'inherit']});
   try {
-    await waitForFile(portFile);
+    await waitForPortFile(portFile, server);
     const port = fs.readFileSync(portFile, 'utf8').trim();
     const client = cablesim.connect(`127.0.0.1:${port}`);
 
@@ -70,8 +75,11 @@ async function main() {
     client.close();
     console.log('node client: ok');
   } finally {
-    server.kill('SIGTERM');
-    await new Promise((r) => server.on('exit', r));
+    if (server.exitCode === null && server.signalCode === null) {
+      const exited = new Promise((r) => server.on('exit', r));
+      server.kill('SIGTERM');
+      await exited;
+    }
     fs.rmSync(dir, {recursive: true, force: true});
   }
 }

@@ -1,0 +1,689 @@
+#include "engine/model_builder.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include <Eigen/Dense>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "engine/model_choice.h"
+
+namespace cablesim {
+namespace {
+
+using Eigen::Vector3d;
+using Eigen::VectorXd;
+
+// Relative tolerance for matching arc lengths to nodes.
+constexpr double kSnap = 1e-9;
+
+// Arc-length position along a polyline: point and unit tangent at `frac`
+// of its total length. At an interior vertex the tangent is the average of
+// the two segments' directions (side 0), or the incoming (side -1) or
+// outgoing (side +1) segment's.
+void PolylineAt(const std::vector<Vector3d>& pts, double frac, Vector3d* point,
+                Vector3d* tangent, int side = 0) {
+  std::vector<double> cum(pts.size(), 0.0);
+  for (size_t i = 1; i < pts.size(); ++i) cum[i] = cum[i - 1] + (pts[i] - pts[i - 1]).norm();
+  const double total = cum.back();
+  const double s = std::clamp(frac, 0.0, 1.0) * total;
+  size_t seg = 1;
+  while (seg + 1 < pts.size() && cum[seg] < s) ++seg;
+  const Vector3d a = pts[seg - 1], b = pts[seg];
+  const double len = cum[seg] - cum[seg - 1];
+  const double t = len > 0 ? (s - cum[seg - 1]) / len : 0;
+  *point = a + t * (b - a);
+  Vector3d dir = (b - a).normalized();
+  const double tol = kSnap * total;
+  if (std::abs(s - cum[seg]) <= tol && seg + 1 < pts.size()) {
+    const Vector3d out = (pts[seg + 1] - b).normalized();
+    dir = side < 0 ? dir : side > 0 ? out : (dir + out).normalized();
+  } else if (std::abs(s - cum[seg - 1]) <= tol && seg >= 2) {
+    const Vector3d in = (a - pts[seg - 2]).normalized();
+    dir = side > 0 ? dir : side < 0 ? in : (dir + in).normalized();
+  }
+  *tangent = dir;
+}
+
+double PolylineLength(const std::vector<Vector3d>& pts) {
+  double total = 0;
+  for (size_t i = 1; i < pts.size(); ++i) total += (pts[i] - pts[i - 1]).norm();
+  return total;
+}
+
+// The body frame at t = 0 from its x axis (scene.h): columns x, y, z.
+Eigen::Matrix3d BodyFrame(const Vector3d& axis) {
+  const Vector3d x = axis.normalized();
+  Vector3d y = Vector3d::UnitZ().cross(x);
+  if (y.norm() < 1e-12) y = Vector3d::UnitX().cross(x);
+  y.normalize();
+  Eigen::Matrix3d r;
+  r.col(0) = x;
+  r.col(1) = y;
+  r.col(2) = x.cross(y);
+  return r;
+}
+
+LinearVector Constant(const Vector3d& v) {
+  return {LinearForm::Constant(v.x()), LinearForm::Constant(v.y()), LinearForm::Constant(v.z())};
+}
+
+LinearVector Combination(const std::vector<std::pair<double, LinearVector>>& terms) {
+  LinearVector r;
+  for (const auto& [s, v] : terms) r = Add(r, v, s);
+  return r;
+}
+
+}  // namespace
+
+int ModelBuilder::Mesh::Node(const Attachment& at) const {
+  const auto& s = node_s[at.cable];
+  auto it = std::lower_bound(s.begin(), s.end(), at.s_m - snap_m[at.cable]);
+  return first_node[at.cable] + static_cast<int>(it - s.begin());
+}
+
+absl::Status ModelBuilder::ChooseDimension() {
+  absl::StatusOr<int> dim = cablesim::ChooseDimension(scene_);
+  if (!dim.ok()) return dim.status();
+  model_.dim_ = *dim;
+  model_.node_stride_ = 2 * *dim;
+  model_.body_stride_ = *dim == 2 ? 4 : 12;
+  return absl::OkStatus();
+}
+
+void ModelBuilder::MeshCables() {
+  const int num_cables = static_cast<int>(scene_.cables.size());
+  std::vector<std::vector<double>>& node_s = mesh_.node_s;
+  node_s.assign(num_cables, {});
+  mesh_.snap_m.resize(num_cables);
+  for (int c = 0; c < num_cables; ++c) {
+    const CableSpec& cable = scene_.cables[c];
+    mesh_.snap_m[c] = kSnap * cable.length_m;
+    for (int k = 0; k <= cable.elements; ++k)
+      node_s[c].push_back(cable.length_m * k / cable.elements);
+  }
+  auto require = [&](const Attachment& at) {
+    if (at.cable >= 0) node_s[at.cable].push_back(at.s_m);
+  };
+  for (const JointSpec& j : scene_.joints) require(j.a), require(j.b);
+  for (const LoadSpec& l : scene_.loads) require(l.at);
+  for (const ProbeSpec& p : scene_.probes) require(p.at);
+  // Where a bending-free cable kinks (a PIN or a load inside it) and where
+  // it must not (a FIXED joint there).
+  std::vector<std::vector<double>> kink_s(num_cables), smooth_s(num_cables);
+  auto interior = [&](const Attachment& at) {
+    if (at.cable < 0 || scene_.cables[at.cable].bending != BendingModel::kNone) return false;
+    const double len = scene_.cables[at.cable].length_m, tol = mesh_.snap_m[at.cable];
+    return at.s_m > tol && at.s_m < len - tol;
+  };
+  for (const JointSpec& j : scene_.joints) {
+    for (const Attachment* at : {&j.a, &j.b}) {
+      if (!interior(*at)) continue;
+      (j.type == JointType::kPin ? kink_s : smooth_s)[at->cable].push_back(at->s_m);
+    }
+  }
+  for (const LoadSpec& l : scene_.loads)
+    if (interior(l.at)) kink_s[l.at.cable].push_back(l.at.s_m);
+  mesh_.first_node.assign(num_cables + 1, 0);
+  mesh_.twin_of.clear();
+  std::vector<int>& twin_of = mesh_.twin_of;
+  for (int c = 0; c < num_cables; ++c) {
+    auto& s = node_s[c];
+    std::sort(s.begin(), s.end());
+    const double tol = mesh_.snap_m[c];
+    std::vector<double> unique;
+    for (double v : s)
+      if (unique.empty() || v - unique.back() > tol) unique.push_back(v);
+    // A point within tol of the end snaps to it.
+    unique.back() = scene_.cables[c].length_m;
+    auto near = [&](const std::vector<double>& list, double v) {
+      for (double x : list)
+        if (std::abs(x - v) <= tol) return true;
+      return false;
+    };
+    s.clear();
+    for (double v : unique) {
+      s.push_back(v);
+      twin_of.push_back(-1);
+      if (near(kink_s[c], v) && !near(smooth_s[c], v)) {
+        s.push_back(v);
+        twin_of.push_back(static_cast<int>(twin_of.size()) - 1);
+        ++model_.split_nodes_;
+      }
+    }
+    mesh_.first_node[c + 1] = mesh_.first_node[c] + static_cast<int>(s.size());
+  }
+  model_.num_nodes_ = mesh_.nodes();
+}
+
+int ModelBuilder::BodyCoord(int body) const {
+  return model_.node_stride_ * model_.num_nodes_ + model_.body_stride_ * body;
+}
+
+absl::Status ModelBuilder::InitialCoordinates() {
+  const int D = model_.dim_, num_nodes = model_.num_nodes_;
+  const int num_bodies = static_cast<int>(scene_.bodies.size());
+  q0_ = VectorXd::Zero(BodyCoord(num_bodies));
+  model_.initial_velocity_ = scene_.initial_velocity;
+  for (int c = 0; c < static_cast<int>(scene_.cables.size()); ++c) {
+    const CableSpec& cable = scene_.cables[c];
+    const double stretch = PolylineLength(cable.points) / cable.length_m;
+    for (size_t k = 0; k < mesh_.node_s[c].size(); ++k) {
+      const int node = mesh_.first_node[c] + static_cast<int>(k);
+      // The two halves of a split node take the tangents of their sides.
+      const std::vector<int>& twin_of = mesh_.twin_of;
+      const int side = twin_of[node] >= 0                                 ? 1
+                       : node + 1 < num_nodes && twin_of[node + 1] == node ? -1
+                                                                          : 0;
+      Vector3d p, t;
+      PolylineAt(cable.points, mesh_.node_s[c][k] / cable.length_m, &p, &t, side);
+      const int i = NodeCoord(node);
+      const Vector3d slope = stretch * t;
+      q0_.segment(i, D) = p.head(D);
+      q0_.segment(i + D, D) = slope.head(D);
+    }
+  }
+  frame0_.resize(num_bodies);
+  for (int b = 0; b < num_bodies; ++b) {
+    const BodySpec& body = scene_.bodies[b];
+    const int i = BodyCoord(b);
+    frame0_[b] = BodyFrame(body.axis);
+    q0_.segment(i, D) = body.position_m.head(D);
+    MultibodyModel::BodyData data;
+    data.coord = i;
+    data.mass = body.mass_kg;
+    const Vector3d& inertia = body.inertia_kg_m2;
+    if (D == 2) {
+      q0_.segment<2>(i + 2) = frame0_[b].col(0).head<2>();
+      data.jbar = Vector3d(inertia.z(), 0, 0);
+    } else {
+      for (int k = 0; k < 3; ++k) {
+        q0_.segment<3>(i + 3 + 3 * k) = frame0_[b].col(k);
+      }
+      data.jbar = Vector3d::Constant(inertia.sum() / 2) - inertia;
+      if (!(data.jbar.minCoeff() > 0)) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "bodies[%d].inertia: the spatial model needs each principal moment to be less than "
+            "the sum of the other two (a real body's mass lies off every axis); got "
+            "(%.6g, %.6g, %.6g) kg m^2",
+            b, inertia.x(), inertia.y(), inertia.z()));
+      }
+    }
+    model_.bodies_.push_back(data);
+  }
+  return absl::OkStatus();
+}
+
+LinearVector ModelBuilder::NodePosition(int node) const {
+  LinearVector v;
+  for (int d = 0; d < model_.dim_; ++d) v[d] = LinearForm::Coordinate(NodeCoord(node) + d);
+  return v;
+}
+
+LinearVector ModelBuilder::NodeSlope(int node) const {
+  const int D = model_.dim_;
+  LinearVector v;
+  for (int d = 0; d < D; ++d) v[d] = LinearForm::Coordinate(NodeCoord(node) + D + d);
+  return v;
+}
+
+LinearVector ModelBuilder::BodyAxis(int body, int k) const {
+  const int i = BodyCoord(body);
+  LinearVector v;
+  if (model_.dim_ == 3) {
+    for (int d = 0; d < 3; ++d) v[d] = LinearForm::Coordinate(i + 3 + 3 * k + d);
+  } else if (k == 0) {
+    v[0] = LinearForm::Coordinate(i + 2);
+    v[1] = LinearForm::Coordinate(i + 3);
+  } else if (k == 1) {  // perp(u) = (-u_y, u_x)
+    v[0] = LinearForm::Coordinate(i + 3, -1);
+    v[1] = LinearForm::Coordinate(i + 2);
+  } else {
+    v = Constant(Vector3d::UnitZ());
+  }
+  return v;
+}
+
+std::array<LinearVector, 3> ModelBuilder::BodyAxes(int body) const {
+  return {BodyAxis(body, 0), BodyAxis(body, 1), BodyAxis(body, 2)};
+}
+
+LinearVector ModelBuilder::BodyPoint(int body, const Vector3d& p) const {
+  const int D = model_.dim_, i = BodyCoord(body);
+  LinearVector v;
+  for (int d = 0; d < D; ++d) v[d] = LinearForm::Coordinate(i + d);
+  for (int k = 0; k < D; ++k)
+    if (p(k) != 0) v = Add(v, BodyAxis(body, k), p(k));
+  return v;
+}
+
+LinearVector ModelBuilder::PointOf(const Attachment& at) const {
+  if (at.cable >= 0) return NodePosition(mesh_.Node(at));
+  return BodyPoint(at.body, at.point_body_m);
+}
+
+Vector3d ModelBuilder::AtStart(const LinearVector& v) const {
+  return Vector3d(v[0].Evaluate(q0_), v[1].Evaluate(q0_), v[2].Evaluate(q0_));
+}
+
+absl::Status ModelBuilder::Joints() {
+  const int D = model_.dim_, bs = model_.body_stride_;
+  const int num_nodes = model_.num_nodes_;
+  elimination_.grounded.assign(q0_.size(), false);
+  elimination_.clamp_dir.assign(num_nodes, Vector3d::Zero());
+  elimination_.clamped.assign(num_nodes, false);
+  std::vector<bool>& grounded = elimination_.grounded;
+  pending_.clear();
+  for (int ji = 0; ji < static_cast<int>(scene_.joints.size()); ++ji) {
+    const JointSpec& joint = scene_.joints[ji];
+    Attachment a = joint.a, b = joint.b;
+    if (a.IsGround()) std::swap(a, b);
+    if (a.IsGround()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("joints[", ji, "].a: a joint needs a cable or a body on one side"));
+    }
+    const bool fixed = joint.type == JointType::kFixed;
+    if (b.IsGround()) {
+      if (a.cable >= 0) {
+        const int node = mesh_.Node(a);
+        for (int d = 0; d < D; ++d) grounded[NodeCoord(node) + d] = true;
+        if (fixed) {
+          elimination_.clamped[node] = true;
+          elimination_.clamp_dir[node] = AtStart(NodeSlope(node)).normalized();
+        }
+        continue;
+      }
+      const int i = BodyCoord(a.body);
+      if (fixed) {
+        for (int k = 0; k < bs; ++k) grounded[i + k] = true;
+        continue;
+      }
+      if (a.point_body_m.norm() == 0) {
+        for (int d = 0; d < D; ++d) grounded[i + d] = true;
+        continue;
+      }
+    }
+    // Points coincide: D rows.
+    const LinearVector pa = PointOf(a);
+    const LinearVector pb = b.IsGround() ? Constant(AtStart(pa)) : PointOf(b);
+    for (int d = 0; d < D; ++d) {
+      LinearForm diff = pa[d];
+      diff += pb[d].Scaled(-1);
+      pending_.push_back({QuadraticForm::FromLinear(diff), Row::kPosition, ji, -1});
+    }
+    if (!fixed || b.IsGround()) continue;
+    if (absl::Status s = AddOrientationRows(ji, a, b); !s.ok()) return s;
+  }
+  // Each body's axes stay unit and orthogonal.
+  for (int b = 0; b < static_cast<int>(scene_.bodies.size()); ++b) {
+    const auto e = BodyAxes(b);
+    const int axes = D == 2 ? 1 : 3;
+    for (int k = 0; k < axes; ++k) {
+      QuadraticForm f = Dot(e[k], e[k], D);
+      f.c -= 1;
+      pending_.push_back({f, Row::kAxes, -1, b});
+    }
+    for (int k = 0; k < axes; ++k)
+      for (int l = k + 1; l < axes; ++l)
+        pending_.push_back({Dot(e[k], e[l], D), Row::kAxes, -1, b});
+  }
+  return absl::OkStatus();
+}
+
+absl::Status ModelBuilder::AddOrientationRows(int ji, Attachment a, Attachment b) {
+  const int D = model_.dim_;
+  if (a.cable < 0 && b.cable >= 0) std::swap(a, b);  // a node first
+  if (a.cable >= 0 && b.cable >= 0) {
+    // Two cables welded end to end: the slopes stay equal, r_x,b = c r_x,a
+    // with c = |r_x,b| / |r_x,a| at t = 0 (1 for a cable split at the
+    // joint): D linear rows, of full rank in every configuration. (Rows
+    // (r_x,a x r_x,b) . m with fixed m lose rank once the tangent turns
+    // onto m.) The stretch on both sides is thereby tied; that is exact for
+    // a uniform cable without a point load at the joint.
+    const LinearVector ta = NodeSlope(mesh_.Node(a)), tb = NodeSlope(mesh_.Node(b));
+    const Vector3d t0a = AtStart(ta), t0b = AtStart(tb);
+    const double sine = t0a.cross(t0b).norm() / (t0a.norm() * t0b.norm());
+    if (!(sine <= 1e-6) || t0a.dot(t0b) <= 0) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "joints[%d]: FIXED between two cables needs their tangents parallel and in the same "
+          "sense at t = 0 (sine of the angle between them: %.6g)",
+          ji, sine));
+    }
+    const double ratio = t0b.norm() / t0a.norm();
+    for (int d = 0; d < D; ++d) {
+      LinearForm diff = tb[d];
+      diff += ta[d].Scaled(-ratio);
+      pending_.push_back({QuadraticForm::FromLinear(diff), Row::kSlope, ji, -1});
+    }
+  } else if (a.cable >= 0) {
+    // A cable tangent along the body's x axis: t . e2 = 0 (and t . e3 = 0).
+    const LinearVector t = NodeSlope(mesh_.Node(a));
+    pending_.push_back({Dot(t, BodyAxis(b.body, 1), D), Row::kDirection, ji, -1});
+    if (D == 3) pending_.push_back({Dot(t, BodyAxis(b.body, 2), D), Row::kDirection, ji, -1});
+  } else {
+    // Two bodies welded: with B0 = A0 R0 at t = 0, b's axes must stay
+    // A R0: e2_b . u_hat = 0, e3_b . u_hat = 0, e3_b . v_hat = 0 where
+    // u_hat, v_hat are A R0 e_x, A R0 e_y (planar: the first only).
+    const Eigen::Matrix3d r0 = frame0_[a.body].transpose() * frame0_[b.body];
+    const auto ea = BodyAxes(a.body);
+    const LinearVector u_hat =
+        Combination({{r0(0, 0), ea[0]}, {r0(1, 0), ea[1]}, {r0(2, 0), ea[2]}});
+    const LinearVector v_hat =
+        Combination({{r0(0, 1), ea[0]}, {r0(1, 1), ea[1]}, {r0(2, 1), ea[2]}});
+    pending_.push_back({Dot(BodyAxis(b.body, 1), u_hat, D), Row::kDirection, ji, -1});
+    if (D == 3) {
+      pending_.push_back({Dot(BodyAxis(b.body, 2), u_hat, D), Row::kDirection, ji, -1});
+      pending_.push_back({Dot(BodyAxis(b.body, 2), v_hat, D), Row::kDirection, ji, -1});
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::Status ModelBuilder::CheckJointsAtStart() const {
+  std::vector<double> gap2(scene_.joints.size(), 0.0);
+  for (const PendingRow& r : pending_) {
+    const double v = r.f.Evaluate(q0_);
+    if (r.kind == Row::kPosition) gap2[r.joint] += v * v;
+    if (r.kind == Row::kDirection && std::abs(v) > 1e-6) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "joints[%d]: FIXED needs the cable tangent parallel to the other side's axis at "
+          "t = 0 (sine of the angle between them: %.6g)",
+          r.joint, v));
+    }
+  }
+  for (size_t j = 0; j < gap2.size(); ++j) {
+    if (std::sqrt(gap2[j]) > 1e-6) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "joints[%d]: its two points are %.6g m apart at t = 0 (they must coincide)",
+          static_cast<int>(j), std::sqrt(gap2[j])));
+    }
+  }
+  return absl::OkStatus();
+}
+
+void ModelBuilder::OrderUnknowns() {
+  MultibodyModel& m = model_;
+  const int D = m.dim_, bs = m.body_stride_, ncoord = static_cast<int>(q0_.size());
+  const int num_bodies = static_cast<int>(scene_.bodies.size());
+  const std::vector<bool>& grounded = elimination_.grounded;
+  m.c_ = VectorXd::Zero(ncoord);
+  m.s_ = VectorXd::Zero(ncoord);
+  m.j_.assign(ncoord, -1);
+  int next = 0;
+  std::vector<bool> body_placed(num_bodies, false);
+  auto place_body = [&](int b) {
+    if (body_placed[b]) return;
+    body_placed[b] = true;
+    const int i = BodyCoord(b);
+    for (int k = 0; k < bs; ++k) {
+      if (grounded[i + k]) {
+        m.c_(i + k) = q0_(i + k);
+      } else {
+        m.j_[i + k] = next++;
+        m.s_(i + k) = 1;
+      }
+    }
+  };
+  std::vector<std::vector<int>> bodies_at_node(m.num_nodes_);
+  for (const JointSpec& joint : scene_.joints) {
+    if (joint.a.cable >= 0 && joint.b.body >= 0)
+      bodies_at_node[mesh_.Node(joint.a)].push_back(joint.b.body);
+    if (joint.b.cable >= 0 && joint.a.body >= 0)
+      bodies_at_node[mesh_.Node(joint.b)].push_back(joint.a.body);
+  }
+  for (int node = 0; node < m.num_nodes_; ++node) {
+    const int i = NodeCoord(node);
+    const int twin = mesh_.twin_of[node];
+    for (int k = 0; k < D; ++k) {
+      if (twin >= 0) {
+        const int t = NodeCoord(twin) + k;
+        m.j_[i + k] = m.j_[t];
+        m.s_(i + k) = m.s_(t);
+        m.c_(i + k) = m.c_(t);
+      } else if (grounded[i + k]) {
+        m.c_(i + k) = q0_(i + k);
+      } else {
+        m.j_[i + k] = next++;
+        m.s_(i + k) = 1;
+      }
+    }
+    if (elimination_.clamped[node]) {
+      const int alpha = next++;
+      for (int k = 0; k < D; ++k) {
+        m.j_[i + D + k] = alpha;
+        m.s_(i + D + k) = elimination_.clamp_dir[node](k);
+      }
+    } else {
+      for (int k = D; k < 2 * D; ++k) {
+        m.j_[i + k] = next++;
+        m.s_(i + k) = 1;
+      }
+    }
+    for (int b : bodies_at_node[node]) place_body(b);
+  }
+  for (int b = 0; b < num_bodies; ++b) place_body(b);
+  m.dofs_ = next;
+
+  // z0 and v0 by least squares through the map (exact for consistent data).
+  m.z0_ = m.Reduce(q0_);
+  VectorXd qd0 = VectorXd::Zero(ncoord);
+  m.RigidVelocity(q0_, &qd0);
+  m.v0_ = m.Reduce(qd0);
+}
+
+void ModelBuilder::KeepMovableRows() {
+  MultibodyModel& m = model_;
+  // A row that no unknown can change (both sides held by ground, say a
+  // pinned node and a body pinned at its centre of mass, or the axes of a
+  // welded body) is satisfied by construction, as far as
+  // CheckJointsAtStart allows, and could never be corrected.
+  // The test is the row's gradient on z at t = 0 (the rows are linear or
+  // bilinear, so a row with a zero reduced gradient there is one that the
+  // elimination has made constant, e.g. a clamped node welded to a body
+  // welded to ground).
+  for (const PendingRow& r : pending_) {
+    VectorXd grad = VectorXd::Zero(m.dofs_);
+    for (const auto& [i, v] : r.f.linear)
+      if (m.j_[i] >= 0) grad(m.j_[i]) += v * m.s_(i);
+    for (const auto& [ij, v] : r.f.quadratic) {
+      if (m.j_[ij.first] >= 0) grad(m.j_[ij.first]) += v * m.s_(ij.first) * q0_(ij.second);
+      if (m.j_[ij.second] >= 0) grad(m.j_[ij.second]) += v * m.s_(ij.second) * q0_(ij.first);
+    }
+    if (grad.lpNorm<Eigen::Infinity>() > 1e-12) m.AddRow(r.f, r.kind, r.joint, r.body);
+  }
+}
+
+template <int D>
+void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* elements) {
+  const double extent = q0_.lpNorm<Eigen::Infinity>();  // scene size [m]
+  const Eigen::Matrix<double, D, 1> g = scene_.gravity_m_s2.head<D>();
+  const std::vector<int>& first_node = mesh_.first_node;
+  for (int c = 0; c < static_cast<int>(scene_.cables.size()); ++c) {
+    const CableSpec& cable = scene_.cables[c];
+    const double ea = cable.youngs_modulus_pa * cable.area_m2;
+    const double ei = cable.youngs_modulus_pa * cable.second_moment_m4;
+    const double mpl = cable.density_kg_m3 * cable.area_m2;
+    for (int k = first_node[c]; k + 1 < first_node[c + 1]; ++k) {
+      if (mesh_.twin_of[k + 1] == k) continue;  // the two halves of a split node
+      const int local = k - first_node[c];
+      const double l = mesh_.node_s[c][local + 1] - mesh_.node_s[c][local];
+      MultibodyModel::ElementData<D> e;
+      e.element = AncfCableElement<D>(l, ea, ei, cable.bending);
+      // Energy the element can hold from coordinates known to 16 eps
+      // (1 + |q0|_inf): a strain of that over l, a curvature of it over l^2.
+      const double strain = 16 * std::numeric_limits<double>::epsilon() * (1 + extent) / l;
+      model_.energy_roundoff_ += (ea + ei / (l * l)) * l * strain * strain;
+      e.first_coord = NodeCoord(k);
+      e.mass_per_length = mpl;
+      e.gravity = e.element.GravityForce(mpl, g);
+      const auto me = e.element.MassMatrix(mpl);
+      for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b) e.mbar(a, b) = me(D * a, D * b);
+      elements->push_back(e);
+    }
+  }
+}
+
+void ModelBuilder::BuildElements() {
+  if (model_.dim_ == 2) {
+    BuildElementsOf<2>(&model_.elements2_);
+  } else {
+    BuildElementsOf<3>(&model_.elements3_);
+  }
+}
+
+void ModelBuilder::ConstantForces() {
+  MultibodyModel& m = model_;
+  const int D = m.dim_;
+  m.constant_force_ = VectorXd::Zero(q0_.size());
+  for (const auto& e : m.elements2_) m.constant_force_.segment<8>(e.first_coord) += e.gravity;
+  for (const auto& e : m.elements3_) m.constant_force_.segment<12>(e.first_coord) += e.gravity;
+  for (const MultibodyModel::BodyData& b : m.bodies_)
+    m.constant_force_.segment(b.coord, D) += b.mass * scene_.gravity_m_s2.head(D);
+  // A force F at a point r = sum_i a_i q_i + c does the work F . dr, so its
+  // generalized force is sum_d F_d a_{d,i} on q_i (constant: the point is
+  // linear in q).
+  auto add_point_force = [&](const LinearVector& point, const Vector3d& force) {
+    for (int d = 0; d < D; ++d)
+      for (const auto& [i, v] : point[d].terms) m.constant_force_(i) += v * force(d);
+  };
+  for (const LoadSpec& load : scene_.loads) {
+    add_point_force(PointOf(load.at), load.force_n);
+    if (load.at.body >= 0 && load.torque_nm.norm() > 0) {
+      m.torques_.push_back({load.at.body, load.torque_nm});
+    }
+  }
+}
+
+void ModelBuilder::Probes() {
+  MultibodyModel& m = model_;
+  m.probe_term_begin_.push_back(0);
+  for (const ProbeSpec& p : scene_.probes) {
+    const LinearVector point = PointOf(p.at);
+    for (int d = 0; d < 3; ++d) {
+      for (const auto& [i, v] : point[d].terms) m.probe_terms_.push_back({i, v});
+      m.probe_term_begin_.push_back(static_cast<int>(m.probe_terms_.size()));
+      m.probe_const_.push_back(point[d].c);
+    }
+    m.probe_names_.push_back(p.name);
+  }
+}
+
+template <int D>
+void ModelBuilder::SetupElementSlots(const std::vector<MultibodyModel::ElementData<D>>& elements) {
+  MultibodyModel& m = model_;
+  constexpr int kN = 4 * D, kN2 = kN * kN;
+  m.element_slots_.resize(kN2 * elements.size());
+  m.element_factors_.resize(kN2 * elements.size());
+  for (size_t k = 0; k < elements.size(); ++k) {
+    const MultibodyModel::ElementData<D>& e = elements[k];
+    for (int a = 0; a < kN; ++a) {
+      for (int b = 0; b < kN; ++b) {
+        const int ia = e.first_coord + a, ib = e.first_coord + b;
+        const int ja = m.j_[ia], jb = m.j_[ib];
+        // A(ja, jb) with ja > jb is stored once; the diagonal takes every
+        // (a, b) with ja == jb (both orders of a != b), as the sum requires.
+        const int slot = (ja >= 0 && jb >= 0 && ja >= jb) ? m.mass_.Slot(ja, jb) : -1;
+        m.element_slots_[kN2 * k + kN * a + b] = slot;
+        m.element_factors_[kN2 * k + kN * a + b] = slot < 0 ? 0 : m.s_(ia) * m.s_(ib);
+      }
+    }
+    const auto me = e.element.MassMatrix(e.mass_per_length);
+    for (int t = 0; t < kN2; ++t) {
+      const int slot = m.element_slots_[kN2 * k + t];
+      if (slot >= 0)
+        m.mass_.values()[slot] += m.element_factors_[kN2 * k + t] * me(t / kN, t % kN);
+    }
+  }
+}
+
+void ModelBuilder::EnvelopeAndMass() {
+  MultibodyModel& m = model_;
+  const int D = m.dim_, bs = m.body_stride_;
+  m.envelope_.resize(m.dofs_);
+  for (int j = 0; j < m.dofs_; ++j) m.envelope_[j] = j;
+  auto couple = [&](const int* idx, int n) {
+    int lo = std::numeric_limits<int>::max();
+    for (int k = 0; k < n; ++k)
+      if (m.j_[idx[k]] >= 0) lo = std::min(lo, m.j_[idx[k]]);
+    for (int k = 0; k < n; ++k)
+      if (m.j_[idx[k]] >= 0) m.envelope_[m.j_[idx[k]]] = std::min(m.envelope_[m.j_[idx[k]]], lo);
+  };
+  {
+    std::vector<int> idx(4 * D);
+    for (const auto& e : m.elements2_) {
+      for (int k = 0; k < 8; ++k) idx[k] = e.first_coord + k;
+      couple(idx.data(), 8);
+    }
+    for (const auto& e : m.elements3_) {
+      for (int k = 0; k < 12; ++k) idx[k] = e.first_coord + k;
+      couple(idx.data(), 12);
+    }
+  }
+  for (const MultibodyModel::BodyData& b : m.bodies_) {
+    std::vector<int> idx(bs);
+    for (int k = 0; k < bs; ++k) idx[k] = b.coord + k;
+    couple(idx.data(), bs);
+  }
+  for (const Row& row : m.rows_) {
+    couple(&m.row_coord_[row.coord_begin], row.coord_end - row.coord_begin);
+  }
+
+  // The reduced mass matrix, with the element scatter tables.
+  m.mass_.SetPattern(m.envelope_);
+  if (D == 2) {
+    SetupElementSlots(m.elements2_);
+  } else {
+    SetupElementSlots(m.elements3_);
+  }
+  for (const MultibodyModel::BodyData& b : m.bodies_) {
+    for (int k = 0; k < bs; ++k) {
+      const int j = m.j_[b.coord + k];
+      if (j < 0) continue;
+      const double diag = k < D ? b.mass : b.jbar((k - D) / D);
+      m.mass_.values()[m.mass_.Slot(j, j)] += m.s_(b.coord + k) * m.s_(b.coord + k) * diag;
+    }
+  }
+}
+
+void ModelBuilder::ConstraintPattern() {
+  MultibodyModel& m = model_;
+  m.jac_pattern_.cols = m.dofs_;
+  for (const Row& row : m.rows_) {
+    for (int k = row.coord_begin; k < row.coord_end; ++k) {
+      if (m.j_[m.row_coord_[k]] < 0) continue;
+      m.jac_pattern_.col.push_back(m.j_[m.row_coord_[k]]);
+      m.jac_pattern_.value.push_back(0);
+    }
+    m.jac_pattern_.row_start.push_back(static_cast<int>(m.jac_pattern_.col.size()));
+  }
+  m.mono_row_.assign(m.mono_a_.size(), -1);
+  m.mono_col_.assign(m.mono_a_.size(), -1);
+  m.mono_factor_.assign(m.mono_a_.size(), 0.0);
+  for (const Row& row : m.rows_) {
+    const int* coord = &m.row_coord_[row.coord_begin];
+    for (int k = row.mono_begin; k < row.mono_end; ++k) {
+      const int a = coord[m.mono_a_[k]], b = coord[m.mono_b_[k]];
+      const int ja = m.j_[a], jb = m.j_[b];
+      if (ja < 0 || jb < 0) continue;
+      // w q_a q_b has Hessian entries (a, b) and (b, a) equal to w; on z
+      // they land on (ja, jb) and (jb, ja): stored once off the diagonal,
+      // twice (2 w) on it.
+      m.mono_row_[k] = std::max(ja, jb);
+      m.mono_col_[k] = std::min(ja, jb);
+      m.mono_factor_[k] = m.mono_w_[k] * m.s_(a) * m.s_(b) * (ja == jb ? 2 : 1);
+    }
+  }
+}
+
+MultibodyModel ModelBuilder::Finish() {
+  model_.scratch_full_ = VectorXd::Zero(q0_.size());
+  model_.scratch_roundoff_ = VectorXd::Zero(q0_.size());
+  model_.ProjectInitialVelocity();
+  return std::move(model_);
+}
+
+}  // namespace cablesim
