@@ -1,5 +1,7 @@
 #include "client/cli.h"
 
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <optional>
@@ -10,6 +12,8 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_split.h"
+#include "absl/strings/ascii.h"
 #include "cablesim/version.h"
 #include "client/cli_common.h"
 #include "client/cli_jobs.h"
@@ -48,7 +52,9 @@ const std::set<std::string>& ValueOptions() {
                                 "workers",
                                 "max-energy-drift",
                                 "max-wall-seconds",
-                                "max-constraint-violation"};
+                                "max-constraint-violation",
+                                "tls-ca",
+                                "token-file"};
   return *options;
 }
 
@@ -250,6 +256,10 @@ SCENE is a cablesim.v1.Scene (proto/cablesim/v1/scene.proto) in protobuf
 JSON, or in text format when its name ends in .txtpb, .textproto or .pbtxt.
 SWEEP.json is a cablesim.v1.SweepFile (proto/cablesim/v1/service.proto).
 
+With --server, every command also takes --tls-ca CA.pem (TLS, the server's
+certificate checked against that CA) and --token-file FILE (the first word
+of its first line that is not a # comment is sent as a bearer token).
+
 Exit status: 0 success; 1 error writing the output or reaching the server,
 or the run (watch: the job) was cancelled; 2 bad input (usage, scene or
 sweep file, invalid scene, a server limit); 3 numerical failure of the run
@@ -289,7 +299,32 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
     return UsageError(
         err, absl::StrCat(command, ": unexpected argument \"", a.positional[wanted], "\""));
   }
+  RemoteSecurity security;
   for (const auto& [name, value] : a.options) {
+    if (name == "tls-ca" || name == "token-file") {
+      if (!a.server.has_value()) {
+        return UsageError(err, absl::StrCat("--", name, " is for a --server"));
+      }
+      std::ifstream in(value, std::ios::binary);
+      std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      if (!in.good() && !in.eof()) text.clear();
+      if (text.empty()) {
+        err << "cablesim: cannot read " << value << " (--" << name << ")\n";
+        return kExitIoError;
+      }
+      if (name == "tls-ca") {
+        security.tls_ca_pem = text;
+      } else {
+        // The first token of the first line that is not a comment.
+        for (absl::string_view line : absl::StrSplit(text, '\n')) {
+          line = absl::StripAsciiWhitespace(line);
+          if (line.empty() || line[0] == '#') continue;
+          security.token = std::string(line.substr(0, line.find_first_of(" \t")));
+          break;
+        }
+      }
+      continue;
+    }
     const bool allowed =
         (command == "jobs" && (name == "state" || name == "sweep" || name == "limit")) ||
         (command == "sweep" && name != "state" && name != "sweep" && name != "limit");
@@ -299,6 +334,7 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
       command != "sweep") {
     return UsageError(err, absl::StrCat(command, ": --out is only for run"));
   }
+  SetRemoteSecurity(security);
   if (command == "validate") return Validate(a.positional[1], a.server, out, err);
   if (command == "run") return Run(a.positional[1], a.out, a.server, out, err);
   if (command == "submit") return cli_internal::Submit(a, out, err);

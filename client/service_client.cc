@@ -5,11 +5,53 @@
 #include <filesystem>
 #include <limits>
 #include <thread>
+#include <utility>
+#include <vector>
+
+#include <grpcpp/support/client_interceptor.h>
 
 #include "absl/strings/str_cat.h"
 #include "convert/run_proto.h"
 
 namespace cablesim {
+namespace {
+
+RemoteSecurity& Security() {
+  static RemoteSecurity* security = new RemoteSecurity();
+  return *security;
+}
+
+// Adds `authorization: Bearer TOKEN` to every call of the channel.
+class TokenInterceptor : public grpc::experimental::Interceptor {
+ public:
+  explicit TokenInterceptor(const std::string& token) : value_("Bearer " + token) {}
+  void Intercept(grpc::experimental::InterceptorBatchMethods* methods) override {
+    if (methods->QueryInterceptionHookPoint(
+            grpc::experimental::InterceptionHookPoints::PRE_SEND_INITIAL_METADATA)) {
+      methods->GetSendInitialMetadata()->insert({"authorization", value_});
+    }
+    methods->Proceed();
+  }
+
+ private:
+  const std::string value_;
+};
+
+class TokenInterceptorFactory : public grpc::experimental::ClientInterceptorFactoryInterface {
+ public:
+  explicit TokenInterceptorFactory(std::string token) : token_(std::move(token)) {}
+  grpc::experimental::Interceptor* CreateClientInterceptor(
+      grpc::experimental::ClientRpcInfo*) override {
+    return new TokenInterceptor(token_);
+  }
+
+ private:
+  const std::string token_;
+};
+
+}  // namespace
+
+void SetRemoteSecurity(RemoteSecurity security) { Security() = std::move(security); }
 
 Connection::~Connection() {
   stub.reset();
@@ -33,7 +75,19 @@ absl::StatusOr<std::unique_ptr<Connection>> Connect(const std::optional<std::str
   if (server.has_value()) {
     grpc::ChannelArguments args;
     args.SetMaxReceiveMessageSize(64 << 20);
-    c->channel = grpc::CreateCustomChannel(*server, grpc::InsecureChannelCredentials(), args);
+    const RemoteSecurity& security = Security();
+    std::shared_ptr<grpc::ChannelCredentials> credentials = grpc::InsecureChannelCredentials();
+    if (!security.tls_ca_pem.empty()) {
+      grpc::SslCredentialsOptions ssl;
+      ssl.pem_root_certs = security.tls_ca_pem;
+      credentials = grpc::SslCredentials(ssl);
+    }
+    std::vector<std::unique_ptr<grpc::experimental::ClientInterceptorFactoryInterface>> tokens;
+    if (!security.token.empty()) {
+      tokens.push_back(std::make_unique<TokenInterceptorFactory>(security.token));
+    }
+    c->channel = grpc::experimental::CreateCustomChannelWithInterceptors(
+        *server, credentials, args, std::move(tokens));
   } else {
     ServerOptions options;
     // The user's own process: no limits beyond the engine's.

@@ -28,6 +28,16 @@ struct Connection {
   ~Connection();
 };
 
+// How Connect reaches a remote server: TLS with this CA (PEM text; empty:
+// plain text), and a bearer token sent with every call (empty: none).
+// Set by the command line from --tls-ca and --token-file for the one
+// command it runs.
+struct RemoteSecurity {
+  std::string tls_ca_pem;
+  std::string token;
+};
+void SetRemoteSecurity(RemoteSecurity security);
+
 // `server` "host:port": a channel to it. Otherwise an in-process service
 // without limits; with `jobs`, it has a job store in a fresh temporary
 // directory (removed with the connection) and `workers` workers.

@@ -9,7 +9,7 @@ packages=(
   libprotobuf-dev protobuf-compiler
   libgrpc++-dev protobuf-compiler-grpc
   libgtest-dev libgmock-dev libbenchmark-dev
-  libsqlite3-dev
+  libsqlite3-dev zlib1g-dev
   python3 python3-grpcio python3-protobuf python3-numpy python3-matplotlib
   clang libclang-rt-14-dev
 )

@@ -9,6 +9,8 @@
 #include <Eigen/QR>
 #include <Spectra/SymGEigsShiftSolver.h>
 
+#include <functional>
+
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "engine/newton_convergence.h"
@@ -148,11 +150,15 @@ class MassProduct {
 // S = B A^{-1} B^T (dense: few constraint equations). Also counts, by
 // Sylvester's law of inertia, the constrained eigenvalues below sigma:
 // neg(KKT) = neg(A) + pos(S) = (eigenvalues below sigma) + m.
+// Thrown out of the Lanczos iteration when the caller asks to stop.
+struct StopLanczos {};
+
 class ConstrainedShiftInvert {
  public:
   using Scalar = double;
-  ConstrainedShiftInvert(const SkylineLdlt& k, const SkylineLdlt& mass, const Eigen::MatrixXd& b)
-      : k_(k), mass_(mass), b_(b) {
+  ConstrainedShiftInvert(const SkylineLdlt& k, const SkylineLdlt& mass, const Eigen::MatrixXd& b,
+                         const std::function<bool()>* should_stop)
+      : k_(k), mass_(mass), b_(b), should_stop_(should_stop) {
     a_ = k;
   }
   Eigen::Index rows() const { return k_.size(); }
@@ -172,6 +178,10 @@ class ConstrainedShiftInvert {
   }
 
   void perform_op(const double* x, double* y) const {
+    // The caller's stop request, once per solve (a solve costs far more
+    // than the check): a deadline, a cancelled job or shutdown stops the
+    // iteration within one solve.
+    if (should_stop_ != nullptr && *should_stop_ && (*should_stop_)()) throw StopLanczos{};
     const int n = k_.size();
     Eigen::Map<Eigen::VectorXd> out(y, n);
     out = Eigen::Map<const Eigen::VectorXd>(x, n);
@@ -194,6 +204,7 @@ class ConstrainedShiftInvert {
   const SkylineLdlt& k_;
   const SkylineLdlt& mass_;
   const Eigen::MatrixXd& b_;
+  const std::function<bool()>* should_stop_;
   SkylineLdlt a_;
   bool ok_ = false;
   Eigen::MatrixXd y_, schur_;
@@ -212,10 +223,10 @@ double MaxDiagonal(const SkylineLdlt& a) {
 // so when the inertia at the highest one found counts more eigenvalues below
 // it than were found, more are asked for and the solve repeated.
 bool LanczosModes(const SkylineLdlt& k, const SkylineLdlt& mass, const Eigen::MatrixXd& b,
-                  int free_dofs, int modes, Eigen::VectorXd* omega2, Eigen::MatrixXd* shapes,
-                  std::string* reason) {
+                  int free_dofs, int modes, const std::function<bool()>* should_stop,
+                  Eigen::VectorXd* omega2, Eigen::MatrixXd* shapes, std::string* reason) {
   const int n = k.size();
-  ConstrainedShiftInvert op(k, mass, b);
+  ConstrainedShiftInvert op(k, mass, b, should_stop);
   MassProduct mop(&mass);
   // Shift: 0 (inverse iteration, best separated) when K_T is positive
   // definite on the unknowns; otherwise (rigid modes, bodies held only by
@@ -299,7 +310,8 @@ absl::StatusOr<int> ModalSolver::ModeCount(const MultibodyModel& model,
 }
 
 ModalSolver::Result ModalSolver::Solve(MultibodyModel* model, const Eigen::VectorXd& z_eq,
-                                       int modes, Method method) {
+                                       int modes, Method method,
+                                       const std::function<bool()>& should_stop) {
   Result result;
   const int n = model->dofs();
   const int m = model->multipliers();
@@ -340,8 +352,14 @@ ModalSolver::Result ModalSolver::Solve(MultibodyModel* model, const Eigen::Vecto
           result.free_dofs - 1);
       return result;
     }
-    result.ok = LanczosModes(stiffness, model->mass(), bal.b, result.free_dofs, modes,
-                             &result.omega2, &result.shapes, &result.reason);
+    try {
+      result.ok = LanczosModes(stiffness, model->mass(), bal.b, result.free_dofs, modes,
+                               &should_stop, &result.omega2, &result.shapes, &result.reason);
+    } catch (const StopLanczos&) {
+      result.ok = false;
+      result.stopped = true;
+      result.reason = "stopped by the caller during the eigensolver";
+    }
     return result;
   }
   Eigen::MatrixXd k = Dense(stiffness);
@@ -379,7 +397,14 @@ void RunModalAnalysis(MultibodyModel* model, const SolverSettings& settings, int
   }
   summary->end_time_s = 1;  // the equilibrium is at the full load
   if (StopRequested(control, summary)) return;
-  const ModalSolver::Result modal = ModalSolver::Solve(model, z, modes);
+  const ModalSolver::Result modal = ModalSolver::Solve(
+      model, z, modes, ModalSolver::Method::kAuto,
+      control.should_stop ? control.should_stop : std::function<bool()>());
+  if (modal.stopped) {
+    summary->status = "cancelled";
+    summary->error = "stopped by the caller during MODAL analysis (eigensolver)";
+    return;
+  }
   if (!modal.ok) {
     Fail(summary, 1, absl::StrCat("MODAL: ", modal.reason));
     return;

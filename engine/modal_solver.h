@@ -37,6 +37,8 @@
 #include <Eigen/Core>
 
 #include "absl/status/status.h"
+#include <functional>
+
 #include "absl/status/statusor.h"
 #include "engine/multibody_model.h"
 #include "engine/scene.h"
@@ -63,6 +65,7 @@ class ModalSolver {
     Eigen::VectorXd omega2;
     Eigen::MatrixXd shapes;
     int free_dofs = 0;  // dofs minus the rank of the constraint Jacobian
+    bool stopped = false;  // `should_stop` returned true (then !ok)
   };
 
   // The number of modes a MODAL run of `settings` computes on `model`
@@ -74,8 +77,12 @@ class ModalSolver {
 
   // The `modes` lowest modes about the equilibrium `z_eq` of `model` under
   // its full loads. kAuto: dense up to kDenseDofs unknowns, else Lanczos.
+  // `should_stop` (empty: never) is checked at every operator application
+  // of the Lanczos iteration, so a caller's stop request ends it within
+  // one linear solve.
   static Result Solve(MultibodyModel* model, const Eigen::VectorXd& z_eq, int modes,
-                      Method method = Method::kAuto);
+                      Method method = Method::kAuto,
+                      const std::function<bool()>& should_stop = {});
 };
 
 // Runs a MODAL analysis: finds the equilibrium (load increments of the

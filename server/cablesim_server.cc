@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "absl/strings/str_cat.h"
+#include "server/request_parse_interceptor.h"
 
 namespace cablesim {
 
@@ -22,18 +23,34 @@ absl::StatusOr<std::unique_ptr<CablesimServer>> CablesimServer::Start(
         std::make_unique<JobManager>(s->store_.get(), options.workers, options.limits, options.log);
     s->jobs_->set_test_only_gate_dir(options.test_only_job_gate_dir);
   }
-  s->service_ = std::make_unique<CablesimServiceImpl>(s->jobs_.get(), options.limits, options.log);
+  s->service_ = std::make_unique<CablesimServiceImpl>(s->jobs_.get(), options.limits, options.log,
+                                                      options.tokens);
   s->log_ = options.log;
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
   if (!options.listen.empty()) {
-    builder.AddListeningPort(options.listen, grpc::InsecureServerCredentials(), &s->port_);
+    std::shared_ptr<grpc::ServerCredentials> credentials = grpc::InsecureServerCredentials();
+    if (!options.tls_cert_pem.empty()) {
+      // gRPC's own TLS: the certificate and key, and with a client CA,
+      // clients must present a certificate it signed.
+      grpc::SslServerCredentialsOptions ssl(
+          options.tls_client_ca_pem.empty()
+              ? GRPC_SSL_DONT_REQUEST_CLIENT_CERTIFICATE
+              : GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY);
+      ssl.pem_root_certs = options.tls_client_ca_pem;
+      ssl.pem_key_cert_pairs.push_back({options.tls_key_pem, options.tls_cert_pem});
+      credentials = grpc::SslServerCredentials(ssl);
+    }
+    builder.AddListeningPort(options.listen, credentials, &s->port_);
   }
   builder.SetMaxReceiveMessageSize(options.limits.max_message_bytes);
   builder.SetMaxSendMessageSize(options.limits.max_message_bytes);
   builder.RegisterService(s->service_.get());
+  std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> interceptors;
+  interceptors.push_back(std::make_unique<RequestParseInterceptorFactory>());
+  builder.experimental().SetInterceptorCreators(std::move(interceptors));
   s->server_ = builder.BuildAndStart();
   if (s->server_ == nullptr || (!options.listen.empty() && s->port_ == 0)) {
     s->down_ = true;

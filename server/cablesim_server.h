@@ -9,6 +9,7 @@
 
 #include <grpcpp/grpcpp.h>
 
+#include <map>
 #include <memory>
 #include <string>
 
@@ -31,6 +32,13 @@ struct ServerOptions {
   ServerLimits limits;
   // Report jobs, sweeps and shutdown on stderr.
   bool log = true;
+  // TLS: the server's certificate chain and private key (PEM text); empty:
+  // no TLS. With a client CA (PEM), clients must present a certificate it
+  // signed (mutual TLS).
+  std::string tls_cert_pem, tls_key_pem, tls_client_ca_pem;
+  // Bearer tokens -> tenant (CablesimServiceImpl::Authorize); empty: none
+  // needed.
+  std::map<std::string, std::string> tokens;
   // TEST ONLY: see JobManager::set_test_only_gate_dir (empty: off).
   std::string test_only_job_gate_dir;
 };

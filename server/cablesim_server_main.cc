@@ -16,6 +16,8 @@
 #include <string>
 #include <fstream>
 #include <iostream>
+#include <iterator>
+#include <utility>
 #include <thread>
 #include <vector>
 
@@ -23,6 +25,9 @@
 #include "absl/flags/reflection.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
+#include "absl/strings/strip.h"
+#include "absl/strings/ascii.h"
 #include "cablesim/version.h"
 #include "server/cablesim_server.h"
 
@@ -30,13 +35,37 @@ ABSL_FLAG(std::string, listen, "127.0.0.1:50051", "host:port to listen on (port 
 ABSL_FLAG(std::string, data_dir, "", "directory of the job database (required)");
 ABSL_FLAG(int, workers, 0, "job worker threads (0: the number of cores)");
 ABSL_FLAG(std::string, port_file, "", "write the bound port to this file once serving");
+ABSL_FLAG(std::string, tls_cert, "", "TLS: the server's certificate chain (PEM file)");
+ABSL_FLAG(std::string, tls_key, "", "TLS: the server's private key (PEM file)");
+ABSL_FLAG(std::string, tls_client_ca, "",
+          "TLS: clients must present a certificate signed by this CA (PEM file; mutual TLS)");
+ABSL_FLAG(std::string, token_file, "",
+          "bearer tokens a client must send, one \"TOKEN TENANT\" per line (# comments)");
+ABSL_FLAG(bool, insecure, false,
+          "allow listening beyond loopback without TLS and tokens (never on a shared network)");
 ABSL_FLAG(int, max_elements, 5000, "limit: cable elements per scene");
 ABSL_FLAG(int64_t, max_steps, 5'000'000, "limit: time steps (or load steps) per run");
 ABSL_FLAG(int64_t, max_frames, 200'000, "limit: output frames per run");
 ABSL_FLAG(int64_t, max_trajectory_values, 32 << 20, "limit: frames x columns kept per run");
 ABSL_FLAG(int, max_sweep_items, 1000, "limit: items per sweep");
 ABSL_FLAG(int, max_streams, 64, "limit: concurrent Run streams");
+ABSL_FLAG(int, max_streams_per_peer, 16,
+          "limit: concurrent Run streams of one client address");
+ABSL_FLAG(int64_t, max_queued_jobs_per_peer, 1000,
+          "limit: jobs (sweep items included) one client address has queued or running");
+ABSL_FLAG(int, max_modes, 200, "limit: MODAL modes per run");
+ABSL_FLAG(int64_t, max_modal_bytes, int64_t{1} << 30,
+          "limit: estimated memory of a MODAL run's modes (8 x dofs x (3 modes + 1) bytes)");
+ABSL_FLAG(int64_t, max_name_bytes, 256,
+          "limit: bytes of any string in a request (names, sweep paths); names are also "
+          "bounded by the scene format (256)");
+ABSL_FLAG(int64_t, max_coordinates, 1'000'000, "limit: coordinates of a scene's model");
 ABSL_FLAG(int, max_message_bytes, 16 << 20, "limit: gRPC message size");
+ABSL_FLAG(double, retention_max_age_s, 0,
+          "delete finished jobs and sweeps this many seconds after they finished (0: keep)");
+ABSL_FLAG(int64_t, retention_max_bytes, 0,
+          "delete the oldest finished jobs and sweeps while stored results take more bytes "
+          "than this (0: no limit)");
 ABSL_FLAG(double, stall_timeout_s, 30, "cancel a stream whose client reads nothing this long");
 ABSL_FLAG(double, shutdown_grace_s, 2,
           "on SIGTERM, wait this long for calls (and idle client connections) to end");
@@ -134,7 +163,79 @@ int main(int argc, char** argv) {
   limits.max_sweep_items = absl::GetFlag(FLAGS_max_sweep_items);
   limits.max_streams = absl::GetFlag(FLAGS_max_streams);
   limits.max_message_bytes = absl::GetFlag(FLAGS_max_message_bytes);
+  limits.max_modes = absl::GetFlag(FLAGS_max_modes);
+  limits.max_modal_bytes = absl::GetFlag(FLAGS_max_modal_bytes);
+  limits.max_name_bytes = absl::GetFlag(FLAGS_max_name_bytes);
+  limits.max_coordinates = absl::GetFlag(FLAGS_max_coordinates);
+  limits.max_streams_per_peer = absl::GetFlag(FLAGS_max_streams_per_peer);
+  limits.max_queued_jobs_per_peer = absl::GetFlag(FLAGS_max_queued_jobs_per_peer);
+  if (const double age = absl::GetFlag(FLAGS_retention_max_age_s); age > 0) {
+    limits.retention_max_age = absl::Seconds(age);
+  } else if (age < 0) {
+    return UsageError("--retention-max-age-s: must be >= 0");
+  }
+  if (const int64_t bytes = absl::GetFlag(FLAGS_retention_max_bytes); bytes > 0) {
+    limits.retention_max_bytes = bytes;
+  } else if (bytes < 0) {
+    return UsageError("--retention-max-bytes: must be >= 0");
+  }
   limits.stall_timeout = absl::Seconds(absl::GetFlag(FLAGS_stall_timeout_s));
+  auto read_file = [](const std::string& path, std::string* text) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return false;
+    text->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    return true;
+  };
+  const std::string cert = absl::GetFlag(FLAGS_tls_cert), key = absl::GetFlag(FLAGS_tls_key),
+                    client_ca = absl::GetFlag(FLAGS_tls_client_ca),
+                    token_file = absl::GetFlag(FLAGS_token_file);
+  if (cert.empty() != key.empty()) return UsageError("--tls-cert and --tls-key go together");
+  if (!client_ca.empty() && cert.empty()) return UsageError("--tls-client-ca needs --tls-cert");
+  for (const auto& [path, text] :
+       {std::pair{cert, &options.tls_cert_pem}, std::pair{key, &options.tls_key_pem},
+        std::pair{client_ca, &options.tls_client_ca_pem}}) {
+    if (!path.empty() && !read_file(path, text)) {
+      std::cerr << "cablesim-server: cannot read " << path << "\n";
+      return 1;
+    }
+  }
+  if (!token_file.empty()) {
+    std::string text;
+    if (!read_file(token_file, &text)) {
+      std::cerr << "cablesim-server: cannot read " << token_file << "\n";
+      return 1;
+    }
+    int line_number = 0;
+    for (absl::string_view line : absl::StrSplit(text, '\n')) {
+      ++line_number;
+      line = absl::StripAsciiWhitespace(line);
+      if (line.empty() || line[0] == '#') continue;
+      std::vector<std::string> fields = absl::StrSplit(line, ' ', absl::SkipWhitespace());
+      if (fields.size() != 2 || fields[0].size() < 16) {
+        std::cerr << "cablesim-server: " << token_file << ":" << line_number
+                  << ": expected \"TOKEN TENANT\" with a token of at least 16 characters\n";
+        return 1;
+      }
+      options.tokens[fields[0]] = fields[1];
+    }
+    if (options.tokens.empty()) {
+      std::cerr << "cablesim-server: " << token_file << ": no tokens\n";
+      return 1;
+    }
+  }
+  // Beyond loopback, only with TLS and tokens (or when told it is fine).
+  {
+    std::string host = options.listen.substr(0, options.listen.rfind(':'));
+    const bool loopback = absl::StartsWith(host, "127.") || host == "localhost" ||
+                          host == "[::1]" || absl::StartsWith(options.listen, "unix:");
+    if (!loopback && (options.tls_cert_pem.empty() || options.tokens.empty()) &&
+        !absl::GetFlag(FLAGS_insecure)) {
+      return UsageError(absl::StrCat(
+          "--listen ", options.listen,
+          ": beyond loopback the server needs --tls-cert/--tls-key and --token-file "
+          "(or --insecure, to accept anyone who can reach the port)"));
+    }
+  }
   // Only the tests set this (tests/server_test_util.h); no flag, so it is
   // not offered in --help, and it is announced loudly when present.
   if (const char* gate = std::getenv("CABLESIM_TEST_ONLY_JOB_GATE"); gate && *gate) {

@@ -1,10 +1,13 @@
 #include "server/cablesim_service.h"
 
+#include <algorithm>
 #include <chrono>
 #include <iostream>
+#include <limits>
 #include <set>
 #include <utility>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "cablesim/version.h"
@@ -12,6 +15,7 @@
 #include "convert/run_proto.h"
 #include "convert/scene_file.h"
 #include "server/energy_report.h"
+#include "server/job_store.h"
 
 namespace cablesim {
 
@@ -21,18 +25,57 @@ class StreamSlot {
  public:
   // `counted`: the stream takes one of the max_streams slots (runs do;
   // watchers and result downloads only register with the watchdog).
-  StreamSlot(CablesimServiceImpl* service, grpc::ServerContext* context, bool counted = true)
+  // A counted stream also takes one of its client's max_streams_per_peer
+  // slots (`client`: ClientKey), so that one client cannot hold every slot.
+  StreamSlot(CablesimServiceImpl* service, grpc::ServerContext* context, bool counted = true,
+             const std::string& client = "")
       : service_(service), watch_{context}, counted_(counted) {
-    acquired_ = !counted_ || service_->streams_.fetch_add(1) < service_->limits_.max_streams;
+    if (counted_) peer_ = client.empty() ? PeerOf(context) : client;
     absl::MutexLock lock(&service_->mu_);
+    if (counted_) {
+      const ServerLimits& limits = service_->limits_;
+      int& mine = service_->peer_streams_[peer_];
+      if (service_->streams_ >= limits.max_streams) {
+        refusal_ = absl::StrCat("the server already runs ", limits.max_streams,
+                                " streams (max_streams); try again later");
+      } else if (mine >= limits.max_streams_per_peer) {
+        refusal_ = absl::StrCat("this client (", peer_, ") already runs ", mine,
+                                " streams, the server's limit is ", limits.max_streams_per_peer,
+                                " (max_streams_per_peer); try again later");
+      }
+      acquired_ = refusal_.empty();
+      if (acquired_) {
+        ++service_->streams_;
+        ++mine;
+      } else if (mine == 0) {
+        service_->peer_streams_.erase(peer_);
+      }
+    } else {
+      acquired_ = true;
+    }
     service_->watched_[&watch_] = true;
   }
   ~StreamSlot() {
-    if (counted_) service_->streams_.fetch_sub(1);
     absl::MutexLock lock(&service_->mu_);
+    if (counted_ && acquired_) {
+      --service_->streams_;
+      if (--service_->peer_streams_[peer_] == 0) service_->peer_streams_.erase(peer_);
+    }
     service_->watched_.erase(&watch_);
   }
   bool acquired() const { return acquired_; }
+  // Why not acquired (names the limit).
+  const std::string& refusal() const { return refusal_; }
+
+  // "ipv4:127.0.0.1:5555" -> "ipv4:127.0.0.1", "ipv6:[::1]:5555" -> "ipv6:[::1]".
+  static std::string PeerOf(const grpc::ServerContext* context) {
+    std::string peer = context->peer();
+    const size_t colon = peer.rfind(':');
+    if ((peer.rfind("ipv4:", 0) == 0 || peer.rfind("ipv6:", 0) == 0) && colon > 5) {
+      peer.resize(colon);
+    }
+    return peer;
+  }
   CablesimServiceImpl::StreamWatch* watch() { return &watch_; }
 
  private:
@@ -40,6 +83,8 @@ class StreamSlot {
   CablesimServiceImpl::StreamWatch watch_;
   const bool counted_;
   bool acquired_ = false;
+  std::string peer_;
+  std::string refusal_;
 };
 
 namespace {
@@ -169,8 +214,49 @@ RunControl ControlFor(grpc::ServerContext* context, const ServerLimits& limits) 
 
 }  // namespace
 
-CablesimServiceImpl::CablesimServiceImpl(JobManager* jobs, ServerLimits limits, bool log)
-    : jobs_(jobs), limits_(limits), log_(log) {
+grpc::Status CablesimServiceImpl::Owned(const std::string& id, const std::string& tenant) const {
+  if (tokens_.empty() || jobs_ == nullptr) return grpc::Status::OK;
+  absl::StatusOr<std::string> owner = jobs_->store()->Tenant(id);
+  if (!owner.ok()) return ToGrpc(owner.status());
+  if (*owner != tenant) {
+    // As if it did not exist: another tenant learns nothing about it.
+    return grpc::Status(grpc::StatusCode::NOT_FOUND,
+                        absl::StrCat("no ", IsSweepId(id) ? "sweep" : "job", " \"", id, "\""));
+  }
+  return grpc::Status::OK;
+}
+
+std::string CablesimServiceImpl::ClientKey(const grpc::ServerContext* context,
+                                           const std::string& tenant) const {
+  return tokens_.empty() ? StreamSlot::PeerOf(context) : absl::StrCat("tenant ", tenant);
+}
+
+grpc::Status CablesimServiceImpl::Authorize(grpc::ServerContext* context,
+                                            std::string* tenant) const {
+  if (tokens_.empty()) return grpc::Status::OK;
+  const auto& metadata = context->client_metadata();
+  const auto it = metadata.find("authorization");
+  if (it == metadata.end()) {
+    return grpc::Status(grpc::StatusCode::UNAUTHENTICATED,
+                        "authorization: this server needs a bearer token (metadata "
+                        "\"authorization: Bearer TOKEN\")");
+  }
+  const absl::string_view value(it->second.data(), it->second.size());
+  constexpr absl::string_view kBearer = "Bearer ";
+  const auto token = absl::StartsWith(value, kBearer)
+                         ? tokens_.find(std::string(value.substr(kBearer.size())))
+                         : tokens_.end();
+  if (token == tokens_.end()) {
+    return grpc::Status(grpc::StatusCode::UNAUTHENTICATED,
+                        "authorization: not a token this server knows");
+  }
+  *tenant = token->second;
+  return grpc::Status::OK;
+}
+
+CablesimServiceImpl::CablesimServiceImpl(JobManager* jobs, ServerLimits limits, bool log,
+                                         std::map<std::string, std::string> tokens)
+    : jobs_(jobs), limits_(limits), log_(log), tokens_(std::move(tokens)) {
   watchdog_ = std::thread([this] { Watchdog(); });
 }
 
@@ -227,29 +313,32 @@ grpc::Status CablesimServiceImpl::NoJobs() const {
                       "this service has no job store (start cablesim-server with --data-dir)");
 }
 
-grpc::Status CablesimServiceImpl::Validate(grpc::ServerContext*, const v1::ValidateRequest* request,
+grpc::Status CablesimServiceImpl::Validate(grpc::ServerContext* context,
+                                           const v1::ValidateRequest* request,
                                            v1::ValidateResponse* response) {
-  // Validation only: the limits are not part of the verdict.
-  ServerLimits unlimited;
-  unlimited.max_elements = std::numeric_limits<int>::max();
-  unlimited.max_steps = std::numeric_limits<int64_t>::max();
-  unlimited.max_frames = std::numeric_limits<int64_t>::max();
-  unlimited.max_trajectory_values = std::numeric_limits<int64_t>::max();
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
+  // The same checks as Run and SubmitJob, limits included (so a scene the
+  // server would refuse is never called valid, and costs no more to
+  // validate than to refuse).
   const absl::StatusOr<v1::Scene> scene =
       SceneOfRequest(request->has_scene(), request->scene(), request->scene_json());
   absl::StatusOr<CheckedScene> checked =
-      scene.ok() ? CheckScene(*scene, unlimited) : absl::StatusOr<CheckedScene>(scene.status());
+      scene.ok() ? CheckScene(*scene, limits_) : absl::StatusOr<CheckedScene>(scene.status());
   if (checked.ok()) {
     response->set_valid(true);
     *response->mutable_model() = ModelInfoToProto(checked->info);
     return grpc::Status::OK;
   }
-  if (checked.status().code() != absl::StatusCode::kInvalidArgument) {
+  const absl::StatusCode code = checked.status().code();
+  if (code != absl::StatusCode::kInvalidArgument && code != absl::StatusCode::kResourceExhausted) {
     return ToGrpc(checked.status());
   }
   response->set_valid(false);
   const std::string message(checked.status().message());
   v1::FieldError* error = response->add_errors();
+  error->set_code(code == absl::StatusCode::kInvalidArgument ? "INVALID_ARGUMENT"
+                                                             : "RESOURCE_EXHAUSTED");
   // Messages read `path: rule` (convert/scene_from_proto.h).
   const size_t colon = message.find(": ");
   if (colon != std::string::npos && message.find(' ') >= colon) {
@@ -263,11 +352,11 @@ grpc::Status CablesimServiceImpl::Validate(grpc::ServerContext*, const v1::Valid
 
 grpc::Status CablesimServiceImpl::Run(grpc::ServerContext* context, const v1::RunRequest* request,
                                       grpc::ServerWriter<v1::RunEvent>* writer) {
-  StreamSlot slot(this, context);
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
+  StreamSlot slot(this, context, /*counted=*/true, ClientKey(context, tenant));
   if (!slot.acquired()) {
-    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
-                        absl::StrCat("the server already runs ", limits_.max_streams,
-                                     " streams (max_streams); try again later"));
+    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, slot.refusal());
   }
   const absl::StatusOr<v1::Scene> scene =
       SceneOfRequest(request->has_scene(), request->scene(), request->scene_json());
@@ -277,7 +366,7 @@ grpc::Status CablesimServiceImpl::Run(grpc::ServerContext* context, const v1::Ru
   StreamingSink sink(writer, slot.watch(), BatchSize(request->frames_per_batch()),
                      checked->scene.name, checked->end_time_s);
   absl::StatusOr<RunSummary> summary =
-      RunScene(checked->scene, &sink, ControlFor(context, limits_));
+      RunSceneWithinMemory(checked->scene, &sink, ControlFor(context, limits_));
   if (!summary.ok()) return ToGrpc(summary.status());
   if (sink.gone() || context->IsCancelled()) {
     return grpc::Status(grpc::StatusCode::CANCELLED, "the client cancelled or went away");
@@ -291,58 +380,117 @@ grpc::Status CablesimServiceImpl::Run(grpc::ServerContext* context, const v1::Ru
   return grpc::Status::OK;
 }
 
-grpc::Status CablesimServiceImpl::SubmitJob(grpc::ServerContext*,
+grpc::Status CablesimServiceImpl::SubmitJob(grpc::ServerContext* context,
                                             const v1::SubmitJobRequest* request,
                                             v1::Job* response) {
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
   const absl::StatusOr<v1::Scene> scene =
       SceneOfRequest(request->has_scene(), request->scene(), request->scene_json());
   if (!scene.ok()) return ToGrpc(scene.status());
-  absl::StatusOr<v1::Job> job = jobs_->Submit(*scene);
+  absl::StatusOr<v1::Job> job = jobs_->Submit(*scene, ClientKey(context, tenant), tenant);
   if (!job.ok()) return ToGrpc(job.status());
   *response = std::move(*job);
   if (log_) std::cerr << "cablesim-server: job " << response->id() << " queued\n";
   return grpc::Status::OK;
 }
 
-grpc::Status CablesimServiceImpl::GetJob(grpc::ServerContext*, const v1::GetJobRequest* request,
+grpc::Status CablesimServiceImpl::GetJob(grpc::ServerContext* context,
+                                         const v1::GetJobRequest* request,
                                          v1::Job* response) {
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
+  if (grpc::Status s = Owned(request->id(), tenant); !s.ok()) return s;
   absl::StatusOr<v1::Job> job = jobs_->Get(request->id());
   if (!job.ok()) return ToGrpc(job.status());
   *response = std::move(*job);
   return grpc::Status::OK;
 }
 
-grpc::Status CablesimServiceImpl::ListJobs(grpc::ServerContext*, const v1::ListJobsRequest* request,
+grpc::Status CablesimServiceImpl::ListJobs(grpc::ServerContext* context,
+                                           const v1::ListJobsRequest* request,
                                            v1::ListJobsResponse* response) {
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
-  const int limit = request->limit() <= 0 ? 100 : std::min(request->limit(), 10000);
+  const int asked = request->page_size() > 0 ? request->page_size() : request->limit();
+  const int limit = asked <= 0 ? 100 : std::min(asked, 10000);
+  // The page token is the id of the last job of the previous page.
+  // One more than asked, to know whether another page follows.
   absl::StatusOr<std::vector<v1::Job>> jobs =
-      jobs_->store()->ListJobs(request->state(), request->sweep_id(), limit);
+      jobs_->store()->ListJobs(request->state(), request->sweep_id(), limit + 1,
+                               request->page_token(),
+                               tokens_.empty() ? nullptr : &tenant);
   if (!jobs.ok()) return ToGrpc(jobs.status());
-  for (v1::Job& job : *jobs) {
+  // Never a response over the message limit: stop at half of it.
+  const size_t budget = static_cast<size_t>(limits_.max_message_bytes) / 2;
+  size_t bytes = 0;
+  for (size_t i = 0; i < jobs->size(); ++i) {
+    v1::Job& job = (*jobs)[i];
     jobs_->AddProgress(&job);
+    const size_t size = job.ByteSizeLong() + 8;
+    const bool full = static_cast<int>(i) == limit || (i > 0 && bytes + size > budget);
+    if (full) {
+      response->set_next_page_token(response->jobs(response->jobs_size() - 1).id());
+      break;
+    }
+    bytes += size;
     *response->add_jobs() = std::move(job);
   }
   return grpc::Status::OK;
 }
 
-grpc::Status CablesimServiceImpl::CancelJob(grpc::ServerContext*,
+grpc::Status CablesimServiceImpl::CancelJob(grpc::ServerContext* context,
                                             const v1::CancelJobRequest* request,
                                             v1::Job* response) {
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
+  if (grpc::Status s = Owned(request->id(), tenant); !s.ok()) return s;
   absl::StatusOr<v1::Job> job = jobs_->Cancel(request->id());
   if (!job.ok()) return ToGrpc(job.status());
   *response = std::move(*job);
   return grpc::Status::OK;
 }
 
+grpc::Status CablesimServiceImpl::DeleteJob(grpc::ServerContext* context,
+                                            const v1::DeleteJobRequest* request,
+                                            v1::DeleteResponse* response) {
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
+  if (jobs_ == nullptr) return NoJobs();
+  if (grpc::Status s = Owned(request->id(), tenant); !s.ok()) return s;
+  absl::StatusOr<int64_t> freed = jobs_->DeleteJob(request->id());
+  if (!freed.ok()) return ToGrpc(freed.status());
+  response->set_freed_bytes(*freed);
+  if (log_) std::cerr << "cablesim-server: job " << request->id() << " deleted\n";
+  return grpc::Status::OK;
+}
+
+grpc::Status CablesimServiceImpl::DeleteSweep(grpc::ServerContext* context,
+                                              const v1::DeleteSweepRequest* request,
+                                              v1::DeleteResponse* response) {
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
+  if (jobs_ == nullptr) return NoJobs();
+  if (grpc::Status s = Owned(request->id(), tenant); !s.ok()) return s;
+  absl::StatusOr<int64_t> freed = jobs_->DeleteSweep(request->id());
+  if (!freed.ok()) return ToGrpc(freed.status());
+  response->set_freed_bytes(*freed);
+  if (log_) std::cerr << "cablesim-server: sweep " << request->id() << " deleted\n";
+  return grpc::Status::OK;
+}
+
 grpc::Status CablesimServiceImpl::WatchJob(grpc::ServerContext* context,
                                            const v1::WatchJobRequest* request,
                                            grpc::ServerWriter<v1::Job>* writer) {
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
   StreamSlot slot(this, context, /*counted=*/false);
+  if (grpc::Status s = Owned(request->id(), tenant); !s.ok()) return s;
   std::string last;
   while (true) {
     const uint64_t seen = jobs_->version();
@@ -367,8 +515,11 @@ grpc::Status CablesimServiceImpl::WatchJob(grpc::ServerContext* context,
 grpc::Status CablesimServiceImpl::GetJobResult(grpc::ServerContext* context,
                                                const v1::GetJobResultRequest* request,
                                                grpc::ServerWriter<v1::RunEvent>* writer) {
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   v1::Job job;
   StoredResult result;
+  if (grpc::Status s = Owned(request->id(), tenant); !s.ok()) return s;
   if (grpc::Status s = FinishedResult(request->id(), &job, &result); !s.ok()) return s;
   StreamSlot slot(this, context, /*counted=*/false);
   v1::RunEvent event;
@@ -401,19 +552,19 @@ grpc::Status CablesimServiceImpl::GetJobResult(grpc::ServerContext* context,
 grpc::Status CablesimServiceImpl::GetEnergy(grpc::ServerContext* context,
                                             const v1::EnergyRequest* request,
                                             v1::EnergyResponse* response) {
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   if (request->has_scene()) {
-    StreamSlot slot(this, context);
+    StreamSlot slot(this, context, /*counted=*/true, ClientKey(context, tenant));
     if (!slot.acquired()) {
-      return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
-                          absl::StrCat("the server already runs ", limits_.max_streams,
-                                       " streams (max_streams); try again later"));
+      return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, slot.refusal());
     }
     absl::StatusOr<CheckedScene> checked = CheckScene(request->scene(), limits_);
     if (!checked.ok()) return ToGrpc(checked.status());
     StoredResult result;
     RowSink sink(&result);
     absl::StatusOr<RunSummary> summary =
-        RunScene(checked->scene, &sink, ControlFor(context, limits_));
+        RunSceneWithinMemory(checked->scene, &sink, ControlFor(context, limits_));
     if (!summary.ok()) return ToGrpc(summary.status());
     if (context->IsCancelled()) return grpc::Status(grpc::StatusCode::CANCELLED, "cancelled");
     *response = EnergyFromTrajectory(result.header, result.values, SummaryToProto(*summary));
@@ -424,14 +575,17 @@ grpc::Status CablesimServiceImpl::GetEnergy(grpc::ServerContext* context,
   }
   v1::Job job;
   StoredResult result;
+  if (grpc::Status s = Owned(request->job_id(), tenant); !s.ok()) return s;
   if (grpc::Status s = FinishedResult(request->job_id(), &job, &result); !s.ok()) return s;
   *response = EnergyFromTrajectory(result.header, result.values, job.summary());
   return grpc::Status::OK;
 }
 
-grpc::Status CablesimServiceImpl::SubmitSweep(grpc::ServerContext*,
+grpc::Status CablesimServiceImpl::SubmitSweep(grpc::ServerContext* context,
                                               const v1::SubmitSweepRequest* request,
                                               v1::Sweep* response) {
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
   v1::SubmitSweepRequest submitted = *request;
   if (!request->base_json().empty()) {
@@ -441,7 +595,8 @@ grpc::Status CablesimServiceImpl::SubmitSweep(grpc::ServerContext*,
     *submitted.mutable_base() = std::move(*base);
     submitted.clear_base_json();
   }
-  absl::StatusOr<v1::Sweep> sweep = jobs_->SubmitSweep(submitted);
+  absl::StatusOr<v1::Sweep> sweep =
+      jobs_->SubmitSweep(submitted, ClientKey(context, tenant), tenant);
   if (!sweep.ok()) return ToGrpc(sweep.status());
   *response = std::move(*sweep);
   if (log_)
@@ -478,9 +633,12 @@ v1::SweepItem ItemOf(JobManager* jobs, const v1::Sweep& sweep, const v1::Job& jo
 grpc::Status CablesimServiceImpl::WatchSweep(grpc::ServerContext* context,
                                              const v1::WatchSweepRequest* request,
                                              grpc::ServerWriter<v1::SweepEvent>* writer) {
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
   StreamSlot slot(this, context, /*counted=*/false);
   std::set<std::string> reported;
+  if (grpc::Status s = Owned(request->id(), tenant); !s.ok()) return s;
   bool first = true;
   while (true) {
     const uint64_t seen = jobs_->version();
@@ -517,10 +675,13 @@ grpc::Status CablesimServiceImpl::WatchSweep(grpc::ServerContext* context,
   }
 }
 
-grpc::Status CablesimServiceImpl::GetSweepResults(grpc::ServerContext*,
+grpc::Status CablesimServiceImpl::GetSweepResults(grpc::ServerContext* context,
                                                   const v1::GetSweepResultsRequest* request,
                                                   v1::SweepResults* response) {
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
+  if (grpc::Status s = Owned(request->id(), tenant); !s.ok()) return s;
   absl::StatusOr<v1::Sweep> sweep = jobs_->store()->GetSweep(request->id());
   if (!sweep.ok()) return ToGrpc(sweep.status());
   absl::StatusOr<std::vector<v1::Job>> jobs =
@@ -537,9 +698,11 @@ grpc::Status CablesimServiceImpl::GetSweepResults(grpc::ServerContext*,
   return grpc::Status::OK;
 }
 
-grpc::Status CablesimServiceImpl::GetServerInfo(grpc::ServerContext*,
+grpc::Status CablesimServiceImpl::GetServerInfo(grpc::ServerContext* context,
                                                 const v1::GetServerInfoRequest*,
                                                 v1::ServerInfo* response) {
+  std::string tenant;
+  if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   response->set_version(CABLESIM_VERSION);
   response->set_build_type(CABLESIM_BUILD_TYPE);
   response->set_sanitizers(CABLESIM_SANITIZERS);
@@ -553,8 +716,22 @@ grpc::Status CablesimServiceImpl::GetServerInfo(grpc::ServerContext*,
   response->set_stall_timeout_s(absl::ToDoubleSeconds(limits_.stall_timeout));
   response->set_max_scene_bytes(kMaxSceneBytes);
   response->set_max_scene_nesting(kMaxSceneNesting);
-  response->set_max_name_bytes(plausible::kMaxNameBytes);
+  // The converter's bound on names, or the server's own on every string
+  // of a request (--max-name-bytes) when that is lower.
+  response->set_max_name_bytes(static_cast<int32_t>(
+      std::min<int64_t>(plausible::kMaxNameBytes, limits_.max_name_bytes)));
   response->set_jobs(jobs_ != nullptr);
+  response->set_max_modes(limits_.max_modes);
+  response->set_max_modal_bytes(limits_.max_modal_bytes);
+  response->set_max_coordinates(limits_.max_coordinates);
+  response->set_max_streams_per_peer(limits_.max_streams_per_peer);
+  response->set_max_queued_jobs_per_peer(limits_.max_queued_jobs_per_peer);
+  if (limits_.retention_max_age != absl::InfiniteDuration()) {
+    response->set_retention_max_age_s(absl::ToDoubleSeconds(limits_.retention_max_age));
+  }
+  if (limits_.retention_max_bytes != std::numeric_limits<int64_t>::max()) {
+    response->set_retention_max_bytes(limits_.retention_max_bytes);
+  }
   return grpc::Status::OK;
 }
 

@@ -15,6 +15,7 @@
 #include <atomic>
 #include <map>
 #include <memory>
+#include <string>
 #include <thread>
 
 #include "absl/synchronization/mutex.h"
@@ -29,7 +30,9 @@ class CablesimServiceImpl final : public v1::CablesimService::Service {
   // `jobs` may be null (an in-process service for `cablesim run`): the job
   // and sweep calls then answer UNIMPLEMENTED.
   // `log`: report on stderr.
-  CablesimServiceImpl(JobManager* jobs, ServerLimits limits, bool log = true);
+  // `tokens`: bearer token -> tenant; empty: no authentication.
+  CablesimServiceImpl(JobManager* jobs, ServerLimits limits, bool log = true,
+                      std::map<std::string, std::string> tokens = {});
   ~CablesimServiceImpl() override;
 
   grpc::Status Validate(grpc::ServerContext* context, const v1::ValidateRequest* request,
@@ -54,6 +57,10 @@ class CablesimServiceImpl final : public v1::CablesimService::Service {
                            v1::Sweep* response) override;
   grpc::Status WatchSweep(grpc::ServerContext* context, const v1::WatchSweepRequest* request,
                           grpc::ServerWriter<v1::SweepEvent>* writer) override;
+  grpc::Status DeleteJob(grpc::ServerContext* context, const v1::DeleteJobRequest* request,
+                         v1::DeleteResponse* response) override;
+  grpc::Status DeleteSweep(grpc::ServerContext* context, const v1::DeleteSweepRequest* request,
+                           v1::DeleteResponse* response) override;
   grpc::Status GetSweepResults(grpc::ServerContext* context,
                                const v1::GetSweepResultsRequest* request,
                                v1::SweepResults* response) override;
@@ -72,13 +79,27 @@ class CablesimServiceImpl final : public v1::CablesimService::Service {
   // FAILED_PRECONDITION while it has no result, UNIMPLEMENTED without jobs.
   grpc::Status FinishedResult(const std::string& id, v1::Job* job, StoredResult* result) const;
   grpc::Status NoJobs() const;
+  // UNAUTHENTICATED unless the call carries `authorization: Bearer T` with
+  // T one of tokens_ (OK when there are none).
+  // `tenant`: the token's tenant.
+  grpc::Status Authorize(grpc::ServerContext* context, std::string* tenant) const;
+  // NOT_FOUND unless job or sweep `id` exists and, with tokens, belongs to
+  // `tenant`.
+  grpc::Status Owned(const std::string& id, const std::string& tenant) const;
+  // Whose share a call counts against (max_streams_per_peer,
+  // max_queued_jobs_per_peer): the tenant with tokens, else the client's
+  // address without its port.
+  std::string ClientKey(const grpc::ServerContext* context, const std::string& tenant) const;
   void Watchdog();
 
   JobManager* jobs_;
   const ServerLimits limits_;
   const bool log_;
-  std::atomic<int> streams_{0};
+  const std::map<std::string, std::string> tokens_;
   absl::Mutex mu_;
+  // Counted streams, in all and per peer (StreamSlot).
+  int streams_ ABSL_GUARDED_BY(mu_) = 0;
+  std::map<std::string, int> peer_streams_ ABSL_GUARDED_BY(mu_);
   std::map<StreamWatch*, bool> watched_ ABSL_GUARDED_BY(mu_);
   bool stop_ ABSL_GUARDED_BY(mu_) = false;
   std::thread watchdog_;

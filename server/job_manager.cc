@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <set>
 #include <utility>
 
@@ -70,6 +71,7 @@ absl::Status JobManager::Start() {
       if (!present.count(id)) queue_.push_back(id);
     }
   }
+  ApplyRetention();
   for (int i = 0; i < workers_; ++i) threads_.emplace_back([this] { Work(); });
   return absl::OkStatus();
 }
@@ -113,20 +115,26 @@ void JobManager::Enqueue(const std::string& id) {
   ++version_;
 }
 
-absl::StatusOr<v1::Job> JobManager::Submit(const v1::Scene& scene) {
+absl::StatusOr<v1::Job> JobManager::Submit(const v1::Scene& scene, const std::string& peer,
+                                           const std::string& tenant) {
   absl::StatusOr<CheckedScene> checked = CheckScene(scene, limits_);
   if (!checked.ok()) return checked.status();
-  absl::StatusOr<v1::Job> job = store_->InsertJob(scene, checked->end_time_s);
+  absl::StatusOr<v1::Job> job =
+      store_->InsertJob(scene, checked->end_time_s, peer, limits_.max_queued_jobs_per_peer,
+                        tenant);
   if (!job.ok()) return job.status();
   Enqueue(job->id());
   return job;
 }
 
-absl::StatusOr<v1::Sweep> JobManager::SubmitSweep(const v1::SubmitSweepRequest& request) {
+absl::StatusOr<v1::Sweep> JobManager::SubmitSweep(const v1::SubmitSweepRequest& request,
+                                                  const std::string& peer,
+                                                  const std::string& tenant) {
   std::vector<double> end_times;
   absl::StatusOr<std::vector<v1::Scene>> items = ExpandSweep(request, limits_, &end_times);
   if (!items.ok()) return items.status();
-  absl::StatusOr<v1::Sweep> sweep = store_->InsertSweep(request, *items, end_times);
+  absl::StatusOr<v1::Sweep> sweep = store_->InsertSweep(
+      request, *items, end_times, peer, limits_.max_queued_jobs_per_peer, tenant);
   if (!sweep.ok()) return sweep.status();
   absl::MutexLock lock(&mu_);
   for (const std::string& id : sweep->job_ids()) queue_.push_back(id);
@@ -148,6 +156,39 @@ absl::StatusOr<v1::Job> JobManager::Cancel(const std::string& id) {
   }
   Changed();
   return Get(id);
+}
+
+absl::StatusOr<int64_t> JobManager::DeleteJob(const std::string& id) {
+  absl::StatusOr<int64_t> freed = store_->DeleteJob(id);
+  if (freed.ok()) Changed();
+  return freed;
+}
+
+absl::StatusOr<int64_t> JobManager::DeleteSweep(const std::string& id) {
+  absl::StatusOr<int64_t> freed = store_->DeleteSweep(id);
+  if (freed.ok()) Changed();
+  return freed;
+}
+
+void JobManager::ApplyRetention() {
+  const bool by_age = limits_.retention_max_age != absl::InfiniteDuration();
+  if (!by_age && limits_.retention_max_bytes == std::numeric_limits<int64_t>::max()) return;
+  const int64_t older_than =
+      by_age ? NowUnixMs() - absl::ToInt64Milliseconds(limits_.retention_max_age)
+             : std::numeric_limits<int64_t>::min();
+  absl::StatusOr<RetentionReport> report =
+      store_->ApplyRetention(older_than, limits_.retention_max_bytes);
+  if (!report.ok()) {
+    if (log_) std::cerr << "cablesim-server: retention: " << report.status() << "\n";
+    return;
+  }
+  if (report->jobs > 0) {
+    if (log_) {
+      std::cerr << "cablesim-server: retention deleted " << report->jobs << " jobs ("
+                << report->sweeps << " sweeps), " << report->bytes << " bytes of results\n";
+    }
+    Changed();
+  }
 }
 
 absl::StatusOr<v1::Job> JobManager::Get(const std::string& id) {
@@ -229,7 +270,7 @@ void JobManager::RunOne(const std::string& id) {
     control.should_stop = [&] { return running->stop.load() != 0; };
     // Rejected steps count too: allow the nominal limit twice over.
     control.max_steps = 2 * limits_.max_steps;
-    absl::StatusOr<RunSummary> ran = RunScene(*scene, &sink, control);
+    absl::StatusOr<RunSummary> ran = RunSceneWithinMemory(*scene, &sink, control);
     if (ran.ok()) {
       summary = std::move(*ran);
     } else {
@@ -256,6 +297,7 @@ void JobManager::RunOne(const std::string& id) {
     std::cerr << "cablesim-server: job " << id << " " << v1::JobState_Name(state) << " ("
               << summary.frames << " frames, " << summary.wall_seconds << " s)\n";
   forget();
+  ApplyRetention();
 }
 
 void JobManager::WaitAtTestGate(const std::string& id, const Running& running) {

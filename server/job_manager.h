@@ -36,9 +36,21 @@ class JobManager {
   // Stops the workers; running jobs go back to QUEUED. Idempotent.
   void Shutdown();
 
-  absl::StatusOr<v1::Job> Submit(const v1::Scene& scene);
-  absl::StatusOr<v1::Sweep> SubmitSweep(const v1::SubmitSweepRequest& request);
+  // `peer`: the submitting client's address, for
+  // limits().max_queued_jobs_per_peer.
+  // `tenant`: the owner (JobStore::InsertJob).
+  absl::StatusOr<v1::Job> Submit(const v1::Scene& scene, const std::string& peer = "",
+                                 const std::string& tenant = "");
+  absl::StatusOr<v1::Sweep> SubmitSweep(const v1::SubmitSweepRequest& request,
+                                        const std::string& peer = "",
+                                        const std::string& tenant = "");
   absl::StatusOr<v1::Job> Cancel(const std::string& id);
+  // JobStore::DeleteJob / DeleteSweep (watchers see the change).
+  absl::StatusOr<int64_t> DeleteJob(const std::string& id);
+  absl::StatusOr<int64_t> DeleteSweep(const std::string& id);
+  // Deletes what limits().retention_max_age / retention_max_bytes no
+  // longer keep (at start-up and after every finished job).
+  void ApplyRetention();
   // The stored job with the progress of a running one.
   absl::StatusOr<v1::Job> Get(const std::string& id);
   void AddProgress(v1::Job* job);

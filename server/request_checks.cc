@@ -1,6 +1,7 @@
 #include "server/request_checks.h"
 
 #include <cmath>
+#include <new>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -10,6 +11,58 @@
 #include "convert/scene_from_proto.h"
 
 namespace cablesim {
+
+absl::Status CheckStringLengths(const google::protobuf::Message& message,
+                                const ServerLimits& limits, const std::string& prefix) {
+  using google::protobuf::FieldDescriptor;
+  const google::protobuf::Reflection* reflection = message.GetReflection();
+  std::vector<const FieldDescriptor*> fields;
+  reflection->ListFields(message, &fields);
+  for (const FieldDescriptor* field : fields) {
+    const std::string path = absl::StrCat(prefix, prefix.empty() ? "" : ".", field->name());
+    const int n = field->is_repeated() ? reflection->FieldSize(message, field) : 1;
+    for (int i = 0; i < n; ++i) {
+      const std::string at = field->is_repeated() ? absl::StrCat(path, "[", i, "]") : path;
+      if (field->type() == FieldDescriptor::TYPE_STRING ||
+          field->type() == FieldDescriptor::TYPE_BYTES) {
+        std::string scratch;
+        const std::string& value =
+            field->is_repeated()
+                ? reflection->GetRepeatedStringReference(message, field, i, &scratch)
+                : reflection->GetStringReference(message, field, &scratch);
+        if (static_cast<int64_t>(value.size()) > limits.max_name_bytes) {
+          return absl::ResourceExhaustedError(
+              absl::StrFormat("%s: %d bytes, the server's limit is %d (max_name_bytes)", at,
+                              value.size(), limits.max_name_bytes));
+        }
+      } else if (field->type() == FieldDescriptor::TYPE_MESSAGE) {
+        const google::protobuf::Message& sub =
+            field->is_repeated() ? reflection->GetRepeatedMessage(message, field, i)
+                                 : reflection->GetMessage(message, field);
+        if (absl::Status s = CheckStringLengths(sub, limits, at); !s.ok()) return s;
+      }
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<RunSummary> RunSceneWithinMemory(const Scene& scene, FrameSink* sink,
+                                                const RunControl& control) {
+  try {
+    return RunScene(scene, sink, control);
+  } catch (const std::bad_alloc&) {
+    int64_t elements = 0;
+    for (const CableSpec& cable : scene.cables) elements += cable.elements;
+    std::string what = absl::StrFormat("%d cable elements", elements);
+    if (scene.solver.analysis == Analysis::kModal) {
+      absl::StrAppendFormat(&what, ", %d modes", scene.solver.modes);
+    }
+    return absl::ResourceExhaustedError(absl::StrFormat(
+        "cables, solver: the run needs more memory than the server could allocate (%s); "
+        "ask for fewer elements, frames or modes",
+        what));
+  }
+}
 
 absl::StatusOr<v1::Scene> SceneOfRequest(bool has_scene, const v1::Scene& scene,
                                          const std::string& json, absl::string_view json_field) {
@@ -27,6 +80,7 @@ absl::StatusOr<v1::Scene> SceneOfRequest(bool has_scene, const v1::Scene& scene,
 
 absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimits& limits) {
   CheckedScene checked;
+  if (absl::Status s = CheckStringLengths(proto, limits); !s.ok()) return s;
   absl::StatusOr<Scene> scene = SceneFromProto(proto);
   if (!scene.ok()) return scene.status();
   checked.scene = std::move(*scene);
@@ -78,6 +132,29 @@ absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimi
         "cables: the model has %d elements, the server's limit is %d (max_elements)",
         checked.info.elements, limits.max_elements));
   }
+  if (checked.info.coordinates > limits.max_coordinates) {
+    return absl::ResourceExhaustedError(absl::StrFormat(
+        "cables, bodies: the model has %d coordinates, the server's limit is %d "
+        "(max_coordinates)",
+        checked.info.coordinates, limits.max_coordinates));
+  }
+  if (solver.analysis == Analysis::kModal) {
+    // As the engine: the modes asked for, or 10 (at most every unknown).
+    const int64_t dofs = checked.info.dofs;
+    const int64_t modes = solver.modes > 0 ? solver.modes : std::min<int64_t>(10, dofs);
+    if (modes > limits.max_modes) {
+      return absl::ResourceExhaustedError(
+          absl::StrFormat("solver.modes: %d modes asked for, the server's limit is %d (max_modes)",
+                          modes, limits.max_modes));
+    }
+    const double bytes = 8.0 * static_cast<double>(dofs) * static_cast<double>(3 * modes + 1);
+    if (bytes > static_cast<double>(limits.max_modal_bytes)) {
+      return absl::ResourceExhaustedError(absl::StrFormat(
+          "solver.modes: %d modes of %d unknowns need about %.0f MB, the server's limit is "
+          "%.0f MB (max_modal_bytes)",
+          modes, dofs, bytes / 1e6, static_cast<double>(limits.max_modal_bytes) / 1e6));
+    }
+  }
   return checked;
 }
 
@@ -95,6 +172,7 @@ std::vector<double> SweepAxisValues(const google::protobuf::RepeatedPtrField<v1:
 absl::StatusOr<std::vector<v1::Scene>> ExpandSweep(const v1::SubmitSweepRequest& request,
                                                    const ServerLimits& limits,
                                                    std::vector<double>* end_times_s) {
+  if (absl::Status s = CheckStringLengths(request, limits); !s.ok()) return s;
   if (request.axes().empty()) return absl::InvalidArgumentError("axes: at least one axis");
   int64_t items = 1;
   for (int a = 0; a < request.axes_size(); ++a) {

@@ -7,6 +7,7 @@
 // expands to valid items (errors naming `axes[i]`).
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,27 @@ struct ServerLimits {
   int max_message_bytes = 16 << 20;  // gRPC receive limit
   // A Run stream whose client reads nothing for this long is cancelled.
   absl::Duration stall_timeout = absl::Seconds(30);
+  // Limits added later default to "none" here, so that in-process users
+  // (`cablesim run`) keep the engine's own bounds; cablesim-server sets
+  // them from its flags (README, service section).
+  // MODAL: modes computed per run, and the memory the eigensolver's basis
+  // and the mode shapes take (8 bytes x dofs x (3 modes + 1) estimated).
+  int max_modes = std::numeric_limits<int>::max();
+  int64_t max_modal_bytes = std::numeric_limits<int64_t>::max();
+  // Bytes of any one string in a request (names, references, sweep paths).
+  int64_t max_name_bytes = std::numeric_limits<int64_t>::max();
+  // Counted streams (Run, GetEnergy of a scene) of one client address.
+  int max_streams_per_peer = std::numeric_limits<int>::max();
+  // Jobs queued or running that one client address submitted (sweep
+  // items included).
+  int64_t max_queued_jobs_per_peer = std::numeric_limits<int64_t>::max();
+  // Coordinates of the model built (nodal and body coordinates).
+  int64_t max_coordinates = std::numeric_limits<int64_t>::max();
+  // Retention of finished jobs and sweeps: deleted once finished longer
+  // ago than this, or, oldest first, while the stored results take more
+  // than max_bytes. Infinite / max: kept.
+  absl::Duration retention_max_age = absl::InfiniteDuration();
+  int64_t retention_max_bytes = std::numeric_limits<int64_t>::max();
 };
 
 struct CheckedScene {
@@ -48,8 +70,25 @@ absl::StatusOr<v1::Scene> SceneOfRequest(bool has_scene, const v1::Scene& scene,
                                          const std::string& json,
                                          absl::string_view json_field = "scene_json");
 
-// Validates `proto`, builds its model and checks it against `limits`.
+// Validates `proto`, builds its model and checks it against `limits`:
+// every string's length, the steps, frames and numbers kept, the elements
+// summed over all cables before anything is built, then the model's
+// elements and coordinates and, for MODAL, the modes and their memory.
+// The one costing of a scene: Validate, Run, SubmitJob, sweeps and
+// GetEnergy all call it.
 absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimits& limits);
+
+// RunScene, with an allocation that fails (std::bad_alloc: the run needs
+// more memory than the server can get) answered as ResourceExhausted
+// naming the scene's size, instead of an exception that the RPC would
+// report as UNKNOWN (or that would end a job's worker thread).
+absl::StatusOr<RunSummary> RunSceneWithinMemory(const Scene& scene, FrameSink* sink,
+                                                const RunControl& control);
+
+// ResourceExhausted naming the first string field of `message` (its path,
+// after `prefix`) longer than limits.max_name_bytes.
+absl::Status CheckStringLengths(const google::protobuf::Message& message,
+                                const ServerLimits& limits, const std::string& prefix = "");
 
 // The items of a sweep (cartesian product, last axis fastest), each
 // checked with CheckScene; `end_times_s` receives each item's end time.

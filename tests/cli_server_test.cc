@@ -113,7 +113,7 @@ TEST_F(CliServerTest, SubmitWatchJobsEnergyCancel) {
   const CliResult submitted = Cli({"submit", Scene("job", 0.1), "--server", address});
   ASSERT_EQ(submitted.code, 0) << submitted.err;
   EXPECT_THAT(submitted.out, StartsWith(R"({"id":"j-)"));
-  const std::string id = submitted.out.substr(7, 8);
+  const std::string id = submitted.out.substr(7, submitted.out.find('"', 7) - 7);
   const std::string csv = *dir_ + "/job.csv";
   const CliResult watched = Cli({"watch", id, "--server", address, "--out", csv});
   ASSERT_EQ(watched.code, 0) << watched.err;
@@ -137,12 +137,12 @@ TEST_F(CliServerTest, SubmitWatchJobsEnergyCancel) {
   // while `long` holds the only worker, is cancelled before it ever runs.
   const CliResult long_job = Cli({"submit", Scene("long", 19, "gated-long"), "--server", address});
   ASSERT_EQ(long_job.code, 0);
-  const std::string long_id = long_job.out.substr(7, 8);
+  const std::string long_id = long_job.out.substr(7, long_job.out.find('"', 7) - 7);
   ASSERT_TRUE(server_->WaitForLog(absl::StrCat("job ", long_id, " waits at the gate")));
   const CliResult queued_job =
       Cli({"submit", Scene("queued", 19, "gated-queued"), "--server", address});
   ASSERT_EQ(queued_job.code, 0);
-  const std::string queued_id = queued_job.out.substr(7, 8);
+  const std::string queued_id = queued_job.out.substr(7, queued_job.out.find('"', 7) - 7);
   for (const std::string& job : {queued_id, long_id}) {
     const CliResult cancelled = Cli({"cancel", job, "--server", address});
     ASSERT_EQ(cancelled.code, 0) << cancelled.err;
@@ -172,8 +172,8 @@ TEST_F(CliServerTest, SweepWritesOneRowPerItemAndFailsOnAThreshold) {
   ASSERT_EQ(rows.size(), 7u);
   EXPECT_THAT(rows[0], StartsWith("index,job_id,state,solver.step,cables[0].elements,status,"));
   EXPECT_THAT(rows[0], HasSubstr(",final.tip.x,"));
-  EXPECT_THAT(rows[1], StartsWith("0,j-000001,SUCCEEDED,0.001,4,ok,"));
-  EXPECT_THAT(rows[6], StartsWith("5,j-000006,SUCCEEDED,5e-04,8,ok,"));
+  EXPECT_THAT(rows[1], ::testing::MatchesRegex("0,j-[A-Za-z0-9_-]{22},SUCCEEDED,0.001,4,ok,.*"));
+  EXPECT_THAT(rows[6], ::testing::MatchesRegex("5,j-[A-Za-z0-9_-]{22},SUCCEEDED,5e-04,8,ok,.*"));
 
   // Backward Euler dissipates a few percent here: a drift limit of 1e-9
   // is exceeded by every item; exit code 3, the table still written.

@@ -65,7 +65,8 @@ class ServerTest : public ::testing::Test {
     gate_ = new testing::JobGate(dir);
     server_ = new ServerProcess(dir,
                                 {"--workers=1", "--max-elements=200", "--max-frames=20000",
-                                 "--max-streams=40", "--max-trajectory-values=1048576"},
+                                 "--max-streams=40", "--max-trajectory-values=1048576",
+                                 "--max-modes=6", "--max-name-bytes=64", "--max-streams-per-peer=40"},
                                 {gate_->env()});
   }
   static void TearDownTestSuite() {
@@ -187,6 +188,121 @@ TEST_F(ServerTest, LimitsAreResourceExhausted) {
   scene.set_name(std::string(17 << 20, 'x'));
   s = RunOnServer(stub.get(), scene);
   EXPECT_EQ(s.status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+}
+
+TEST_F(ServerTest, MalformedRequestsAreInvalidArgumentWithAMessage) {
+  // Not a protobuf message at all (field 31, wire type 7 does not exist),
+  // and a well-formed ValidateRequest / RunRequest / SubmitJobRequest whose
+  // scene name (field 1 of field 1) is not UTF-8.
+  const std::string garbage("\xff\xff\xff\xff", 4);
+  const std::string not_utf8("\x0a\x04\x0a\x02\xc3\x28", 6);
+  for (const char* method : {"/cablesim.v1.CablesimService/Validate",
+                             "/cablesim.v1.CablesimService/Run",
+                             "/cablesim.v1.CablesimService/SubmitJob"}) {
+    for (const std::string& body : {garbage, not_utf8}) {
+      SCOPED_TRACE(absl::StrCat(method, " ", body.size()));
+      std::string response;
+      const grpc::Status s = testing::RawCall(server_->Channel(), method, body, &response);
+      EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+      EXPECT_THAT(s.error_message(), HasSubstr("not a valid request message for " +
+                                               std::string(method)));
+    }
+  }
+  // An error of the server itself is not turned into INVALID_ARGUMENT: a
+  // well-formed request is answered as before.
+  std::string response;
+  const std::string valid("\x0a\x00", 2);  // ValidateRequest{scene: {}}
+  EXPECT_TRUE(
+      testing::RawCall(server_->Channel(), "/cablesim.v1.CablesimService/Validate", valid, &response)
+          .ok());
+}
+
+// Validate, Run, SubmitJob, sweeps and GetEnergy refuse the same scene the
+// same way, before any work.
+void ExpectRefusedEverywhere(v1::CablesimService::Stub* stub, const v1::Scene& scene,
+                             const std::string& path, const std::string& limit) {
+  auto expect_refused = [&](const grpc::Status& s, const char* call) {
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << call;
+    EXPECT_THAT(s.error_message(), HasSubstr(limit)) << call;
+  };
+  {
+    grpc::ClientContext context;
+    v1::ValidateRequest request;
+    *request.mutable_scene() = scene;
+    v1::ValidateResponse response;
+    ASSERT_TRUE(stub->Validate(&context, request, &response).ok());
+    EXPECT_FALSE(response.valid());
+    ASSERT_EQ(response.errors_size(), 1);
+    EXPECT_EQ(response.errors(0).path(), path);
+    EXPECT_EQ(response.errors(0).code(), "RESOURCE_EXHAUSTED");
+    EXPECT_THAT(response.errors(0).message(), HasSubstr(limit));
+  }
+  const Streamed run = RunOnServer(stub, scene);
+  expect_refused(run.status, "Run");
+  EXPECT_THAT(run.status.error_message(), StartsWith(path + ": "));
+  grpc::ClientContext submit_context, energy_context, sweep_context;
+  v1::SubmitJobRequest submit;
+  *submit.mutable_scene() = scene;
+  v1::Job job;
+  expect_refused(stub->SubmitJob(&submit_context, submit, &job), "SubmitJob");
+  v1::EnergyRequest energy;
+  *energy.mutable_scene() = scene;
+  v1::EnergyResponse energy_response;
+  expect_refused(stub->GetEnergy(&energy_context, energy, &energy_response), "GetEnergy");
+  v1::SubmitSweepRequest sweep;
+  *sweep.mutable_base() = scene;
+  v1::SweepAxis* axis = sweep.add_axes();
+  axis->set_path("gravity.y");
+  axis->add_values(-9.81);
+  v1::Sweep sweep_response;
+  expect_refused(stub->SubmitSweep(&sweep_context, sweep, &sweep_response), "SubmitSweep");
+}
+
+TEST_F(ServerTest, EveryCallCostsARequestTheSameWay) {
+  auto stub = server_->Stub();
+  // Three cables of 80 elements: each within --max-elements=200, together
+  // over it.
+  v1::Scene scene = Pendulum(0.01, 1e-3, 1e-3);
+  scene.mutable_cables(0)->set_elements(80);
+  for (const char* name : {"second", "third"}) {
+    v1::Cable* cable = scene.add_cables();
+    *cable = scene.cables(0);
+    cable->set_name(name);
+  }
+  {
+    SCOPED_TRACE("elements summed over the cables");
+    ExpectRefusedEverywhere(stub.get(), scene, "cables", "(max_elements)");
+  }
+  // A name over --max-name-bytes=64, in the scene and in a probe.
+  scene = Pendulum(0.01, 1e-3, 1e-3);
+  scene.set_name(std::string(65, 'n'));
+  {
+    SCOPED_TRACE("scene name");
+    ExpectRefusedEverywhere(stub.get(), scene, "name", "65 bytes, the server's limit is 64");
+  }
+  scene = Pendulum(0.01, 1e-3, 1e-3);
+  scene.mutable_probes(0)->set_name(std::string(100, 'p'));
+  {
+    SCOPED_TRACE("probe name");
+    ExpectRefusedEverywhere(stub.get(), scene, "probes[0].name", "(max_name_bytes)");
+  }
+  // MODAL with more modes than --max-modes=6.
+  auto modal = ReadSceneFile(absl::StrCat(CABLESIM_SOURCE_DIR, "/scenes/hanging-chain-modes.json"));
+  ASSERT_TRUE(modal.ok()) << modal.status();
+  modal->mutable_solver()->set_modes(7);
+  {
+    SCOPED_TRACE("modes");
+    ExpectRefusedEverywhere(stub.get(), *modal, "solver.modes", "(max_modes)");
+  }
+  // Within the limits, every call accepts it.
+  modal->mutable_solver()->set_modes(6);
+  grpc::ClientContext context;
+  v1::ValidateRequest request;
+  *request.mutable_scene() = *modal;
+  v1::ValidateResponse response;
+  ASSERT_TRUE(stub->Validate(&context, request, &response).ok());
+  EXPECT_TRUE(response.valid());
+  EXPECT_TRUE(RunOnServer(stub.get(), *modal).status.ok());
 }
 
 TEST_F(ServerTest, HealthServiceIsServing) {
@@ -509,12 +625,9 @@ TEST_F(ServerTest, ASecondServerOnTheSameDataDirectoryRefusesToStart) {
   // Two servers on one store could run a job twice.
   const std::string dir = testing::FreshDir("server_test_second");
   ServerProcess first(dir);
-  const std::string binary = absl::StrCat(CABLESIM_BIN_DIR, "/cablesim-server");
-  const int status = std::system(
-      absl::StrCat("'", binary, "' --listen=127.0.0.1:0 --data-dir='", dir, "' 2>/dev/null")
-          .c_str());
-  ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 1);
+  std::string log;
+  EXPECT_EQ(testing::StartRefused(dir, &log), 1);
+  EXPECT_THAT(log, HasSubstr("in use by another cablesim-server"));
 }
 
 }  // namespace

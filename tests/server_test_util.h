@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <fcntl.h>
@@ -47,9 +48,14 @@ inline std::string FreshDir(const std::string& name) {
 // to DIR/server.log (see WaitForLog), printed when the test has failed.
 class ServerProcess {
  public:
+  // `address_space_bytes` > 0: the child's RLIMIT_AS (so that a large
+  // allocation fails inside the server).
   ServerProcess(std::string data_dir, std::vector<std::string> flags = {},
-                std::vector<std::string> env = {})
-      : data_dir_(std::move(data_dir)), flags_(std::move(flags)), env_(std::move(env)) {
+                std::vector<std::string> env = {}, uint64_t address_space_bytes = 0)
+      : data_dir_(std::move(data_dir)),
+        flags_(std::move(flags)),
+        env_(std::move(env)),
+        address_space_bytes_(address_space_bytes) {
     Start();
   }
   ~ServerProcess() {
@@ -88,6 +94,10 @@ class ServerProcess {
       if (::getppid() != parent) _exit(127);  // the test died before prctl
       const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0600);
       if (fd >= 0) ::dup2(fd, STDERR_FILENO);
+      if (address_space_bytes_ > 0) {
+        const struct rlimit limit = {address_space_bytes_, address_space_bytes_};
+        ::setrlimit(RLIMIT_AS, &limit);
+      }
       execve(argv[0], argv.data(), envp.data());
       _exit(127);
     }
@@ -154,9 +164,24 @@ class ServerProcess {
   std::string data_dir_;
   std::vector<std::string> flags_;
   std::vector<std::string> env_;
+  uint64_t address_space_bytes_ = 0;
   pid_t pid_ = -1;
   int port_ = 0;
 };
+
+// Starts a cablesim-server on `data_dir` expected to refuse to start;
+// returns its exit code (124: still running after 60 s, so it did not
+// refuse) and its stderr in `log`.
+inline int StartRefused(const std::string& data_dir, std::string* log) {
+  const std::string log_path = absl::StrCat(data_dir, "/refused.log");
+  const int status = std::system(absl::StrCat("timeout 60 '", CABLESIM_BIN_DIR,
+                                              "/cablesim-server' --listen=127.0.0.1:0 --data-dir='",
+                                              data_dir, "' 2>'", log_path, "'")
+                                     .c_str());
+  std::ifstream in(log_path);
+  log->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
 
 // One request message and the first response message of `method`, as raw
 // bytes (for services whose .proto is not installed: health, reflection).
@@ -244,6 +269,23 @@ inline v1::Job WaitForState(v1::CablesimService::Stub* stub, const std::string& 
   context.TryCancel();
   (void)reader->Finish();
   return job;
+}
+
+// GetJobResult of job `id` read to the end: its status and frame rows.
+struct JobResultRead {
+  grpc::Status status;
+  int64_t rows = 0;
+};
+inline JobResultRead ReadJobResult(v1::CablesimService::Stub* stub, const std::string& id) {
+  grpc::ClientContext context;
+  v1::GetJobResultRequest request;
+  request.set_id(id);
+  auto reader = stub->GetJobResult(&context, request);
+  v1::RunEvent event;
+  JobResultRead read;
+  while (reader->Read(&event)) read.rows += event.has_frames() ? event.frames().rows() : 0;
+  read.status = reader->Finish();
+  return read;
 }
 
 inline v1::JobState WaitForJob(v1::CablesimService::Stub* stub, const std::string& id,

@@ -13,6 +13,7 @@ energy components to a PNG.
 """
 
 import argparse
+import collections
 import json
 import sys
 
@@ -38,9 +39,55 @@ class RunResult:
         return self.data[:, self.columns.index(name)]
 
 
-def connect(address):
-    """A stub for the cablesim-server at `address` ("host:port")."""
-    channel = grpc.insecure_channel(address)
+class _CallDetails(collections.namedtuple(
+        "_CallDetails", ("method", "timeout", "metadata", "credentials", "wait_for_ready",
+                         "compression")), grpc.ClientCallDetails):
+    pass
+
+
+class _BearerToken(grpc.UnaryUnaryClientInterceptor, grpc.UnaryStreamClientInterceptor):
+    """Adds `authorization: Bearer TOKEN` to every call (an interceptor, not
+    call credentials, so that it also works on a loopback channel without
+    TLS)."""
+
+    def __init__(self, token):
+        self._entry = ("authorization", "Bearer " + token)
+
+    def _details(self, details):
+        return _CallDetails(details.method, details.timeout,
+                            list(details.metadata or []) + [self._entry], details.credentials,
+                            getattr(details, "wait_for_ready", None),
+                            getattr(details, "compression", None))
+
+    def intercept_unary_unary(self, continuation, details, request):
+        return continuation(self._details(details), request)
+
+    def intercept_unary_stream(self, continuation, details, request):
+        return continuation(self._details(details), request)
+
+
+def read_token(path):
+    """The token in a token file: the first word of its first line that is
+    not a # comment."""
+    with open(path) as f:
+        for line in f:
+            line = line.strip()
+            if line and not line.startswith("#"):
+                return line.split()[0]
+    raise ValueError("%s: no token" % path)
+
+
+def connect(address, tls_ca=None, token=None):
+    """A stub for the cablesim-server at `address` ("host:port"). `tls_ca`:
+    a CA certificate file (PEM): TLS, the server's certificate checked
+    against it. `token`: a bearer token sent with every call."""
+    if tls_ca:
+        with open(tls_ca, "rb") as f:
+            channel = grpc.secure_channel(address, grpc.ssl_channel_credentials(f.read()))
+    else:
+        channel = grpc.insecure_channel(address)
+    if token:
+        channel = grpc.intercept_channel(channel, _BearerToken(token))
     return service_pb2_grpc.CablesimServiceStub(channel)
 
 
@@ -124,8 +171,11 @@ def main(argv):
     parser.add_argument("scene", help="scene file (protobuf JSON)")
     parser.add_argument("--server", default="127.0.0.1:50051")
     parser.add_argument("--png", help="plot the first probe's path and the energies here")
+    parser.add_argument("--tls-ca", help="TLS: the CA certificate (PEM) the server's is checked against")
+    parser.add_argument("--token-file", help="send the token in this file (its first word)")
     args = parser.parse_args(argv)
-    stub = connect(args.server)
+    stub = connect(args.server, tls_ca=args.tls_ca,
+                   token=read_token(args.token_file) if args.token_file else None)
     try:
         result = run(stub, load_scene(args.scene))
     except grpc.RpcError as e:

@@ -93,5 +93,56 @@ class ClientTest(unittest.TestCase):
         self.assertTrue(caught.exception.details().startswith("cables[0].length"))
 
 
+class TlsAndTokenTest(unittest.TestCase):
+    """connect(tls_ca=..., token=...) against a server with TLS (a CA made
+    here with openssl) and --token-file."""
+
+    def test_tls_and_token(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            def sh(command):
+                subprocess.run(command, shell=True, cwd=tmp, check=True,
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            sh("openssl req -x509 -newkey rsa:2048 -nodes -keyout ca.key -out ca.pem -days 1 "
+               "-subj /CN=cablesim-test-ca")
+            sh("openssl req -newkey rsa:2048 -nodes -keyout server.key -out server.csr "
+               "-subj /CN=localhost")
+            with open(os.path.join(tmp, "ext"), "w") as f:
+                f.write("subjectAltName=DNS:localhost,IP:127.0.0.1\n")
+            sh("openssl x509 -req -in server.csr -CA ca.pem -CAkey ca.key -CAcreateserial "
+               "-out server.pem -days 1 -extfile ext")
+            token = "tok-python-0123456789"
+            with open(os.path.join(tmp, "tokens"), "w") as f:
+                f.write(token + " py\n")
+            with open(os.path.join(tmp, "my-token"), "w") as f:
+                f.write("# mine\n" + token + "\n")
+            port_file = os.path.join(tmp, "port")
+            os.mkdir(os.path.join(tmp, "data"))
+            server = subprocess.Popen(
+                [os.path.join(BIN, "cablesim-server"), "--listen=127.0.0.1:0",
+                 "--data-dir=" + os.path.join(tmp, "data"), "--port-file=" + port_file,
+                 "--tls-cert=" + os.path.join(tmp, "server.pem"),
+                 "--tls-key=" + os.path.join(tmp, "server.key"),
+                 "--token-file=" + os.path.join(tmp, "tokens")])
+            try:
+                while not os.path.exists(port_file):
+                    if server.poll() is not None:
+                        raise RuntimeError("cablesim-server exited with %d" % server.returncode)
+                    time.sleep(0.01)
+                with open(port_file) as f:
+                    address = "localhost:" + f.read().strip()
+                ca = os.path.join(tmp, "ca.pem")
+                request = cablesim_client.service_pb2.GetServerInfoRequest()
+                stub = cablesim_client.connect(
+                    address, tls_ca=ca,
+                    token=cablesim_client.read_token(os.path.join(tmp, "my-token")))
+                self.assertTrue(stub.GetServerInfo(request, timeout=30).version)
+                with self.assertRaises(grpc.RpcError) as raised:
+                    cablesim_client.connect(address, tls_ca=ca).GetServerInfo(request, timeout=30)
+                self.assertEqual(raised.exception.code(), grpc.StatusCode.UNAUTHENTICATED)
+            finally:
+                server.terminate()
+                server.wait(timeout=30)
+
+
 if __name__ == "__main__":
     unittest.main()
