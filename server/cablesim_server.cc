@@ -18,6 +18,7 @@ absl::StatusOr<std::unique_ptr<CablesimServer>> CablesimServer::Start(
   if (!options.data_dir.empty()) {
     StoreOptions store_options;
     store_options.lease_ms = options.lease_ms;
+    store_options.notifications = options.store_notifications;
     absl::StatusOr<std::unique_ptr<JobStore>> store =
         JobStore::Open(options.data_dir, store_options);
     if (!store.ok()) return store.status();

@@ -31,6 +31,8 @@ struct ServerOptions {
   std::string data_dir;
   // Shared stores: how long a claim holds without a heartbeat.
   int64_t lease_ms = 10'000;
+  // Shared stores: StoreOptions::notifications.
+  bool store_notifications = true;
   int workers = 1;
   ServerLimits limits;
   // Report jobs, sweeps and shutdown on stderr.

@@ -35,7 +35,8 @@
 
 ABSL_FLAG(std::string, listen, "127.0.0.1:50051", "host:port to listen on (port 0: any free)");
 ABSL_FLAG(std::string, data_dir, "",
-          "directory of the embedded job database (SQLite); the same as --store sqlite:DIR");
+          "directory of the job database (SQLite, created when missing); the same as "
+          "--store sqlite:DIR");
 ABSL_FLAG(std::string, store, "",
           "the job store: sqlite:DIR (one server) or postgresql://USER@HOST:PORT/DB (shared by "
           "any number of servers; libpq URL, PGPASSWORD or ~/.pgpass for a password)");

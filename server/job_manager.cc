@@ -81,6 +81,8 @@ void JobManager::Shutdown() {
   }
   for (std::thread& t : threads_) t.join();
   threads_.clear();
+  // The store may outlive this manager: no more calls into it.
+  if (store_->shared()) store_->SetChangeListener(nullptr);
 }
 
 uint64_t JobManager::version() {

@@ -71,6 +71,9 @@ struct StoreOptions {
   // Shared stores: a claim holds for this long after the last heartbeat;
   // after it, another server takes the job again.
   int64_t lease_ms = 10'000;
+  // Shared stores: listen for other servers' changes (LISTEN/NOTIFY);
+  // false: rely on polling alone (benchmarks measure the difference).
+  bool notifications = true;
 };
 
 class JobStore {
@@ -174,7 +177,8 @@ class JobStore {
 
   // Shared stores: `listener` is called (from another thread) whenever
   // another server changes a job, so that watchers and idle workers need
-  // not wait for their next poll. Call before use; nothing for SQLite.
+  // not wait for their next poll; null stops the calls (once this
+  // returns, none is under way). Nothing for SQLite.
   virtual void SetChangeListener(std::function<void()> listener) {}
 };
 

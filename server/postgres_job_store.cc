@@ -334,8 +334,17 @@ absl::Status PostgresJobStore::Migrate() {
 }
 
 void PostgresJobStore::SetChangeListener(std::function<void()> listener) {
-  listener_ = std::move(listener);
-  if (!listen_thread_.joinable()) listen_thread_ = std::thread([this] { Listen(); });
+  const bool start = listener != nullptr;
+  {
+    absl::MutexLock lock(&listener_mu_);
+    listener_ = std::move(listener);
+  }
+  if (start && options_.notifications && !listen_thread_.joinable()) listen_thread_ = std::thread([this] { Listen(); });
+}
+
+void PostgresJobStore::CallListener() {
+  absl::MutexLock lock(&listener_mu_);
+  if (listener_) listener_();
 }
 
 void PostgresJobStore::Listen() {
@@ -350,7 +359,7 @@ void PostgresJobStore::Listen() {
         absl::SleepFor(absl::Milliseconds(500));
         continue;
       }
-      listener_();  // whatever happened while not listening
+      CallListener();  // whatever happened while not listening
     }
     pollfd fd = {PQsocket(conn), POLLIN, 0};
     if (::poll(&fd, 1, 200) <= 0) continue;
@@ -360,7 +369,7 @@ void PostgresJobStore::Listen() {
       changed |= owner_ != n->extra;  // this server's own changes it knows
       PQfreemem(n);
     }
-    if (changed) listener_();
+    if (changed) CallListener();
   }
   PQfinish(conn);
 }

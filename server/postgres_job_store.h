@@ -107,6 +107,7 @@ class PostgresJobStore final : public JobStore {
   // NOTIFY the other servers (payload: owner_); mu_ held.
   void Notify();
   void Listen();
+  void CallListener();
 
   const std::string url_;
   const StoreOptions options_;
@@ -114,7 +115,10 @@ class PostgresJobStore final : public JobStore {
   std::string describe_;
   absl::Mutex mu_;
   PGconn* conn_ ABSL_GUARDED_BY(mu_);
-  std::function<void()> listener_;
+  // Set and called under listener_mu_, so that clearing it (a manager
+  // shutting down) waits for a call under way.
+  absl::Mutex listener_mu_;
+  std::function<void()> listener_ ABSL_GUARDED_BY(listener_mu_);
   std::atomic<bool> stop_{false};
   std::thread listen_thread_;
 
