@@ -74,6 +74,39 @@ TEST(ServerDataDirTest, ADirectoryThatCannotBeCreatedIsNamed) {
                                           ": Not a directory")));
 }
 
+// The store flag: --store sqlite:DIR is --data-dir DIR; one of the two,
+// and a store of a kind the server knows, or a usage error (exit 2); a
+// database that cannot be reached ends the start (exit 1), named without
+// its password.
+TEST(ServerDataDirTest, TheStoreFlagTakesSqliteOrPostgresql) {
+  const std::string root = FreshDir("store_flag");
+  auto start = [&](const std::string& flags, std::string* log) {
+    const int status = std::system(absl::StrCat("timeout 60 '", CABLESIM_BIN_DIR,
+                                                "/cablesim-server' --listen=127.0.0.1:0 ", flags,
+                                                " 2>'", root, "/log'")
+                                       .c_str());
+    *log = ReadAll(root + "/log");
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  };
+  std::string log;
+  EXPECT_EQ(start("", &log), 2);
+  EXPECT_THAT(log, HasSubstr("give one of --data-dir DIR and --store"));
+  EXPECT_EQ(start(absl::StrCat("--data-dir=", root, "/a --store=sqlite:", root, "/b"), &log), 2);
+  EXPECT_EQ(start("--store=mysql://db/jobs", &log), 2);
+  EXPECT_THAT(log, HasSubstr("expected sqlite:DIR or postgresql://"));
+  EXPECT_EQ(start("--store=postgresql://cablesim:s3cret@127.0.0.1:1/jobs?connect_timeout=5", &log),
+            1);
+  EXPECT_THAT(log, HasSubstr("cannot connect to the PostgreSQL job store"));
+  EXPECT_THAT(log, ::testing::Not(HasSubstr("s3cret")));
+
+  // sqlite:DIR serves, and creates DIR as --data-dir does.
+  const std::string dir = root + "/sqlite-store";
+  ServerProcess server(root, {"--store=sqlite:" + dir});
+  ASSERT_GT(server.port(), 0);
+  EXPECT_TRUE(server.WaitForLog("jobs in sqlite:" + dir));
+  EXPECT_TRUE(std::filesystem::exists(dir + "/cablesim.db"));
+}
+
 // The block of README.md that follows "A CI job against a daemon".
 std::string ReadmeCiRecipe() {
   const std::string readme = ReadAll(absl::StrCat(CABLESIM_SOURCE_DIR, "/README.md"));
