@@ -210,5 +210,59 @@ TEST(ServerSharedStoreTest, ThreeServersShareOneQueueAndSurviveKillNine) {
   EXPECT_EQ(got.sweep().failed(), 0);
 }
 
+// A job running on one server, cancelled through another: the cancel is
+// recorded in the database and reaches the job at its server's next
+// heartbeat; the watcher on the other server sees it CANCELLED.
+TEST(ServerSharedStoreTest, ACancelThroughAnotherServerStopsTheJob) {
+  CABLESIM_POSTGRES_URL_OR_SKIP(url, "cancel");
+  const std::string gate_root = testing::FreshDir("shared_cancel_gate");
+  const testing::JobGate gate(gate_root);  // never opened: the job waits
+  std::vector<std::unique_ptr<ServerProcess>> servers;
+  for (int i = 0; i < 2; ++i) {
+    servers.push_back(std::make_unique<ServerProcess>(
+        testing::FreshDir(absl::StrCat("shared_cancel_", i)),
+        std::vector<std::string>{"--store=" + url, "--workers=1", "--lease-s=2"},
+        std::vector<std::string>{gate.env()}));
+    ASSERT_GT(servers.back()->port(), 0);
+  }
+  v1::SubmitJobRequest request;
+  *request.mutable_scene() = Pendulum(5, 1e-4, 0.01);
+  request.mutable_scene()->set_name("gated-cancel");
+  v1::Job job;
+  {
+    grpc::ClientContext context;
+    ASSERT_TRUE(servers[0]->Stub()->SubmitJob(&context, request, &job).ok());
+  }
+  // Which server runs it: the one whose log says it waits at the gate.
+  const std::string waits = absl::StrCat("job ", job.id(), " waits at the gate");
+  int runner = -1;
+  for (int tries = 0; tries < 2000 && runner < 0; ++tries) {
+    for (int i = 0; i < 2; ++i) {
+      if (ReadLog(*servers[i]).find(waits) != std::string::npos) runner = i;
+    }
+    absl::SleepFor(absl::Milliseconds(10));
+  }
+  ASSERT_GE(runner, 0) << "no server took the job";
+  const int other = 1 - runner;
+  auto stub = servers[other]->Stub();
+  const absl::Time asked = absl::Now();
+  {
+    grpc::ClientContext context;
+    v1::CancelJobRequest cancel;
+    cancel.set_id(job.id());
+    v1::Job answer;
+    ASSERT_TRUE(stub->CancelJob(&context, cancel, &answer).ok());
+  }
+  v1::Job last;
+  EXPECT_EQ(testing::WaitForJob(stub.get(), job.id(), &last), v1::CANCELLED);
+  const double seconds = absl::ToDoubleSeconds(absl::Now() - asked);
+  std::cout << "job running on server " << runner << ", cancelled through server " << other
+            << ": CANCELLED after " << seconds << " s" << std::endl;
+  // The heartbeat comes every min(lease / 4, 1 s) = 0.5 s; 10 s is far
+  // from both it and the job's own 5 s of simulated time.
+  EXPECT_LT(seconds, 10.0);
+  EXPECT_EQ(last.attempts(), 1);
+}
+
 }  // namespace
 }  // namespace cablesim
