@@ -3,7 +3,8 @@
 //
 // A 60-item sweep submitted to one server is run by all three (each
 // server's share is printed); any server answers for any job. Then the
-// same sweep again, and one server is killed with SIGKILL mid-sweep: once
+// same sweep again, and one server is killed with SIGKILL mid-sweep while
+// it holds an item (the test-only job gate decides the moment): once
 // its lease expires, the others take its item again, every item finishes
 // exactly once (one "SUCCEEDED" line in all the servers' logs together),
 // and every item's summary, last frame and energy report are identical to
@@ -17,6 +18,7 @@
 #include <iostream>
 #include <iterator>
 #include <map>
+#include <set>
 #include <memory>
 #include <string>
 #include <vector>
@@ -38,8 +40,10 @@ constexpr int kServers = 3;
 v1::SubmitSweepRequest SixtyItems() {
   v1::SubmitSweepRequest request;
   request.set_name("shared-store");
-  // ~0.2 s of computing per item.
+  // ~0.2 s of computing per item; "gated": each item waits after its
+  // first frame until the test opens its gate (RunGated).
   *request.mutable_base() = Pendulum(0.2, 1e-4, 0.01);
+  request.mutable_base()->set_name("gated-shared-store");
   v1::SweepAxis* axis = request.add_axes();
   axis->set_path("gravity.y");
   for (int i = 0; i < kItems; ++i) axis->add_values(-9.0 - 0.01 * i);
@@ -127,13 +131,50 @@ std::vector<int> Shares(const std::vector<std::unique_ptr<ServerProcess>>& serve
   return shares;
 }
 
+// Runs sweep `sweep` to its end, opening the gate of every item as soon as
+// a server waits at it. With `victim` >= 0: the first item server
+// `victim` waits on once a third of the items have finished stays closed,
+// server `victim` is killed with SIGKILL while it holds that item (its
+// one worker blocked there, so it can have finished nothing else
+// unlogged), then the gate opens for the server that takes the item
+// again; returns that item's id.
+std::string RunGated(const std::vector<std::unique_ptr<ServerProcess>>& servers,
+                     const testing::JobGate& gate, v1::CablesimService::Stub* stub,
+                     const std::string& sweep, int victim) {
+  std::set<std::string> opened;
+  std::string caught;
+  const std::string prefix = "TEST ONLY: job ", suffix = " waits at the gate";
+  const absl::Time give_up = absl::Now() + absl::Seconds(180);
+  while (absl::Now() < give_up) {
+    for (int i = 0; i < static_cast<int>(servers.size()); ++i) {
+      const std::string log = ReadLog(*servers[i]);
+      for (size_t at = log.find(prefix); at != std::string::npos; at = log.find(prefix, at + 1)) {
+        const size_t start = at + prefix.size(), end = log.find(suffix, start);
+        if (end == std::string::npos) break;
+        const std::string id = log.substr(start, end - start);
+        if (!opened.insert(id).second) continue;
+        if (caught.empty() && i == victim && FinishedCount(stub, sweep) >= kItems / 3) {
+          caught = id;
+          servers[i]->Kill(SIGKILL);
+        }
+        gate.Open(id);
+      }
+    }
+    if (FinishedCount(stub, sweep) == kItems) break;
+    absl::SleepFor(absl::Milliseconds(10));
+  }
+  return caught;
+}
+
 TEST(ServerSharedStoreTest, ThreeServersShareOneQueueAndSurviveKillNine) {
   CABLESIM_POSTGRES_URL_OR_SKIP(url, "shared");
+  const testing::JobGate gate(testing::FreshDir("shared_gate"));
   std::vector<std::unique_ptr<ServerProcess>> servers;
   for (int i = 0; i < kServers; ++i) {
     servers.push_back(std::make_unique<ServerProcess>(
         testing::FreshDir(absl::StrCat("shared_", i)),
-        std::vector<std::string>{"--store=" + url, "--workers=1", "--lease-s=2"}));
+        std::vector<std::string>{"--store=" + url, "--workers=1", "--lease-s=2"},
+        std::vector<std::string>{gate.env()}));
     ASSERT_GT(servers.back()->port(), 0);
   }
   std::vector<std::unique_ptr<v1::CablesimService::Stub>> stubs;
@@ -145,6 +186,7 @@ TEST(ServerSharedStoreTest, ThreeServersShareOneQueueAndSurviveKillNine) {
     grpc::ClientContext context;
     ASSERT_TRUE(stubs[0]->SubmitSweep(&context, SixtyItems(), &first).ok());
   }
+  EXPECT_TRUE(RunGated(servers, gate, stubs[1].get(), first.id(), -1).empty());
   // Answered by server 2, which did not take the submission.
   const std::vector<v1::Job> first_jobs = WaitForSweep(stubs[2].get(), first.id());
   ASSERT_EQ(first_jobs.size(), static_cast<size_t>(kItems));
@@ -174,11 +216,8 @@ TEST(ServerSharedStoreTest, ThreeServersShareOneQueueAndSurviveKillNine) {
     grpc::ClientContext context;
     ASSERT_TRUE(stubs[2]->SubmitSweep(&context, SixtyItems(), &second).ok());
   }
-  while (FinishedCount(stubs[0].get(), second.id()) < kItems / 3) {
-    absl::SleepFor(absl::Milliseconds(20));
-  }
-  const std::string killed_log_before = ReadLog(*servers[1]);
-  servers[1]->Kill(SIGKILL);
+  const std::string victim = RunGated(servers, gate, stubs[0].get(), second.id(), 1);
+  ASSERT_FALSE(victim.empty()) << "server 1 was never caught holding an item";
   const std::vector<v1::Job> second_jobs = WaitForSweep(stubs[0].get(), second.id());
   ASSERT_EQ(second_jobs.size(), static_cast<size_t>(kItems));
   std::map<std::string, int> second_runs;
@@ -188,14 +227,15 @@ TEST(ServerSharedStoreTest, ThreeServersShareOneQueueAndSurviveKillNine) {
     EXPECT_EQ(job.state(), v1::SUCCEEDED);
     EXPECT_EQ(second_runs[job.id()], 1) << job.id() << " finished other than once";
     retaken += job.attempts() > 1;
+    // The item server 1 held when it died ran again, as attempt 2.
+    if (job.id() == victim) EXPECT_EQ(job.attempts(), 2);
   }
-  std::cout << "60-item sweep with server 1 killed (SIGKILL) after " << kItems / 3
+  std::cout << "60-item sweep with server 1 killed (SIGKILL) holding an item after at least "
+            << kItems / 3
             << " items, items per server:";
   for (int i = 0; i < kServers; ++i) std::cout << " server " << i << ": " << second_shares[i];
   std::cout << "; items taken again after the lease expired: " << retaken << std::endl;
-  // Server 1 was running an item when it died (one worker, a queue never
-  // empty): that item ran again, as attempt 2.
-  EXPECT_GE(retaken, 1);
+  EXPECT_EQ(retaken, 1);
   EXPECT_GT(second_shares[0], 0);
   EXPECT_GT(second_shares[2], 0);
 
