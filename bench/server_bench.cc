@@ -31,6 +31,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench/sweep_bench_util.h"
 #include "client/service_client.h"
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
@@ -54,14 +55,6 @@ v1::Scene Pendulum(double output_interval_s) {
   scene.mutable_solver()->set_step(1e-4);
   scene.mutable_solver()->set_output_interval(output_interval_s);
   return scene;
-}
-
-ServerLimits NoLimits() {
-  ServerLimits limits;
-  limits.max_frames = std::numeric_limits<int64_t>::max();
-  limits.max_trajectory_values = std::numeric_limits<int64_t>::max();
-  limits.max_steps = std::numeric_limits<int64_t>::max() / 4;
-  return limits;
 }
 
 void BM_StreamInProcessEngine(benchmark::State& state) {
@@ -129,26 +122,12 @@ void BM_Sweep(benchmark::State& state) {
     auto server = *CablesimServer::Start(options);
     auto stub = v1::CablesimService::NewStub(server->InProcessChannel());
     state.ResumeTiming();
-    v1::Sweep sweep;
-    {
-      grpc::ClientContext context;
-      if (!stub->SubmitSweep(&context, request, &sweep).ok()) {
-        state.SkipWithError("SubmitSweep failed");
-        break;
-      }
-    }
-    grpc::ClientContext context;
-    v1::WatchSweepRequest watch;
-    watch.set_id(sweep.id());
-    auto reader = stub->WatchSweep(&context, watch);
-    v1::SweepEvent event;
-    while (reader->Read(&event)) {
-    }
-    if (!reader->Finish().ok() || event.progress().failed() != 0) {
-      state.SkipWithError("sweep failed");
+    absl::StatusOr<int> finished = RunSweepToTheEnd(stub.get(), request);
+    if (!finished.ok()) {
+      state.SkipWithError(std::string(finished.status().message()).c_str());
       break;
     }
-    items += event.progress().finished();
+    items += *finished;
     state.PauseTiming();
     stub.reset();
     server->Shutdown(absl::ZeroDuration());

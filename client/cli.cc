@@ -256,6 +256,11 @@ SCENE is a cablesim.v1.Scene (proto/cablesim/v1/scene.proto) in protobuf
 JSON, or in text format when its name ends in .txtpb, .textproto or .pbtxt.
 SWEEP.json is a cablesim.v1.SweepFile (proto/cablesim/v1/service.proto).
 
+--server takes any gRPC target: HOST:PORT, several servers sharing one job
+store (ipv4:127.0.0.1:50051,127.0.0.1:50052) or a DNS name with several
+addresses (dns:///cablesim.example:50051); calls are spread over them
+(gRPC's round_robin policy) and go on when one of them stops.
+
 With --server, every command also takes --tls-ca CA.pem (TLS, the server's
 certificate checked against that CA) and --token-file FILE (the first word
 of its first line that is not a # comment is sent as a bearer token).

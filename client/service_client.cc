@@ -75,6 +75,9 @@ absl::StatusOr<std::unique_ptr<Connection>> Connect(const std::optional<std::str
   if (server.has_value()) {
     grpc::ChannelArguments args;
     args.SetMaxReceiveMessageSize(64 << 20);
+    // A target may name several servers (ipv4:A:P,B:Q, or a DNS name with
+    // several addresses): spread the calls over all that answer.
+    args.SetLoadBalancingPolicyName("round_robin");
     const RemoteSecurity& security = Security();
     std::shared_ptr<grpc::ChannelCredentials> credentials = grpc::InsecureChannelCredentials();
     if (!security.tls_ca_pem.empty()) {

@@ -10,6 +10,7 @@ packages=(
   libgrpc++-dev protobuf-compiler-grpc
   libgtest-dev libgmock-dev libbenchmark-dev
   libsqlite3-dev zlib1g-dev
+  libpq-dev postgresql
   python3 python3-grpcio python3-protobuf python3-numpy python3-matplotlib
   clang libclang-rt-14-dev
 )

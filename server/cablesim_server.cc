@@ -16,12 +16,17 @@ absl::StatusOr<std::unique_ptr<CablesimServer>> CablesimServer::Start(
   std::unique_ptr<CablesimServer> s(new CablesimServer());
   s->limits_ = options.limits;
   if (!options.data_dir.empty()) {
-    absl::StatusOr<std::unique_ptr<JobStore>> store = JobStore::Open(options.data_dir);
+    StoreOptions store_options;
+    store_options.lease_ms = options.lease_ms;
+    store_options.notifications = options.store_notifications;
+    absl::StatusOr<std::unique_ptr<JobStore>> store =
+        JobStore::Open(options.data_dir, store_options);
     if (!store.ok()) return store.status();
     s->store_ = std::move(*store);
     s->jobs_ =
         std::make_unique<JobManager>(s->store_.get(), options.workers, options.limits, options.log);
     s->jobs_->set_test_only_gate_dir(options.test_only_job_gate_dir);
+    s->jobs_->set_lease(absl::Milliseconds(options.lease_ms));
   }
   s->service_ = std::make_unique<CablesimServiceImpl>(s->jobs_.get(), options.limits, options.log,
                                                       options.tokens);

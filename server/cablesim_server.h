@@ -26,8 +26,13 @@ struct ServerOptions {
   // host:port to listen on (port 0: any free port, see port()); empty: no
   // network port, in-process channels only.
   std::string listen;
-  // Directory of the job store; empty: no jobs (Run and Validate only).
+  // The job store: `sqlite:DIR`, a bare DIR, or `postgresql://...`
+  // (JobStore::Open); empty: no jobs (Run and Validate only).
   std::string data_dir;
+  // Shared stores: how long a claim holds without a heartbeat.
+  int64_t lease_ms = 10'000;
+  // Shared stores: StoreOptions::notifications.
+  bool store_notifications = true;
   int workers = 1;
   ServerLimits limits;
   // Report jobs, sweeps and shutdown on stderr.
@@ -51,6 +56,8 @@ class CablesimServer {
   // The port bound (0 when not listening).
   int port() const { return port_; }
   std::shared_ptr<grpc::Channel> InProcessChannel();
+  // The job store, for logs (JobStore::Describe; never a password).
+  std::string store_description() const { return store_ ? store_->Describe() : "none"; }
 
   // Stops the workers (running jobs go back to QUEUED), then the server:
   // calls still running after `grace` are cancelled. Idempotent.

@@ -1,8 +1,10 @@
 // cablesim-server: the cablesim gRPC service (proto/cablesim/v1/service.proto).
 //
 //   cablesim-server --listen 127.0.0.1:50051 --data-dir DIR [--workers N]
+//   cablesim-server --listen ... --store postgresql://USER@HOST:PORT/DB
 //
-// Jobs and results live in SQLite under DIR. SIGTERM or SIGINT shuts down
+// Jobs and results live in SQLite under DIR (created when missing), or in
+// a PostgreSQL database that several servers share. SIGTERM or SIGINT shuts down
 // gracefully: running jobs stop at their next step and stay queued for the
 // next start. Logs go to stderr. With --port-file, the port actually bound
 // (useful with port 0) is written to that file once the server serves.
@@ -32,7 +34,14 @@
 #include "server/cablesim_server.h"
 
 ABSL_FLAG(std::string, listen, "127.0.0.1:50051", "host:port to listen on (port 0: any free)");
-ABSL_FLAG(std::string, data_dir, "", "directory of the job database (required)");
+ABSL_FLAG(std::string, data_dir, "",
+          "directory of the job database (SQLite, created when missing); the same as "
+          "--store sqlite:DIR");
+ABSL_FLAG(std::string, store, "",
+          "the job store: sqlite:DIR (one server) or postgresql://USER@HOST:PORT/DB (shared by "
+          "any number of servers; libpq URL, PGPASSWORD or ~/.pgpass for a password)");
+ABSL_FLAG(double, lease_s, 10,
+          "shared store: a job whose server sent no heartbeat for this long is taken again");
 ABSL_FLAG(int, workers, 0, "job worker threads (0: the number of cores)");
 ABSL_FLAG(std::string, port_file, "", "write the bound port to this file once serving");
 ABSL_FLAG(std::string, tls_cert, "", "TLS: the server's certificate chain (PEM file)");
@@ -74,14 +83,16 @@ namespace {
 
 constexpr char kUsage[] =
     "Usage: cablesim-server --listen HOST:PORT --data-dir DIR [--workers N] [--LIMIT N ...]\n"
+    "       cablesim-server --listen HOST:PORT --store sqlite:DIR|postgresql://... [...]\n"
     "\n"
     "The cablesim gRPC service (proto/cablesim/v1/service.proto): runs, durable jobs\n"
-    "and sweeps, with the jobs in SQLite under DIR. Flags may be written --data-dir\n"
-    "or --data_dir, --flag=value or --flag value.\n"
+    "and sweeps, with the jobs in SQLite under DIR (created when missing), or in a\n"
+    "PostgreSQL database shared by any number of servers. Flags may be written\n"
+    "--data-dir or --data_dir, --flag=value or --flag value.\n"
     "\n"
     "Exit status: 0 after SIGTERM or SIGINT (running jobs stay queued) and for\n"
     "--help and --version, 1 when the server cannot start (address in use, data\n"
-    "directory unusable), 2 for a usage error.\n";
+    "directory or database unusable), 2 for a usage error.\n";
 
 // The flags of this file, sorted, as --help lists them.
 void PrintHelp(std::ostream& out) {
@@ -152,7 +163,23 @@ int main(int argc, char** argv) {
   cablesim::ServerOptions options;
   options.listen = absl::GetFlag(FLAGS_listen);
   options.data_dir = absl::GetFlag(FLAGS_data_dir);
-  if (options.data_dir.empty()) return UsageError("--data-dir is required");
+  const std::string store = absl::GetFlag(FLAGS_store);
+  if (options.data_dir.empty() == store.empty()) {
+    return UsageError("give one of --data-dir DIR and --store sqlite:DIR|postgresql://...");
+  }
+  if (!store.empty()) {
+    if (!absl::StartsWith(store, "sqlite:") && !absl::StartsWith(store, "postgresql://") &&
+        !absl::StartsWith(store, "postgres://")) {
+      return UsageError(absl::StrCat("--store ", store,
+                                     ": expected sqlite:DIR or postgresql://USER@HOST:PORT/DB"));
+    }
+    options.data_dir = store;
+  }
+  if (const double lease = absl::GetFlag(FLAGS_lease_s); lease >= 0.2) {
+    options.lease_ms = static_cast<int64_t>(lease * 1000);
+  } else {
+    return UsageError("--lease-s: must be >= 0.2");
+  }
   options.workers = absl::GetFlag(FLAGS_workers);
   if (options.workers <= 0) options.workers = std::max(1u, std::thread::hardware_concurrency());
   cablesim::ServerLimits& limits = options.limits;
@@ -260,7 +287,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   std::cerr << "cablesim-server: listening on port " << (*server)->port() << " (" << options.listen
-            << "), data in " << options.data_dir << ", " << options.workers << " workers\n";
+            << "), jobs in " << (*server)->store_description() << ", " << options.workers << " workers\n";
   const std::string port_file = absl::GetFlag(FLAGS_port_file);
   if (!port_file.empty()) {
     const std::string tmp = port_file + ".tmp";

@@ -1,5 +1,6 @@
 #include "server/job_manager.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 #include <limits>
@@ -62,17 +63,11 @@ absl::Status JobManager::Start() {
     std::cerr << "cablesim-server: " << queued->size() << " queued jobs (" << *requeued
               << " interrupted and requeued)\n";
   }
-  {
-    // A job submitted between the server's start of listening and this
-    // call is in queue_ already: queue each id once.
-    absl::MutexLock lock(&mu_);
-    const std::set<std::string> present(queue_.begin(), queue_.end());
-    for (const std::string& id : *queued) {
-      if (!present.count(id)) queue_.push_back(id);
-    }
-  }
+  // Another server's change: watchers look again, idle workers claim.
+  if (store_->shared()) store_->SetChangeListener([this] { WorkArrived(); });
   ApplyRetention();
   for (int i = 0; i < workers_; ++i) threads_.emplace_back([this] { Work(); });
+  if (store_->shared()) threads_.emplace_back([this] { Heartbeats(); });
   return absl::OkStatus();
 }
 
@@ -86,6 +81,8 @@ void JobManager::Shutdown() {
   }
   for (std::thread& t : threads_) t.join();
   threads_.clear();
+  // The store may outlive this manager: no more calls into it.
+  if (store_->shared()) store_->SetChangeListener(nullptr);
 }
 
 uint64_t JobManager::version() {
@@ -109,9 +106,9 @@ void JobManager::Changed() {
   ++version_;
 }
 
-void JobManager::Enqueue(const std::string& id) {
+void JobManager::WorkArrived() {
   absl::MutexLock lock(&mu_);
-  queue_.push_back(id);
+  ++work_;
   ++version_;
 }
 
@@ -123,7 +120,7 @@ absl::StatusOr<v1::Job> JobManager::Submit(const v1::Scene& scene, const std::st
       store_->InsertJob(scene, checked->end_time_s, peer, limits_.max_queued_jobs_per_peer,
                         tenant);
   if (!job.ok()) return job.status();
-  Enqueue(job->id());
+  WorkArrived();
   return job;
 }
 
@@ -136,23 +133,32 @@ absl::StatusOr<v1::Sweep> JobManager::SubmitSweep(const v1::SubmitSweepRequest& 
   absl::StatusOr<v1::Sweep> sweep = store_->InsertSweep(
       request, *items, end_times, peer, limits_.max_queued_jobs_per_peer, tenant);
   if (!sweep.ok()) return sweep.status();
-  absl::MutexLock lock(&mu_);
-  for (const std::string& id : sweep->job_ids()) queue_.push_back(id);
-  ++version_;
+  WorkArrived();
   return sweep;
 }
 
 absl::StatusOr<v1::Job> JobManager::Cancel(const std::string& id) {
-  // The store first, then the running jobs: a worker registers a job in
-  // running_ before it claims it (QUEUED -> RUNNING), so a job that is no
-  // longer QUEUED here is either finished or already in running_. (Asked in
-  // the other order, a worker could claim the job between the two looks and
-  // the cancel would be acknowledged but never carried out.)
-  absl::StatusOr<bool> cancelled = store_->CancelQueued(id);
-  if (!cancelled.ok()) return cancelled.status();
+  // The store first, then the running jobs, under claim_mu_: a worker
+  // claims a job (QUEUED -> RUNNING) and enters it in running_ under the
+  // same lock, so a job that is no longer QUEUED here is either finished,
+  // running here, or (shared stores) running on another server. (Without
+  // the lock a worker could claim the job between the two looks and the
+  // cancel would be acknowledged but never carried out.)
+  bool here = false;
+  absl::StatusOr<bool> cancelled;
   {
+    absl::MutexLock claim_lock(&claim_mu_);
+    cancelled = store_->CancelQueued(id);
+    if (!cancelled.ok()) return cancelled.status();
     absl::MutexLock lock(&mu_);
-    if (auto it = running_.find(id); it != running_.end()) it->second->stop = 1;
+    if (auto it = running_.find(id); it != running_.end()) {
+      it->second->stop = 1;
+      here = true;
+    }
+  }
+  // Elsewhere: its server learns it at its next heartbeat.
+  if (!*cancelled && !here) {
+    if (absl::Status s = store_->RequestCancel(id); !s.ok()) return s;
   }
   Changed();
   return Get(id);
@@ -209,42 +215,86 @@ void JobManager::AddProgress(v1::Job* job) {
 }
 
 void JobManager::Work() {
+  // Without notifications from other servers (or when one is missed), a
+  // shared store is polled; an embedded one changes only through this
+  // process, which wakes the workers itself.
+  const absl::Duration poll = store_->shared() ? absl::Milliseconds(500) : absl::Seconds(5);
   while (true) {
-    std::string id;
+    uint64_t seen;
     {
       absl::MutexLock lock(&mu_);
-      auto ready = [&]()
-                       ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) { return stopping_ || !queue_.empty(); };
-      mu_.Await(absl::Condition(&ready));
       if (stopping_) return;
-      id = queue_.front();
-      queue_.pop_front();
+      seen = work_;
     }
-    RunOne(id);
+    std::optional<Claim> claim;
+    auto running = std::make_shared<Running>();
+    {
+      absl::MutexLock claim_lock(&claim_mu_);
+      absl::StatusOr<std::optional<Claim>> next = store_->ClaimNext();
+      if (!next.ok()) {
+        if (log_) std::cerr << "cablesim-server: claiming a job: " << next.status() << "\n";
+      } else if (next->has_value()) {
+        claim = **next;
+        running->attempt = claim->attempt;
+        absl::MutexLock lock(&mu_);
+        // Still here from a claim this server lost (its lease expired
+        // while the database was out of reach): that run stores nothing.
+        if (auto it = running_.find(claim->id); it != running_.end()) it->second->stop = 3;
+        running_[claim->id] = running;
+        if (stopping_) running->stop = 2;
+        ++version_;
+      }
+    }
+    if (!claim.has_value()) {
+      absl::MutexLock lock(&mu_);
+      auto woken = [&]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) { return stopping_ || work_ != seen; };
+      mu_.AwaitWithTimeout(absl::Condition(&woken), poll);
+      continue;
+    }
+    RunOne(*claim, std::move(running));
   }
 }
 
-void JobManager::RunOne(const std::string& id) {
-  auto running = std::make_shared<Running>();
-  {
+void JobManager::Heartbeats() {
+  const absl::Duration every = std::min(lease_ / 4, absl::Seconds(1));
+  bool failing = false;
+  while (true) {
+    std::vector<RunningJob> jobs;
+    {
+      absl::MutexLock lock(&mu_);
+      auto stop = [&]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) { return stopping_; };
+      if (mu_.AwaitWithTimeout(absl::Condition(&stop), every)) return;
+      for (const auto& [id, r] : running_) jobs.push_back({id, r->attempt, r->t.load()});
+    }
+    absl::StatusOr<HeartbeatReply> reply = store_->Heartbeat(jobs);
+    if (!reply.ok()) {
+      if (log_ && !failing) std::cerr << "cablesim-server: heartbeat: " << reply.status() << "\n";
+      failing = true;
+      continue;
+    }
+    failing = false;
     absl::MutexLock lock(&mu_);
-    if (stopping_) return;
-    // Another worker has this job (an id queued twice): leave its entry,
-    // which cancel and shutdown need, alone.
-    if (!running_.emplace(id, running).second) return;
+    for (const auto& [ids, stop] : {std::pair{&reply->cancel, 1}, std::pair{&reply->lost, 3}}) {
+      for (const std::string& id : *ids) {
+        if (auto it = running_.find(id); it != running_.end()) {
+          int none = 0;
+          it->second->stop.compare_exchange_strong(none, stop);
+        }
+      }
+    }
   }
+}
+
+void JobManager::RunOne(const Claim& claim, std::shared_ptr<Running> running) {
+  const std::string& id = claim.id;
   auto forget = [&] {
     absl::MutexLock lock(&mu_);
-    running_.erase(id);
+    // Only this run's entry (a later claim of the same job has its own).
+    if (auto it = running_.find(id); it != running_.end() && it->second == running) {
+      running_.erase(it);
+    }
     ++version_;
   };
-  absl::StatusOr<bool> claimed = store_->MarkRunning(id);
-  if (!claimed.ok() || !*claimed) {  // cancelled meanwhile, or already run
-    if (!claimed.ok() && log_)
-      std::cerr << "cablesim-server: " << id << ": " << claimed.status() << "\n";
-    forget();
-    return;
-  }
   Changed();
   StoredResult result;
   RunSummary summary;
@@ -282,20 +332,30 @@ void JobManager::RunOne(const std::string& id) {
     summary.error = std::string(scene.status().message());
   }
   if (running->stop.load() == 2) {
-    // Shutdown: leave the job for the next start.
-    if (absl::Status s = store_->Requeue(id); !s.ok()) {
+    // Shutdown: leave the job for the next start (or another server).
+    if (absl::Status s = store_->Requeue(id, claim.attempt); !s.ok()) {
       if (log_) std::cerr << "cablesim-server: " << id << ": " << s << "\n";
     }
     forget();
     return;
   }
   const v1::JobState state = StateOf(summary);
-  absl::StatusOr<bool> finished = store_->Finish(id, state, SummaryToProto(summary), result);
-  if (!finished.ok() && log_)
-    std::cerr << "cablesim-server: " << id << ": " << finished.status() << "\n";
-  if (log_)
+  absl::StatusOr<bool> finished =
+      running->stop.load() == 3
+          ? absl::StatusOr<bool>(false)
+          : store_->Finish(id, state, SummaryToProto(summary), result, claim.attempt);
+  if (!finished.ok()) {
+    if (log_) std::cerr << "cablesim-server: " << id << ": " << finished.status() << "\n";
+  } else if (!*finished) {
+    if (log_) {
+      std::cerr << "cablesim-server: job " << id << " attempt " << claim.attempt
+                << ": result discarded, the claim no longer holds (its lease expired and "
+                   "another claim took the job)\n";
+    }
+  } else if (log_) {
     std::cerr << "cablesim-server: job " << id << " " << v1::JobState_Name(state) << " ("
               << summary.frames << " frames, " << summary.wall_seconds << " s)\n";
+  }
   forget();
   ApplyRetention();
 }

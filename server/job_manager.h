@@ -2,14 +2,22 @@
 #define CABLESIM_SERVER_JOB_MANAGER_H_
 
 // Runs the durable jobs of a JobStore on a pool of worker threads, oldest
-// first. Cancelling a running job stops it at its next step (through the
+// first: each worker claims the next job from the store (JobStore::
+// ClaimNext), so with a shared store the servers together drain one queue.
+// Cancelling a running job stops it at its next step (through the
 // engine's RunControl); shutting down stops running jobs the same way but
 // puts them back to QUEUED, so they run again after a restart. Watchers
 // wait for changes (a job's state, or its progress at most every 200 ms).
+//
+// With a shared store a heartbeat thread renews the leases of the running
+// jobs a few times per lease and stores their progress; it also carries
+// cancellations made on other servers to the job, and stops a job whose
+// claim was lost (its result would be refused). Idle workers wake on the
+// store's notifications and poll besides (twice a second), which also
+// retakes jobs whose server died once their lease has expired.
 
 #include <atomic>
 #include <cstdint>
-#include <deque>
 #include <map>
 #include <memory>
 #include <string>
@@ -72,15 +80,22 @@ class JobManager {
   // have finished. Empty (the default): no job ever waits. Call before
   // Start().
   void set_test_only_gate_dir(std::string dir) { gate_dir_ = std::move(dir); }
+  // Shared stores: the lease the store gives a claim (StoreOptions); the
+  // heartbeat runs every lease / 4, at most every second. Call before
+  // Start().
+  void set_lease(absl::Duration lease) { lease_ = lease; }
 
  private:
   struct Running {
-    std::atomic<int> stop{0};  // 1 cancel, 2 shutdown
+    std::atomic<int> stop{0};  // 1 cancel, 2 shutdown, 3 claim lost
     std::atomic<double> t{0};
+    int attempt = 0;
   };
-  void Enqueue(const std::string& id);
+  // New work may be waiting: wake an idle worker.
+  void WorkArrived();
   void Work();
-  void RunOne(const std::string& id);
+  void RunOne(const Claim& claim, std::shared_ptr<Running> running);
+  void Heartbeats();
   void WaitAtTestGate(const std::string& id, const Running& running);
   void Changed();
 
@@ -89,10 +104,15 @@ class JobManager {
   const ServerLimits limits_;
   const bool log_;
   std::string gate_dir_;
+  absl::Duration lease_ = absl::Seconds(10);
+  // Held while a job is claimed and entered in running_, and while a
+  // cancel looks at the store and then at running_: a cancel sees every
+  // job either still QUEUED or already running here.
+  absl::Mutex claim_mu_ ABSL_ACQUIRED_BEFORE(mu_);
   absl::Mutex mu_;
-  std::deque<std::string> queue_ ABSL_GUARDED_BY(mu_);
   std::map<std::string, std::shared_ptr<Running>> running_ ABSL_GUARDED_BY(mu_);
   uint64_t version_ ABSL_GUARDED_BY(mu_) = 0;
+  uint64_t work_ ABSL_GUARDED_BY(mu_) = 0;
   bool stopping_ ABSL_GUARDED_BY(mu_) = false;
   std::vector<std::thread> threads_;
 };

@@ -1,25 +1,15 @@
 #ifndef CABLESIM_SERVER_JOB_STORE_H_
 #define CABLESIM_SERVER_JOB_STORE_H_
 
-// Durable jobs, sweeps and results in one SQLite database
-// (DIR/cablesim.db, write-ahead log, synchronous=FULL): a job is stored
-// before its id is returned, and a job's result and its final state are
-// written in one transaction, so after `kill -9` and a restart every
-// accepted job is either finished with its result or runs again, never
-// both. Thread-safe (one connection behind a mutex).
-//
-// One server per directory: Open takes an exclusive flock on the database
-// file itself (the kernel drops it when the process dies, even by kill -9;
-// no file can be removed to get around it), so two servers can never run
-// the same job.
-//
-// Integrity: the directory is made 0700 and the database files 0600.
-// Open runs `PRAGMA quick_check` and refuses a damaged database
-// (DATA_LOSS); DIR/store-id names the database the directory belongs to,
-// so a database that was emptied, truncated or replaced is refused
-// (FAILED_PRECONDITION) instead of starting afresh and reusing job ids.
-// Each result is stored with a CRC-32 of its bytes, verified on every
-// read: a mismatch is DATA_LOSS, never altered numbers.
+// Durable jobs, sweeps and results: the interface of the job stores
+// (SqliteJobStore, one server's embedded database, the default;
+// PostgresJobStore, one database shared by any number of servers). Both
+// keep the same promises: a job is stored before its id is returned; a
+// job's result and its final state are written in one transaction, by the
+// one claim that holds the job, so every accepted job reaches one stored
+// result, exactly once, whatever process dies when; each result is stored
+// with a CRC-32 of its bytes, verified on every read (a mismatch is
+// DATA_LOSS, never altered numbers). Thread-safe.
 //
 // Ids: job `j-` and sweep `s-` followed by 128 random bits (22 URL-safe
 // base64 characters), so that they cannot be guessed; rows stored before
@@ -28,15 +18,15 @@
 
 #include <cstdint>
 #include <limits>
+#include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
 #include "absl/synchronization/mutex.h"
 #include "cablesim/v1/service.pb.h"
-
-struct sqlite3;
 
 namespace cablesim {
 
@@ -53,93 +43,143 @@ struct RetentionReport {
   int64_t bytes = 0;   // bytes of stored results freed
 };
 
+// A job taken by a worker: its id and the attempt this claim is (Finish
+// and Requeue with the attempt act only while the claim still holds).
+struct Claim {
+  std::string id;
+  int attempt = 0;
+};
+
+// A running job as its worker reports it (JobStore::Heartbeat).
+struct RunningJob {
+  std::string id;
+  int attempt = 0;
+  double progress_time_s = 0;
+};
+
+// What a heartbeat learnt about the jobs it renewed.
+struct HeartbeatReply {
+  // Jobs whose cancellation another server recorded (RequestCancel).
+  std::vector<std::string> cancel;
+  // Jobs whose claim no longer holds (the lease expired and another claim
+  // took the job): their worker stops and stores nothing.
+  std::vector<std::string> lost;
+};
+
+// How a store is opened.
+struct StoreOptions {
+  // Shared stores: a claim holds for this long after the last heartbeat;
+  // after it, another server takes the job again.
+  int64_t lease_ms = 10'000;
+  // Shared stores: listen for other servers' changes (LISTEN/NOTIFY);
+  // false: rely on polling alone (benchmarks measure the difference).
+  bool notifications = true;
+};
+
 class JobStore {
  public:
-  // Opens (creating if needed) DIR/cablesim.db; DIR must exist.
-  static absl::StatusOr<std::unique_ptr<JobStore>> Open(const std::string& dir);
-  ~JobStore();
+  // `spec`: `sqlite:DIR` or a bare DIR (SqliteJobStore), or a libpq URL
+  // `postgresql://[user[:password]@]host[:port]/database[?...]`
+  // (PostgresJobStore).
+  static absl::StatusOr<std::unique_ptr<JobStore>> Open(const std::string& spec,
+                                                        const StoreOptions& options = {});
+  virtual ~JobStore() = default;
 
-  // Puts jobs left RUNNING by a crash or shutdown back to QUEUED; returns
-  // how many.
-  absl::StatusOr<int> RequeueRunning();
+  // What the store is, for logs (never a password).
+  virtual std::string Describe() const = 0;
+  // Whether other servers may use the same store (then the manager sends
+  // heartbeats and polls for work queued elsewhere).
+  virtual bool shared() const { return false; }
+
+  // Puts jobs left RUNNING by a dead server back to QUEUED; returns how
+  // many. (SQLite: every RUNNING job, as only this server can use it;
+  // shared: those whose lease has expired.)
+  virtual absl::StatusOr<int> RequeueRunning() = 0;
 
   // Stores a QUEUED job for `scene`, `end_time_s` the run's end (progress),
   // submitted by client address `peer`; ResourceExhausted (naming
   // max_queued_jobs_per_peer) when that peer would have more than
   // `max_unfinished` jobs queued or running.
   // `tenant`: the token's tenant that owns it ("" without tokens).
-  absl::StatusOr<v1::Job> InsertJob(
+  virtual absl::StatusOr<v1::Job> InsertJob(
       const v1::Scene& scene, double end_time_s, const std::string& peer = "",
       int64_t max_unfinished = std::numeric_limits<int64_t>::max(),
-      const std::string& tenant = "");
+      const std::string& tenant = "") = 0;
   // Stores the sweep and its item jobs in one transaction (the items count
   // against `max_unfinished` as InsertJob).
-  absl::StatusOr<v1::Sweep> InsertSweep(
+  virtual absl::StatusOr<v1::Sweep> InsertSweep(
       const v1::SubmitSweepRequest& request, const std::vector<v1::Scene>& items,
       const std::vector<double>& end_times_s, const std::string& peer = "",
       int64_t max_unfinished = std::numeric_limits<int64_t>::max(),
-      const std::string& tenant = "");
+      const std::string& tenant = "") = 0;
 
-  absl::StatusOr<v1::Job> GetJob(const std::string& id);
-  absl::StatusOr<v1::Scene> GetScene(const std::string& id);
+  // The job; a RUNNING job of a shared store carries the progress its
+  // server last reported.
+  virtual absl::StatusOr<v1::Job> GetJob(const std::string& id) = 0;
+  virtual absl::StatusOr<v1::Scene> GetScene(const std::string& id) = 0;
   // Newest first, at most `limit`, and with `tenant`, only that tenant's.
   // Paging: only jobs older than job `after_id` (InvalidArgument when no
   // such job).
-  absl::StatusOr<std::vector<v1::Job>> ListJobs(v1::JobState state, const std::string& sweep_id,
-                                                int limit, const std::string& after_id = "",
-                                                const std::string* tenant = nullptr);
+  virtual absl::StatusOr<std::vector<v1::Job>> ListJobs(
+      v1::JobState state, const std::string& sweep_id, int limit,
+      const std::string& after_id = "", const std::string* tenant = nullptr) = 0;
   // The tenant that owns job or sweep `id` (by its prefix); NotFound.
-  absl::StatusOr<std::string> Tenant(const std::string& id);
+  virtual absl::StatusOr<std::string> Tenant(const std::string& id) = 0;
   // Ids of QUEUED jobs, oldest first.
-  absl::StatusOr<std::vector<std::string>> QueuedJobIds();
+  virtual absl::StatusOr<std::vector<std::string>> QueuedJobIds() = 0;
 
+  // Takes the oldest QUEUED job (shared stores: or a RUNNING one whose
+  // lease has expired) for this store's owner: QUEUED -> RUNNING,
+  // attempts + 1. Nullopt when there is none. Two claims never get the
+  // same job (shared stores: FOR UPDATE SKIP LOCKED).
+  virtual absl::StatusOr<std::optional<Claim>> ClaimNext() = 0;
   // QUEUED -> RUNNING (attempts + 1); false when the job was not QUEUED.
-  absl::StatusOr<bool> MarkRunning(const std::string& id);
-  // RUNNING -> QUEUED (shutdown before it finished).
-  absl::Status Requeue(const std::string& id);
+  virtual absl::StatusOr<bool> MarkRunning(const std::string& id) = 0;
+  // RUNNING -> QUEUED (shutdown before it finished); with `attempt` > 0,
+  // only while that claim holds.
+  virtual absl::Status Requeue(const std::string& id, int attempt = 0) = 0;
   // QUEUED -> CANCELLED; false when the job was not QUEUED.
-  absl::StatusOr<bool> CancelQueued(const std::string& id);
+  virtual absl::StatusOr<bool> CancelQueued(const std::string& id) = 0;
+  // Records that RUNNING job `id` should stop (its server learns it at its
+  // next Heartbeat). Nothing to do for a store only one server uses.
+  virtual absl::Status RequestCancel(const std::string& id) { return absl::OkStatus(); }
+  // Renews the leases of this server's running jobs and stores their
+  // progress. Nothing to do for a store only one server uses.
+  virtual absl::StatusOr<HeartbeatReply> Heartbeat(const std::vector<RunningJob>& running) {
+    return HeartbeatReply();
+  }
   // RUNNING -> `state` with the summary and the trajectory, in one
-  // transaction; false when the job was not RUNNING.
-  absl::StatusOr<bool> Finish(const std::string& id, v1::JobState state,
-                              const v1::RunSummary& summary, const StoredResult& result);
+  // transaction; false when the job was not RUNNING (or, with `attempt`
+  // > 0, when that claim no longer holds).
+  virtual absl::StatusOr<bool> Finish(const std::string& id, v1::JobState state,
+                                      const v1::RunSummary& summary, const StoredResult& result,
+                                      int attempt = 0) = 0;
 
   // NotFound when the job has no result.
-  absl::StatusOr<StoredResult> GetResult(const std::string& id);
+  virtual absl::StatusOr<StoredResult> GetResult(const std::string& id) = 0;
 
   // The sweep with its counts and job ids.
-  absl::StatusOr<v1::Sweep> GetSweep(const std::string& id);
+  virtual absl::StatusOr<v1::Sweep> GetSweep(const std::string& id) = 0;
 
   // Deletes a finished job outside any sweep and its result; returns the
   // bytes of result freed. NotFound for no such job; FailedPrecondition
   // while it is queued or running, or when it is a sweep's item. Ids are
-  // never reused (AUTOINCREMENT).
-  absl::StatusOr<int64_t> DeleteJob(const std::string& id);
+  // never reused.
+  virtual absl::StatusOr<int64_t> DeleteJob(const std::string& id) = 0;
   // Deletes a sweep whose items have all finished, with its items and
   // their results; returns the bytes freed.
-  absl::StatusOr<int64_t> DeleteSweep(const std::string& id);
+  virtual absl::StatusOr<int64_t> DeleteSweep(const std::string& id) = 0;
   // Retention: deletes finished jobs (outside sweeps) and whole finished
   // sweeps, oldest finished first, while they finished before
   // `older_than_unix_ms` or the stored results take more than `max_bytes`.
-  absl::StatusOr<RetentionReport> ApplyRetention(int64_t older_than_unix_ms, int64_t max_bytes);
+  virtual absl::StatusOr<RetentionReport> ApplyRetention(int64_t older_than_unix_ms,
+                                                         int64_t max_bytes) = 0;
 
- private:
-  JobStore(sqlite3* db, int lock_fd) : db_(db), lock_fd_(lock_fd) {}
-  absl::Status Exec(const char* sql);
-  // Open's checks (quick_check, the store id), the schema and migrations.
-  absl::Status CheckAndMigrate(const std::string& dir);
-  // The row of job or sweep `id` (by its prefix), -1 when none; mu_ held.
-  int64_t LookUpSeq(const std::string& id);
-  // Deletes the jobs matching `where` (with ?1 bound to `key`) and their
-  // results; in the caller's transaction, mu_ held.
-  absl::Status DeleteJobRows(const std::string& where, int64_t key);
-  // ResourceExhausted when `peer` has unfinished jobs and `adding` more
-  // would exceed `max_unfinished`; mu_ held.
-  absl::Status CheckPeerRoom(const std::string& peer, int64_t adding, int64_t max_unfinished);
-
-  absl::Mutex mu_;
-  sqlite3* db_;
-  int lock_fd_;
+  // Shared stores: `listener` is called (from another thread) whenever
+  // another server changes a job, so that watchers and idle workers need
+  // not wait for their next poll; null stops the calls (once this
+  // returns, none is under way). Nothing for SQLite.
+  virtual void SetChangeListener(std::function<void()> listener) {}
 };
 
 // The ids of rows made before ids were random (`j-000042`), which such
@@ -149,6 +189,23 @@ std::string SweepId(int64_t seq);
 // Whether `id` names a sweep (`s-...`) rather than a job (`j-...`).
 bool IsSweepId(const std::string& id);
 int64_t NowUnixMs();
+// Shared by the implementations: a new public id (`j-`/`s-` and 128
+// random bits), the CRC-32 of a result's header and values, the doubles
+// of a values blob, whether a state is final, 128 random bits as hex.
+absl::StatusOr<std::string> NewPublicId(char prefix);
+int64_t ResultChecksum(const void* header, size_t header_bytes, const void* vals,
+                       size_t vals_bytes);
+std::vector<double> DoublesFromBlob(const std::string& blob);
+bool IsFinished(v1::JobState state);
+// ResourceExhausted: client `peer` has `unfinished` jobs and asks for
+// `adding` more beyond `max_unfinished` (max_queued_jobs_per_peer).
+absl::Status PeerLimitExceeded(const std::string& peer, int64_t unfinished, int64_t adding,
+                               int64_t max_unfinished);
+absl::StatusOr<std::string> RandomId();
+// Creates directory `dir` (0700; missing parents with the default mode)
+// unless it exists; FailedPrecondition naming it and the reason when it
+// cannot, or when `dir` is not a directory.
+absl::Status CreateDataDir(const std::string& dir);
 
 }  // namespace cablesim
 

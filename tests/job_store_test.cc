@@ -1,22 +1,36 @@
-// The job store's state machine: a job is finished at most once, with its
-// result in the same transaction; what a restart requeues; a second store
-// on the same directory is refused.
+// The job stores' state machine, the same tests against both
+// implementations (SqliteJobStore in a fresh directory, PostgresJobStore
+// in a fresh database of a PostgreSQL server the test starts): a job is
+// finished at most once, with its result in the same transaction; claims
+// take the oldest job and never one twice; what a restart requeues;
+// cancel, delete, retention and the per-client limit. Then what only one
+// of them does: a second SQLite store on the same directory is refused;
+// several PostgreSQL stores share one queue, leases expire and a stale
+// claim stores nothing, migrations are versioned.
 
 #include "server/job_store.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-
-#include <filesystem>
+#include <libpq-fe.h>
 #include <unistd.h>
 
+#include <filesystem>
+#include <mutex>
+#include <set>
+#include <thread>
+
 #include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
+#include "server/postgres_job_store.h"
+#include "tests/postgres_test_util.h"
 
 namespace cablesim {
 namespace {
 
 std::string FreshDir(const std::string& name) {
-  const std::string dir = absl::StrCat(::testing::TempDir(), "/job_store_test_", name, "_", ::getpid());
+  const std::string dir =
+      absl::StrCat(::testing::TempDir(), "/job_store_test_", name, "_", ::getpid());
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
@@ -28,8 +42,52 @@ v1::Scene Named(const std::string& name) {
   return scene;
 }
 
-TEST(JobStoreTest, AJobFinishesOnceWithItsResult) {
-  auto store = *JobStore::Open(FreshDir("once"));
+StoredResult TwoRows() {
+  StoredResult result;
+  result.header.add_columns("t");
+  result.header.add_columns("x");
+  result.values = {0, 1, 0.5, 2};
+  return result;
+}
+
+// A short lease, so that a restart test need not wait long for a dead
+// claim to expire (the SQLite store has no leases: a restart requeues
+// every running job, as only one server uses it).
+constexpr int64_t kLeaseMs = 300;
+
+class JobStoreTest : public ::testing::TestWithParam<std::string> {
+ protected:
+  // The spec of a fresh store for this test: a directory or a database.
+  std::string FreshSpec(const std::string& name) {
+    if (GetParam() == "sqlite") return "sqlite:" + FreshDir(name);
+    std::string why;
+    testing::TestPostgres* pg = testing::TestPostgres::Get(&why);
+    if (pg == nullptr) return "";
+    return pg->NewDatabase(name);
+  }
+  void SetUp() override {
+    if (GetParam() == "postgresql") {
+      std::string why;
+      if (testing::TestPostgres::Get(&why) == nullptr) {
+        if (testing::TestPostgres::NotInstalled(why)) {
+          GTEST_SKIP() << "PostgreSQL tests skipped: " << why;
+        }
+        FAIL() << "PostgreSQL is installed but cannot start: " << why;
+      }
+    }
+  }
+  static std::unique_ptr<JobStore> OpenStore(const std::string& spec) {
+    StoreOptions options;
+    options.lease_ms = kLeaseMs;
+    absl::StatusOr<std::unique_ptr<JobStore>> store = JobStore::Open(spec, options);
+    EXPECT_TRUE(store.ok()) << store.status();
+    return store.ok() ? std::move(*store) : nullptr;
+  }
+};
+
+TEST_P(JobStoreTest, AJobFinishesOnceWithItsResult) {
+  auto store = OpenStore(FreshSpec("once"));
+  ASSERT_NE(store, nullptr);
   const v1::Job job = *store->InsertJob(Named("a"), 2.0);
   // 128 random bits, URL-safe: nothing to guess from.
   EXPECT_THAT(job.id(), ::testing::MatchesRegex("j-[A-Za-z0-9_-]{22}"));
@@ -40,29 +98,27 @@ TEST(JobStoreTest, AJobFinishesOnceWithItsResult) {
   ASSERT_TRUE(*store->MarkRunning(job.id()));
   EXPECT_FALSE(*store->MarkRunning(job.id()));  // already claimed
 
-  StoredResult result;
-  result.header.add_columns("t");
-  result.header.add_columns("x");
-  result.values = {0, 1, 0.5, 2};
   v1::RunSummary summary;
   summary.set_status("ok");
   summary.set_frames(2);
-  ASSERT_TRUE(*store->Finish(job.id(), v1::SUCCEEDED, summary, result));
+  ASSERT_TRUE(*store->Finish(job.id(), v1::SUCCEEDED, summary, TwoRows()));
   // A second finish (a worker that lost the race) changes nothing.
   EXPECT_FALSE(*store->Finish(job.id(), v1::FAILED, {}, {}));
   const v1::Job done = *store->GetJob(job.id());
   EXPECT_EQ(done.state(), v1::SUCCEEDED);
   EXPECT_EQ(done.attempts(), 1);
   EXPECT_EQ(done.summary().frames(), 2);
+  EXPECT_EQ(done.stored_bytes(), 4 * 8 + TwoRows().header.ByteSizeLong());
   const StoredResult kept = *store->GetResult(job.id());
-  EXPECT_EQ(kept.values, result.values);
+  EXPECT_EQ(kept.values, TwoRows().values);
   EXPECT_EQ(kept.header.columns_size(), 2);
 }
 
-TEST(JobStoreTest, AResultWithoutFramesIsKept) {
+TEST_P(JobStoreTest, AResultWithoutFramesIsKept) {
   // A run can end before its first frame (e.g. a STATIC run failing in its
   // first increment): the empty trajectory is stored, not NULL.
-  auto store = *JobStore::Open(FreshDir("empty"));
+  auto store = OpenStore(FreshSpec("empty"));
+  ASSERT_NE(store, nullptr);
   const v1::Job job = *store->InsertJob(Named("b"), 1.0);
   ASSERT_TRUE(*store->MarkRunning(job.id()));
   v1::RunSummary summary;
@@ -72,11 +128,41 @@ TEST(JobStoreTest, AResultWithoutFramesIsKept) {
   EXPECT_TRUE(store->GetResult(job.id())->values.empty());
 }
 
-TEST(JobStoreTest, RestartRequeuesRunningJobsAndKeepsTheRest) {
-  const std::string dir = FreshDir("restart");
+TEST_P(JobStoreTest, ClaimsTakeTheOldestJobOnceAndAStaleClaimStoresNothing) {
+  auto store = OpenStore(FreshSpec("claim"));
+  ASSERT_NE(store, nullptr);
+  const std::string a = store->InsertJob(Named("a"), 1)->id();
+  const std::string b = store->InsertJob(Named("b"), 1)->id();
+  const std::string c = store->InsertJob(Named("c"), 1)->id();
+  ASSERT_TRUE(*store->CancelQueued(b));
+  std::optional<Claim> first = *store->ClaimNext();
+  ASSERT_TRUE(first.has_value());
+  EXPECT_EQ(first->id, a);
+  EXPECT_EQ(first->attempt, 1);
+  std::optional<Claim> second = *store->ClaimNext();
+  ASSERT_TRUE(second.has_value());
+  EXPECT_EQ(second->id, c);  // b was cancelled
+  EXPECT_FALSE(store->ClaimNext()->has_value());
+  // Requeued (a shutdown), then claimed again: attempt 2. The first claim
+  // can no longer finish it nor requeue it.
+  ASSERT_TRUE(store->Requeue(a, 1).ok());
+  std::optional<Claim> again = *store->ClaimNext();
+  ASSERT_TRUE(again.has_value());
+  EXPECT_EQ(again->id, a);
+  EXPECT_EQ(again->attempt, 2);
+  EXPECT_FALSE(*store->Finish(a, v1::SUCCEEDED, {}, TwoRows(), 1));
+  ASSERT_TRUE(store->Requeue(a, 1).ok());
+  EXPECT_EQ(store->GetJob(a)->state(), v1::RUNNING);
+  EXPECT_TRUE(*store->Finish(a, v1::SUCCEEDED, {}, TwoRows(), 2));
+  EXPECT_EQ(store->GetJob(a)->attempts(), 2);
+}
+
+TEST_P(JobStoreTest, RestartRequeuesRunningJobsAndKeepsTheRest) {
+  const std::string spec = FreshSpec("restart");
   std::string queued, running, cancelled;
   {
-    auto store = *JobStore::Open(dir);
+    auto store = OpenStore(spec);
+    ASSERT_NE(store, nullptr);
     queued = store->InsertJob(Named("q"), 1)->id();
     running = store->InsertJob(Named("r"), 1)->id();
     cancelled = store->InsertJob(Named("c"), 1)->id();
@@ -84,7 +170,10 @@ TEST(JobStoreTest, RestartRequeuesRunningJobsAndKeepsTheRest) {
     ASSERT_TRUE(*store->CancelQueued(cancelled));
     EXPECT_FALSE(*store->CancelQueued(running));  // running: the worker stops it
   }                                               // as if the process died here
-  auto store = *JobStore::Open(dir);
+  // No heartbeat renews the dead claim's lease.
+  absl::SleepFor(absl::Milliseconds(2 * kLeaseMs));
+  auto store = OpenStore(spec);
+  ASSERT_NE(store, nullptr);
   EXPECT_EQ(*store->RequeueRunning(), 1);
   EXPECT_EQ(*store->QueuedJobIds(), (std::vector<std::string>{queued, running}));
   EXPECT_EQ(store->GetJob(cancelled)->state(), v1::CANCELLED);
@@ -93,18 +182,9 @@ TEST(JobStoreTest, RestartRequeuesRunningJobsAndKeepsTheRest) {
   EXPECT_EQ(store->GetJob("nonsense").status().code(), absl::StatusCode::kNotFound);
 }
 
-TEST(JobStoreTest, ASecondStoreOnTheSameDirectoryIsRefused) {
-  const std::string dir = FreshDir("lock");
-  auto first = JobStore::Open(dir);
-  ASSERT_TRUE(first.ok());
-  auto second = JobStore::Open(dir);
-  EXPECT_EQ(second.status().code(), absl::StatusCode::kFailedPrecondition);
-  first->reset();
-  EXPECT_TRUE(JobStore::Open(dir).ok());  // the lock went with the first
-}
-
-TEST(JobStoreTest, SweepStoresItsItemsInOrder) {
-  auto store = *JobStore::Open(FreshDir("sweep"));
+TEST_P(JobStoreTest, SweepStoresItsItemsInOrder) {
+  auto store = OpenStore(FreshSpec("sweep"));
+  ASSERT_NE(store, nullptr);
   v1::SubmitSweepRequest request;
   request.set_name("s");
   v1::SweepAxis* axis = request.add_axes();
@@ -123,6 +203,207 @@ TEST(JobStoreTest, SweepStoresItsItemsInOrder) {
   EXPECT_EQ(later.finished(), 1);
   EXPECT_EQ(later.failed(), 1);
   EXPECT_EQ(later.axes_size(), 1);
+  // Listing a sweep's items, newest first; a job id is not a sweep.
+  const std::vector<v1::Job> items = *store->ListJobs(v1::JOB_STATE_UNSPECIFIED, sweep.id(), 10);
+  ASSERT_EQ(items.size(), 2u);
+  EXPECT_EQ(items[0].id(), sweep.job_ids(1));
+  EXPECT_EQ(store->GetSweep(sweep.job_ids(0)).status().code(), absl::StatusCode::kNotFound);
+}
+
+TEST_P(JobStoreTest, ListJobsPagesNewestFirstAndByTenant) {
+  auto store = OpenStore(FreshSpec("list"));
+  ASSERT_NE(store, nullptr);
+  std::vector<std::string> ids;
+  for (int i = 0; i < 5; ++i) {
+    ids.push_back(store->InsertJob(Named(absl::StrCat("n", i)), 1, "peer", 100,
+                                   i % 2 ? "odd" : "even")
+                      ->id());
+  }
+  const std::vector<v1::Job> page = *store->ListJobs(v1::QUEUED, "", 2);
+  ASSERT_EQ(page.size(), 2u);
+  EXPECT_EQ(page[0].id(), ids[4]);
+  const std::vector<v1::Job> next = *store->ListJobs(v1::QUEUED, "", 10, page[1].id());
+  ASSERT_EQ(next.size(), 3u);
+  EXPECT_EQ(next[0].id(), ids[2]);
+  const std::string odd = "odd";
+  EXPECT_EQ(store->ListJobs(v1::JOB_STATE_UNSPECIFIED, "", 10, "", &odd)->size(), 2u);
+  EXPECT_EQ(*store->Tenant(ids[1]), "odd");
+  EXPECT_EQ(store->ListJobs(v1::QUEUED, "", 10, "j-nonesuch").status().code(),
+            absl::StatusCode::kInvalidArgument);
+  EXPECT_TRUE(store->ListJobs(v1::RUNNING, "", 10)->empty());
+}
+
+TEST_P(JobStoreTest, OneClientCannotQueueBeyondItsLimit) {
+  auto store = OpenStore(FreshSpec("peer"));
+  ASSERT_NE(store, nullptr);
+  ASSERT_TRUE(store->InsertJob(Named("a"), 1, "10.0.0.1", 2).ok());
+  ASSERT_TRUE(store->InsertJob(Named("b"), 1, "10.0.0.1", 2).ok());
+  const absl::StatusOr<v1::Job> third = store->InsertJob(Named("c"), 1, "10.0.0.1", 2);
+  EXPECT_EQ(third.status().code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_THAT(third.status().message(), ::testing::HasSubstr("max_queued_jobs_per_peer"));
+  EXPECT_TRUE(store->InsertJob(Named("d"), 1, "10.0.0.2", 2).ok());  // another client
+  v1::SubmitSweepRequest request;
+  request.set_name("s");
+  EXPECT_EQ(store->InsertSweep(request, {Named("x")}, {1}, "10.0.0.1", 2).status().code(),
+            absl::StatusCode::kResourceExhausted);
+}
+
+TEST_P(JobStoreTest, DeleteAndRetentionFreeFinishedWorkOnly) {
+  auto store = OpenStore(FreshSpec("delete"));
+  ASSERT_NE(store, nullptr);
+  const std::string done = store->InsertJob(Named("done"), 1)->id();
+  const std::string waiting = store->InsertJob(Named("waiting"), 1)->id();
+  ASSERT_TRUE(*store->MarkRunning(done));
+  ASSERT_TRUE(*store->Finish(done, v1::SUCCEEDED, {}, TwoRows()));
+  v1::SubmitSweepRequest request;
+  request.set_name("s");
+  const v1::Sweep sweep = *store->InsertSweep(request, {Named("x"), Named("y")}, {1, 1});
+  EXPECT_EQ(store->DeleteJob(waiting).status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_EQ(store->DeleteJob(sweep.job_ids(0)).status().code(),
+            absl::StatusCode::kFailedPrecondition);
+  EXPECT_EQ(store->DeleteSweep(sweep.id()).status().code(),
+            absl::StatusCode::kFailedPrecondition);
+  EXPECT_EQ(store->DeleteJob("j-nonesuch").status().code(), absl::StatusCode::kNotFound);
+  const int64_t bytes = store->GetJob(done)->stored_bytes();
+  EXPECT_EQ(*store->DeleteJob(done), bytes);
+  EXPECT_EQ(store->GetJob(done).status().code(), absl::StatusCode::kNotFound);
+  for (const std::string& id : sweep.job_ids()) {
+    ASSERT_TRUE(*store->MarkRunning(id));
+    ASSERT_TRUE(*store->Finish(id, v1::SUCCEEDED, {}, TwoRows()));
+  }
+  // Retention by bytes: everything finished goes (the sweep as a whole);
+  // the queued job stays.
+  const RetentionReport report = *store->ApplyRetention(std::numeric_limits<int64_t>::min(), 0);
+  EXPECT_EQ(report.jobs, 2);
+  EXPECT_EQ(report.sweeps, 1);
+  EXPECT_EQ(report.bytes, 2 * bytes);
+  EXPECT_EQ(store->GetSweep(sweep.id()).status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(store->GetJob(waiting)->state(), v1::QUEUED);
+}
+
+INSTANTIATE_TEST_SUITE_P(BothStores, JobStoreTest, ::testing::Values("sqlite", "postgresql"),
+                         [](const auto& info) { return info.param; });
+
+TEST(SqliteJobStoreTest, ASecondStoreOnTheSameDirectoryIsRefused) {
+  const std::string dir = FreshDir("lock");
+  auto first = JobStore::Open(dir);
+  ASSERT_TRUE(first.ok());
+  auto second = JobStore::Open(dir);
+  EXPECT_EQ(second.status().code(), absl::StatusCode::kFailedPrecondition);
+  first->reset();
+  EXPECT_TRUE(JobStore::Open("sqlite:" + dir).ok());  // the lock went with the first
+}
+
+// --- PostgreSQL only: several stores (servers) on one database ---------
+
+std::unique_ptr<JobStore> OpenPostgres(const std::string& url, int64_t lease_ms) {
+  StoreOptions options;
+  options.lease_ms = lease_ms;
+  absl::StatusOr<std::unique_ptr<JobStore>> store = JobStore::Open(url, options);
+  EXPECT_TRUE(store.ok()) << store.status();
+  return store.ok() ? std::move(*store) : nullptr;
+}
+
+TEST(PostgresJobStoreTest, StoresOnOneDatabaseNeverClaimTheSameJob) {
+  CABLESIM_POSTGRES_URL_OR_SKIP(url, "claims");
+  constexpr int kJobs = 60, kStores = 3, kThreadsPerStore = 2;
+  std::vector<std::unique_ptr<JobStore>> stores;
+  for (int i = 0; i < kStores; ++i) stores.push_back(OpenPostgres(url, 10'000));
+  for (const auto& s : stores) ASSERT_NE(s, nullptr);
+  for (int i = 0; i < kJobs; ++i) ASSERT_TRUE(stores[i % kStores]->InsertJob(Named("j"), 1).ok());
+  std::mutex mu;
+  std::vector<std::string> claimed;
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kStores * kThreadsPerStore; ++t) {
+    threads.emplace_back([&, t] {
+      JobStore* store = stores[t % kStores].get();
+      while (true) {
+        absl::StatusOr<std::optional<Claim>> c = store->ClaimNext();
+        ASSERT_TRUE(c.ok()) << c.status();
+        if (!c->has_value()) return;
+        ASSERT_TRUE(*store->Finish((*c)->id, v1::SUCCEEDED, {}, TwoRows(), (*c)->attempt));
+        std::lock_guard<std::mutex> lock(mu);
+        claimed.push_back((*c)->id);
+      }
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  EXPECT_EQ(claimed.size(), static_cast<size_t>(kJobs));
+  EXPECT_EQ(std::set<std::string>(claimed.begin(), claimed.end()).size(),
+            static_cast<size_t>(kJobs));
+}
+
+TEST(PostgresJobStoreTest, AnExpiredLeaseIsTakenAgainAndTheDeadClaimStoresNothing) {
+  CABLESIM_POSTGRES_URL_OR_SKIP(url, "lease");
+  auto dead = OpenPostgres(url, 300);
+  auto alive = OpenPostgres(url, 300);
+  ASSERT_NE(dead, nullptr);
+  ASSERT_NE(alive, nullptr);
+  const std::string id = dead->InsertJob(Named("j"), 1)->id();
+  const Claim first = **dead->ClaimNext();
+  // While the lease holds, nobody else takes the job; the heartbeat keeps
+  // it, reports progress to every store, and carries a cancel request.
+  EXPECT_FALSE(alive->ClaimNext()->has_value());
+  for (int i = 0; i < 4; ++i) {
+    absl::SleepFor(absl::Milliseconds(150));
+    const HeartbeatReply reply = *dead->Heartbeat({{id, first.attempt, 0.25 * i}});
+    EXPECT_TRUE(reply.lost.empty());
+    EXPECT_TRUE(reply.cancel.empty());
+  }
+  EXPECT_FALSE(alive->ClaimNext()->has_value());  // 600 ms after the claim: renewed
+  EXPECT_EQ(alive->GetJob(id)->progress_time_s(), 0.75);
+  ASSERT_TRUE(alive->RequestCancel(id).ok());
+  EXPECT_EQ(dead->Heartbeat({{id, first.attempt, 1}})->cancel,
+            std::vector<std::string>{id});
+  // Then the heartbeats stop (the server died): after the lease, another
+  // store takes the job as attempt 2, and the first claim can neither
+  // renew, nor finish, nor requeue it.
+  absl::SleepFor(absl::Milliseconds(450));
+  const std::optional<Claim> second = *alive->ClaimNext();
+  ASSERT_TRUE(second.has_value());
+  EXPECT_EQ(second->id, id);
+  EXPECT_EQ(second->attempt, 2);
+  EXPECT_EQ(dead->Heartbeat({{id, first.attempt, 1}})->lost, std::vector<std::string>{id});
+  EXPECT_FALSE(*dead->Finish(id, v1::SUCCEEDED, {}, TwoRows(), first.attempt));
+  ASSERT_TRUE(dead->Requeue(id, first.attempt).ok());
+  EXPECT_EQ(alive->GetJob(id)->state(), v1::RUNNING);
+  EXPECT_TRUE(*alive->Finish(id, v1::SUCCEEDED, {}, TwoRows(), second->attempt));
+  EXPECT_EQ(dead->GetResult(id)->values, TwoRows().values);
+}
+
+TEST(PostgresJobStoreTest, MigrationsAreVersionedAndANewerSchemaIsRefused) {
+  CABLESIM_POSTGRES_URL_OR_SKIP(url, "migrate");
+  ASSERT_NE(OpenPostgres(url, 1000), nullptr);
+  ASSERT_NE(OpenPostgres(url, 1000), nullptr);  // again: nothing to apply
+  PGconn* conn = PQconnectdb(url.c_str());
+  ASSERT_EQ(PQstatus(conn), CONNECTION_OK);
+  auto versions = [&] {
+    PGresult* r = PQexec(conn, "SELECT version FROM schema_migrations ORDER BY version");
+    std::vector<int> v;
+    for (int i = 0; i < PQntuples(r); ++i) v.push_back(std::atoi(PQgetvalue(r, i, 0)));
+    PQclear(r);
+    return v;
+  };
+  std::vector<int> expected;
+  for (int v = 1; v <= PostgresJobStore::LatestSchemaVersion(); ++v) expected.push_back(v);
+  EXPECT_EQ(versions(), expected);
+  PQclear(PQexec(conn,
+                 "INSERT INTO schema_migrations VALUES (999, 'from the future', 0)"));
+  const absl::StatusOr<std::unique_ptr<JobStore>> refused = JobStore::Open(url);
+  EXPECT_EQ(refused.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(refused.status().message(), ::testing::HasSubstr("schema is version 999"));
+  PQfinish(conn);
+}
+
+TEST(PostgresJobStoreTest, AnUnreachableDatabaseIsNamedWithoutItsPassword) {
+  // A port nothing listens on (bound, never listened to, then closed).
+  const absl::StatusOr<std::unique_ptr<JobStore>> store =
+      JobStore::Open("postgresql://cablesim:s3cret@127.0.0.1:1/nowhere?connect_timeout=5");
+  EXPECT_EQ(store.status().code(), absl::StatusCode::kUnavailable);
+  EXPECT_THAT(store.status().message(),
+              ::testing::HasSubstr("cannot connect to the PostgreSQL job store"));
+  EXPECT_THAT(std::string(store.status().message()),
+              ::testing::Not(::testing::HasSubstr("s3cret")));
 }
 
 }  // namespace

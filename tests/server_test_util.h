@@ -70,8 +70,12 @@ class ServerProcess {
     const std::string port_file = absl::StrCat(data_dir_, "/port");
     std::filesystem::remove(port_file);
     std::vector<std::string> args = {absl::StrCat(CABLESIM_BIN_DIR, "/cablesim-server"),
-                                     "--listen=127.0.0.1:0", "--data-dir=" + data_dir_,
-                                     "--port-file=" + port_file};
+                                     "--listen=127.0.0.1:0", "--port-file=" + port_file};
+    // With --store among the flags, DIR holds only the port file and the
+    // log.
+    bool store = false;
+    for (const std::string& f : flags_) store |= f.rfind("--store", 0) == 0;
+    if (!store) args.push_back("--data-dir=" + data_dir_);
     args.insert(args.end(), flags_.begin(), flags_.end());
     // Everything the child needs is prepared before fork (after it, only
     // async-signal-safe calls).

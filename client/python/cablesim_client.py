@@ -78,14 +78,19 @@ def read_token(path):
 
 
 def connect(address, tls_ca=None, token=None):
-    """A stub for the cablesim-server at `address` ("host:port"). `tls_ca`:
-    a CA certificate file (PEM): TLS, the server's certificate checked
-    against it. `token`: a bearer token sent with every call."""
+    """A stub for the cablesim-server at `address` ("host:port", or a gRPC
+    target naming several servers that share one job store:
+    "ipv4:127.0.0.1:50051,127.0.0.1:50052" or "dns:///name:port"; calls are
+    spread over them with gRPC's round_robin policy). `tls_ca`: a CA
+    certificate file (PEM): TLS, the server's certificate checked against
+    it. `token`: a bearer token sent with every call."""
+    options = [("grpc.lb_policy_name", "round_robin")]
     if tls_ca:
         with open(tls_ca, "rb") as f:
-            channel = grpc.secure_channel(address, grpc.ssl_channel_credentials(f.read()))
+            channel = grpc.secure_channel(
+                address, grpc.ssl_channel_credentials(f.read()), options=options)
     else:
-        channel = grpc.insecure_channel(address)
+        channel = grpc.insecure_channel(address, options=options)
     if token:
         channel = grpc.intercept_channel(channel, _BearerToken(token))
     return service_pb2_grpc.CablesimServiceStub(channel)
