@@ -34,3 +34,11 @@ if command -v npm > /dev/null && [ ! -d "$node_dir/node_modules/@grpc/grpc-js" ]
   (cd "$node_dir" && npm ci --no-audit --no-fund --loglevel=error) ||
     echo "install-deps: npm ci in client/node failed: node_client_test will fail" >&2
 fi
+# The deployment checks' npm packages (deploy/package-lock.json: the
+# Kubernetes schemas of kubernetes-models, a YAML parser): CTest's
+# deploy_files_slow_test needs them.
+deploy_dir="$(cd "$(dirname "$0")" && pwd)"
+if command -v npm > /dev/null && [ ! -d "$deploy_dir/node_modules/kubernetes-models" ]; then
+  (cd "$deploy_dir" && npm ci --no-audit --no-fund --loglevel=error) ||
+    echo "install-deps: npm ci in deploy failed: deploy_files_slow_test will fail" >&2
+fi
