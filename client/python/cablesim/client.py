@@ -134,7 +134,7 @@ class Client:
     def info(self, timeout: Optional[float] = None) -> Record:
         """The server's version, build and limits (ServerInfo)."""
         return to_record(self.stub.GetServerInfo(service_pb2.GetServerInfoRequest(),
-                                                 timeout=timeout, wait_for_ready=True))
+                                                 timeout=timeout))
 
     @_raises_error
     def validate(self, scene: SceneLike) -> Record:
