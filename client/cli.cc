@@ -16,6 +16,7 @@
 #include "absl/strings/ascii.h"
 #include "cablesim/version.h"
 #include "client/cli_common.h"
+#include "client/cli_health.h"
 #include "client/cli_jobs.h"
 #include "client/cli_sweep.h"
 #include "client/json_line.h"
@@ -54,7 +55,8 @@ const std::set<std::string>& ValueOptions() {
                                 "max-wall-seconds",
                                 "max-constraint-violation",
                                 "tls-ca",
-                                "token-file"};
+                                "token-file",
+                                "item"};
   return *options;
 }
 
@@ -241,12 +243,16 @@ std::string CliUsage() {
       one JSON line with the report; --out writes the time series.
   cablesim sweep SWEEP.json [--out results.csv] [--server HOST:PORT]
                  [--workers N] [--max-energy-drift X] [--max-wall-seconds X]
-                 [--max-constraint-violation X] [--allow-outside]
+                 [--max-constraint-violation X] [--allow-outside] [--item I]
       Queue a parameter sweep, wait for every item and write one row per
       item (axis values, summary, final probe values). Without --server the
       sweep runs in this process on N workers (default: the cores). The
       sweep file's base_file must lie under the sweep file's directory
-      unless --allow-outside.
+      unless --allow-outside. With --item I only item I (0-based, the last
+      axis varying fastest) runs and its row is written, under index I.
+  cablesim health --server HOST:PORT
+      Ask the server's gRPC health service whether it is serving; print one
+      JSON line; exit 0 only when it is SERVING.
   cablesim help | --help
       Print this text.
   cablesim --version
@@ -291,7 +297,8 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   const std::string& command = a.positional[0];
   static const std::map<std::string, const char*> kArgument = {
       {"run", "SCENE"}, {"validate", "SCENE"}, {"submit", "SCENE"},        {"jobs", nullptr},
-      {"watch", "JOB"}, {"cancel", "JOB"},     {"energy", "SCENE or JOB"}, {"sweep", "SWEEP.json"}};
+      {"watch", "JOB"}, {"cancel", "JOB"},     {"energy", "SCENE or JOB"}, {"sweep", "SWEEP.json"},
+      {"health", nullptr}};
   const auto known = kArgument.find(command);
   if (known == kArgument.end()) {
     return UsageError(err, absl::StrCat("unknown command \"", command, "\""));
@@ -347,6 +354,7 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   if (command == "watch") return cli_internal::Watch(a, out, err);
   if (command == "cancel") return cli_internal::Cancel(a, out, err);
   if (command == "energy") return cli_internal::Energy(a, out, err);
+  if (command == "health") return cli_internal::Health(a, out, err);
   return cli_internal::SweepCommand(a, out, err);
 }
 

@@ -1,6 +1,8 @@
 #include "client/cli_sweep.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -38,6 +40,21 @@ absl::StatusOr<double> DoubleOption(const Arguments& a, const std::string& name)
 
 }  // namespace
 
+absl::Status NarrowSweepToItem(int64_t item, v1::SubmitSweepRequest* request) {
+  // The last axis varies fastest: item = sum_k i_k * prod_{j > k} n_j.
+  for (int k = request->axes_size() - 1; k >= 0; --k) {
+    v1::SweepAxis* axis = request->mutable_axes(k);
+    if (axis->values_size() == 0) {
+      return absl::InvalidArgumentError(absl::StrCat("axes[", k, "].values: empty"));
+    }
+    const double value = axis->values(static_cast<int>(item % axis->values_size()));
+    item /= axis->values_size();
+    axis->clear_values();
+    axis->add_values(value);
+  }
+  return absl::OkStatus();
+}
+
 int SweepCommand(const Arguments& a, std::ostream& out, std::ostream& err) {
   const std::string& path = a.positional[1];
   const absl::StatusOr<double> max_drift = DoubleOption(a, "max-energy-drift");
@@ -52,11 +69,32 @@ int SweepCommand(const Arguments& a, std::ostream& out, std::ostream& err) {
       return UsageError(err, "--workers: a number >= 1");
     }
   }
-  const absl::StatusOr<v1::SubmitSweepRequest> request =
+  absl::StatusOr<v1::SubmitSweepRequest> request =
       ReadSweepFile(path, a.options.count("allow-outside") > 0);
   if (!request.ok()) {
     err << "cablesim: " << request.status().message() << "\n";
     return kExitBadInput;
+  }
+  // --item I: the sweep narrowed to its item I (each axis to the one value
+  // it takes there), reported under index I.
+  int first_index = 0;
+  if (auto it = a.options.find("item"); it != a.options.end()) {
+    int64_t items = 1;
+    for (const v1::SweepAxis& axis : request->axes()) items *= std::max(axis.values_size(), 1);
+    int item = -1;
+    if (!absl::SimpleAtoi(it->second, &item) || item < 0) {
+      return UsageError(err, "--item: a number >= 0");
+    }
+    if (item >= items) {
+      return UsageError(err, absl::StrCat("--item: ", item, " is not an item of ", path, " (",
+                                          items, " items, 0 to ", items - 1, ")"));
+    }
+    const absl::Status narrowed = NarrowSweepToItem(item, &*request);
+    if (!narrowed.ok()) {
+      err << "cablesim: " << path << ": " << narrowed.message() << "\n";
+      return kExitBadInput;
+    }
+    first_index = item;
   }
   std::unique_ptr<Connection> c = ConnectOrReport(a.server, true, workers, err);
   if (c == nullptr) return kExitIoError;
@@ -115,7 +153,7 @@ int SweepCommand(const Arguments& a, std::ostream& out, std::ostream& err) {
   int failed = 0, violations = 0;
   for (const v1::SweepItem& item : results.items()) {
     const v1::RunSummary& s = item.summary();
-    table << item.index() << "," << item.job_id() << "," << v1::JobState_Name(item.state());
+    table << first_index + item.index() << "," << item.job_id() << "," << v1::JobState_Name(item.state());
     for (double v : item.axis_values()) table << "," << JsonLine::Number(v);
     table << "," << CsvCell(s.status()) << "," << CsvCell(s.error());
     for (double v :
@@ -131,7 +169,8 @@ int SweepCommand(const Arguments& a, std::ostream& out, std::ostream& err) {
                                              : std::string());
     }
     table << "\n";
-    const std::string who = absl::StrCat("sweep item ", item.index(), " (", item.job_id(), ")");
+    const std::string who =
+        absl::StrCat("sweep item ", first_index + item.index(), " (", item.job_id(), ")");
     if (item.state() != v1::SUCCEEDED) {
       ++failed;
       err << "cablesim: " << who << ": " << v1::JobState_Name(item.state())

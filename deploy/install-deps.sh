@@ -12,6 +12,7 @@ packages=(
   libsqlite3-dev zlib1g-dev
   libpq-dev postgresql
   python3 python3-grpcio python3-protobuf python3-numpy python3-matplotlib
+  python3-venv python3-setuptools python3-wheel python3-pandas
   clang libclang-rt-14-dev
 )
 as_root=()
@@ -33,4 +34,12 @@ node_dir="$(cd "$(dirname "$0")/.." && pwd)/client/node"
 if command -v npm > /dev/null && [ ! -d "$node_dir/node_modules/@grpc/grpc-js" ]; then
   (cd "$node_dir" && npm ci --no-audit --no-fund --loglevel=error) ||
     echo "install-deps: npm ci in client/node failed: node_client_test will fail" >&2
+fi
+# The deployment checks' npm packages (deploy/package-lock.json: the
+# Kubernetes schemas of kubernetes-models, a YAML parser): CTest's
+# deploy_files_slow_test needs them.
+deploy_dir="$(cd "$(dirname "$0")" && pwd)"
+if command -v npm > /dev/null && [ ! -d "$deploy_dir/node_modules/kubernetes-models" ]; then
+  (cd "$deploy_dir" && npm ci --no-audit --no-fund --loglevel=error) ||
+    echo "install-deps: npm ci in deploy failed: deploy_files_slow_test will fail" >&2
 fi

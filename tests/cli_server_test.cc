@@ -1,6 +1,7 @@
 // The command line against a cablesim-server on a loopback port, and its
 // sweep command in-process: the same output as the in-process run, the job
-// commands, and a sweep that fails on a threshold.
+// commands, a sweep that fails on a threshold, and one item of a sweep
+// run alone (--item).
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -8,6 +9,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "client/cli.h"
 #include "server_test_util.h"
@@ -189,6 +192,61 @@ TEST_F(CliServerTest, SweepWritesOneRowPerItemAndFailsOnAThreshold) {
   const CliResult bad = Cli({"sweep", sweep, "--out", csv});
   EXPECT_EQ(bad.code, 2);
   EXPECT_THAT(bad.err, HasSubstr("axes[0].path: "));
+}
+
+std::vector<std::string> Lines(const std::string& text) {
+  return absl::StrSplit(text, '\n', absl::SkipEmpty());
+}
+
+// A CSV row without the columns that differ between two runs of the same
+// item: job_id (random) and wall_seconds.
+std::string Comparable(const std::string& row, const std::vector<std::string>& header) {
+  std::vector<std::string> cells = absl::StrSplit(row, ',');
+  std::vector<std::string> kept;
+  for (size_t k = 0; k < cells.size(); ++k) {
+    if (header[k] != "job_id" && header[k] != "wall_seconds") kept.push_back(cells[k]);
+  }
+  return absl::StrJoin(kept, ",");
+}
+
+// `cablesim sweep SWEEP.json --item I`: one item of a sweep run alone (as
+// one pod of deploy/kubernetes/sweep-indexed-job.yaml does) writes the same
+// row as item I of the whole sweep.
+TEST_F(CliServerTest, SweepItemAloneWritesTheRowOfTheWholeSweep) {
+  const std::string& dir = *dir_;
+  Scene("item_base", 0.05);
+  const std::string sweep = dir + "/item_sweep.json";
+  std::ofstream(sweep) << R"({"name": "items", "base_file": "item_base.json",
+    "axes": [{"path": "solver.step", "values": [1e-3, 5e-4]},
+             {"path": "cables[0].elements", "values": [4, 6, 8]}]})";
+
+  const CliResult all = Cli({"sweep", sweep, "--workers", "2"});
+  ASSERT_EQ(all.code, 0) << all.err;
+  const std::vector<std::string> rows = Lines(all.out);
+  ASSERT_EQ(rows.size(), 7u);
+  const std::vector<std::string> header = absl::StrSplit(rows[0], ',');
+  for (int i = 0; i < 6; ++i) {
+    SCOPED_TRACE(i);
+    const std::string out = absl::StrCat(dir, "/item-", i, ".csv");
+    const CliResult one =
+        Cli({"sweep", sweep, "--item", std::to_string(i), "--out", out, "--workers", "1"});
+    ASSERT_EQ(one.code, 0) << one.err;
+    const std::vector<std::string> written = Lines(Read(out));
+    ASSERT_EQ(written.size(), 2u);  // the header and item i's row
+    EXPECT_EQ(written[0], rows[0]);
+    EXPECT_EQ(Comparable(written[1], header), Comparable(rows[1 + i], header));
+    EXPECT_THAT(written[1], StartsWith(absl::StrCat(i, ",j-")));
+  }
+
+  const CliResult outside = Cli({"sweep", sweep, "--item", "6"});
+  EXPECT_EQ(outside.code, 2);
+  EXPECT_THAT(outside.err, HasSubstr("--item: 6 is not an item of"));
+  EXPECT_THAT(outside.err, HasSubstr("(6 items, 0 to 5)"));
+  const CliResult negative = Cli({"sweep", sweep, "--item", "-1"});
+  EXPECT_EQ(negative.code, 2);
+  EXPECT_THAT(negative.err, HasSubstr("--item: a number >= 0"));
+  EXPECT_EQ(Cli({"sweep", sweep, "--item", "x"}).code, 2);
+  EXPECT_EQ(Cli({"run", sweep, "--item", "0"}).code, 2);  // only for sweep
 }
 
 }  // namespace

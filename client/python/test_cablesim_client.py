@@ -6,13 +6,13 @@ import os
 import subprocess
 import sys
 import tempfile
-import time
 import unittest
 
 import grpc
 import numpy as np
 
 import cablesim_client
+from live_server import start_server
 
 SOURCE = os.environ["CABLESIM_SOURCE_DIR"]
 BIN = os.environ["CABLESIM_BIN_DIR"]
@@ -22,18 +22,8 @@ class ClientTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.tmp = tempfile.TemporaryDirectory()
-        port_file = os.path.join(cls.tmp.name, "port")
-        cls.server = subprocess.Popen(
-            [os.path.join(BIN, "cablesim-server"), "--listen=127.0.0.1:0",
-             "--data-dir=" + cls.tmp.name, "--port-file=" + port_file, "--workers=1"])
-        # Until the server has written its port (or exited): no time limit
-        # that a busy machine could exceed.
-        while not os.path.exists(port_file):
-            if cls.server.poll() is not None:
-                raise RuntimeError("cablesim-server exited with %d" % cls.server.returncode)
-            time.sleep(0.01)
-        with open(port_file) as f:
-            cls.address = "127.0.0.1:" + f.read().strip()
+        cls.server, port = start_server(cls.tmp.name, "--workers=1")
+        cls.address = "127.0.0.1:%d" % port
         cls.channel = grpc.insecure_channel(cls.address)
         cls.stub = cablesim_client.service_pb2_grpc.CablesimServiceStub(cls.channel)
 
@@ -115,21 +105,13 @@ class TlsAndTokenTest(unittest.TestCase):
                 f.write(token + " py\n")
             with open(os.path.join(tmp, "my-token"), "w") as f:
                 f.write("# mine\n" + token + "\n")
-            port_file = os.path.join(tmp, "port")
             os.mkdir(os.path.join(tmp, "data"))
-            server = subprocess.Popen(
-                [os.path.join(BIN, "cablesim-server"), "--listen=127.0.0.1:0",
-                 "--data-dir=" + os.path.join(tmp, "data"), "--port-file=" + port_file,
-                 "--tls-cert=" + os.path.join(tmp, "server.pem"),
-                 "--tls-key=" + os.path.join(tmp, "server.key"),
-                 "--token-file=" + os.path.join(tmp, "tokens")])
+            server, port = start_server(
+                os.path.join(tmp, "data"), "--tls-cert=" + os.path.join(tmp, "server.pem"),
+                "--tls-key=" + os.path.join(tmp, "server.key"),
+                "--token-file=" + os.path.join(tmp, "tokens"))
             try:
-                while not os.path.exists(port_file):
-                    if server.poll() is not None:
-                        raise RuntimeError("cablesim-server exited with %d" % server.returncode)
-                    time.sleep(0.01)
-                with open(port_file) as f:
-                    address = "localhost:" + f.read().strip()
+                address = "localhost:%d" % port
                 ca = os.path.join(tmp, "ca.pem")
                 request = cablesim_client.service_pb2.GetServerInfoRequest()
                 stub = cablesim_client.connect(

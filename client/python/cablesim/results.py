@@ -1,0 +1,274 @@
+"""What the service returns, as Python values: trajectories and sweep tables
+as numpy arrays (and pandas DataFrames when pandas is installed), jobs and
+summaries with enums as names. Units are SI: s, m, m/s, m/s^2, J.
+"""
+
+import dataclasses
+from typing import Any, Dict, List, Optional
+
+import numpy as np
+from google.protobuf import descriptor
+
+
+class Record(dict):
+    """A message as a dict whose keys are also attributes
+    (`summary["status"]` or `summary.status`); enums are names, repeated
+    fields lists, nested messages Records."""
+
+    def __getattr__(self, name):
+        try:
+            return self[name]
+        except KeyError:
+            raise AttributeError(name) from None
+
+
+def to_record(message) -> Record:
+    """Every field of `message` (defaults included) as a Record."""
+    record = Record()
+    for field in message.DESCRIPTOR.fields:
+        value = getattr(message, field.name)
+        if field.label == descriptor.FieldDescriptor.LABEL_REPEATED:
+            record[field.name] = [_value(field, v) for v in value]
+        else:
+            record[field.name] = _value(field, value)
+    return record
+
+
+def _value(field, value):
+    if field.type == descriptor.FieldDescriptor.TYPE_MESSAGE:
+        return to_record(value)
+    if field.type == descriptor.FieldDescriptor.TYPE_ENUM:
+        number = field.enum_type.values_by_number.get(value)
+        return number.name if number is not None else value
+    return value
+
+
+def _pandas():
+    try:
+        import pandas
+    except ImportError:
+        raise ImportError("to_pandas() needs pandas (Debian: python3-pandas; "
+                          "pip: cablesim[pandas])") from None
+    return pandas
+
+
+@dataclasses.dataclass
+class Result:
+    """A run's trajectory: `data` has one row per output frame and one column
+    per name in `columns` (the CSV columns of `cablesim run --out`: t, then
+    per probe NAME.x ... NAME.az, then energy.* and constraint.violation).
+    `info` is the model built (ModelInfo), `summary` the run's summary
+    (RunSummary; `summary.status` is "ok", "failed" or "cancelled")."""
+
+    columns: List[str]
+    data: np.ndarray
+    info: Record
+    summary: Record
+    scene_name: str = ""
+
+    def column(self, name: str) -> np.ndarray:
+        """The column `name` (e.g. "t", "tip.x", "energy.total")."""
+        try:
+            return self.data[:, self.columns.index(name)]
+        except ValueError:
+            raise KeyError("no column %r (columns: %s)" % (name, ", ".join(self.columns))) from None
+
+    __getitem__ = column
+
+    @property
+    def t(self) -> np.ndarray:
+        """Time [s] of each frame (the load factor for STATIC and MODAL)."""
+        return self.column("t")
+
+    def position(self, probe: str) -> np.ndarray:
+        """The probe's position [m], frames x 3 (x, y, z)."""
+        return np.column_stack([self.column(probe + "." + c) for c in "xyz"])
+
+    def to_pandas(self):
+        """The trajectory as a pandas DataFrame with the same columns."""
+        return _pandas().DataFrame(self.data, columns=self.columns)
+
+    def plot(self, png_path: str, probe: Optional[str] = None) -> None:
+        """Plots the path of `probe` (default: the first) and the energy
+        components against time to `png_path` (matplotlib, Agg)."""
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        probe = probe or self.info.probe_names[0]
+        fig, (path_ax, energy_ax) = plt.subplots(1, 2, figsize=(11, 4.5))
+        path_ax.plot(self.column(probe + ".x"), self.column(probe + ".y"))
+        path_ax.set_xlabel("x [m]")
+        path_ax.set_ylabel("y [m]")
+        path_ax.set_title("path of " + probe)
+        path_ax.set_aspect("equal", adjustable="datalim")
+        for name in ("kinetic", "potential", "axial", "bending", "total"):
+            energy_ax.plot(self.t, self.column("energy." + name), label=name)
+        energy_ax.set_xlabel("t [s]")
+        energy_ax.set_ylabel("energy [J]")
+        energy_ax.legend()
+        energy_ax.set_title("energy")
+        fig.tight_layout()
+        fig.savefig(png_path, dpi=100)
+        plt.close(fig)
+
+
+def result_from_events(events) -> Result:
+    """Collects a Run (or GetJobResult) stream: header, frame batches,
+    summary."""
+    header, summary, chunks = None, None, []
+    for event in events:
+        kind = event.WhichOneof("event")
+        if kind == "header":
+            header = event.header
+        elif kind == "frames":
+            chunks.append(np.asarray(event.frames.values, dtype=np.float64))
+        elif kind == "summary":
+            summary = event.summary
+    if header is None or summary is None:
+        raise RuntimeError("the stream ended without a %s" % ("header" if header is None else "summary"))
+    flat = np.concatenate(chunks) if chunks else np.zeros(0)
+    return Result(columns=list(header.columns), data=flat.reshape(-1, len(header.columns)),
+                  info=to_record(header.info), summary=to_record(summary),
+                  scene_name=header.scene_name)
+
+
+@dataclasses.dataclass
+class Job:
+    """A durable job. `state` is a name: "QUEUED", "RUNNING", "SUCCEEDED",
+    "FAILED" or "CANCELLED"; `summary` is set once it finished. Times in
+    milliseconds since the Unix epoch (0: not yet)."""
+
+    id: str
+    state: str
+    name: str
+    attempts: int
+    progress_time_s: float
+    end_time_s: float
+    created_unix_ms: int
+    started_unix_ms: int
+    finished_unix_ms: int
+    summary: Optional[Record]
+    sweep_id: str
+    sweep_index: int
+
+    @property
+    def finished(self) -> bool:
+        return self.state in ("SUCCEEDED", "FAILED", "CANCELLED")
+
+    @classmethod
+    def from_message(cls, job) -> "Job":
+        r = to_record(job)
+        return cls(id=r.id, state=r.state, name=r.name, attempts=r.attempts,
+                   progress_time_s=r.progress_time_s, end_time_s=r.end_time_s,
+                   created_unix_ms=r.created_unix_ms, started_unix_ms=r.started_unix_ms,
+                   finished_unix_ms=r.finished_unix_ms,
+                   summary=r.summary if job.HasField("summary") else None,
+                   sweep_id=r.sweep_id, sweep_index=r.sweep_index)
+
+
+@dataclasses.dataclass
+class Energy:
+    """Energy diagnostics [J]: one entry per frame in each array, the
+    `report` (EnergyReport: initial, final, min, max, relative_drift, scale,
+    energy_dissipated, max_constraint_violation) and the run's `summary`."""
+
+    t: np.ndarray
+    kinetic: np.ndarray
+    potential: np.ndarray
+    axial: np.ndarray
+    bending: np.ndarray
+    total: np.ndarray
+    constraint_violation: np.ndarray
+    report: Record
+    summary: Record
+
+    @classmethod
+    def from_message(cls, response) -> "Energy":
+        arrays = {name: np.asarray(getattr(response, name), dtype=np.float64)
+                  for name in ("t", "kinetic", "potential", "axial", "bending", "total",
+                               "constraint_violation")}
+        return cls(report=to_record(response.report), summary=to_record(response.summary), **arrays)
+
+    def to_pandas(self):
+        names = ("t", "kinetic", "potential", "axial", "bending", "total", "constraint_violation")
+        return _pandas().DataFrame({n: getattr(self, n) for n in names})
+
+
+# The per-item numbers of a sweep table, the columns of `cablesim sweep`'s
+# CSV between the axes and the final values.
+SWEEP_SUMMARY_COLUMNS = ("wall_seconds", "frames", "steps", "rejected_steps", "newton_iterations",
+                         "end_time_s", "energy_initial", "energy_final", "energy_dissipated")
+
+
+@dataclasses.dataclass
+class SweepResult:
+    """A sweep's table, one row per item in item order (the last axis
+    varying fastest). `axis_values` is items x axes (columns `axis_paths`),
+    `final` items x frame columns (`final_columns`: each item's last frame;
+    NaN until the item finished), `states` the job states by name,
+    `summaries` and `energy` the items' RunSummary and EnergyReport."""
+
+    id: str
+    name: str
+    axis_paths: List[str]
+    axis_values: np.ndarray
+    job_ids: List[str]
+    states: List[str]
+    summaries: List[Record]
+    energy: List[Record]
+    final_columns: List[str]
+    final: np.ndarray
+
+    @property
+    def items(self) -> int:
+        return len(self.job_ids)
+
+    def summary_column(self, name: str) -> np.ndarray:
+        """One summary number per item, e.g. "wall_seconds", "steps"."""
+        return np.array([float(s[name]) for s in self.summaries])
+
+    @property
+    def relative_drift(self) -> np.ndarray:
+        return np.array([e.relative_drift for e in self.energy])
+
+    def table(self) -> Dict[str, Any]:
+        """The columns of `cablesim sweep --out` (index, job_id, state, the
+        axis paths, status, error, the summary numbers,
+        energy_relative_drift, max_constraint_violation, final.*), each a
+        list or a numpy array."""
+        columns: Dict[str, Any] = {"index": np.arange(self.items), "job_id": self.job_ids,
+                                   "state": self.states}
+        for k, path in enumerate(self.axis_paths):
+            columns[path] = self.axis_values[:, k]
+        columns["status"] = [s.status for s in self.summaries]
+        columns["error"] = [s.error for s in self.summaries]
+        for name in SWEEP_SUMMARY_COLUMNS:
+            columns[name] = self.summary_column(name)
+        columns["energy_relative_drift"] = self.relative_drift
+        columns["max_constraint_violation"] = self.summary_column("max_constraint_violation")
+        for k, name in enumerate(self.final_columns):
+            columns["final." + name] = self.final[:, k]
+        return columns
+
+    def to_pandas(self):
+        return _pandas().DataFrame(self.table())
+
+    @classmethod
+    def from_message(cls, results) -> "SweepResult":
+        sweep = results.sweep
+        ncol = len(results.final_columns)
+        final = np.full((len(results.items), ncol), np.nan)
+        for i, item in enumerate(results.items):
+            if len(item.final_values) == ncol:
+                final[i] = item.final_values
+        return cls(
+            id=sweep.id, name=sweep.name, axis_paths=[a.path for a in sweep.axes],
+            axis_values=np.array([list(item.axis_values) for item in results.items],
+                                 dtype=np.float64).reshape(len(results.items), len(sweep.axes)),
+            job_ids=[item.job_id for item in results.items],
+            states=[to_record(item).state for item in results.items],
+            summaries=[to_record(item.summary) for item in results.items],
+            energy=[to_record(item.energy) for item in results.items],
+            final_columns=list(results.final_columns), final=final)
