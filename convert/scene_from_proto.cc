@@ -154,6 +154,66 @@ absl::Status CheckTolerance(absl::string_view path, double value) {
   return absl::OkStatus();
 }
 
+// How deep TimeFunction.sum may nest.
+constexpr int kMaxTimeFunctionDepth = 8;
+
+absl::StatusOr<TimeFunction> ConvertTimeFunction(const std::string& path,
+                                                 const v1::TimeFunction& p, int depth = 0) {
+  TimeFunction f;
+  CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(path, "constant"), p.constant()));
+  f.set_constant(p.constant());
+  if (p.has_table()) {
+    const std::string table = Sub(path, "table");
+    const auto& times = p.table().times();
+    const auto& values = p.table().values();
+    if (times.empty()) return Invalid(Sub(table, "times"), "must have at least one entry");
+    if (values.size() != times.size()) {
+      return Invalid(Sub(table, "values"),
+                     absl::StrCat("must have as many entries as times (", times.size(), "; got ",
+                                  values.size(), ")"));
+    }
+    for (int k = 0; k < times.size(); ++k) {
+      CABLESIM_RETURN_IF_ERROR(CheckFinite(Indexed(table, "times", k), times[k]));
+      CABLESIM_RETURN_IF_ERROR(CheckFinite(Indexed(table, "values", k), values[k]));
+      if (k > 0 && !(times[k] > times[k - 1])) {
+        return Invalid(Sub(table, "times"),
+                       absl::StrCat("times must increase (times[", k, "] = ", Num(times[k]),
+                                    " after ", Num(times[k - 1]), ")"));
+      }
+    }
+    f.set_table({times.begin(), times.end()}, {values.begin(), values.end()});
+  }
+  if (p.has_harmonic()) {
+    const std::string h = Sub(path, "harmonic");
+    CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(h, "amplitude"), p.harmonic().amplitude()));
+    CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(h, "frequency"), p.harmonic().frequency()));
+    CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(h, "phase"), p.harmonic().phase()));
+    f.add_harmonic({p.harmonic().amplitude(), p.harmonic().frequency(), p.harmonic().phase()});
+  }
+  if (p.has_ramp()) {
+    const std::string r = Sub(path, "ramp");
+    CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(r, "slope"), p.ramp().slope()));
+    CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(r, "start"), p.ramp().start()));
+    f.add_ramp({p.ramp().slope(), p.ramp().start()});
+  }
+  for (int i = 0; i < p.sum_size(); ++i) {
+    const std::string sub = Indexed(path, "sum", i);
+    if (depth + 1 >= kMaxTimeFunctionDepth)
+      return Invalid(sub, absl::StrCat("at most ", kMaxTimeFunctionDepth, " levels of sum"));
+    CABLESIM_ASSIGN_OR_RETURN(TimeFunction term, ConvertTimeFunction(sub, p.sum(i), depth + 1));
+    f.add_term(std::move(term));
+  }
+  return f;
+}
+
+absl::StatusOr<TimeVector> ConvertTimeVector(const std::string& path, const v1::TimeVec3& p) {
+  TimeVector v;
+  CABLESIM_ASSIGN_OR_RETURN(v[0], ConvertTimeFunction(Sub(path, "x"), p.x()));
+  CABLESIM_ASSIGN_OR_RETURN(v[1], ConvertTimeFunction(Sub(path, "y"), p.y()));
+  CABLESIM_ASSIGN_OR_RETURN(v[2], ConvertTimeFunction(Sub(path, "z"), p.z()));
+  return v;
+}
+
 absl::StatusOr<Eigen::Vector3d> FiniteVector(absl::string_view path, const v1::Vec3& v) {
   CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(path, "x"), v.x()));
   CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(path, "y"), v.y()));
@@ -519,6 +579,22 @@ class SceneConverter {
       return Invalid(Sub(path, "b"),
                      absl::StrCat("joins body \"", scene_.bodies[a.body].name, "\" to itself"));
     }
+    if (j.has_motion()) {
+      const std::string motion = Sub(path, "motion");
+      CABLESIM_ASSIGN_OR_RETURN(joint->motion, ConvertTimeVector(motion, j.motion()));
+      if (joint->HasMotion() && !b.IsGround()) {
+        return Invalid(motion, "only a joint to ground moves (side b must be the ground)");
+      }
+      for (int d = 0; d < 3; ++d) {
+        const double start = joint->motion[d](0);
+        if (std::abs(start) > 1e-12) {
+          return Invalid(Sub(motion, std::string(1, "xyz"[d])),
+                         absl::StrCat("must be 0 at t = 0 (the scene places the joint at its "
+                                      "start; got ",
+                                      Num(start), " m)"));
+        }
+      }
+    }
     return absl::OkStatus();
   }
 
@@ -531,7 +607,17 @@ class SceneConverter {
     CABLESIM_ASSIGN_OR_RETURN(load->torque_nm, VectorInRange(torque_path, l.torque(), plausible::kTorque));
     if (load->at.cable >= 0) {
       if (!load->torque_nm.isZero(0)) return Invalid(torque_path, "allowed on bodies only");
-    } else {
+    }
+    if (l.has_varying_force()) {
+      CABLESIM_ASSIGN_OR_RETURN(load->varying_force_n,
+                                ConvertTimeVector(Sub(path, "varying_force"), l.varying_force()));
+    }
+    if (l.has_varying_torque()) {
+      const std::string varying_torque = Sub(path, "varying_torque");
+      CABLESIM_ASSIGN_OR_RETURN(load->varying_torque_nm,
+                                ConvertTimeVector(varying_torque, l.varying_torque()));
+      if (load->at.cable >= 0 && !IsZero(load->varying_torque_nm))
+        return Invalid(varying_torque, "allowed on bodies only");
     }
     return absl::OkStatus();
   }
