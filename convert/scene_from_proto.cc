@@ -13,6 +13,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/string_view.h"
 #include "convert/plausible_ranges.h"
+#include "engine/polyline.h"
 
 // Local helpers for early return on error.
 #define CABLESIM_RETURN_IF_ERROR(expr)   \
@@ -312,6 +313,8 @@ class SceneConverter {
     for (int i = 0; i < proto_.joints_size(); ++i) {
       CABLESIM_RETURN_IF_ERROR(ConvertJoint(i, &scene_.joints[i]));
     }
+    // Bodies threaded on a cable: a PIN at each face, after the scene's own.
+    for (const JointSpec& joint : threaded_joints_) scene_.joints.push_back(joint);
     scene_.loads.resize(proto_.loads_size());
     for (int i = 0; i < proto_.loads_size(); ++i) {
       CABLESIM_RETURN_IF_ERROR(ConvertLoad(i, &scene_.loads[i]));
@@ -508,10 +511,66 @@ class SceneConverter {
       return Invalid(Sub(path, "mass"), "required (give cylinder + density, or mass + inertia)");
     }
 
+    if (b.has_on()) return PlaceOnCable(i, b);
     CABLESIM_ASSIGN_OR_RETURN(body->position_m, VectorInRange(Sub(path, "position"), b.position(), plausible::kCoordinate));
     body->axis = Eigen::Vector3d::UnitX();
     if (b.has_axis()) {
       CABLESIM_ASSIGN_OR_RETURN(body->axis, Direction(Sub(path, "axis"), b.axis()));
+    }
+    return absl::OkStatus();
+  }
+
+  // Body.on: the position and axis from the cable's polyline (the points
+  // the model builder lays the cable's nodes at), and for a threaded body
+  // the two PIN joints at its faces.
+  absl::Status PlaceOnCable(int i, const v1::Body& b) {
+    BodySpec* body = &scene_.bodies[i];
+    const std::string path = Indexed("", "bodies", i);
+    const std::string on = Sub(path, "on");
+    if (b.has_position()) return Invalid(Sub(path, "position"), "not with on (the cable places the body)");
+    if (b.has_axis()) return Invalid(Sub(path, "axis"), "not with on (the cable's tangent is the axis)");
+    CABLESIM_RETURN_IF_ERROR(CheckNameLength(Sub(on, "cable"), b.on().cable()));
+    const auto it = cable_index_.find(b.on().cable());
+    if (it == cable_index_.end()) {
+      return Invalid(Sub(on, "cable"), absl::StrCat("no cable named \"", b.on().cable(), "\""));
+    }
+    const CableSpec& cable = scene_.cables[it->second];
+    const double length = cable.length_m, s = b.on().s();
+    const std::string s_path = Sub(on, "s");
+    CABLESIM_RETURN_IF_ERROR(CheckFinite(s_path, s));
+    const double half = b.on().threaded() ? b.cylinder().height() / 2 : 0;
+    if (b.on().threaded() && !b.has_cylinder()) {
+      return Invalid(Sub(on, "threaded"),
+                     "needs cylinder (its faces are where the cable enters and leaves)");
+    }
+    const double tolerance = kArcLengthTolerance * length;
+    if (s - half < -tolerance || s + half > length + tolerance) {
+      return Invalid(s_path, absl::StrCat("must be in [", Num(half), ", ", Num(length - half),
+                                          "] (got ", Num(s), ")"));
+    }
+    Eigen::Vector3d point, tangent;
+    if (!b.on().threaded()) {
+      PolylineAt(cable.points, std::clamp(s, 0.0, length) / length, &point, &tangent);
+      body->position_m = point;
+      body->axis = tangent;
+      return absl::OkStatus();
+    }
+    const double s1 = std::max(s - half, 0.0), s2 = std::min(s + half, length);
+    Eigen::Vector3d p1, p2;
+    PolylineAt(cable.points, s1 / length, &p1, &tangent);
+    PolylineAt(cable.points, s2 / length, &p2, &tangent);
+    const double chord = (p2 - p1).norm();
+    if (!(chord > 0)) return Invalid(s_path, "the cable's faces coincide");
+    body->position_m = (p1 + p2) / 2;
+    body->axis = (p2 - p1) / chord;
+    for (const auto& [arc, x] : {std::pair{s1, -chord / 2}, std::pair{s2, chord / 2}}) {
+      JointSpec joint;
+      joint.type = JointType::kPin;
+      joint.a.cable = it->second;
+      joint.a.s_m = arc;
+      joint.b.body = i;
+      joint.b.point_body_m = Eigen::Vector3d(x, 0, 0);
+      threaded_joints_.push_back(joint);
     }
     return absl::OkStatus();
   }
@@ -805,6 +864,8 @@ class SceneConverter {
   Scene scene_;
   std::map<std::string, int, std::less<>> cable_index_;
   std::map<std::string, int, std::less<>> body_index_;
+  // The PIN joints at the faces of bodies threaded on a cable (Body.on).
+  std::vector<JointSpec> threaded_joints_;
   std::map<std::string, int, std::less<>> probe_index_;
 };
 
