@@ -52,6 +52,14 @@ std::string CsvWriter::Header(const std::vector<std::string>& probe_names) {
   return header;
 }
 
+std::string CsvWriter::HeaderFor(const ModelInfo& info) {
+  std::string header = Header(info.probe_names);
+  for (const std::string& name : info.force_probe_names) {
+    for (const char* column : {"fx", "fy", "fz"}) absl::StrAppend(&header, ",", name, ".", column);
+  }
+  return header;
+}
+
 absl::Status CsvWriter::CheckStream(const char* what) {
   if (status_.ok() && !*out_) {
     const int error = errno;
@@ -70,7 +78,7 @@ absl::Status CsvWriter::OnStart(const ModelInfo& info) {
   started_ = true;
   probe_count_ = info.probe_names.size();
   errno = 0;
-  *out_ << Header(info.probe_names) << '\n';
+  *out_ << HeaderFor(info) << '\n';
   out_->flush();
   return CheckStream("writing the header");
 }
@@ -99,6 +107,7 @@ absl::Status CsvWriter::OnFrame(const Frame& frame) {
        {e.kinetic, e.potential, e.axial, e.bending, e.total, frame.constraint_violation}) {
     AppendNumber(&row, value);
   }
+  for (const Eigen::Vector3d& force : frame.support_forces) AppendVector(&row, force);
   row += '\n';
   errno = 0;
   out_->write(row.data(), static_cast<std::streamsize>(row.size()));

@@ -60,6 +60,8 @@ class CsvWriter : public FrameSink {
 
   // The header line for `probe_names`, without the newline.
   static std::string Header(const std::vector<std::string>& probe_names);
+  // The same, then NAME.fx NAME.fy NAME.fz per probe on a moving support.
+  static std::string HeaderFor(const ModelInfo& info);
 
  private:
   CsvWriter(std::unique_ptr<std::ofstream> file, std::string name);

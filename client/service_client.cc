@@ -134,7 +134,7 @@ absl::StatusOr<RunSummary> ReadRunStream(grpc::ClientContext* context,
     if (event.has_header()) {
       const ModelInfo info = ModelInfoFromProto(event.header().info());
       probes = static_cast<int>(info.probe_names.size());
-      columns = FrameRowSize(probes);
+      columns = FrameRowSize(probes) + 3 * static_cast<int>(info.force_probe_names.size());
       end_time = event.header().end_time_s();
       sink_error = sink->OnStart(info);
     } else if (event.has_frames()) {

@@ -13,6 +13,7 @@ v1::ModelInfo ModelInfoToProto(const ModelInfo& info) {
   p.set_elements(info.elements);
   p.set_nodes(info.nodes);
   for (const std::string& name : info.probe_names) p.add_probe_names(name);
+  for (const std::string& name : info.force_probe_names) p.add_force_probe_names(name);
   return p;
 }
 
@@ -25,6 +26,7 @@ ModelInfo ModelInfoFromProto(const v1::ModelInfo& p) {
   info.elements = p.elements();
   info.nodes = p.nodes();
   info.probe_names.assign(p.probe_names().begin(), p.probe_names().end());
+  info.force_probe_names.assign(p.force_probe_names().begin(), p.force_probe_names().end());
   return info;
 }
 
@@ -120,6 +122,14 @@ std::vector<std::string> FrameColumns(const std::vector<std::string>& probe_name
   return columns;
 }
 
+std::vector<std::string> FrameColumnsFor(const ModelInfo& info) {
+  std::vector<std::string> columns = FrameColumns(info.probe_names);
+  for (const std::string& name : info.force_probe_names) {
+    for (const char* c : {"fx", "fy", "fz"}) columns.push_back(absl::StrCat(name, ".", c));
+  }
+  return columns;
+}
+
 void AppendFrameRow(const Frame& frame, google::protobuf::RepeatedField<double>* values) {
   values->Add(frame.t);
   for (const ProbeSample& p : frame.probes) {
@@ -134,6 +144,8 @@ void AppendFrameRow(const Frame& frame, google::protobuf::RepeatedField<double>*
   values->Add(e.bending);
   values->Add(e.total);
   values->Add(frame.constraint_violation);
+  for (const Eigen::Vector3d& f : frame.support_forces)
+    for (int k = 0; k < 3; ++k) values->Add(f[k]);
 }
 
 void FrameFromRow(absl::Span<const double> row, int probes, Frame* frame) {
@@ -152,6 +164,10 @@ void FrameFromRow(absl::Span<const double> row, int probes, Frame* frame) {
   e.bending = row[i++];
   e.total = row[i++];
   frame->constraint_violation = row[i++];
+  // The rest: the forces of moving supports, 3 per probe on one.
+  frame->support_forces.resize((row.size() - i) / 3);
+  for (Eigen::Vector3d& f : frame->support_forces)
+    for (int k = 0; k < 3; ++k) f[k] = row[i++];
 }
 
 }  // namespace cablesim

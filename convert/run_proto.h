@@ -34,6 +34,9 @@ inline constexpr int kTrailingValues = 6;
 
 // The column names of a frame row for these probes.
 std::vector<std::string> FrameColumns(const std::vector<std::string>& probe_names);
+// The same, then NAME.fx NAME.fy NAME.fz per probe on a moving support
+// (info.force_probe_names): the columns of a scene's frames.
+std::vector<std::string> FrameColumnsFor(const ModelInfo& info);
 inline int FrameRowSize(int probes) { return 1 + kValuesPerProbe * probes + kTrailingValues; }
 
 // Appends `frame` as one row to `values`.

@@ -13,6 +13,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/string_view.h"
 #include "convert/plausible_ranges.h"
+#include "engine/polyline.h"
 
 // Local helpers for early return on error.
 #define CABLESIM_RETURN_IF_ERROR(expr)   \
@@ -154,6 +155,66 @@ absl::Status CheckTolerance(absl::string_view path, double value) {
   return absl::OkStatus();
 }
 
+// How deep TimeFunction.sum may nest.
+constexpr int kMaxTimeFunctionDepth = 8;
+
+absl::StatusOr<TimeFunction> ConvertTimeFunction(const std::string& path,
+                                                 const v1::TimeFunction& p, int depth = 0) {
+  TimeFunction f;
+  CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(path, "constant"), p.constant()));
+  f.set_constant(p.constant());
+  if (p.has_table()) {
+    const std::string table = Sub(path, "table");
+    const auto& times = p.table().times();
+    const auto& values = p.table().values();
+    if (times.empty()) return Invalid(Sub(table, "times"), "must have at least one entry");
+    if (values.size() != times.size()) {
+      return Invalid(Sub(table, "values"),
+                     absl::StrCat("must have as many entries as times (", times.size(), "; got ",
+                                  values.size(), ")"));
+    }
+    for (int k = 0; k < times.size(); ++k) {
+      CABLESIM_RETURN_IF_ERROR(CheckFinite(Indexed(table, "times", k), times[k]));
+      CABLESIM_RETURN_IF_ERROR(CheckFinite(Indexed(table, "values", k), values[k]));
+      if (k > 0 && !(times[k] > times[k - 1])) {
+        return Invalid(Sub(table, "times"),
+                       absl::StrCat("times must increase (times[", k, "] = ", Num(times[k]),
+                                    " after ", Num(times[k - 1]), ")"));
+      }
+    }
+    f.set_table({times.begin(), times.end()}, {values.begin(), values.end()});
+  }
+  if (p.has_harmonic()) {
+    const std::string h = Sub(path, "harmonic");
+    CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(h, "amplitude"), p.harmonic().amplitude()));
+    CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(h, "frequency"), p.harmonic().frequency()));
+    CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(h, "phase"), p.harmonic().phase()));
+    f.add_harmonic({p.harmonic().amplitude(), p.harmonic().frequency(), p.harmonic().phase()});
+  }
+  if (p.has_ramp()) {
+    const std::string r = Sub(path, "ramp");
+    CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(r, "slope"), p.ramp().slope()));
+    CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(r, "start"), p.ramp().start()));
+    f.add_ramp({p.ramp().slope(), p.ramp().start()});
+  }
+  for (int i = 0; i < p.sum_size(); ++i) {
+    const std::string sub = Indexed(path, "sum", i);
+    if (depth + 1 >= kMaxTimeFunctionDepth)
+      return Invalid(sub, absl::StrCat("at most ", kMaxTimeFunctionDepth, " levels of sum"));
+    CABLESIM_ASSIGN_OR_RETURN(TimeFunction term, ConvertTimeFunction(sub, p.sum(i), depth + 1));
+    f.add_term(std::move(term));
+  }
+  return f;
+}
+
+absl::StatusOr<TimeVector> ConvertTimeVector(const std::string& path, const v1::TimeVec3& p) {
+  TimeVector v;
+  CABLESIM_ASSIGN_OR_RETURN(v[0], ConvertTimeFunction(Sub(path, "x"), p.x()));
+  CABLESIM_ASSIGN_OR_RETURN(v[1], ConvertTimeFunction(Sub(path, "y"), p.y()));
+  CABLESIM_ASSIGN_OR_RETURN(v[2], ConvertTimeFunction(Sub(path, "z"), p.z()));
+  return v;
+}
+
 absl::StatusOr<Eigen::Vector3d> FiniteVector(absl::string_view path, const v1::Vec3& v) {
   CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(path, "x"), v.x()));
   CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(path, "y"), v.y()));
@@ -252,6 +313,8 @@ class SceneConverter {
     for (int i = 0; i < proto_.joints_size(); ++i) {
       CABLESIM_RETURN_IF_ERROR(ConvertJoint(i, &scene_.joints[i]));
     }
+    // Bodies threaded on a cable: a PIN at each face, after the scene's own.
+    for (const JointSpec& joint : threaded_joints_) scene_.joints.push_back(joint);
     scene_.loads.resize(proto_.loads_size());
     for (int i = 0; i < proto_.loads_size(); ++i) {
       CABLESIM_RETURN_IF_ERROR(ConvertLoad(i, &scene_.loads[i]));
@@ -448,10 +511,66 @@ class SceneConverter {
       return Invalid(Sub(path, "mass"), "required (give cylinder + density, or mass + inertia)");
     }
 
+    if (b.has_on()) return PlaceOnCable(i, b);
     CABLESIM_ASSIGN_OR_RETURN(body->position_m, VectorInRange(Sub(path, "position"), b.position(), plausible::kCoordinate));
     body->axis = Eigen::Vector3d::UnitX();
     if (b.has_axis()) {
       CABLESIM_ASSIGN_OR_RETURN(body->axis, Direction(Sub(path, "axis"), b.axis()));
+    }
+    return absl::OkStatus();
+  }
+
+  // Body.on: the position and axis from the cable's polyline (the points
+  // the model builder lays the cable's nodes at), and for a threaded body
+  // the two PIN joints at its faces.
+  absl::Status PlaceOnCable(int i, const v1::Body& b) {
+    BodySpec* body = &scene_.bodies[i];
+    const std::string path = Indexed("", "bodies", i);
+    const std::string on = Sub(path, "on");
+    if (b.has_position()) return Invalid(Sub(path, "position"), "not with on (the cable places the body)");
+    if (b.has_axis()) return Invalid(Sub(path, "axis"), "not with on (the cable's tangent is the axis)");
+    CABLESIM_RETURN_IF_ERROR(CheckNameLength(Sub(on, "cable"), b.on().cable()));
+    const auto it = cable_index_.find(b.on().cable());
+    if (it == cable_index_.end()) {
+      return Invalid(Sub(on, "cable"), absl::StrCat("no cable named \"", b.on().cable(), "\""));
+    }
+    const CableSpec& cable = scene_.cables[it->second];
+    const double length = cable.length_m, s = b.on().s();
+    const std::string s_path = Sub(on, "s");
+    CABLESIM_RETURN_IF_ERROR(CheckFinite(s_path, s));
+    const double half = b.on().threaded() ? b.cylinder().height() / 2 : 0;
+    if (b.on().threaded() && !b.has_cylinder()) {
+      return Invalid(Sub(on, "threaded"),
+                     "needs cylinder (its faces are where the cable enters and leaves)");
+    }
+    const double tolerance = kArcLengthTolerance * length;
+    if (s - half < -tolerance || s + half > length + tolerance) {
+      return Invalid(s_path, absl::StrCat("must be in [", Num(half), ", ", Num(length - half),
+                                          "] (got ", Num(s), ")"));
+    }
+    Eigen::Vector3d point, tangent;
+    if (!b.on().threaded()) {
+      PolylineAt(cable.points, std::clamp(s, 0.0, length) / length, &point, &tangent);
+      body->position_m = point;
+      body->axis = tangent;
+      return absl::OkStatus();
+    }
+    const double s1 = std::max(s - half, 0.0), s2 = std::min(s + half, length);
+    Eigen::Vector3d p1, p2;
+    PolylineAt(cable.points, s1 / length, &p1, &tangent);
+    PolylineAt(cable.points, s2 / length, &p2, &tangent);
+    const double chord = (p2 - p1).norm();
+    if (!(chord > 0)) return Invalid(s_path, "the cable's faces coincide");
+    body->position_m = (p1 + p2) / 2;
+    body->axis = (p2 - p1) / chord;
+    for (const auto& [arc, x] : {std::pair{s1, -chord / 2}, std::pair{s2, chord / 2}}) {
+      JointSpec joint;
+      joint.type = JointType::kPin;
+      joint.a.cable = it->second;
+      joint.a.s_m = arc;
+      joint.b.body = i;
+      joint.b.point_body_m = Eigen::Vector3d(x, 0, 0);
+      threaded_joints_.push_back(joint);
     }
     return absl::OkStatus();
   }
@@ -519,6 +638,22 @@ class SceneConverter {
       return Invalid(Sub(path, "b"),
                      absl::StrCat("joins body \"", scene_.bodies[a.body].name, "\" to itself"));
     }
+    if (j.has_motion()) {
+      const std::string motion = Sub(path, "motion");
+      CABLESIM_ASSIGN_OR_RETURN(joint->motion, ConvertTimeVector(motion, j.motion()));
+      if (joint->HasMotion() && !b.IsGround()) {
+        return Invalid(motion, "only a joint to ground moves (side b must be the ground)");
+      }
+      for (int d = 0; d < 3; ++d) {
+        const double start = joint->motion[d](0);
+        if (std::abs(start) > 1e-12) {
+          return Invalid(Sub(motion, std::string(1, "xyz"[d])),
+                         absl::StrCat("must be 0 at t = 0 (the scene places the joint at its "
+                                      "start; got ",
+                                      Num(start), " m)"));
+        }
+      }
+    }
     return absl::OkStatus();
   }
 
@@ -531,7 +666,17 @@ class SceneConverter {
     CABLESIM_ASSIGN_OR_RETURN(load->torque_nm, VectorInRange(torque_path, l.torque(), plausible::kTorque));
     if (load->at.cable >= 0) {
       if (!load->torque_nm.isZero(0)) return Invalid(torque_path, "allowed on bodies only");
-    } else {
+    }
+    if (l.has_varying_force()) {
+      CABLESIM_ASSIGN_OR_RETURN(load->varying_force_n,
+                                ConvertTimeVector(Sub(path, "varying_force"), l.varying_force()));
+    }
+    if (l.has_varying_torque()) {
+      const std::string varying_torque = Sub(path, "varying_torque");
+      CABLESIM_ASSIGN_OR_RETURN(load->varying_torque_nm,
+                                ConvertTimeVector(varying_torque, l.varying_torque()));
+      if (load->at.cable >= 0 && !IsZero(load->varying_torque_nm))
+        return Invalid(varying_torque, "allowed on bodies only");
     }
     return absl::OkStatus();
   }
@@ -719,6 +864,8 @@ class SceneConverter {
   Scene scene_;
   std::map<std::string, int, std::less<>> cable_index_;
   std::map<std::string, int, std::less<>> body_index_;
+  // The PIN joints at the faces of bodies threaded on a cable (Body.on).
+  std::vector<JointSpec> threaded_joints_;
   std::map<std::string, int, std::less<>> probe_index_;
 };
 

@@ -61,6 +61,7 @@ void GeneralizedAlphaStepper::LoadMass() {
 }
 
 bool GeneralizedAlphaStepper::Initialize(std::string* reason) {
+  model_->SetTime(t_);
   model_->ToFull(z_, &q_);
   model_->NetForce(q_, 1.0, &f_);
   model_->Constraints(q_, &phi_, &solver_.b());
@@ -104,6 +105,7 @@ void GeneralizedAlphaStepper::Restore() {
   acc_ = acc_old_;
   lambda_ = lambda_old_;
   g_ = g_old_;
+  t_ = t_old_;
 }
 
 double GeneralizedAlphaStepper::LocalErrorNorm(double h, double atol, double rtol) const {
@@ -118,6 +120,7 @@ double GeneralizedAlphaStepper::LocalErrorNorm(double h, double atol, double rto
 
 Stepper::StepStats GeneralizedAlphaStepper::Step(double h) {
   const bool reuse = settings_.reuse_factorization;
+  model_->SetTime(t_ + h);
   StepStats st = Solve(h, !reuse || refresh_);
   if (!st.converged && reuse && st.reason.find("non-finite pivot") == std::string::npos) {
     // Safeguard: a kept Newton matrix may be what failed; retry once fresh.
@@ -314,6 +317,8 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
   h_last_ = h;
   // g_{n+1} from the converged evaluation (forces and Jacobian at z_{n+1}).
   g_ = bt_lambda_ - f_;
+  t_old_ = t_;
+  t_ += h;
   return st;
 }
 

@@ -143,6 +143,11 @@ class GeneralizedAlphaStepper final : public Stepper {
   bool refresh_ = true;
   // The last step's size (0: none yet) and the one before, for the predictor.
   double h_last_ = 0, h_old_ = 0;
+  // Time [s] of the state, and before the last step. Every step sets the
+  // model's time to t_{n+1}: both variants impose Phi(z_{n+1}, t_{n+1}) = 0
+  // and evaluate f at t_{n+1} (HHT's f_n is kept in g_ from the step
+  // before, so the alpha-weighted sum takes the load at t_n and t_{n+1}).
+  double t_ = 0, t_old_ = 0;
 };
 
 }  // namespace cablesim

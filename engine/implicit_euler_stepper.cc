@@ -41,6 +41,7 @@ void ImplicitEulerStepper::Restore() {
   v_ = v_old_;
   a_ = a_old_;
   lambda_ = lambda_old_;
+  t_ = t_old_;
 }
 
 double ImplicitEulerStepper::LocalErrorNorm(double h, double atol, double rtol) const {
@@ -51,6 +52,7 @@ double ImplicitEulerStepper::LocalErrorNorm(double h, double atol, double rtol) 
 }
 
 bool ImplicitEulerStepper::Initialize(std::string* reason) {
+  model_->SetTime(t_);
   model_->ToFull(z_, &q_);
   model_->NetForce(q_, 1.0, &f_);
   model_->Constraints(q_, &phi_, &solver_.b());
@@ -92,6 +94,7 @@ double ImplicitEulerStepper::AssembleForces(double h) {
 ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
   StepStats st;
   const double tol = settings_.newton_tolerance;
+  model_->SetTime(t_ + h);
   v1_ = v_ + h * a_;
   lambda1_ = lambda_;
   double last_increment = 0, previous_increment = 0;
@@ -198,6 +201,8 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
   v_.swap(v1_);
   lambda_.swap(lambda1_);
   a_ = (v_ - v_old_) / h;
+  t_old_ = t_;
+  t_ += h;
   return st;
 }
 

@@ -72,6 +72,10 @@ class ImplicitEulerStepper final : public Stepper {
   int n_ = 0, m_ = 0;
   Eigen::VectorXd z_, v_, a_, lambda_;
   Eigen::VectorXd z_old_, v_old_, a_old_, lambda_old_;  // before the last step
+  // Time [s] of the state, and before the last step: each step sets the
+  // model's time to its end (prescribed motions and varying loads at
+  // t_{n+1}, where backward Euler imposes Phi(z_{n+1}, t_{n+1}) = 0).
+  double t_ = 0, t_old_ = 0;
   // Newton work vectors.
   Eigen::VectorXd z1_, v1_, lambda1_, q_, f_, phi_, mdv_, rhs_, dx_, bt_mu_;
   // The residual's rounding floor per unknown, and the terms summed into it.

@@ -10,6 +10,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "engine/model_choice.h"
+#include "engine/polyline.h"
 
 namespace cablesim {
 namespace {
@@ -19,40 +20,6 @@ using Eigen::VectorXd;
 
 // Relative tolerance for matching arc lengths to nodes.
 constexpr double kSnap = 1e-9;
-
-// Arc-length position along a polyline: point and unit tangent at `frac`
-// of its total length. At an interior vertex the tangent is the average of
-// the two segments' directions (side 0), or the incoming (side -1) or
-// outgoing (side +1) segment's.
-void PolylineAt(const std::vector<Vector3d>& pts, double frac, Vector3d* point,
-                Vector3d* tangent, int side = 0) {
-  std::vector<double> cum(pts.size(), 0.0);
-  for (size_t i = 1; i < pts.size(); ++i) cum[i] = cum[i - 1] + (pts[i] - pts[i - 1]).norm();
-  const double total = cum.back();
-  const double s = std::clamp(frac, 0.0, 1.0) * total;
-  size_t seg = 1;
-  while (seg + 1 < pts.size() && cum[seg] < s) ++seg;
-  const Vector3d a = pts[seg - 1], b = pts[seg];
-  const double len = cum[seg] - cum[seg - 1];
-  const double t = len > 0 ? (s - cum[seg - 1]) / len : 0;
-  *point = a + t * (b - a);
-  Vector3d dir = (b - a).normalized();
-  const double tol = kSnap * total;
-  if (std::abs(s - cum[seg]) <= tol && seg + 1 < pts.size()) {
-    const Vector3d out = (pts[seg + 1] - b).normalized();
-    dir = side < 0 ? dir : side > 0 ? out : (dir + out).normalized();
-  } else if (std::abs(s - cum[seg - 1]) <= tol && seg >= 2) {
-    const Vector3d in = (a - pts[seg - 2]).normalized();
-    dir = side > 0 ? dir : side < 0 ? in : (dir + in).normalized();
-  }
-  *tangent = dir;
-}
-
-double PolylineLength(const std::vector<Vector3d>& pts) {
-  double total = 0;
-  for (size_t i = 1; i < pts.size(); ++i) total += (pts[i] - pts[i - 1]).norm();
-  return total;
-}
 
 // The body frame at t = 0 from its x axis (scene.h): columns x, y, z.
 Eigen::Matrix3d BodyFrame(const Vector3d& axis) {
@@ -286,6 +253,28 @@ absl::Status ModelBuilder::Joints() {
           absl::StrCat("joints[", ji, "].a: a joint needs a cable or a body on one side"));
     }
     const bool fixed = joint.type == JointType::kFixed;
+    if (b.IsGround() && joint.HasMotion()) {
+      // A moving support: its point stays as rows (below); FIXED keeps the
+      // orientation by elimination, as a fixed support does.
+      if (fixed && a.cable >= 0) {
+        const int node = mesh_.Node(a);
+        elimination_.clamped[node] = true;
+        elimination_.clamp_dir[node] = AtStart(NodeSlope(node)).normalized();
+      } else if (fixed) {
+        const int i = BodyCoord(a.body);
+        for (int k = D; k < bs; ++k) grounded[i + k] = true;
+      }
+      const LinearVector pa = PointOf(a);
+      const Vector3d p0 = AtStart(pa);
+      for (int d = 0; d < D; ++d) {
+        LinearForm diff = pa[d];
+        diff.c -= p0(d);
+        PendingRow row{QuadraticForm::FromLinear(diff), Row::kPosition, ji, -1};
+        row.motion_axis = d;
+        pending_.push_back(row);
+      }
+      continue;
+    }
     if (b.IsGround()) {
       if (a.cable >= 0) {
         const int node = mesh_.Node(a);
@@ -492,8 +481,33 @@ void ModelBuilder::KeepMovableRows() {
       if (m.j_[ij.first] >= 0) grad(m.j_[ij.first]) += v * m.s_(ij.first) * q0_(ij.second);
       if (m.j_[ij.second] >= 0) grad(m.j_[ij.second]) += v * m.s_(ij.second) * q0_(ij.first);
     }
-    if (grad.lpNorm<Eigen::Infinity>() > 1e-12) m.AddRow(r.f, r.kind, r.joint, r.body);
+    if (grad.lpNorm<Eigen::Infinity>() <= 1e-12) continue;
+    m.AddRow(r.f, r.kind, r.joint, r.body);
+    if (r.motion_axis >= 0) {
+      MultibodyModel::MovingRow moving;
+      moving.row = static_cast<int>(m.rows_.size()) - 1;
+      moving.joint = r.joint;
+      moving.axis = r.motion_axis;
+      moving.c0 = r.f.c;
+      moving.motion = scene_.joints[r.joint].motion[r.motion_axis];
+      m.moving_rows_.push_back(moving);
+    }
   }
+}
+
+absl::Status ModelBuilder::CheckMovingRows() const {
+  std::vector<int> kept(scene_.joints.size(), 0), wanted(scene_.joints.size(), 0);
+  for (const PendingRow& r : pending_)
+    if (r.motion_axis >= 0) ++wanted[r.joint];
+  for (const MultibodyModel::MovingRow& m : model_.moving_rows_) ++kept[m.joint];
+  for (size_t j = 0; j < kept.size(); ++j) {
+    if (kept[j] != wanted[j]) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "joints[%d].motion: the point it moves is also held by a fixed joint to ground",
+          static_cast<int>(j)));
+    }
+  }
+  return absl::OkStatus();
 }
 
 template <int D>
@@ -551,9 +565,23 @@ void ModelBuilder::ConstantForces() {
       for (const auto& [i, v] : point[d].terms) m.constant_force_(i) += v * force(d);
   };
   for (const LoadSpec& load : scene_.loads) {
-    add_point_force(PointOf(load.at), load.force_n);
-    if (load.at.body >= 0 && load.torque_nm.norm() > 0) {
-      m.torques_.push_back({load.at.body, load.torque_nm});
+    const LinearVector point = PointOf(load.at);
+    add_point_force(point, load.force_n);
+    if (!IsZero(load.varying_force_n)) {
+      MultibodyModel::VaryingForce v;
+      for (int d = 0; d < D; ++d)
+        for (const auto& [i, c] : point[d].terms) v.point[d].push_back({i, c});
+      v.force = load.varying_force_n;
+      m.varying_forces_.push_back(std::move(v));
+    }
+    const bool varying_torque = !IsZero(load.varying_torque_nm);
+    if (load.at.body >= 0 && (load.torque_nm.norm() > 0 || varying_torque)) {
+      MultibodyModel::TorqueLoad t;
+      t.body = load.at.body;
+      t.torque = t.base = load.torque_nm;
+      t.varying = load.varying_torque_nm;
+      t.is_varying = varying_torque;
+      m.torques_.push_back(std::move(t));
     }
   }
 }
@@ -569,6 +597,24 @@ void ModelBuilder::Probes() {
       m.probe_const_.push_back(point[d].c);
     }
     m.probe_names_.push_back(p.name);
+  }
+  // Probes placed where a moving support holds its cable or body report
+  // the support's force (its rows' multipliers).
+  m.probe_force_rows_.assign(scene_.probes.size(), {-1, -1, -1});
+  for (size_t p = 0; p < scene_.probes.size(); ++p) {
+    const Attachment& at = scene_.probes[p].at;
+    bool found = false;
+    for (const MultibodyModel::MovingRow& row : m.moving_rows_) {
+      const JointSpec& joint = scene_.joints[row.joint];
+      const Attachment& held = joint.a.IsGround() ? joint.b : joint.a;
+      const bool same = at.cable >= 0 ? held.cable == at.cable && mesh_.Node(held) == mesh_.Node(at)
+                                      : held.body == at.body && held.body >= 0 &&
+                                            (held.point_body_m - at.point_body_m).norm() <= 1e-12;
+      if (!same) continue;
+      m.probe_force_rows_[p][row.axis] = row.row;
+      found = true;
+    }
+    if (found) m.force_probes_.push_back(static_cast<int>(p));
   }
 }
 
@@ -682,6 +728,10 @@ void ModelBuilder::ConstraintPattern() {
 MultibodyModel ModelBuilder::Finish() {
   model_.scratch_full_ = VectorXd::Zero(q0_.size());
   model_.scratch_roundoff_ = VectorXd::Zero(q0_.size());
+  model_.time_dependent_ = !model_.moving_rows_.empty() || !model_.varying_forces_.empty();
+  for (const MultibodyModel::TorqueLoad& t : model_.torques_)
+    if (t.is_varying) model_.time_dependent_ = true;
+  model_.SetTime(0);
   model_.ProjectInitialVelocity();
   return std::move(model_);
 }

@@ -58,6 +58,9 @@ class ModelBuilder {
     MultibodyModel::Row::Kind kind;
     int joint;  // scene joint, or -1 for a body's own axis constraint
     int body;   // the body of an axis constraint, or -1
+    // A moving support's position row: the component of the joint's
+    // motion subtracted from it in time (-1: none).
+    int motion_axis = -1;
   };
 
   explicit ModelBuilder(const Scene& scene) : scene_(scene) {}
@@ -90,7 +93,11 @@ class ModelBuilder {
 
   // elimination(): the coordinates that joints to ground hold (a node's
   // position; a whole body welded to ground; a body's centre of mass when
-  // pinned there) and the clamped nodes. pending_rows(): every other joint
+  // pinned there) and the clamped nodes. A joint to ground with a motion
+  // (a moving support) keeps its point as D rows r - p0 - d(t) instead
+  // (rheonomic: MultibodyModel::SetTime); FIXED still clamps a node's
+  // slope to its initial direction, or a body's axes to their initial
+  // ones. pending_rows(): every other joint
   // as constraint rows (points coincide: D rows; FIXED also ties slopes or
   // axes), then each body's axes unit and orthogonal (1 row planar, 6
   // spatial). Fails for a joint with ground on both sides, and for FIXED
@@ -117,6 +124,10 @@ class ModelBuilder {
   // system singular.
   void KeepMovableRows();
 
+  // Fails when a moving support's row was dropped by KeepMovableRows (its
+  // point is also held by a fixed joint to ground): names the joint.
+  absl::Status CheckMovingRows() const;
+
   // The ANCF elements between consecutive nodes (not between the halves
   // of a split node) with their gravity [N] and scalar mass matrices [kg],
   // and the model's energy_roundoff [J].
@@ -124,11 +135,13 @@ class ModelBuilder {
 
   // The constant generalized force [N, or N m per unit slope]: element and
   // body gravity and each load's force at its point; the torques on
-  // bodies, kept apart (their work is summed step by step).
+  // bodies, kept apart (their work is summed step by step), and the
+  // time-varying forces with their points (evaluated by SetTime).
   void ConstantForces();
 
   // Each probe's point as a linear form of q (position [m] = const + sum
-  // coeff q_i).
+  // coeff q_i); a probe on the point a moving support holds also gets that
+  // support's rows (its force, MultibodyModel::ProbeForces).
   void Probes();
 
   // The skyline envelope of the Newton matrix on z (what elements, bodies
@@ -140,8 +153,9 @@ class ModelBuilder {
   // Hessian entry on z and factor.
   void ConstraintPattern();
 
-  // The model: scratch space, the initial velocity projected onto the
-  // joints. The builder is spent.
+  // The model: scratch space, its time set to 0 (moving supports and
+  // varying loads at their start), the initial velocity projected onto
+  // the joints (and the supports' initial velocity). The builder is spent.
   MultibodyModel Finish();
 
   // Results of the steps.

@@ -41,12 +41,16 @@ std::string OutOfPlaneField(const Scene& scene) {
     const std::string path = absl::StrCat("joints[", i, "]");
     if (auto f = attachment(path + ".a", scene.joints[i].a); !f.empty()) return f;
     if (auto f = attachment(path + ".b", scene.joints[i].b); !f.empty()) return f;
+    if (!scene.joints[i].motion[2].IsZero()) return path + ".motion.z";
   }
   for (size_t i = 0; i < scene.loads.size(); ++i) {
     const std::string path = absl::StrCat("loads[", i, "]");
     if (auto f = attachment(path + ".at", scene.loads[i].at); !f.empty()) return f;
     if (auto f = Z(path + ".force", scene.loads[i].force_n); !f.empty()) return f;
     if (auto f = NotAboutZ(path + ".torque", scene.loads[i].torque_nm); !f.empty()) return f;
+    if (!scene.loads[i].varying_force_n[2].IsZero()) return path + ".varying_force.z";
+    if (!scene.loads[i].varying_torque_nm[0].IsZero()) return path + ".varying_torque.x";
+    if (!scene.loads[i].varying_torque_nm[1].IsZero()) return path + ".varying_torque.y";
   }
   for (size_t i = 0; i < scene.probes.size(); ++i) {
     if (auto f = attachment(absl::StrCat("probes[", i, "]"), scene.probes[i].at); !f.empty())

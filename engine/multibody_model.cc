@@ -91,6 +91,7 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
   if (absl::Status s = builder.CheckJointsAtStart(); !s.ok()) return s;
   builder.OrderUnknowns();
   builder.KeepMovableRows();
+  if (absl::Status s = builder.CheckMovingRows(); !s.ok()) return s;
   builder.BuildElements();
   builder.ConstantForces();
   builder.Probes();
@@ -161,6 +162,8 @@ void MultibodyModel::ProjectInitialVelocity() {
   Constraints(q0, &phi, &jac);
   VectorXd jv(nrows);
   jac.Multiply(v0_.data(), jv.data());
+  // Moving supports: Phi_z v + Phi_t = 0 with Phi_t = -motion'(t).
+  for (const MovingRow& m : moving_rows_) jv(m.row) -= m.rate;
   if (jv.lpNorm<Eigen::Infinity>() <= 1e-14 * (1 + v0_.lpNorm<Eigen::Infinity>())) return;
   SkylineLdlt mass = mass_;
   if (!mass.Factor()) return;
@@ -187,6 +190,7 @@ ModelInfo MultibodyModel::Info() const {
   info.elements = elements();
   info.nodes = nodes();
   info.probe_names = probe_names_;
+  for (int p : force_probes_) info.force_probe_names.push_back(probe_names_[p]);
   return info;
 }
 
@@ -244,6 +248,11 @@ double MultibodyModel::NetForce(const VectorXd& q, double load_factor, VectorXd*
   // constraints keep. Their derivative is skew-symmetric, so the symmetric
   // Newton matrix leaves it out (Newton then converges linearly, at a rate
   // of order h^2 |T| / J, instead of quadratically).
+  // Time-varying forces at points (their value at time_, SetTime).
+  for (const VaryingForce& l : varying_forces_) {
+    for (int d = 0; d < dim_; ++d)
+      for (const ProbeTerm& t : l.point[d]) full(t.coord) += load_factor * t.coeff * l.value(d);
+  }
   for (const TorqueLoad& t : torques_) {
     const int c = bodies_[t.body].coord;
     if (dim_ == 2) {
@@ -326,6 +335,21 @@ void MultibodyModel::ConstraintGamma(const VectorXd& q, const VectorXd& qdot,
       acc += mono_w_[k] * qdot(coord[mono_a_[k]]) * qdot(coord[mono_b_[k]]);
     (*gamma)(i) = -2 * acc;
   }
+  for (const MovingRow& m : moving_rows_) (*gamma)(m.row) += m.accel;
+}
+
+void MultibodyModel::SetTime(double t) {
+  time_ = t;
+  if (!time_dependent_) return;
+  for (MovingRow& m : moving_rows_) {
+    const TimeFunction::Value v = m.motion.Evaluate(t);
+    rows_[m.row].c = m.c0 - v.f;
+    m.rate = v.df;
+    m.accel = v.ddf;
+  }
+  for (VaryingForce& l : varying_forces_) l.value = Evaluate(l.force, t);
+  for (TorqueLoad& tl : torques_)
+    if (tl.is_varying) tl.torque = tl.base + Evaluate(tl.varying, t);
 }
 
 template <int D>
@@ -361,20 +385,38 @@ EnergySample MultibodyModel::Energy(const VectorXd& q, const VectorXd& qdot,
   // Gravity and point loads are constant forces on q: V = -F . q. Element
   // gravity is exactly -Q_g . e (MODEL.md section 2).
   en.potential = -load_factor * constant_force_.dot(q);
-  // Torques: their work so far (AccumulateTorqueWork).
-  en.potential -= torque_work_;
+  // Torques, time-varying loads, moving supports: their work so far
+  // (AccumulateExternalWork).
+  en.potential -= external_work_;
   en.total = en.kinetic + en.potential + en.axial + en.bending;
   return en;
 }
 
-void MultibodyModel::AccumulateTorqueWork(const VectorXd& q_before, const VectorXd& q_after,
-                                          double load_factor) {
-  for (const TorqueLoad& t : torques_) {
-    const int c = bodies_[t.body].coord;
+void MultibodyModel::AccumulateExternalWork(const VectorXd& q_before, const VectorXd& q_after,
+                                            double t_before, double t_after,
+                                            const VectorXd& lambda_before,
+                                            const VectorXd& lambda_after, double load_factor) {
+  for (const VaryingForce& l : varying_forces_) {
+    const Vector3d mean = 0.5 * (Evaluate(l.force, t_before) + Evaluate(l.force, t_after));
+    for (int d = 0; d < dim_; ++d)
+      for (const ProbeTerm& t : l.point[d])
+        external_work_ += load_factor * mean(d) * t.coeff * (q_after(t.coord) - q_before(t.coord));
+  }
+  for (const MovingRow& m : moving_rows_) {
+    const double lambda = 0.5 * (lambda_before(m.row) + lambda_after(m.row));
+    external_work_ -= lambda * (m.motion(t_after) - m.motion(t_before));
+  }
+  for (const TorqueLoad& tl : torques_) {
+    const Vector3d torque =
+        tl.is_varying
+            ? Vector3d(tl.base + 0.5 * (Evaluate(tl.varying, t_before) +
+                                        Evaluate(tl.varying, t_after)))
+            : tl.torque;
+    const int c = bodies_[tl.body].coord;
     if (dim_ == 2) {
       // Exact for a constant torque: T_z times the angle turned.
       const Eigen::Vector2d u0 = q_before.segment<2>(c + 2), u1 = q_after.segment<2>(c + 2);
-      torque_work_ += load_factor * t.torque.z() *
+      external_work_ += load_factor * torque.z() *
                       std::atan2(u0.x() * u1.y() - u0.y() * u1.x(), u0.dot(u1));
     } else {
       // T . phi with phi the rotation vector of the step (exact when the
@@ -385,7 +427,7 @@ void MultibodyModel::AccumulateTorqueWork(const VectorXd& q_before, const Vector
         after.col(k) = q_after.segment<3>(c + 3 + 3 * k);
       }
       const Eigen::AngleAxisd delta(Eigen::Matrix3d(after * before.transpose()));
-      torque_work_ += load_factor * t.torque.dot(delta.angle() * delta.axis());
+      external_work_ += load_factor * torque.dot(delta.angle() * delta.axis());
     }
   }
 }
@@ -446,6 +488,23 @@ void MultibodyModel::Probes(const VectorXd& q, const VectorXd& qdot, const Vecto
       s.position_m(d) = x;
       s.velocity_m_s(d) = v;
       s.acceleration_m_s2(d) = a;
+    }
+  }
+}
+
+}  // namespace cablesim
+
+namespace cablesim {
+
+void MultibodyModel::ProbeForces(const VectorXd& lambda,
+                                 std::vector<Eigen::Vector3d>* out) const {
+  out->resize(force_probes_.size());
+  for (size_t k = 0; k < force_probes_.size(); ++k) {
+    Eigen::Vector3d& force = (*out)[k];
+    force.setZero();
+    for (int d = 0; d < 3; ++d) {
+      const int row = probe_force_rows_[force_probes_[k]][d];
+      if (row >= 0) force(d) = -lambda(row);
     }
   }
 }

@@ -38,6 +38,7 @@
 //
 // All vectors of size dofs() are "reduced"; of size coordinates() "full".
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -132,24 +133,52 @@ class MultibodyModel {
   void AddConstraintHessian(const Eigen::VectorXd& q, const Eigen::VectorXd& lambda,
                             double scale, SkylineLdlt* a) const;
 
-  // gamma_i = -qdot^T (d^2 Phi_i / dq^2) qdot, the right-hand side of the
-  // acceleration-level constraints (eq. 30 without time dependence).
+  // gamma_i = -qdot^T (d^2 Phi_i / dq^2) qdot - d^2 Phi_i / dt^2, the
+  // right-hand side of the acceleration-level constraints Phi_z zdd =
+  // gamma (eq. 30), at the time of SetTime. Only the rows of moving
+  // supports depend on time: Phi_i = r_i - p_i - d_i(t), so their
+  // -Phi_tt = d_i''(t).
   void ConstraintGamma(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
                        Eigen::VectorXd* gamma) const;
 
+  // Time. Prescribed motions (rows Phi_i(q, t) = r_i(q) - p_i - d_i(t) of a
+  // joint to ground whose ground point moves by d(t)) and time-varying
+  // loads are evaluated at the time set here; Constraints, NetForce and
+  // ConstraintGamma use it. A scene without either has nothing to
+  // evaluate (is_time_dependent() false) and SetTime only stores t.
+  void SetTime(double t);
+  double time() const { return time_; }
+  bool is_time_dependent() const { return time_dependent_; }
+
   // Energy of a full state; potential includes the constant loads, and
-  // minus the work torques have done so far (AccumulateTorqueWork).
+  // minus the work the external agents have done so far
+  // (AccumulateExternalWork): torques, time-varying loads and moving
+  // supports. `total` is then what the exact solution conserves.
   EnergySample Energy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
                       double load_factor) const;
 
-  // A torque on a body is not a constant force in these coordinates, so its
-  // work is summed step by step: call this after every accepted step (or
-  // load increment) with the full configurations before and after it.
-  // Exact in the plane; in space, exact when the step's rotation axis is
-  // fixed, second order otherwise.
-  bool has_torques() const { return !torques_.empty(); }
-  void AccumulateTorqueWork(const Eigen::VectorXd& q_before, const Eigen::VectorXd& q_after,
-                            double load_factor);
+  // Work that is not a potential's is summed step by step: call this after
+  // every accepted step (or load increment) with the full configurations,
+  // times and multipliers before and after it.
+  //  - a torque on a body (not a constant force in these coordinates): its
+  //    mean over the step times the rotation vector of the step; exact in
+  //    the plane for a constant torque, in space when the rotation axis is
+  //    fixed, second order otherwise;
+  //  - a time-varying force F(t) at a point x: (F(t0) + F(t1)) / 2 . (x1 -
+  //    x0), the trapezoidal rule (second order);
+  //  - a moving support: the force it exerts on the system is -lambda_i
+  //    along row i, and the support point moves by d_i(t1) - d_i(t0), so
+  //    W = -(lambda_i0 + lambda_i1) / 2 (d_i(t1) - d_i(t0)) (second order).
+  bool has_external_work() const {
+    return !torques_.empty() || !varying_forces_.empty() || !moving_rows_.empty();
+  }
+  void AccumulateExternalWork(const Eigen::VectorXd& q_before, const Eigen::VectorXd& q_after,
+                              double t_before, double t_after,
+                              const Eigen::VectorXd& lambda_before,
+                              const Eigen::VectorXd& lambda_after, double load_factor);
+  // Starts the sum over (a new run of the same model).
+  void ResetExternalWork() { external_work_ = 0; }
+  double external_work() const { return external_work_; }
 
   // Angular momentum about the world origin [kg m^2/s], exact for the
   // discretised mass: sum over elements of mbar_ab r_a x rdot_b (r_a the
@@ -160,6 +189,10 @@ class MultibodyModel {
   // Probes from full position, velocity and acceleration.
   void Probes(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
               const Eigen::VectorXd& qddot, std::vector<ProbeSample>* out) const;
+  // The force [N] a moving support exerts on what it holds, -lambda of its
+  // position rows, per probe placed on such a joint
+  // (ModelInfo::force_probe_names).
+  void ProbeForces(const Eigen::VectorXd& lambda, std::vector<Eigen::Vector3d>* out) const;
 
   // Which joint a constraint row belongs to (for messages), or -1 for a
   // body's own axis constraints.
@@ -182,10 +215,33 @@ class MultibodyModel {
     double mass = 0;
     Eigen::Vector3d jbar = Eigen::Vector3d::Zero();  // per axis [kg m^2]
   };
-  // A torque load on a body [N m] and the rotation seen so far.
+  // A torque load on a body [N m]: torque = base + varying(t).
   struct TorqueLoad {
     int body = 0;
     Eigen::Vector3d torque = Eigen::Vector3d::Zero();
+    Eigen::Vector3d base = Eigen::Vector3d::Zero();
+    TimeVector varying;
+    bool is_varying = false;
+  };
+  // A flat linear form sum coeff * q[coord].
+  struct ProbeTerm {
+    int coord = 0;
+    double coeff = 0;
+  };
+  // A time-varying force at a point: per component d, the point's linear
+  // form (the generalized force is F_d coeff on q[coord]).
+  struct VaryingForce {
+    std::array<std::vector<ProbeTerm>, 3> point;
+    TimeVector force;
+    Eigen::Vector3d value = Eigen::Vector3d::Zero();  // force(time_)
+  };
+  // A constraint row of a moving support: c = c0 - motion(t).
+  struct MovingRow {
+    int row = 0;
+    int joint = 0, axis = 0;  // scene joint and component of its motion
+    double c0 = 0;
+    TimeFunction motion;
+    double rate = 0, accel = 0;  // motion' and motion'' at time_
   };
   // Constraint rows as flat quadratic forms over local coordinate lists:
   // phi = c + sum lin_val * q[coord[lin_local]] + sum w q[coord[a]] q[coord[b]].
@@ -264,10 +320,6 @@ class MultibodyModel {
 
   // Probes: per probe and component d < 3, a linear form over q (as flat
   // term lists); velocity and acceleration use the same coefficients.
-  struct ProbeTerm {
-    int coord = 0;
-    double coeff = 0;
-  };
   std::vector<int> probe_term_begin_;  // size 3 * probes + 1
   std::vector<ProbeTerm> probe_terms_;
   std::vector<double> probe_const_;    // 3 per probe
@@ -281,8 +333,16 @@ class MultibodyModel {
   SparseRows jac_pattern_;
   // Scratch (full size) for NetForce.
   Eigen::VectorXd scratch_full_, scratch_roundoff_;
-  // Work done by the torques so far [J].
-  double torque_work_ = 0;
+  // Per probe on a moving support, its row per component (-1: none).
+  std::vector<std::array<int, 3>> probe_force_rows_;
+  std::vector<int> force_probes_;  // which probes (ascending)
+  // Time dependence.
+  double time_ = 0;
+  bool time_dependent_ = false;
+  std::vector<MovingRow> moving_rows_;
+  std::vector<VaryingForce> varying_forces_;
+  // Work done by torques, time-varying loads and moving supports so far [J].
+  double external_work_ = 0;
 };
 
 }  // namespace cablesim

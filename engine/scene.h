@@ -8,11 +8,14 @@
 //
 // Units are SI: m, kg, s, N, Pa, rad.
 
+#include <array>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
+
+#include "engine/time_function.h"
 
 namespace cablesim {
 
@@ -71,16 +74,31 @@ struct Attachment {
   bool IsGround() const { return cable < 0 && body < 0; }
 };
 
+// Three time functions: a vector (x, y, z) that varies in time.
+using TimeVector = std::array<TimeFunction, 3>;
+bool IsZero(const TimeVector& v);
+// Its value, first or second derivative (order 0, 1, 2) at t.
+Eigen::Vector3d Evaluate(const TimeVector& v, double t, int order = 0);
+
 struct JointSpec {
   JointType type = JointType::kPin;
   Attachment a;  // never ground
   Attachment b;
+  // Joints to ground only: the ground point moves by motion(t) [m] from
+  // its place at t = 0 (motion(0) = 0); a FIXED joint keeps its initial
+  // direction (the support translates). Zero: a fixed support.
+  TimeVector motion;
+  bool HasMotion() const { return !IsZero(motion); }
 };
 
 struct LoadSpec {
   Attachment at;
   Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
   Eigen::Vector3d torque_nm = Eigen::Vector3d::Zero();  // bodies only
+  // Added to force_n and torque_nm at time t (statics: at t = 0).
+  TimeVector varying_force_n;
+  TimeVector varying_torque_nm;
+  bool IsVarying() const { return !IsZero(varying_force_n) || !IsZero(varying_torque_nm); }
 };
 
 struct ProbeSpec {

@@ -31,13 +31,15 @@ class FrameRecorder {
   }
 
   // Evaluates the frame at a state without delivering it (frame()).
+  // `lambda`: the multipliers, for the forces of moving supports.
   void Evaluate(double t, double load_factor, const Eigen::VectorXd& z, const Eigen::VectorXd* v,
-                const Eigen::VectorXd* a) {
+                const Eigen::VectorXd* a, const Eigen::VectorXd* lambda = nullptr) {
     model_->ToFull(z, &q_);
     if (v) model_->RateToFull(*v, &qd_);
     if (a) model_->RateToFull(*a, &qdd_);
     frame_.t = t;
     model_->Probes(q_, qd_, qdd_, &frame_.probes);
+    if (lambda) model_->ProbeForces(*lambda, &frame_.support_forces);
     frame_.energy = model_->Energy(q_, qd_, load_factor);
     frame_.angular_momentum = model_->AngularMomentum(q_, qd_);
     model_->Constraints(q_, &phi_, nullptr);
@@ -68,8 +70,9 @@ class FrameRecorder {
   }
 
   absl::Status Emit(double t, double load_factor, const Eigen::VectorXd& z,
-                    const Eigen::VectorXd* v, const Eigen::VectorXd* a) {
-    Evaluate(t, load_factor, z, v, a);
+                    const Eigen::VectorXd* v, const Eigen::VectorXd* a,
+                    const Eigen::VectorXd* lambda = nullptr) {
+    Evaluate(t, load_factor, z, v, a, lambda);
     return Deliver();
   }
 
@@ -85,31 +88,41 @@ class FrameRecorder {
   double energy_scale_ = 0;
 };
 
-// Sums the work of torque loads over accepted steps, for the energy
-// balance (MultibodyModel::AccumulateTorqueWork); nothing without torques.
-class TorqueWork {
+// Sums the work of torques, time-varying loads and moving supports over
+// accepted steps, for the energy balance (MultibodyModel::
+// AccumulateExternalWork); nothing in a scene without them.
+class ExternalWork {
  public:
-  explicit TorqueWork(MultibodyModel* model) : model_(model) {
-    if (!model->has_torques()) return;
+  explicit ExternalWork(MultibodyModel* model) : model_(model) {
+    model->ResetExternalWork();
+    if (!model->has_external_work()) return;
     before_.setZero(model->coordinates());
     after_.setZero(model->coordinates());
+    lambda_before_.setZero(model->multipliers());
   }
-  void Before(const Eigen::VectorXd& z) {
-    if (model_->has_torques()) model_->ToFull(z, &before_);
+  void Before(const Eigen::VectorXd& z, double t, const Eigen::VectorXd& lambda) {
+    if (!model_->has_external_work()) return;
+    model_->ToFull(z, &before_);
+    t_before_ = t;
+    lambda_before_ = lambda;
   }
-  void After(const Eigen::VectorXd& z, double load_factor) {
-    if (!model_->has_torques()) return;
+  void After(const Eigen::VectorXd& z, double t, const Eigen::VectorXd& lambda,
+             double load_factor) {
+    if (!model_->has_external_work()) return;
     model_->ToFull(z, &after_);
-    model_->AccumulateTorqueWork(before_, after_, load_factor);
+    model_->AccumulateExternalWork(before_, after_, t_before_, t, lambda_before_, lambda,
+                                   load_factor);
   }
 
  private:
   MultibodyModel* model_;
-  Eigen::VectorXd before_, after_;
+  Eigen::VectorXd before_, after_, lambda_before_;
+  double t_before_ = 0;
 };
 
 // Every scene conserves its total energy (gravity and constant loads are
-// potential; nothing does work from outside), so a rise of more than this
+// potential; the work of torques, time-varying loads and moving supports is
+// counted in it, MultibodyModel::Energy), so a rise of more than this
 // fraction of the largest energy term is the stepper going unstable (the
 // second-order steppers can, on stiff nonlinear cables at large steps): the
 // run stops and says so rather than deliver it.
@@ -158,12 +171,14 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     Fail(summary, 0, reason);
     return;
   }
-  if (absl::Status s = rec->Emit(0, 1, stepper.z(), &stepper.v(), &stepper.a()); !s.ok()) {
+  ExternalWork external_work(model);
+  model->SetTime(0);
+  if (absl::Status s = rec->Emit(0, 1, stepper.z(), &stepper.v(), &stepper.a(), &stepper.lambda());
+      !s.ok()) {
     summary->status = "cancelled";
     summary->error = std::string(s.message());
     return;
   }
-  TorqueWork torque_work(model);
   const double h_nominal = settings.step_s;
   const double h_min = std::ldexp(h_nominal, -settings.max_step_halvings);
   const double interval =
@@ -189,6 +204,8 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   const int n = static_cast<int>(stepper.z().size());
   Eigen::VectorXd z_0 = stepper.z(), v_0 = stepper.v(), a_0 = stepper.a();
   Eigen::VectorXd z_i(n), v_i(n), a_i(n);
+  // Multipliers (the forces of moving supports) linearly between steps.
+  Eigen::VectorXd lambda_0 = stepper.lambda(), lambda_i(lambda_0.size());
   auto frame_time = [&](long k) { return std::min(duration, k * interval); };
   auto Interpolate = [&](double th, double d, const Stepper& s) {
     const double th2 = th * th, th3 = th2 * th;
@@ -199,6 +216,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     z_i = h00 * z_0 + (h10 * d) * v_0 + h01 * s.z() + (h11 * d) * s.v();
     v_i = (d00 / d) * z_0 + d10 * v_0 + (d01 / d) * s.z() + d11 * s.v();
     a_i = (1 - th) * a_0 + th * s.a();
+    lambda_i = (1 - th) * lambda_0 + th * s.lambda();
   };
   auto CheckAndDeliver = [&](double tf) {
     const EnergySample& e = rec->frame().energy;
@@ -225,7 +243,8 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   while (next_frame <= frames) {
     // A frame already reached (a duration within rounding of the last).
     if (const double tf = frame_time(next_frame); tf - t <= 1e-12 * std::max(1.0, tf)) {
-      rec->Evaluate(tf, 1, stepper.z(), &stepper.v(), &stepper.a());
+      model->SetTime(tf);
+      rec->Evaluate(tf, 1, stepper.z(), &stepper.v(), &stepper.a(), &stepper.lambda());
       if (!CheckAndDeliver(tf)) return;
       ++next_frame;
       continue;
@@ -238,7 +257,8 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     z_0 = stepper.z();
     v_0 = stepper.v();
     a_0 = stepper.a();
-    torque_work.Before(stepper.z());
+    lambda_0 = stepper.lambda();
+    external_work.Before(stepper.z(), t, stepper.lambda());
     const auto st = stepper.Step(h_try);
     summary->newton_iterations += st.newton_iterations;
     summary->linear_iterations += st.linear_iterations;
@@ -294,7 +314,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     if (st.converged) {
       const double t0 = t;
       t += h_try;
-      torque_work.After(stepper.z(), 1);
+      external_work.After(stepper.z(), t, stepper.lambda(), 1);
       ++summary->steps;
       summary->min_step_s = std::min(summary->min_step_s, h_try);
       summary->max_step_s = std::max(summary->max_step_s, h_try);
@@ -315,10 +335,12 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
         if (!at_end && tf > t) break;
         if (at_end) {
           t = tf;
-          rec->Evaluate(tf, 1, stepper.z(), &stepper.v(), &stepper.a());
+          model->SetTime(tf);
+          rec->Evaluate(tf, 1, stepper.z(), &stepper.v(), &stepper.a(), &stepper.lambda());
         } else {
           Interpolate((tf - t0) / h_try, h_try, stepper);
-          rec->Evaluate(tf, 1, z_i, &v_i, &a_i);
+          model->SetTime(tf);
+          rec->Evaluate(tf, 1, z_i, &v_i, &a_i, &lambda_i);
         }
         if (!CheckAndDeliver(tf)) return;
         ++next_frame;
@@ -341,13 +363,18 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
 void RunStatic(MultibodyModel* model, const SolverSettings& settings, const RunControl& control,
                FrameRecorder* rec, RunSummary* summary) {
   StaticSolver solver(model, settings);
-  TorqueWork torque_work(model);
+  // Statics is the equilibrium at t = 0: moving supports at their start,
+  // time-varying loads at their value there (scaled by the load factor).
+  model->SetTime(0);
+  ExternalWork external_work(model);
   auto on_increment = [&](const Eigen::VectorXd& z0, const Eigen::VectorXd& z1, double alpha) {
-    torque_work.Before(z0);
-    torque_work.After(z1, alpha);
+    // Moving supports do not move at t = 0: their work is 0 (lambda unused).
+    external_work.Before(z0, 0, solver.lambda());
+    external_work.After(z1, 0, solver.lambda(), alpha);
   };
   auto on_target = [&](double alpha) {
-    if (absl::Status s = rec->Emit(alpha, alpha, solver.z(), nullptr, nullptr); !s.ok()) {
+    if (absl::Status s = rec->Emit(alpha, alpha, solver.z(), nullptr, nullptr, &solver.lambda());
+        !s.ok()) {
       summary->status = "cancelled";
       summary->error = std::string(s.message());
       return false;

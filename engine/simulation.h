@@ -28,6 +28,10 @@ struct ModelInfo {
   int elements = 0;        // cable elements, inserted nodes included
   int nodes = 0;           // cable nodes (a node split where a cable kinks counts once)
   std::vector<std::string> probe_names;
+  // The probes placed on a moving support (a joint to ground with a
+  // motion), in scene order: their samples carry force_n, written as
+  // NAME.fx NAME.fy NAME.fz after the other columns.
+  std::vector<std::string> force_probe_names;
 };
 
 struct ProbeSample {
@@ -37,7 +41,9 @@ struct ProbeSample {
 };
 
 // Energy [J]. `potential` is that of gravity and of the constant applied
-// loads (both conservative), so `total` is conserved by the exact solution.
+// loads (both conservative) minus the work done so far by torques,
+// time-varying loads and moving supports (summed step by step), so `total`
+// is conserved by the exact solution.
 struct EnergySample {
   double kinetic = 0;
   double potential = 0;
@@ -55,6 +61,10 @@ struct Frame {
   // planar model); conserved about any axis along which the applied loads
   // and joints to ground exert no moment.
   Eigen::Vector3d angular_momentum = Eigen::Vector3d::Zero();
+  // Per probe of ModelInfo::force_probe_names: the force [N] its moving
+  // support exerts on the cable or body it holds (the cable pulls the
+  // support with the opposite force). Empty in most scenes.
+  std::vector<Eigen::Vector3d> support_forces;
   // Largest absolute constraint residual (m for positions, dimensionless
   // for tangent cross products).
   double constraint_violation = 0;

@@ -17,8 +17,11 @@ v1::EnergyResponse EnergyFromTrajectory(const v1::RunHeader& header,
   report->set_energy_dissipated(summary.energy_dissipated());
   if (columns < 1 + kTrailingValues) return response;
   const size_t rows = values.size() / columns;
-  // The trailing columns: kinetic, potential, axial, bending, total, violation.
-  const int e0 = columns - kTrailingValues;
+  // The trailing columns: kinetic, potential, axial, bending, total, violation
+  // (then, in a scene with moving supports, their forces).
+  int e0 = columns - kTrailingValues;
+  for (int c = 0; c < columns; ++c)
+    if (header.columns(c) == "energy.kinetic") e0 = c;
   double scale = 0, lo = INFINITY, hi = -INFINITY, violation = 0;
   for (size_t r = 0; r < rows; ++r) {
     const double* row = values.data() + r * columns;

@@ -22,7 +22,7 @@ class CollectingSink : public FrameSink {
       : result_(result), progress_(std::move(progress)) {}
   absl::Status OnStart(const ModelInfo& info) override {
     *result_->header.mutable_info() = ModelInfoToProto(info);
-    for (std::string& c : FrameColumns(info.probe_names)) result_->header.add_columns(std::move(c));
+    for (std::string& c : FrameColumnsFor(info)) result_->header.add_columns(std::move(c));
     probes_ = static_cast<int>(info.probe_names.size());
     return absl::OkStatus();
   }

@@ -108,9 +108,31 @@ absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimi
         "solver.output_interval: %d frames asked for, the server's limit is %d (max_frames)",
         checked.frames, limits.max_frames));
   }
+  // Probes on a moving support add 3 columns (its force): counted for
+  // every probe held by one (as the model builder matches them, by cable
+  // and arc length or by body and point).
+  int64_t force_values = 0;
+  for (const ProbeSpec& probe : checked.scene.probes) {
+    for (const JointSpec& joint : checked.scene.joints) {
+      if (!joint.HasMotion()) continue;
+      const Attachment& held = joint.a.IsGround() ? joint.b : joint.a;
+      const Attachment& at = probe.at;
+      const bool same =
+          at.cable >= 0
+              ? held.cable == at.cable &&
+                    std::abs(held.s_m - at.s_m) <=
+                        1e-9 * checked.scene.cables[at.cable].length_m
+              : held.body == at.body && at.body >= 0 && held.point_body_m == at.point_body_m;
+      if (same) {
+        force_values += 3;
+        break;
+      }
+    }
+  }
   const int64_t values =
       checked.frames *
-      (1 + kValuesPerProbe * static_cast<int64_t>(checked.scene.probes.size()) + kTrailingValues);
+      (1 + kValuesPerProbe * static_cast<int64_t>(checked.scene.probes.size()) + kTrailingValues +
+       force_values);
   if (values > limits.max_trajectory_values) {
     return absl::ResourceExhaustedError(absl::StrFormat(
         "probes: %d frames of %d probes make %d numbers, the server's limit is %d "

@@ -1,0 +1,124 @@
+// Time functions (engine/time_function.h) against their closed forms, and
+// the scene validation of prescribed motions and time-varying loads.
+
+#include <cmath>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "convert/scene_file.h"
+#include "convert/scene_from_proto.h"
+#include "engine/time_function.h"
+
+namespace cablesim {
+namespace {
+
+using ::testing::HasSubstr;
+
+constexpr double kPi = 3.14159265358979323846;
+
+TEST(TimeFunctionTest, ZeroByDefault) {
+  const TimeFunction f;
+  EXPECT_TRUE(f.IsZero());
+  const TimeFunction::Value v = f.Evaluate(3.0);
+  EXPECT_EQ(v.f, 0);
+  EXPECT_EQ(v.df, 0);
+  EXPECT_EQ(v.ddf, 0);
+}
+
+TEST(TimeFunctionTest, HarmonicValueAndDerivativesExact) {
+  // A sin(w t + phi): derivatives A w cos, -A w^2 sin (to rounding: 1e-12
+  // relative to the largest term, A w^2).
+  const double a = 0.3, f = 1.7, phi = 0.4, w = 2 * kPi * f;
+  const TimeFunction h = TimeFunction::Sine(a, f, phi);
+  for (double t : {0.0, 0.1, 0.77, 5.3}) {
+    const TimeFunction::Value v = h.Evaluate(t);
+    EXPECT_NEAR(v.f, a * std::sin(w * t + phi), 1e-12 * a);
+    EXPECT_NEAR(v.df, a * w * std::cos(w * t + phi), 1e-12 * a * w);
+    EXPECT_NEAR(v.ddf, -a * w * w * std::sin(w * t + phi), 1e-12 * a * w * w);
+  }
+}
+
+TEST(TimeFunctionTest, TableIsPiecewiseLinearWithPiecewiseConstantDerivative) {
+  const TimeFunction f = TimeFunction::Table({0, 1, 3}, {0, 2, 1});
+  EXPECT_EQ(f.Evaluate(-1).f, 0);  // before the first time: the first value
+  EXPECT_EQ(f.Evaluate(-1).df, 0);
+  EXPECT_DOUBLE_EQ(f.Evaluate(0.5).f, 1);
+  EXPECT_DOUBLE_EQ(f.Evaluate(0.5).df, 2);
+  EXPECT_DOUBLE_EQ(f.Evaluate(2).f, 1.5);
+  EXPECT_DOUBLE_EQ(f.Evaluate(2).df, -0.5);
+  // At a breakpoint, the segment that starts there (right derivative).
+  EXPECT_DOUBLE_EQ(f.Evaluate(1).f, 2);
+  EXPECT_DOUBLE_EQ(f.Evaluate(1).df, -0.5);
+  EXPECT_EQ(f.Evaluate(1).ddf, 0);  // documented: no impulse at the kink
+  EXPECT_EQ(f.Evaluate(7).f, 1);    // after the last time: the last value
+  EXPECT_EQ(f.Evaluate(7).df, 0);
+}
+
+TEST(TimeFunctionTest, RampStartsAtItsStart) {
+  const TimeFunction r = TimeFunction::Linear(2.5, 1.0);
+  EXPECT_EQ(r.Evaluate(0.5).f, 0);
+  EXPECT_EQ(r.Evaluate(0.5).df, 0);
+  EXPECT_DOUBLE_EQ(r.Evaluate(3).f, 5);
+  EXPECT_DOUBLE_EQ(r.Evaluate(3).df, 2.5);
+}
+
+TEST(TimeFunctionTest, PartsAndTermsAdd) {
+  TimeFunction f = TimeFunction::Constant(1);
+  f.add_harmonic({2, 0.5, 0});
+  f.add_term(TimeFunction::Linear(3, 0));
+  f.add_term(TimeFunction::Sine(1, 1, kPi / 2));
+  const double t = 0.3, w1 = kPi, w2 = 2 * kPi;
+  const TimeFunction::Value v = f.Evaluate(t);
+  EXPECT_NEAR(v.f, 1 + 2 * std::sin(w1 * t) + 3 * t + std::cos(w2 * t), 1e-12);
+  EXPECT_NEAR(v.df, 2 * w1 * std::cos(w1 * t) + 3 - w2 * std::sin(w2 * t), 1e-12);
+  EXPECT_NEAR(v.ddf, -2 * w1 * w1 * std::sin(w1 * t) - w2 * w2 * std::cos(w2 * t), 1e-11);
+}
+
+absl::Status Validate(const std::string& json) {
+  auto proto = ParseSceneJson(json);
+  if (!proto.ok()) return proto.status();
+  return SceneFromProto(*proto).status();
+}
+
+std::string PinnedRope(const std::string& motion) {
+  return R"({"cables": [{"name": "rope", "length": 1, "density": 1000, "youngs_modulus": 1e9,
+               "diameter": 0.01}],
+             "joints": [{"type": "PIN", "a": {"cable": "rope", "s": 0}, "motion": )" +
+         motion + R"(}], "solver": {"duration": 1}})";
+}
+
+TEST(TimeFunctionValidationTest, NamesTheField) {
+  EXPECT_TRUE(Validate(PinnedRope(R"({"x": {"harmonic": {"amplitude": 0.1, "frequency": 1}}})")).ok());
+  absl::Status s = Validate(PinnedRope(R"({"x": {"table": {"times": [0, 2, 1], "values": [0, 1, 2]}}})"));
+  EXPECT_THAT(s.message(), HasSubstr("joints[0].motion.x.table.times: times must increase"));
+  s = Validate(PinnedRope(R"({"y": {"table": {"times": [0, 1], "values": [0]}}})"));
+  EXPECT_THAT(s.message(), HasSubstr("joints[0].motion.y.table.values: must have as many"));
+  s = Validate(PinnedRope(R"({"x": {"harmonic": {"amplitude": 1, "frequency": -1}}})"));
+  EXPECT_THAT(s.message(), HasSubstr("joints[0].motion.x.harmonic.frequency: must be >= 0"));
+  s = Validate(PinnedRope(R"({"x": {"sum": [{"ramp": {"slope": 1, "start": -1}}]}})"));
+  EXPECT_THAT(s.message(), HasSubstr("joints[0].motion.x.sum[0].ramp.start: must be >= 0"));
+  // The scene places the joint at t = 0: a motion must start at 0.
+  s = Validate(PinnedRope(R"({"z": {"constant": 0.5}})"));
+  EXPECT_THAT(s.message(), HasSubstr("joints[0].motion.z: must be 0 at t = 0"));
+}
+
+TEST(TimeFunctionValidationTest, OnlyJointsToGroundMoveAndTorquesOnBodies) {
+  absl::Status s = Validate(R"({"cables": [{"name": "a", "length": 1, "density": 1000,
+        "youngs_modulus": 1e9, "diameter": 0.01},
+      {"name": "b", "start": {"x": 1}, "length": 1, "density": 1000, "youngs_modulus": 1e9,
+        "diameter": 0.01}],
+      "joints": [{"type": "PIN", "a": {"cable": "a", "s": 1}, "b": {"cable": "b", "s": 0},
+                  "motion": {"x": {"ramp": {"slope": 1}}}}], "solver": {"duration": 1}})");
+  EXPECT_THAT(s.message(), HasSubstr("joints[0].motion: only a joint to ground moves"));
+  s = Validate(R"({"cables": [{"name": "a", "length": 1, "density": 1000,
+        "youngs_modulus": 1e9, "diameter": 0.01}],
+      "loads": [{"at": {"cable": "a", "s": 1},
+                 "varying_torque": {"z": {"harmonic": {"amplitude": 1, "frequency": 1}}}}],
+      "solver": {"duration": 1}})");
+  EXPECT_THAT(s.message(), HasSubstr("loads[0].varying_torque: allowed on bodies only"));
+}
+
+}  // namespace
+}  // namespace cablesim
