@@ -187,6 +187,8 @@ ModelInfo MultibodyModel::Info() const {
   info.elements = elements();
   info.nodes = nodes();
   info.probe_names = probe_names_;
+  info.cable_names = cable_names_;
+  info.body_names = body_names_;
   return info;
 }
 
@@ -329,34 +331,63 @@ void MultibodyModel::ConstraintGamma(const VectorXd& q, const VectorXd& qdot,
 }
 
 template <int D>
-void MultibodyModel::ElementEnergy(const VectorXd& q, const VectorXd& qdot,
-                                   EnergySample* en) const {
+void MultibodyModel::ElementEnergy(const VectorXd& q, const VectorXd& qdot, EnergySample* en,
+                                   EnergyParts* parts) const {
   constexpr int kN = 4 * D;
   const auto& elements = Elements<D>();
-  for (const ElementData<D>& e : elements) {
+  // The totals are summed element by element, the parts apart (so the
+  // parts' sums check the totals, and the totals are those of a run
+  // without parts, bit for bit).
+  size_t cable = 0;
+  for (size_t k = 0; k < elements.size(); ++k) {
+    const ElementData<D>& e = elements[k];
     const auto qe = q.segment<kN>(e.first_coord);
     const auto ve = qdot.segment<kN>(e.first_coord);
-    en->kinetic += 0.5 * ve.dot(e.element.MassMatrix(e.mass_per_length) * ve);
+    const double kinetic = 0.5 * ve.dot(e.element.MassMatrix(e.mass_per_length) * ve);
     const auto se = e.element.StrainEnergy(qe);
+    en->kinetic += kinetic;
     en->axial += se.axial;
     en->bending += se.bending;
+    if (parts == nullptr) continue;
+    while (static_cast<int>(k) >= cable_element_begin_[cable + 1]) ++cable;
+    PartEnergy* part = &parts->cables[cable];
+    part->kinetic += kinetic;
+    part->axial += se.axial;
+    part->bending += se.bending;
+    // Element gravity is exactly -Q_g . e (MODEL.md section 2).
+    part->gravity -= e.gravity.dot(qe);
   }
 }
 
-EnergySample MultibodyModel::Energy(const VectorXd& q, const VectorXd& qdot,
-                                    double load_factor) const {
+EnergySample MultibodyModel::Energy(const VectorXd& q, const VectorXd& qdot, double load_factor,
+                                    EnergyParts* parts) const {
   EnergySample en;
+  if (parts != nullptr) {
+    parts->cables.assign(cable_names_.size(), PartEnergy());
+    parts->bodies.assign(bodies_.size(), PartEnergy());
+  }
   if (dim_ == 2) {
-    ElementEnergy<2>(q, qdot, &en);
+    ElementEnergy<2>(q, qdot, &en, parts);
   } else {
-    ElementEnergy<3>(q, qdot, &en);
+    ElementEnergy<3>(q, qdot, &en, parts);
   }
   const int D = dim_;
-  for (const BodyData& b : bodies_) {
-    en.kinetic += 0.5 * b.mass * qdot.segment(b.coord, D).squaredNorm();
+  for (size_t i = 0; i < bodies_.size(); ++i) {
+    const BodyData& b = bodies_[i];
+    const double translation = 0.5 * b.mass * qdot.segment(b.coord, D).squaredNorm();
+    en.kinetic += translation;
+    double kinetic = translation;
     const int axes = D == 2 ? 1 : 3;
-    for (int k = 0; k < axes; ++k)
-      en.kinetic += 0.5 * b.jbar(k) * qdot.segment(b.coord + D + D * k, D).squaredNorm();
+    for (int k = 0; k < axes; ++k) {
+      const double rotation = 0.5 * b.jbar(k) * qdot.segment(b.coord + D + D * k, D).squaredNorm();
+      en.kinetic += rotation;
+      kinetic += rotation;
+    }
+    if (parts != nullptr) {
+      PartEnergy& part = parts->bodies[i];
+      part.kinetic = kinetic;
+      part.gravity = -load_factor * b.mass * gravity_.head(D).dot(q.segment(b.coord, D));
+    }
   }
   // Gravity and point loads are constant forces on q: V = -F . q. Element
   // gravity is exactly -Q_g . e (MODEL.md section 2).
@@ -364,6 +395,12 @@ EnergySample MultibodyModel::Energy(const VectorXd& q, const VectorXd& qdot,
   // Torques: their work so far (AccumulateTorqueWork).
   en.potential -= torque_work_;
   en.total = en.kinetic + en.potential + en.axial + en.bending;
+  if (parts != nullptr) {
+    // The element gravity above is at load factor 1 (statics scales it).
+    for (PartEnergy& part : parts->cables) part.gravity *= load_factor;
+    parts->loads = -torque_work_;
+    if (load_force_.size() > 0) parts->loads -= load_factor * load_force_.dot(q);
+  }
   return en;
 }
 

@@ -139,8 +139,13 @@ class MultibodyModel {
 
   // Energy of a full state; potential includes the constant loads, and
   // minus the work torques have done so far (AccumulateTorqueWork).
-  EnergySample Energy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
-                      double load_factor) const;
+  // When `parts` is not null it also receives the energy per cable and per
+  // body (EnergyParts, simulation.h), each part summed over its own
+  // elements, gravity and loads apart from the total's single dot product,
+  // so that the parts' sums check the totals to rounding. Its vectors are
+  // resized (no allocation once they have the size).
+  EnergySample Energy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, double load_factor,
+                      EnergyParts* parts = nullptr) const;
 
   // A torque on a body is not a constant force in these coordinates, so its
   // work is summed step by step: call this after every accepted step (or
@@ -204,8 +209,8 @@ class MultibodyModel {
   double ElementForces(const Eigen::VectorXd& q, Eigen::VectorXd* full, SkylineLdlt* stiffness,
                        double stiffness_scale, Eigen::VectorXd* roundoff) const;
   template <int D>
-  void ElementEnergy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
-                     EnergySample* en) const;
+  void ElementEnergy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, EnergySample* en,
+                     EnergyParts* parts) const;
   template <int D>
   Eigen::Vector3d ElementAngularMomentum(const Eigen::VectorXd& q,
                                          const Eigen::VectorXd& qdot) const;
@@ -249,6 +254,12 @@ class MultibodyModel {
   std::vector<BodyData> bodies_;
   std::vector<TorqueLoad> torques_;
   Eigen::VectorXd constant_force_;  // full: gravity and point loads
+  // Full: the point loads alone (empty without any), for EnergyParts::loads.
+  Eigen::VectorXd load_force_;
+  // Per cable, its first element; one more entry, the element count.
+  std::vector<int> cable_element_begin_;
+  Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();  // [m/s^2]
+  std::vector<std::string> cable_names_, body_names_;
   double energy_roundoff_ = 0;
 
   std::vector<Row> rows_;

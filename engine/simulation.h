@@ -28,6 +28,9 @@ struct ModelInfo {
   int elements = 0;        // cable elements, inserted nodes included
   int nodes = 0;           // cable nodes (a node split where a cable kinks counts once)
   std::vector<std::string> probe_names;
+  // Cable and body names in scene order (the parts of EnergyParts).
+  std::vector<std::string> cable_names;
+  std::vector<std::string> body_names;
 };
 
 struct ProbeSample {
@@ -46,11 +49,36 @@ struct EnergySample {
   double total = 0;
 };
 
+// The energy of one cable or one body [J]. `gravity` is the potential of
+// gravity, -m g . r_c for a body and -int rho A g . r ds for a cable (zero
+// at the world origin, as EnergySample::potential). A body has no strain:
+// its axial and bending are 0.
+struct PartEnergy {
+  double kinetic = 0;
+  double gravity = 0;
+  double axial = 0;
+  double bending = 0;
+};
+
+// EnergySample split by part. Summed over the parts, kinetic, axial and
+// bending are the totals' and gravity plus `loads` is the total potential:
+//   potential = sum gravity + loads,
+// `loads` being the potential of the applied point forces (-F . r) minus
+// the work torques have done so far.
+struct EnergyParts {
+  std::vector<PartEnergy> cables;  // in scene order
+  std::vector<PartEnergy> bodies;  // in scene order
+  double loads = 0;
+};
+
 struct Frame {
   // Time [s] for DYNAMIC; the load factor in (0, 1] for STATIC.
   double t = 0;
   std::vector<ProbeSample> probes;  // in scene order
   EnergySample energy;
+  // The same energy per cable and per body (sized as ModelInfo's
+  // cable_names and body_names in every frame; zeros in a MODAL shape).
+  EnergyParts energy_parts;
   // Angular momentum about the world origin [kg m^2/s] (z only for a
   // planar model); conserved about any axis along which the applied loads
   // and joints to ground exert no moment.

@@ -109,8 +109,9 @@ absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimi
         checked.frames, limits.max_frames));
   }
   const int64_t values =
-      checked.frames *
-      (1 + kValuesPerProbe * static_cast<int64_t>(checked.scene.probes.size()) + kTrailingValues);
+      checked.frames * FrameRowSize(static_cast<int64_t>(checked.scene.probes.size()),
+                                    static_cast<int64_t>(checked.scene.cables.size()),
+                                    static_cast<int64_t>(checked.scene.bodies.size()));
   if (values > limits.max_trajectory_values) {
     return absl::ResourceExhaustedError(absl::StrFormat(
         "probes: %d frames of %d probes make %d numbers, the server's limit is %d "
