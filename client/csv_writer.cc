@@ -16,7 +16,7 @@ void AppendNumber(std::string* row, double value) { absl::StrAppendFormat(row, "
 
 }  // namespace
 
-absl::StatusOr<std::unique_ptr<CsvWriter>> CsvWriter::Create(const std::string& path) {
+absl::StatusOr<std::unique_ptr<std::ofstream>> OpenForWriting(const std::string& path) {
   errno = 0;
   auto file = std::make_unique<std::ofstream>(path, std::ios::out | std::ios::trunc);
   if (!file->is_open()) {
@@ -24,7 +24,13 @@ absl::StatusOr<std::unique_ptr<CsvWriter>> CsvWriter::Create(const std::string& 
     return absl::UnavailableError(absl::StrCat(
         path, ": cannot open for writing: ", error != 0 ? std::strerror(error) : "unknown"));
   }
-  return std::unique_ptr<CsvWriter>(new CsvWriter(std::move(file), path));
+  return file;
+}
+
+absl::StatusOr<std::unique_ptr<CsvWriter>> CsvWriter::Create(const std::string& path) {
+  absl::StatusOr<std::unique_ptr<std::ofstream>> file = OpenForWriting(path);
+  if (!file.ok()) return file.status();
+  return std::unique_ptr<CsvWriter>(new CsvWriter(std::move(*file), path));
 }
 
 CsvWriter::CsvWriter(std::ostream* out, std::string name) : out_(out), name_(std::move(name)) {}
@@ -36,7 +42,9 @@ CsvWriter::~CsvWriter() {
   if (!finished_) Finish().IgnoreError();
 }
 
-std::string CsvWriter::Header(const ModelInfo& info) { return absl::StrJoin(FrameColumns(info), ","); }
+std::string CsvWriter::Header(const ModelInfo& info) {
+  return absl::StrJoin(FrameColumns(info, /*with_nodes=*/false), ",");
+}
 
 absl::Status CsvWriter::CheckStream(const char* what) {
   if (status_.ok() && !*out_) {

@@ -27,6 +27,10 @@
 
 namespace cablesim {
 
+// Creates (or truncates) the file at `path` for writing; Unavailable,
+// naming the file and the reason, when it cannot be opened.
+absl::StatusOr<std::unique_ptr<std::ofstream>> OpenForWriting(const std::string& path);
+
 class CsvWriter : public FrameSink {
  public:
   // Rows written between flushes of the output.

@@ -15,6 +15,9 @@ v1::ModelInfo ModelInfoToProto(const ModelInfo& info) {
   for (const std::string& name : info.probe_names) p.add_probe_names(name);
   for (const std::string& name : info.cable_names) p.add_cable_names(name);
   for (const std::string& name : info.body_names) p.add_body_names(name);
+  for (const int n : info.cable_nodes) p.add_cable_nodes(n);
+  for (const double s : info.node_s) p.add_node_arc_lengths(s);
+  p.set_shape(info.shape);
   return p;
 }
 
@@ -29,6 +32,9 @@ ModelInfo ModelInfoFromProto(const v1::ModelInfo& p) {
   info.probe_names.assign(p.probe_names().begin(), p.probe_names().end());
   info.cable_names.assign(p.cable_names().begin(), p.cable_names().end());
   info.body_names.assign(p.body_names().begin(), p.body_names().end());
+  info.cable_nodes.assign(p.cable_nodes().begin(), p.cable_nodes().end());
+  info.node_s.assign(p.node_arc_lengths().begin(), p.node_arc_lengths().end());
+  info.shape = p.shape();
   return info;
 }
 
@@ -112,6 +118,7 @@ RunSummary SummaryFromProto(const v1::RunSummary& p) {
 
 void AppendFrameRow(const Frame& frame, google::protobuf::RepeatedField<double>* values) {
   ForEachFrameValue(frame, [values](double v) { values->Add(v); });
+  ForEachNodeValue(frame, [values](double v) { values->Add(v); });
 }
 
 void SetFrameHeader(const ModelInfo& info, v1::RunHeader* header) {

@@ -10,7 +10,7 @@ packages=(
   libgrpc++-dev protobuf-compiler-grpc
   libgtest-dev libgmock-dev libbenchmark-dev
   libsqlite3-dev zlib1g-dev
-  python3 python3-grpcio python3-protobuf python3-numpy python3-matplotlib
+  python3 python3-grpcio python3-protobuf python3-numpy python3-matplotlib python3-pil
   clang libclang-rt-14-dev
 )
 as_root=()

@@ -7,7 +7,7 @@
 
 namespace cablesim {
 
-std::vector<std::string> FrameColumns(const ModelInfo& info) {
+std::vector<std::string> FrameColumns(const ModelInfo& info, bool with_nodes) {
   std::vector<std::string> columns = {"t"};
   for (const std::string& name : info.probe_names) {
     for (const char* c : {"x", "y", "z", "vx", "vy", "vz", "ax", "ay", "az"}) {
@@ -29,6 +29,14 @@ std::vector<std::string> FrameColumns(const ModelInfo& info) {
     }
   }
   columns.push_back("loads.energy.potential");
+  if (!info.shape || !with_nodes) return columns;
+  for (size_t i = 0; i < info.cable_nodes.size(); ++i) {
+    for (int k = 0; k < info.cable_nodes[i]; ++k) {
+      for (const char* c : {"x", "y", "z"}) {
+        columns.push_back(absl::StrCat("cables[", i, "].nodes[", k, "].", c));
+      }
+    }
+  }
   return columns;
 }
 
@@ -43,7 +51,8 @@ FrameReader::FrameReader(const ModelInfo& info, absl::Span<const std::string> co
     : row_size_(static_cast<int>(columns.size())),
       probes_(static_cast<int>(info.probe_names.size())),
       cables_(static_cast<int>(info.cable_names.size())),
-      bodies_(static_cast<int>(info.body_names.size())) {
+      bodies_(static_cast<int>(info.body_names.size())),
+      nodes_(info.shape ? static_cast<int>(info.node_s.size()) : 0) {
   absl::flat_hash_map<std::string_view, int> column;
   for (size_t i = 0; i < columns.size(); ++i) column.emplace(columns[i], static_cast<int>(i));
   for (const std::string& name : FrameColumns(info)) {
@@ -56,11 +65,14 @@ void FrameReader::Read(absl::Span<const double> row, Frame* frame) const {
   frame->probes.resize(probes_);
   frame->energy_parts.cables.resize(cables_);
   frame->energy_parts.bodies.resize(bodies_);
+  frame->nodes.resize(nodes_);
   size_t k = 0;
-  ForEachFrameValue(*frame, [&](double& value) {
+  auto read = [&](double& value) {
     const int i = index_[k++];
     value = i >= 0 && static_cast<size_t>(i) < row.size() ? row[i] : 0.0;
-  });
+  };
+  ForEachFrameValue(*frame, read);
+  ForEachNodeValue(*frame, read);
 }
 
 }  // namespace cablesim

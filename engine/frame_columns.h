@@ -13,6 +13,8 @@
 //                cables[i].energy.axial cables[i].energy.bending
 //   per body j   bodies[j].energy.kinetic bodies[j].energy.gravity
 //   loads.energy.potential
+//   with output.shape (ModelInfo::shape), per cable i and node k
+//                cables[i].nodes[k].x cables[i].nodes[k].y cables[i].nodes[k].z
 //
 // (EnergyParts, simulation.h). Parts are named by their index in the scene
 // file, as field paths are (`cables[1].length`): a cable's name is free
@@ -39,8 +41,10 @@ inline constexpr int kValuesPerBody = 2;
 inline constexpr int kTotalValues = 6;
 
 // The column names of a frame row of a model with `info`'s probes, cables
-// and bodies.
-std::vector<std::string> FrameColumns(const ModelInfo& info);
+// and bodies, and its nodes when info.shape and `with_nodes` (the run CSV
+// leaves them out: `cablesim run --shape` writes them in a file of their
+// own, client/shape_csv_writer.h).
+std::vector<std::string> FrameColumns(const ModelInfo& info, bool with_nodes = true);
 
 // The numbers in a row.
 inline int64_t FrameRowSize(int64_t probes, int64_t cables, int64_t bodies) {
@@ -79,6 +83,15 @@ void ForEachFrameValue(FrameT& frame, Add&& add) {
   add(frame.energy_parts.loads);
 }
 
+// Calls add(value) for x, y, z of every node of `frame` (empty without
+// output.shape): the row's last columns, after ForEachFrameValue's.
+template <typename FrameT, typename Add>
+void ForEachNodeValue(FrameT& frame, Add&& add) {
+  for (auto& r : frame.nodes) {
+    for (int k = 0; k < 3; ++k) add(r[k]);
+  }
+}
+
 // Reads frames back from rows whose columns are known by name: each
 // quantity of a Frame is looked up in the column names once, and a column
 // that is absent (a row written before it was added) reads as 0.
@@ -100,8 +113,9 @@ class FrameReader {
 
  private:
   int row_size_ = 0;
-  int probes_ = 0, cables_ = 0, bodies_ = 0;
-  // The column of every number of ForEachFrameValue's order, or -1.
+  int probes_ = 0, cables_ = 0, bodies_ = 0, nodes_ = 0;
+  // The column of every number of ForEachFrameValue's and then
+  // ForEachNodeValue's order, or -1.
   std::vector<int> index_;
 };
 

@@ -428,6 +428,7 @@ void RunModalAnalysis(MultibodyModel* model, const SolverSettings& settings, int
   Frame frame;
   frame.t = 0;
   model->Probes(q, zero, zero, &frame.probes);
+  if (model->shape()) model->NodePositions(q, &frame.nodes);
   frame.energy = model->Energy(q, zero, 1.0, &frame.energy_parts);
   frame.constraint_violation = phi.size() ? phi.lpNorm<Eigen::Infinity>() : 0.0;
   summary->energy_initial = summary->energy_final = frame.energy.total;
@@ -470,6 +471,11 @@ void RunModalAnalysis(MultibodyModel* model, const SolverSettings& settings, int
     mode.probes.resize(samples.size());
     for (size_t p = 0; p < samples.size(); ++p)
       mode.probes[p].position_m = scale * samples[p].velocity_m_s;
+    if (model->shape()) {
+      // The nodes' displacement in the mode, scaled as the probes'.
+      model->NodePositions(shape_q, &mode.nodes);
+      for (Eigen::Vector3d& r : mode.nodes) r *= scale;
+    }
     if (jx.size() > 0) {
       jac.Multiply(shape.data(), jx.data());
       mode.constraint_violation = std::abs(scale) * jx.lpNorm<Eigen::Infinity>();

@@ -570,6 +570,18 @@ void ModelBuilder::ConstantForces() {
 
 void ModelBuilder::Probes() {
   MultibodyModel& m = model_;
+  // The cable nodes (output.shape), a split node's second half left out.
+  m.shape_ = scene_.output.shape;
+  for (size_t c = 0; c + 1 < mesh_.first_node.size(); ++c) {
+    int count = 0;
+    for (int k = mesh_.first_node[c]; k < mesh_.first_node[c + 1]; ++k) {
+      if (mesh_.twin_of[k] >= 0) continue;
+      m.shape_coord_.push_back(NodeCoord(k));
+      m.node_s_.push_back(mesh_.node_s[c][k - mesh_.first_node[c]]);
+      ++count;
+    }
+    m.cable_nodes_.push_back(count);
+  }
   m.probe_term_begin_.push_back(0);
   for (const ProbeSpec& p : scene_.probes) {
     const LinearVector point = PointOf(p.at);

@@ -130,7 +130,7 @@ class ModelBuilder {
   void ConstantForces();
 
   // Each probe's point as a linear form of q (position [m] = const + sum
-  // coeff q_i).
+  // coeff q_i), and the cable nodes whose positions output.shape writes.
   void Probes();
 
   // The skyline envelope of the Newton matrix on z (what elements, bodies

@@ -189,6 +189,9 @@ ModelInfo MultibodyModel::Info() const {
   info.probe_names = probe_names_;
   info.cable_names = cable_names_;
   info.body_names = body_names_;
+  info.cable_nodes = cable_nodes_;
+  info.node_s = node_s_;
+  info.shape = shape_;
   return info;
 }
 
@@ -464,6 +467,15 @@ Eigen::Vector3d MultibodyModel::AngularMomentum(const VectorXd& q, const VectorX
     }
   }
   return l;
+}
+
+void MultibodyModel::NodePositions(const VectorXd& q, std::vector<Vector3d>* out) const {
+  out->resize(shape_coord_.size());
+  for (size_t k = 0; k < shape_coord_.size(); ++k) {
+    Vector3d& r = (*out)[k];
+    r.setZero();
+    r.head(dim_) = q.segment(shape_coord_[k], dim_);
+  }
 }
 
 void MultibodyModel::Probes(const VectorXd& q, const VectorXd& qdot, const VectorXd& qddot,

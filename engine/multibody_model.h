@@ -162,6 +162,13 @@ class MultibodyModel {
   // m r_c x rdot_c + sum_k Jb_k e_k x edot_k. Planar models return (0, 0, L_z).
   Eigen::Vector3d AngularMomentum(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot) const;
 
+  // Whether frames carry the nodes' positions (the scene's output.shape).
+  bool shape() const { return shape_; }
+  // Every cable node's position [m] from full coordinates q (a split node
+  // once), in the order of ModelInfo::node_s; from a rate, the nodes'
+  // velocities. `out` is resized (no allocation once it has the size).
+  void NodePositions(const Eigen::VectorXd& q, std::vector<Eigen::Vector3d>* out) const;
+
   // Probes from full position, velocity and acceleration.
   void Probes(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
               const Eigen::VectorXd& qddot, std::vector<ProbeSample>* out) const;
@@ -260,6 +267,12 @@ class MultibodyModel {
   std::vector<int> cable_element_begin_;
   Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();  // [m/s^2]
   std::vector<std::string> cable_names_, body_names_;
+  // The cable nodes of ModelInfo: per distinct node its position's first
+  // full coordinate; per cable the count; per node its arc length [m].
+  bool shape_ = false;
+  std::vector<int> shape_coord_;
+  std::vector<int> cable_nodes_;
+  std::vector<double> node_s_;
   double energy_roundoff_ = 0;
 
   std::vector<Row> rows_;

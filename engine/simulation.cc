@@ -38,6 +38,7 @@ class FrameRecorder {
     if (a) model_->RateToFull(*a, &qdd_);
     frame_.t = t;
     model_->Probes(q_, qd_, qdd_, &frame_.probes);
+    if (model_->shape()) model_->NodePositions(q_, &frame_.nodes);
     frame_.energy = model_->Energy(q_, qd_, load_factor, &frame_.energy_parts);
     frame_.angular_momentum = model_->AngularMomentum(q_, qd_);
     model_->Constraints(q_, &phi_, nullptr);

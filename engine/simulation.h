@@ -31,6 +31,12 @@ struct ModelInfo {
   // Cable and body names in scene order (the parts of EnergyParts).
   std::vector<std::string> cable_names;
   std::vector<std::string> body_names;
+  // Per cable, its nodes (a split node once), and every node's arc length
+  // in the undeformed cable [m], cable by cable: the nodes of Frame::nodes.
+  std::vector<int> cable_nodes;
+  std::vector<double> node_s;
+  // Whether frames carry Frame::nodes (the scene's output.shape).
+  bool shape = false;
 };
 
 struct ProbeSample {
@@ -86,6 +92,11 @@ struct Frame {
   // Largest absolute constraint residual (m for positions, dimensionless
   // for tangent cross products).
   double constraint_violation = 0;
+  // With output.shape (ModelInfo::shape): every cable node's position [m],
+  // cable by cable, in the order of ModelInfo::node_s; empty otherwise.
+  // In a MODAL shape frame, the nodes' displacement in the mode (scaled as
+  // the probes').
+  std::vector<Eigen::Vector3d> nodes;
 };
 
 class FrameSink {

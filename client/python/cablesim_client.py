@@ -9,7 +9,8 @@ cablesim_python, into build/python); put that directory on PYTHONPATH.
         scenes/falling-pendulum.json --png pendulum.png
 
 streams a run into numpy arrays and plots the first probe's path and the
-energy components to a PNG.
+energy components to a PNG; `--animate cable.gif` also asks for the
+cable's shape (Scene.output.shape) and draws the cables moving.
 """
 
 import argparse
@@ -37,6 +38,21 @@ class RunResult:
 
     def column(self, name):
         return self.data[:, self.columns.index(name)]
+
+    def cable_nodes(self, cable):
+        """The positions of cable `cable`'s nodes (its index in the scene)
+        in every frame, as a frames x nodes x 3 array [m]: the columns
+        cables[i].nodes[k].x, .y, .z that a scene with `output.shape: true`
+        adds (README, "The cable's shape"). Raises ValueError without them."""
+        prefix = "cables[%d].nodes[" % cable
+        first = [i for i, name in enumerate(self.columns)
+                 if name.startswith(prefix) and name.endswith("].x")]
+        if not first:
+            raise ValueError("no node columns for cables[%d]: run the scene with "
+                             "output.shape: true" % cable)
+        index = np.array([[i, self.columns.index(self.columns[i][:-1] + "y"),
+                           self.columns.index(self.columns[i][:-1] + "z")] for i in first])
+        return self.data[:, index]
 
 
 class _CallDetails(collections.namedtuple(
@@ -166,18 +182,83 @@ def plot(result, png_path, probe=None):
     plt.close(fig)
 
 
+def _frame_indices(t, times):
+    """The frame nearest each of `times` (all frames when None)."""
+    if times is None:
+        return list(range(len(t)))
+    return [int(np.argmin(np.abs(t - time))) for time in times]
+
+
+def animate(result, path, times=None, fps=10, plane=("x", "y")):
+    """Draws every cable of `result` (a run of a scene with
+    `output.shape: true`) at the frames nearest `times` (default: every
+    frame) and writes the animation to `path`: a GIF (matplotlib's
+    PillowWriter, Debian's python3-pil), or an MP4 when `path` ends in
+    .mp4 (matplotlib's FFMpegWriter; RuntimeError when ffmpeg is not
+    installed). `plane` names the two world axes drawn. Returns the number
+    of frames written."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib import animation
+
+    axes = {"x": 0, "y": 1, "z": 2}
+    a, b = axes[plane[0]], axes[plane[1]]
+    cables = [result.cable_nodes(i) for i in range(len(result.info.cable_names))]
+    t = result.column("t")
+    frames = _frame_indices(t, times)
+    fig, ax = plt.subplots(figsize=(6, 5))
+    every = np.concatenate([c.reshape(-1, 3) for c in cables])
+    lo, hi = every.min(axis=0), every.max(axis=0)
+    pad = 0.05 * max(hi[a] - lo[a], hi[b] - lo[b], 1e-9)
+    ax.set_xlim(lo[a] - pad, hi[a] + pad)
+    ax.set_ylim(lo[b] - pad, hi[b] + pad)
+    ax.set_aspect("equal")
+    ax.set_xlabel(plane[0] + " [m]")
+    ax.set_ylabel(plane[1] + " [m]")
+    lines = [ax.plot([], [], "o-", markersize=2, label=name)[0]
+             for name in result.info.cable_names]
+    if len(lines) > 1:
+        ax.legend()
+    title = ax.set_title("")
+
+    def draw(k):
+        for line, nodes in zip(lines, cables):
+            line.set_data(nodes[k, :, a], nodes[k, :, b])
+        title.set_text("t = %.4g s" % t[k])
+        return lines + [title]
+
+    if path.endswith(".mp4"):
+        if not animation.FFMpegWriter.isAvailable():
+            plt.close(fig)
+            raise RuntimeError("writing %s needs ffmpeg (apt-get install ffmpeg)" % path)
+        writer = animation.FFMpegWriter(fps=fps)
+    else:
+        writer = animation.PillowWriter(fps=fps)
+    movie = animation.FuncAnimation(fig, draw, frames=frames, blit=False)
+    movie.save(path, writer=writer)
+    plt.close(fig)
+    return len(frames)
+
+
 def main(argv):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("scene", help="scene file (protobuf JSON)")
     parser.add_argument("--server", default="127.0.0.1:50051")
     parser.add_argument("--png", help="plot the first probe's path and the energies here")
+    parser.add_argument("--animate", help="draw the cables (GIF, or MP4 with ffmpeg) here; "
+                        "asks the server for the cable's shape")
     parser.add_argument("--tls-ca", help="TLS: the CA certificate (PEM) the server's is checked against")
     parser.add_argument("--token-file", help="send the token in this file (its first word)")
     args = parser.parse_args(argv)
     stub = connect(args.server, tls_ca=args.tls_ca,
                    token=read_token(args.token_file) if args.token_file else None)
     try:
-        result = run(stub, load_scene(args.scene))
+        scene = load_scene(args.scene)
+        if args.animate:
+            scene.output.shape = True
+        result = run(stub, scene)
     except grpc.RpcError as e:
         print("cablesim_client: %s: %s" % (e.code().name, e.details()), file=sys.stderr)
         return 2 if e.code() == grpc.StatusCode.INVALID_ARGUMENT else 1
@@ -186,6 +267,8 @@ def main(argv):
                       "status": result.summary.status}))
     if args.png:
         plot(result, args.png)
+    if args.animate:
+        animate(result, args.animate)
     return 0 if result.summary.status == "ok" else 3
 
 
