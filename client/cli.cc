@@ -56,7 +56,8 @@ const std::set<std::string>& ValueOptions() {
                                 "max-constraint-violation",
                                 "tls-ca",
                                 "token-file",
-                                "item"};
+                                "item",
+                                "shape"};
   return *options;
 }
 
@@ -188,15 +189,33 @@ int Validate(const std::string& path, const std::optional<std::string>& server, 
   return kExitOk;
 }
 
+// The shape CSV of a run: --shape FILE (which also asks the scene for its
+// shape), else FILE.shape.csv beside --out FILE.csv when the scene's
+// output.shape is true, else none.
+std::optional<std::string> ShapePath(const std::optional<std::string>& shape_flag,
+                                     const std::optional<std::string>& csv_path,
+                                     v1::Scene* scene) {
+  if (shape_flag.has_value()) {
+    scene->mutable_output()->set_shape(true);
+    return shape_flag;
+  }
+  if (!scene->output().shape() || !csv_path.has_value()) return std::nullopt;
+  std::string base = *csv_path;
+  if (absl::EndsWith(base, ".csv")) base.resize(base.size() - 4);
+  return base + ".shape.csv";
+}
+
 int Run(const std::string& path, const std::optional<std::string>& csv_path,
-        const std::optional<std::string>& server, std::ostream& out, std::ostream& err) {
+        const std::optional<std::string>& shape_flag, const std::optional<std::string>& server,
+        std::ostream& out, std::ostream& err) {
   std::string error;
-  const std::optional<v1::Scene> proto = ReadScene(path, err, &error);
+  std::optional<v1::Scene> proto = ReadScene(path, err, &error);
   if (!proto.has_value()) return kExitBadInput;
+  const std::optional<std::string> shape_path = ShapePath(shape_flag, csv_path, &*proto);
   std::unique_ptr<Connection> c = ConnectOrReport(server, false, 0, err);
   if (c == nullptr) return kExitIoError;
 
-  LazyCsvSink sink(csv_path);
+  LazyCsvSink sink(csv_path, shape_path);
   Progress progress(&err, Progress::IsTerminal(err), "run");
   grpc::ClientContext context;
   v1::RunRequest request;
@@ -222,9 +241,12 @@ int Run(const std::string& path, const std::optional<std::string>& csv_path,
 
 std::string CliUsage() {
   return R"(Usage:
-  cablesim run SCENE [--out FILE.csv] [--server HOST:PORT]
+  cablesim run SCENE [--out FILE.csv] [--shape SHAPE.csv] [--server HOST:PORT]
       Run the scene's analysis and print the run summary as one JSON line.
       With --out, write the trajectory (one row per output frame) as CSV.
+      With --shape (or the scene's output.shape, beside --out as
+      FILE.shape.csv), write every cable node's position per frame as CSV
+      t,cable,node,s,x,y,z.
       The run goes through the cablesim service: one started in this
       process, or the cablesim-server at --server.
   cablesim validate SCENE [--server HOST:PORT]
@@ -338,6 +360,7 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
       continue;
     }
     const bool allowed =
+        (command == "run" && name == "shape") ||
         (command == "jobs" && (name == "state" || name == "sweep" || name == "limit")) ||
         (command == "sweep" && name != "state" && name != "sweep" && name != "limit");
     if (!allowed) return UsageError(err, absl::StrCat(command, ": no option --", name));
@@ -348,7 +371,11 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   }
   SetRemoteSecurity(security);
   if (command == "validate") return Validate(a.positional[1], a.server, out, err);
-  if (command == "run") return Run(a.positional[1], a.out, a.server, out, err);
+  if (command == "run") {
+    std::optional<std::string> shape;
+    if (auto it = a.options.find("shape"); it != a.options.end()) shape = it->second;
+    return Run(a.positional[1], a.out, shape, a.server, out, err);
+  }
   if (command == "submit") return cli_internal::Submit(a, out, err);
   if (command == "jobs") return cli_internal::Jobs(a, out, err);
   if (command == "watch") return cli_internal::Watch(a, out, err);

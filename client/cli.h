@@ -4,7 +4,7 @@
 // The `cablesim` command line, callable in-process (tests call it directly;
 // client/cablesim_main.cc forwards main's arguments):
 //
-//   cablesim run SCENE [--out FILE.csv] [--server HOST:PORT]
+//   cablesim run SCENE [--out FILE.csv] [--shape SHAPE.csv] [--server HOST:PORT]
 //   cablesim validate SCENE [--server HOST:PORT]
 //   cablesim submit SCENE --server HOST:PORT
 //   cablesim jobs --server HOST:PORT [--state S] [--sweep ID] [--limit N]

@@ -17,6 +17,7 @@
 #include "cablesim/v1/scene.pb.h"
 #include "client/cli.h"
 #include "client/csv_writer.h"
+#include "client/shape_csv_writer.h"
 #include "client/service_client.h"
 #include "engine/simulation.h"
 
@@ -56,12 +57,21 @@ std::unique_ptr<Connection> ConnectOrReport(const std::optional<std::string>& se
 // Prints the summary and returns the exit code of a finished run.
 int ReportSummary(const RunSummary& summary, std::ostream& out, std::ostream& err);
 
-// Creates the CSV when the run's header arrives (so an invalid scene leaves
-// no file behind) and remembers whether an error was its own.
+// Creates the CSV (and the shape CSV, `shape_path`) when the run's header
+// arrives (so an invalid scene leaves no file behind) and remembers whether
+// an error was its own.
 class LazyCsvSink : public FrameSink {
  public:
-  explicit LazyCsvSink(std::optional<std::string> path) : path_(std::move(path)) {}
+  explicit LazyCsvSink(std::optional<std::string> path,
+                       std::optional<std::string> shape_path = std::nullopt)
+      : path_(std::move(path)), shape_path_(std::move(shape_path)) {}
   absl::Status OnStart(const ModelInfo& info) override {
+    if (shape_path_.has_value()) {
+      absl::StatusOr<std::unique_ptr<ShapeCsvWriter>> created = ShapeCsvWriter::Create(*shape_path_);
+      if (!created.ok()) return Fail(created.status());
+      shape_ = std::move(*created);
+      if (absl::Status s = shape_->OnStart(info); !s.ok()) return Fail(s);
+    }
     if (!path_.has_value()) return absl::OkStatus();
     absl::StatusOr<std::unique_ptr<CsvWriter>> created = CsvWriter::Create(*path_);
     if (!created.ok()) return Fail(created.status());
@@ -69,11 +79,17 @@ class LazyCsvSink : public FrameSink {
     return Fail(csv_->OnStart(info));
   }
   absl::Status OnFrame(const Frame& frame) override {
+    if (shape_ != nullptr) {
+      if (absl::Status s = shape_->OnFrame(frame); !s.ok()) return Fail(s);
+    }
     return csv_ != nullptr ? Fail(csv_->OnFrame(frame)) : absl::OkStatus();
   }
-  // Finishes the CSV; its first error (or the creation error).
+  // Finishes the CSVs; the first error (or the creation error).
   absl::Status Finish() {
     if (!error_.ok()) return error_;
+    if (shape_ != nullptr) {
+      if (absl::Status s = shape_->Finish(); !s.ok()) return s;
+    }
     return csv_ != nullptr ? csv_->Finish() : absl::OkStatus();
   }
   bool failed() const { return !error_.ok(); }
@@ -83,8 +99,9 @@ class LazyCsvSink : public FrameSink {
     if (!s.ok() && error_.ok()) error_ = s;
     return s;
   }
-  std::optional<std::string> path_;
+  std::optional<std::string> path_, shape_path_;
   std::unique_ptr<CsvWriter> csv_;
+  std::unique_ptr<ShapeCsvWriter> shape_;
   absl::Status error_;
 };
 

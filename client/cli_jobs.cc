@@ -60,12 +60,30 @@ std::string EnergyJson(const std::string& source, const v1::EnergyResponse& r) {
 absl::Status WriteEnergyCsv(const std::string& path, const v1::EnergyResponse& r) {
   std::ofstream file(path);
   if (!file) return absl::UnavailableError(absl::StrCat(path, ": cannot open for writing"));
-  // The run CSV's names for the same quantities (FrameColumns without probes).
-  file << absl::StrJoin(FrameColumns({}), ",") << "\n";
+  // The run CSV's names for the same quantities (FrameColumns without
+  // probes), the parts only when the response has them (a job stored
+  // before they were recorded has none).
+  ModelInfo info;
+  for (const v1::PartEnergySeries& c : r.cables()) info.cable_names.push_back(c.name());
+  for (const v1::PartEnergySeries& b : r.bodies()) info.body_names.push_back(b.name());
+  std::vector<std::string> columns = FrameColumns(info);
+  const bool parts = r.loads_size() == r.t_size();
+  if (!parts) columns.resize(1 + kTotalValues);
+  file << absl::StrJoin(columns, ",") << "\n";
   for (int i = 0; i < r.t_size(); ++i) {
-    file << absl::StrFormat("%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", r.t(i), r.kinetic(i),
-                            r.potential(i), r.axial(i), r.bending(i), r.total(i),
-                            r.constraint_violation(i));
+    std::string row = absl::StrFormat("%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", r.t(i),
+                                      r.kinetic(i), r.potential(i), r.axial(i), r.bending(i),
+                                      r.total(i), r.constraint_violation(i));
+    if (parts) {
+      for (const v1::PartEnergySeries& c : r.cables()) {
+        absl::StrAppendFormat(&row, ",%.17g,%.17g,%.17g,%.17g", c.kinetic(i), c.gravity(i),
+                              c.axial(i), c.bending(i));
+      }
+      for (const v1::PartEnergySeries& b : r.bodies())
+        absl::StrAppendFormat(&row, ",%.17g,%.17g", b.kinetic(i), b.gravity(i));
+      absl::StrAppendFormat(&row, ",%.17g", r.loads(i));
+    }
+    file << row << "\n";
   }
   file.close();
   if (!file) return absl::DataLossError(absl::StrCat(path, ": write failed"));

@@ -6,24 +6,17 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
+#include "engine/frame_columns.h"
 
 namespace cablesim {
 namespace {
 
-constexpr const char* kProbeColumns[] = {"x", "y", "z", "vx", "vy", "vz", "ax", "ay", "az"};
-constexpr const char* kTrailingColumns[] = {"energy.kinetic", "energy.potential",
-                                            "energy.axial",   "energy.bending",
-                                            "energy.total",   "constraint.violation"};
-
 void AppendNumber(std::string* row, double value) { absl::StrAppendFormat(row, ",%.17g", value); }
-
-void AppendVector(std::string* row, const Eigen::Vector3d& v) {
-  for (int k = 0; k < 3; ++k) AppendNumber(row, v[k]);
-}
 
 }  // namespace
 
-absl::StatusOr<std::unique_ptr<CsvWriter>> CsvWriter::Create(const std::string& path) {
+absl::StatusOr<std::unique_ptr<std::ofstream>> OpenForWriting(const std::string& path) {
   errno = 0;
   auto file = std::make_unique<std::ofstream>(path, std::ios::out | std::ios::trunc);
   if (!file->is_open()) {
@@ -31,7 +24,13 @@ absl::StatusOr<std::unique_ptr<CsvWriter>> CsvWriter::Create(const std::string& 
     return absl::UnavailableError(absl::StrCat(
         path, ": cannot open for writing: ", error != 0 ? std::strerror(error) : "unknown"));
   }
-  return std::unique_ptr<CsvWriter>(new CsvWriter(std::move(file), path));
+  return file;
+}
+
+absl::StatusOr<std::unique_ptr<CsvWriter>> CsvWriter::Create(const std::string& path) {
+  absl::StatusOr<std::unique_ptr<std::ofstream>> file = OpenForWriting(path);
+  if (!file.ok()) return file.status();
+  return std::unique_ptr<CsvWriter>(new CsvWriter(std::move(*file), path));
 }
 
 CsvWriter::CsvWriter(std::ostream* out, std::string name) : out_(out), name_(std::move(name)) {}
@@ -43,21 +42,8 @@ CsvWriter::~CsvWriter() {
   if (!finished_) Finish().IgnoreError();
 }
 
-std::string CsvWriter::Header(const std::vector<std::string>& probe_names) {
-  std::string header = "t";
-  for (const std::string& name : probe_names) {
-    for (const char* column : kProbeColumns) absl::StrAppend(&header, ",", name, ".", column);
-  }
-  for (const char* column : kTrailingColumns) absl::StrAppend(&header, ",", column);
-  return header;
-}
-
-std::string CsvWriter::HeaderFor(const ModelInfo& info) {
-  std::string header = Header(info.probe_names);
-  for (const std::string& name : info.force_probe_names) {
-    for (const char* column : {"fx", "fy", "fz"}) absl::StrAppend(&header, ",", name, ".", column);
-  }
-  return header;
+std::string CsvWriter::Header(const ModelInfo& info) {
+  return absl::StrJoin(FrameColumns(info, /*with_nodes=*/false), ",");
 }
 
 absl::Status CsvWriter::CheckStream(const char* what) {
@@ -77,8 +63,11 @@ absl::Status CsvWriter::OnStart(const ModelInfo& info) {
   }
   started_ = true;
   probe_count_ = info.probe_names.size();
+  cable_count_ = info.cable_names.size();
+  force_count_ = info.force_probe_names.size();
+  body_count_ = info.body_names.size();
   errno = 0;
-  *out_ << HeaderFor(info) << '\n';
+  *out_ << Header(info) << '\n';
   out_->flush();
   return CheckStream("writing the header");
 }
@@ -90,24 +79,22 @@ absl::Status CsvWriter::OnFrame(const Frame& frame) {
         absl::FailedPreconditionError(absl::StrCat(name_, ": frame outside OnStart ... Finish"));
     return status_;
   }
-  if (frame.probes.size() != probe_count_) {
-    status_ = absl::InternalError(absl::StrCat(name_, ": frame has ", frame.probes.size(),
-                                               " probe samples, the header ", probe_count_));
+  if (frame.probes.size() != probe_count_ ||
+      frame.energy_parts.cables.size() != cable_count_ ||
+      frame.support_forces.size() != force_count_ ||
+      frame.energy_parts.bodies.size() != body_count_) {
+    status_ = absl::InternalError(absl::StrCat(
+        name_, ": frame has ", frame.probes.size(), " probe samples and the energy of ",
+        frame.energy_parts.cables.size(), " cables and ", frame.energy_parts.bodies.size(),
+        " bodies and ", frame.support_forces.size(), " support forces, the header ", probe_count_,
+        ", ", cable_count_, ", ", body_count_, " and ", force_count_));
     return status_;
   }
-  std::string row = absl::StrFormat("%.17g", frame.t);
-  row.reserve(row.size() + (probe_count_ * 9 + 6) * 25);
-  for (const ProbeSample& probe : frame.probes) {
-    AppendVector(&row, probe.position_m);
-    AppendVector(&row, probe.velocity_m_s);
-    AppendVector(&row, probe.acceleration_m_s2);
-  }
-  const EnergySample& e = frame.energy;
-  for (const double value :
-       {e.kinetic, e.potential, e.axial, e.bending, e.total, frame.constraint_violation}) {
-    AppendNumber(&row, value);
-  }
-  for (const Eigen::Vector3d& force : frame.support_forces) AppendVector(&row, force);
+  std::string row;
+  row.reserve(FrameRowSize(probe_count_, cable_count_, body_count_, force_count_) * 25);
+  ForEachFrameValue(frame, [&row](double value) { AppendNumber(&row, value); });
+  // The row starts with t, without the separator.
+  row.erase(0, 1);
   row += '\n';
   errno = 0;
   out_->write(row.data(), static_cast<std::streamsize>(row.size()));

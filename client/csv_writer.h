@@ -1,11 +1,14 @@
 #ifndef CABLESIM_CLIENT_CSV_WRITER_H_
 #define CABLESIM_CLIENT_CSV_WRITER_H_
 
-// Writes a run's trajectory as CSV, one row per frame:
+// Writes a run's trajectory as CSV, one row per frame, in the columns of
+// FrameColumns (engine/frame_columns.h):
 //
 //   t, then for each probe NAME.x NAME.y NAME.z NAME.vx NAME.vy NAME.vz
 //   NAME.ax NAME.ay NAME.az, then energy.kinetic energy.potential
-//   energy.axial energy.bending energy.total constraint.violation
+//   energy.axial energy.bending energy.total constraint.violation, then the
+//   energy per part: cables[i].energy.{kinetic,gravity,axial,bending},
+//   bodies[j].energy.{kinetic,gravity}, loads.energy.potential
 //
 // t is the time [s] (DYNAMIC) or the load factor (STATIC); positions [m],
 // velocities [m/s], accelerations [m/s^2], energies [J]. Numbers are written
@@ -23,6 +26,10 @@
 #include "engine/simulation.h"
 
 namespace cablesim {
+
+// Creates (or truncates) the file at `path` for writing; Unavailable,
+// naming the file and the reason, when it cannot be opened.
+absl::StatusOr<std::unique_ptr<std::ofstream>> OpenForWriting(const std::string& path);
 
 class CsvWriter : public FrameSink {
  public:
@@ -45,7 +52,8 @@ class CsvWriter : public FrameSink {
 
   // Writes the header line. Returns the write error, if any.
   absl::Status OnStart(const ModelInfo& info) override;
-  // Writes one row (every frame must have one sample per probe of OnStart).
+  // Writes one row (every frame must have one sample per probe of OnStart,
+  // and one energy part per cable and body).
   // Flushes every kRowsPerFlush rows. Returns the write error, if any.
   absl::Status OnFrame(const Frame& frame) override;
 
@@ -58,10 +66,9 @@ class CsvWriter : public FrameSink {
   const absl::Status& status() const { return status_; }
   int64_t rows() const { return rows_; }
 
-  // The header line for `probe_names`, without the newline.
-  static std::string Header(const std::vector<std::string>& probe_names);
-  // The same, then NAME.fx NAME.fy NAME.fz per probe on a moving support.
-  static std::string HeaderFor(const ModelInfo& info);
+  // The header line for a model with `info`'s probes, cables and bodies,
+  // without the newline.
+  static std::string Header(const ModelInfo& info);
 
  private:
   CsvWriter(std::unique_ptr<std::ofstream> file, std::string name);
@@ -73,7 +80,7 @@ class CsvWriter : public FrameSink {
   std::ostream* out_;
   std::string name_;
   absl::Status status_;
-  size_t probe_count_ = 0;
+  size_t probe_count_ = 0, cable_count_ = 0, body_count_ = 0, force_count_ = 0;
   bool started_ = false;
   bool finished_ = false;
   int64_t rows_ = 0;

@@ -4,6 +4,8 @@
 
 #include <filesystem>
 #include <limits>
+#include <optional>
+#include <string>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -124,7 +126,7 @@ absl::StatusOr<RunSummary> ReadRunStream(grpc::ClientContext* context,
                                          grpc::ClientReader<v1::RunEvent>* reader, FrameSink* sink,
                                          const std::function<void(double, double)>& on_frame_time) {
   v1::RunEvent event;
-  int probes = 0;
+  std::optional<FrameReader> frames;
   int columns = 0;
   double end_time = 0;
   Frame frame;
@@ -133,8 +135,12 @@ absl::StatusOr<RunSummary> ReadRunStream(grpc::ClientContext* context,
   while (reader->Read(&event)) {
     if (event.has_header()) {
       const ModelInfo info = ModelInfoFromProto(event.header().info());
-      probes = static_cast<int>(info.probe_names.size());
-      columns = FrameRowSize(probes) + 3 * static_cast<int>(info.force_probe_names.size());
+      // Columns by name: a server older or newer than this client may
+      // send fewer or more of them.
+      const std::vector<std::string> names(event.header().columns().begin(),
+                                           event.header().columns().end());
+      frames.emplace(info, names);
+      columns = frames->row_size();
       end_time = event.header().end_time_s();
       sink_error = sink->OnStart(info);
     } else if (event.has_frames()) {
@@ -143,7 +149,7 @@ absl::StatusOr<RunSummary> ReadRunStream(grpc::ClientContext* context,
         sink_error = absl::InternalError("malformed frame batch from the server");
       }
       for (int r = 0; sink_error.ok() && r < b.rows(); ++r) {
-        FrameFromRow(absl::MakeConstSpan(b.values().data() + r * columns, columns), probes, &frame);
+        frames->Read(absl::MakeConstSpan(b.values().data() + r * columns, columns), &frame);
         sink_error = sink->OnFrame(frame);
         if (on_frame_time) on_frame_time(frame.t, end_time);
       }

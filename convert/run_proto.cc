@@ -14,6 +14,11 @@ v1::ModelInfo ModelInfoToProto(const ModelInfo& info) {
   p.set_nodes(info.nodes);
   for (const std::string& name : info.probe_names) p.add_probe_names(name);
   for (const std::string& name : info.force_probe_names) p.add_force_probe_names(name);
+  for (const std::string& name : info.cable_names) p.add_cable_names(name);
+  for (const std::string& name : info.body_names) p.add_body_names(name);
+  for (const int n : info.cable_nodes) p.add_cable_nodes(n);
+  for (const double s : info.node_s) p.add_node_arc_lengths(s);
+  p.set_shape(info.shape);
   return p;
 }
 
@@ -27,6 +32,11 @@ ModelInfo ModelInfoFromProto(const v1::ModelInfo& p) {
   info.nodes = p.nodes();
   info.probe_names.assign(p.probe_names().begin(), p.probe_names().end());
   info.force_probe_names.assign(p.force_probe_names().begin(), p.force_probe_names().end());
+  info.cable_names.assign(p.cable_names().begin(), p.cable_names().end());
+  info.body_names.assign(p.body_names().begin(), p.body_names().end());
+  info.cable_nodes.assign(p.cable_nodes().begin(), p.cable_nodes().end());
+  info.node_s.assign(p.node_arc_lengths().begin(), p.node_arc_lengths().end());
+  info.shape = p.shape();
   return info;
 }
 
@@ -108,66 +118,14 @@ RunSummary SummaryFromProto(const v1::RunSummary& p) {
   return s;
 }
 
-std::vector<std::string> FrameColumns(const std::vector<std::string>& probe_names) {
-  std::vector<std::string> columns = {"t"};
-  for (const std::string& name : probe_names) {
-    for (const char* c : {"x", "y", "z", "vx", "vy", "vz", "ax", "ay", "az"}) {
-      columns.push_back(absl::StrCat(name, ".", c));
-    }
-  }
-  for (const char* c : {"energy.kinetic", "energy.potential", "energy.axial", "energy.bending",
-                        "energy.total", "constraint.violation"}) {
-    columns.push_back(c);
-  }
-  return columns;
-}
-
-std::vector<std::string> FrameColumnsFor(const ModelInfo& info) {
-  std::vector<std::string> columns = FrameColumns(info.probe_names);
-  for (const std::string& name : info.force_probe_names) {
-    for (const char* c : {"fx", "fy", "fz"}) columns.push_back(absl::StrCat(name, ".", c));
-  }
-  return columns;
-}
-
 void AppendFrameRow(const Frame& frame, google::protobuf::RepeatedField<double>* values) {
-  values->Add(frame.t);
-  for (const ProbeSample& p : frame.probes) {
-    for (int k = 0; k < 3; ++k) values->Add(p.position_m[k]);
-    for (int k = 0; k < 3; ++k) values->Add(p.velocity_m_s[k]);
-    for (int k = 0; k < 3; ++k) values->Add(p.acceleration_m_s2[k]);
-  }
-  const EnergySample& e = frame.energy;
-  values->Add(e.kinetic);
-  values->Add(e.potential);
-  values->Add(e.axial);
-  values->Add(e.bending);
-  values->Add(e.total);
-  values->Add(frame.constraint_violation);
-  for (const Eigen::Vector3d& f : frame.support_forces)
-    for (int k = 0; k < 3; ++k) values->Add(f[k]);
+  ForEachFrameValue(frame, [values](double v) { values->Add(v); });
+  ForEachNodeValue(frame, [values](double v) { values->Add(v); });
 }
 
-void FrameFromRow(absl::Span<const double> row, int probes, Frame* frame) {
-  frame->t = row[0];
-  frame->probes.resize(probes);
-  size_t i = 1;
-  for (ProbeSample& p : frame->probes) {
-    for (int k = 0; k < 3; ++k) p.position_m[k] = row[i++];
-    for (int k = 0; k < 3; ++k) p.velocity_m_s[k] = row[i++];
-    for (int k = 0; k < 3; ++k) p.acceleration_m_s2[k] = row[i++];
-  }
-  EnergySample& e = frame->energy;
-  e.kinetic = row[i++];
-  e.potential = row[i++];
-  e.axial = row[i++];
-  e.bending = row[i++];
-  e.total = row[i++];
-  frame->constraint_violation = row[i++];
-  // The rest: the forces of moving supports, 3 per probe on one.
-  frame->support_forces.resize((row.size() - i) / 3);
-  for (Eigen::Vector3d& f : frame->support_forces)
-    for (int k = 0; k < 3; ++k) f[k] = row[i++];
+void SetFrameHeader(const ModelInfo& info, v1::RunHeader* header) {
+  *header->mutable_info() = ModelInfoToProto(info);
+  for (std::string& c : FrameColumns(info)) header->add_columns(std::move(c));
 }
 
 }  // namespace cablesim

@@ -298,6 +298,7 @@ class SceneConverter {
                                              " (expected AUTO, PLANAR or SPATIAL)"));
     }
     CABLESIM_ASSIGN_OR_RETURN(scene_.gravity_m_s2, VectorInRange("gravity", proto_.gravity(), plausible::kGravity));
+    scene_.output.shape = proto_.output().shape();
     if (proto_.cables_size() == 0 && proto_.bodies_size() == 0) {
       return Invalid("cables", "a scene needs at least one cable or body");
     }

@@ -11,7 +11,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libsqlite3-dev zlib1g-dev
   libpq-dev postgresql
-  python3 python3-grpcio python3-protobuf python3-numpy python3-matplotlib
+  python3 python3-grpcio python3-protobuf python3-numpy python3-matplotlib python3-pil
   python3-venv python3-setuptools python3-wheel python3-pandas
   clang libclang-rt-14-dev
 )

@@ -428,7 +428,10 @@ void RunModalAnalysis(MultibodyModel* model, const SolverSettings& settings, int
   Frame frame;
   frame.t = 0;
   model->Probes(q, zero, zero, &frame.probes);
-  frame.energy = model->Energy(q, zero, 1.0);
+  if (model->shape()) model->NodePositions(q, &frame.nodes);
+  frame.energy = model->Energy(q, zero, 1.0, &frame.energy_parts);
+  // MODAL reports no support forces: their columns hold 0.
+  frame.support_forces.assign(model->force_probe_count(), Eigen::Vector3d::Zero());
   frame.constraint_violation = phi.size() ? phi.lpNorm<Eigen::Infinity>() : 0.0;
   summary->energy_initial = summary->energy_final = frame.energy.total;
   summary->max_constraint_violation = frame.constraint_violation;
@@ -464,9 +467,18 @@ void RunModalAnalysis(MultibodyModel* model, const SolverSettings& settings, int
     if (largest > kStillProbe * shape_q.lpNorm<Eigen::Infinity>()) scale = sign / largest;
     Frame mode;
     mode.t = k + 1;
+    // A shape has no energy: every part 0, as the totals.
+    mode.energy_parts.cables.resize(frame.energy_parts.cables.size());
+    mode.energy_parts.bodies.resize(frame.energy_parts.bodies.size());
+    mode.support_forces.assign(model->force_probe_count(), Eigen::Vector3d::Zero());
     mode.probes.resize(samples.size());
     for (size_t p = 0; p < samples.size(); ++p)
       mode.probes[p].position_m = scale * samples[p].velocity_m_s;
+    if (model->shape()) {
+      // The nodes' displacement in the mode, scaled as the probes'.
+      model->NodePositions(shape_q, &mode.nodes);
+      for (Eigen::Vector3d& r : mode.nodes) r *= scale;
+    }
     if (jx.size() > 0) {
       jac.Multiply(shape.data(), jx.data());
       mode.constraint_violation = std::abs(scale) * jx.lpNorm<Eigen::Infinity>();

@@ -515,8 +515,10 @@ void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* 
   const double extent = q0_.lpNorm<Eigen::Infinity>();  // scene size [m]
   const Eigen::Matrix<double, D, 1> g = scene_.gravity_m_s2.head<D>();
   const std::vector<int>& first_node = mesh_.first_node;
+  model_.cable_element_begin_.assign(1, 0);
   for (int c = 0; c < static_cast<int>(scene_.cables.size()); ++c) {
     const CableSpec& cable = scene_.cables[c];
+    model_.cable_names_.push_back(cable.name);
     const double ea = cable.youngs_modulus_pa * cable.area_m2;
     const double ei = cable.youngs_modulus_pa * cable.second_moment_m4;
     const double mpl = cable.density_kg_m3 * cable.area_m2;
@@ -538,6 +540,7 @@ void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* 
         for (int b = 0; b < 4; ++b) e.mbar(a, b) = me(D * a, D * b);
       elements->push_back(e);
     }
+    model_.cable_element_begin_.push_back(static_cast<int>(elements->size()));
   }
 }
 
@@ -552,6 +555,8 @@ void ModelBuilder::BuildElements() {
 void ModelBuilder::ConstantForces() {
   MultibodyModel& m = model_;
   const int D = m.dim_;
+  m.gravity_ = scene_.gravity_m_s2;
+  for (const BodySpec& body : scene_.bodies) m.body_names_.push_back(body.name);
   m.constant_force_ = VectorXd::Zero(q0_.size());
   for (const auto& e : m.elements2_) m.constant_force_.segment<8>(e.first_coord) += e.gravity;
   for (const auto& e : m.elements3_) m.constant_force_.segment<12>(e.first_coord) += e.gravity;
@@ -560,9 +565,14 @@ void ModelBuilder::ConstantForces() {
   // A force F at a point r = sum_i a_i q_i + c does the work F . dr, so its
   // generalized force is sum_d F_d a_{d,i} on q_i (constant: the point is
   // linear in q).
+  if (!scene_.loads.empty()) m.load_force_ = VectorXd::Zero(q0_.size());
   auto add_point_force = [&](const LinearVector& point, const Vector3d& force) {
-    for (int d = 0; d < D; ++d)
-      for (const auto& [i, v] : point[d].terms) m.constant_force_(i) += v * force(d);
+    for (int d = 0; d < D; ++d) {
+      for (const auto& [i, v] : point[d].terms) {
+        m.constant_force_(i) += v * force(d);
+        m.load_force_(i) += v * force(d);
+      }
+    }
   };
   for (const LoadSpec& load : scene_.loads) {
     const LinearVector point = PointOf(load.at);
@@ -588,6 +598,18 @@ void ModelBuilder::ConstantForces() {
 
 void ModelBuilder::Probes() {
   MultibodyModel& m = model_;
+  // The cable nodes (output.shape), a split node's second half left out.
+  m.shape_ = scene_.output.shape;
+  for (size_t c = 0; c + 1 < mesh_.first_node.size(); ++c) {
+    int count = 0;
+    for (int k = mesh_.first_node[c]; k < mesh_.first_node[c + 1]; ++k) {
+      if (mesh_.twin_of[k] >= 0) continue;
+      m.shape_coord_.push_back(NodeCoord(k));
+      m.node_s_.push_back(mesh_.node_s[c][k - mesh_.first_node[c]]);
+      ++count;
+    }
+    m.cable_nodes_.push_back(count);
+  }
   m.probe_term_begin_.push_back(0);
   for (const ProbeSpec& p : scene_.probes) {
     const LinearVector point = PointOf(p.at);

@@ -130,18 +130,21 @@ class ModelBuilder {
 
   // The ANCF elements between consecutive nodes (not between the halves
   // of a split node) with their gravity [N] and scalar mass matrices [kg],
-  // and the model's energy_roundoff [J].
+  // the model's energy_roundoff [J], and where each cable's elements begin
+  // (for the energy per cable).
   void BuildElements();
 
   // The constant generalized force [N, or N m per unit slope]: element and
-  // body gravity and each load's force at its point; the torques on
-  // bodies, kept apart (their work is summed step by step), and the
-  // time-varying forces with their points (evaluated by SetTime).
+  // body gravity and each load's force at its point (the loads' also
+  // apart, for the energy per part); the torques on bodies, kept apart
+  // (their work is summed step by step), and the time-varying forces with
+  // their points (evaluated by SetTime).
   void ConstantForces();
 
   // Each probe's point as a linear form of q (position [m] = const + sum
   // coeff q_i); a probe on the point a moving support holds also gets that
-  // support's rows (its force, MultibodyModel::ProbeForces).
+  // support's rows (its force, MultibodyModel::ProbeForces); and the cable
+  // nodes whose positions output.shape writes.
   void Probes();
 
   // The skyline envelope of the Newton matrix on z (what elements, bodies

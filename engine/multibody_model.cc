@@ -191,6 +191,11 @@ ModelInfo MultibodyModel::Info() const {
   info.nodes = nodes();
   info.probe_names = probe_names_;
   for (int p : force_probes_) info.force_probe_names.push_back(probe_names_[p]);
+  info.cable_names = cable_names_;
+  info.body_names = body_names_;
+  info.cable_nodes = cable_nodes_;
+  info.node_s = node_s_;
+  info.shape = shape_;
   return info;
 }
 
@@ -353,34 +358,63 @@ void MultibodyModel::SetTime(double t) {
 }
 
 template <int D>
-void MultibodyModel::ElementEnergy(const VectorXd& q, const VectorXd& qdot,
-                                   EnergySample* en) const {
+void MultibodyModel::ElementEnergy(const VectorXd& q, const VectorXd& qdot, EnergySample* en,
+                                   EnergyParts* parts) const {
   constexpr int kN = 4 * D;
   const auto& elements = Elements<D>();
-  for (const ElementData<D>& e : elements) {
+  // The totals are summed element by element, the parts apart (so the
+  // parts' sums check the totals, and the totals are those of a run
+  // without parts, bit for bit).
+  size_t cable = 0;
+  for (size_t k = 0; k < elements.size(); ++k) {
+    const ElementData<D>& e = elements[k];
     const auto qe = q.segment<kN>(e.first_coord);
     const auto ve = qdot.segment<kN>(e.first_coord);
-    en->kinetic += 0.5 * ve.dot(e.element.MassMatrix(e.mass_per_length) * ve);
+    const double kinetic = 0.5 * ve.dot(e.element.MassMatrix(e.mass_per_length) * ve);
     const auto se = e.element.StrainEnergy(qe);
+    en->kinetic += kinetic;
     en->axial += se.axial;
     en->bending += se.bending;
+    if (parts == nullptr) continue;
+    while (static_cast<int>(k) >= cable_element_begin_[cable + 1]) ++cable;
+    PartEnergy* part = &parts->cables[cable];
+    part->kinetic += kinetic;
+    part->axial += se.axial;
+    part->bending += se.bending;
+    // Element gravity is exactly -Q_g . e (MODEL.md section 2).
+    part->gravity -= e.gravity.dot(qe);
   }
 }
 
-EnergySample MultibodyModel::Energy(const VectorXd& q, const VectorXd& qdot,
-                                    double load_factor) const {
+EnergySample MultibodyModel::Energy(const VectorXd& q, const VectorXd& qdot, double load_factor,
+                                    EnergyParts* parts) const {
   EnergySample en;
+  if (parts != nullptr) {
+    parts->cables.assign(cable_names_.size(), PartEnergy());
+    parts->bodies.assign(bodies_.size(), PartEnergy());
+  }
   if (dim_ == 2) {
-    ElementEnergy<2>(q, qdot, &en);
+    ElementEnergy<2>(q, qdot, &en, parts);
   } else {
-    ElementEnergy<3>(q, qdot, &en);
+    ElementEnergy<3>(q, qdot, &en, parts);
   }
   const int D = dim_;
-  for (const BodyData& b : bodies_) {
-    en.kinetic += 0.5 * b.mass * qdot.segment(b.coord, D).squaredNorm();
+  for (size_t i = 0; i < bodies_.size(); ++i) {
+    const BodyData& b = bodies_[i];
+    const double translation = 0.5 * b.mass * qdot.segment(b.coord, D).squaredNorm();
+    en.kinetic += translation;
+    double kinetic = translation;
     const int axes = D == 2 ? 1 : 3;
-    for (int k = 0; k < axes; ++k)
-      en.kinetic += 0.5 * b.jbar(k) * qdot.segment(b.coord + D + D * k, D).squaredNorm();
+    for (int k = 0; k < axes; ++k) {
+      const double rotation = 0.5 * b.jbar(k) * qdot.segment(b.coord + D + D * k, D).squaredNorm();
+      en.kinetic += rotation;
+      kinetic += rotation;
+    }
+    if (parts != nullptr) {
+      PartEnergy& part = parts->bodies[i];
+      part.kinetic = kinetic;
+      part.gravity = -load_factor * b.mass * gravity_.head(D).dot(q.segment(b.coord, D));
+    }
   }
   // Gravity and point loads are constant forces on q: V = -F . q. Element
   // gravity is exactly -Q_g . e (MODEL.md section 2).
@@ -389,6 +423,12 @@ EnergySample MultibodyModel::Energy(const VectorXd& q, const VectorXd& qdot,
   // (AccumulateExternalWork).
   en.potential -= external_work_;
   en.total = en.kinetic + en.potential + en.axial + en.bending;
+  if (parts != nullptr) {
+    // The element gravity above is at load factor 1 (statics scales it).
+    for (PartEnergy& part : parts->cables) part.gravity *= load_factor;
+    parts->loads = -external_work_;
+    if (load_force_.size() > 0) parts->loads -= load_factor * load_force_.dot(q);
+  }
   return en;
 }
 
@@ -469,6 +509,15 @@ Eigen::Vector3d MultibodyModel::AngularMomentum(const VectorXd& q, const VectorX
     }
   }
   return l;
+}
+
+void MultibodyModel::NodePositions(const VectorXd& q, std::vector<Vector3d>* out) const {
+  out->resize(shape_coord_.size());
+  for (size_t k = 0; k < shape_coord_.size(); ++k) {
+    Vector3d& r = (*out)[k];
+    r.setZero();
+    r.head(dim_) = q.segment(shape_coord_[k], dim_);
+  }
 }
 
 void MultibodyModel::Probes(const VectorXd& q, const VectorXd& qdot, const VectorXd& qddot,

@@ -154,8 +154,14 @@ class MultibodyModel {
   // minus the work the external agents have done so far
   // (AccumulateExternalWork): torques, time-varying loads and moving
   // supports. `total` is then what the exact solution conserves.
-  EnergySample Energy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
-                      double load_factor) const;
+  // When `parts` is not null it also receives the energy per cable and per
+  // body (EnergyParts, simulation.h), each part summed over its own
+  // elements, gravity and loads apart from the total's single dot product,
+  // so that the parts' sums check the totals to rounding; `parts->loads` is
+  // the constant loads' potential minus the external work. Its vectors are
+  // resized (no allocation once they have the size).
+  EnergySample Energy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, double load_factor,
+                      EnergyParts* parts = nullptr) const;
 
   // Work that is not a potential's is summed step by step: call this after
   // every accepted step (or load increment) with the full configurations,
@@ -186,6 +192,13 @@ class MultibodyModel {
   // m r_c x rdot_c + sum_k Jb_k e_k x edot_k. Planar models return (0, 0, L_z).
   Eigen::Vector3d AngularMomentum(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot) const;
 
+  // Whether frames carry the nodes' positions (the scene's output.shape).
+  bool shape() const { return shape_; }
+  // Every cable node's position [m] from full coordinates q (a split node
+  // once), in the order of ModelInfo::node_s; from a rate, the nodes'
+  // velocities. `out` is resized (no allocation once it has the size).
+  void NodePositions(const Eigen::VectorXd& q, std::vector<Eigen::Vector3d>* out) const;
+
   // Probes from full position, velocity and acceleration.
   void Probes(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
               const Eigen::VectorXd& qddot, std::vector<ProbeSample>* out) const;
@@ -193,6 +206,8 @@ class MultibodyModel {
   // position rows, per probe placed on such a joint
   // (ModelInfo::force_probe_names).
   void ProbeForces(const Eigen::VectorXd& lambda, std::vector<Eigen::Vector3d>* out) const;
+  // The number of probes on a moving support (ProbeForces' size).
+  int force_probe_count() const { return static_cast<int>(force_probes_.size()); }
 
   // Which joint a constraint row belongs to (for messages), or -1 for a
   // body's own axis constraints.
@@ -260,8 +275,8 @@ class MultibodyModel {
   double ElementForces(const Eigen::VectorXd& q, Eigen::VectorXd* full, SkylineLdlt* stiffness,
                        double stiffness_scale, Eigen::VectorXd* roundoff) const;
   template <int D>
-  void ElementEnergy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
-                     EnergySample* en) const;
+  void ElementEnergy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, EnergySample* en,
+                     EnergyParts* parts) const;
   template <int D>
   Eigen::Vector3d ElementAngularMomentum(const Eigen::VectorXd& q,
                                          const Eigen::VectorXd& qdot) const;
@@ -305,6 +320,18 @@ class MultibodyModel {
   std::vector<BodyData> bodies_;
   std::vector<TorqueLoad> torques_;
   Eigen::VectorXd constant_force_;  // full: gravity and point loads
+  // Full: the point loads alone (empty without any), for EnergyParts::loads.
+  Eigen::VectorXd load_force_;
+  // Per cable, its first element; one more entry, the element count.
+  std::vector<int> cable_element_begin_;
+  Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();  // [m/s^2]
+  std::vector<std::string> cable_names_, body_names_;
+  // The cable nodes of ModelInfo: per distinct node its position's first
+  // full coordinate; per cable the count; per node its arc length [m].
+  bool shape_ = false;
+  std::vector<int> shape_coord_;
+  std::vector<int> cable_nodes_;
+  std::vector<double> node_s_;
   double energy_roundoff_ = 0;
 
   std::vector<Row> rows_;

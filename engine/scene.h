@@ -146,6 +146,12 @@ struct SolverSettings {
   InitialState initial_state = InitialState::kAsGiven;  // DYNAMIC only
 };
 
+// What a run writes besides the probes and energies.
+struct OutputSpec {
+  // Every cable node's position in every frame (Frame::nodes).
+  bool shape = false;
+};
+
 struct Scene {
   std::string name;
   ModelChoice model = ModelChoice::kAuto;
@@ -157,6 +163,7 @@ struct Scene {
   std::vector<ProbeSpec> probes;
   InitialVelocitySpec initial_velocity;
   SolverSettings solver;
+  OutputSpec output;
 };
 
 }  // namespace cablesim

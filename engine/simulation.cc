@@ -39,8 +39,14 @@ class FrameRecorder {
     if (a) model_->RateToFull(*a, &qdd_);
     frame_.t = t;
     model_->Probes(q_, qd_, qdd_, &frame_.probes);
-    if (lambda) model_->ProbeForces(*lambda, &frame_.support_forces);
-    frame_.energy = model_->Energy(q_, qd_, load_factor);
+    if (lambda) {
+      model_->ProbeForces(*lambda, &frame_.support_forces);
+    } else {
+      // No multipliers at hand: the columns stay, with 0 (a row keeps its size).
+      frame_.support_forces.assign(model_->force_probe_count(), Eigen::Vector3d::Zero());
+    }
+    if (model_->shape()) model_->NodePositions(q_, &frame_.nodes);
+    frame_.energy = model_->Energy(q_, qd_, load_factor, &frame_.energy_parts);
     frame_.angular_momentum = model_->AngularMomentum(q_, qd_);
     model_->Constraints(q_, &phi_, nullptr);
     frame_.constraint_violation = phi_.size() ? phi_.lpNorm<Eigen::Infinity>() : 0.0;

@@ -32,6 +32,15 @@ struct ModelInfo {
   // motion), in scene order: their samples carry force_n, written as
   // NAME.fx NAME.fy NAME.fz after the other columns.
   std::vector<std::string> force_probe_names;
+  // Cable and body names in scene order (the parts of EnergyParts).
+  std::vector<std::string> cable_names;
+  std::vector<std::string> body_names;
+  // Per cable, its nodes (a split node once), and every node's arc length
+  // in the undeformed cable [m], cable by cable: the nodes of Frame::nodes.
+  std::vector<int> cable_nodes;
+  std::vector<double> node_s;
+  // Whether frames carry Frame::nodes (the scene's output.shape).
+  bool shape = false;
 };
 
 struct ProbeSample {
@@ -52,11 +61,36 @@ struct EnergySample {
   double total = 0;
 };
 
+// The energy of one cable or one body [J]. `gravity` is the potential of
+// gravity, -m g . r_c for a body and -int rho A g . r ds for a cable (zero
+// at the world origin, as EnergySample::potential). A body has no strain:
+// its axial and bending are 0.
+struct PartEnergy {
+  double kinetic = 0;
+  double gravity = 0;
+  double axial = 0;
+  double bending = 0;
+};
+
+// EnergySample split by part. Summed over the parts, kinetic, axial and
+// bending are the totals' and gravity plus `loads` is the total potential:
+//   potential = sum gravity + loads,
+// `loads` being the potential of the applied point forces (-F . r) minus
+// the work torques have done so far.
+struct EnergyParts {
+  std::vector<PartEnergy> cables;  // in scene order
+  std::vector<PartEnergy> bodies;  // in scene order
+  double loads = 0;
+};
+
 struct Frame {
   // Time [s] for DYNAMIC; the load factor in (0, 1] for STATIC.
   double t = 0;
   std::vector<ProbeSample> probes;  // in scene order
   EnergySample energy;
+  // The same energy per cable and per body (sized as ModelInfo's
+  // cable_names and body_names in every frame; zeros in a MODAL shape).
+  EnergyParts energy_parts;
   // Angular momentum about the world origin [kg m^2/s] (z only for a
   // planar model); conserved about any axis along which the applied loads
   // and joints to ground exert no moment.
@@ -68,6 +102,11 @@ struct Frame {
   // Largest absolute constraint residual (m for positions, dimensionless
   // for tangent cross products).
   double constraint_violation = 0;
+  // With output.shape (ModelInfo::shape): every cable node's position [m],
+  // cable by cable, in the order of ModelInfo::node_s; empty otherwise.
+  // In a MODAL shape frame, the nodes' displacement in the mode (scaled as
+  // the probes').
+  std::vector<Eigen::Vector3d> nodes;
 };
 
 class FrameSink {

@@ -136,8 +136,7 @@ class StreamingSink : public FrameSink {
   absl::Status OnStart(const ModelInfo& info) override {
     v1::RunEvent header;
     v1::RunHeader* h = header.mutable_header();
-    *h->mutable_info() = ModelInfoToProto(info);
-    for (std::string& c : FrameColumnsFor(info)) h->add_columns(std::move(c));
+    SetFrameHeader(info, h);
     h->set_scene_name(scene_name_);
     h->set_end_time_s(end_time_s_);
     if (!TimedWrite(writer_, header, watch_)) return Gone();
@@ -181,7 +180,7 @@ class RowSink : public FrameSink {
  public:
   explicit RowSink(StoredResult* result) : result_(result) {}
   absl::Status OnStart(const ModelInfo& info) override {
-    for (std::string& c : FrameColumnsFor(info)) result_->header.add_columns(std::move(c));
+    SetFrameHeader(info, &result_->header);
     return absl::OkStatus();
   }
   absl::Status OnFrame(const Frame& frame) override {

@@ -5,7 +5,8 @@
 // component [J] and the report (service.proto, EnergyReport):
 //   E = kinetic + potential + axial + bending,
 //   relative_drift = (E_final - E_initial) / scale,
-//   scale = max over frames of (kinetic + axial + bending).
+//   scale = max over frames of (kinetic + axial + bending),
+// and the series of each cable and body (EnergyParts, engine/simulation.h).
 
 #include <vector>
 
@@ -13,7 +14,9 @@
 
 namespace cablesim {
 
-// `values` are rows in the header's columns (convert/run_proto.h).
+// `values` are rows in the header's columns (engine/frame_columns.h),
+// found by name: a trajectory stored before the energy per part was
+// recorded has no part series.
 v1::EnergyResponse EnergyFromTrajectory(const v1::RunHeader& header,
                                         const std::vector<double>& values,
                                         const v1::RunSummary& summary);

@@ -21,8 +21,7 @@ class CollectingSink : public FrameSink {
   CollectingSink(StoredResult* result, std::function<void(double)> progress)
       : result_(result), progress_(std::move(progress)) {}
   absl::Status OnStart(const ModelInfo& info) override {
-    *result_->header.mutable_info() = ModelInfoToProto(info);
-    for (std::string& c : FrameColumnsFor(info)) result_->header.add_columns(std::move(c));
+    SetFrameHeader(info, &result_->header);
     probes_ = static_cast<int>(info.probe_names.size());
     return absl::OkStatus();
   }

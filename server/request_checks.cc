@@ -130,12 +130,14 @@ absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimi
     }
   }
   const int64_t values =
-      checked.frames *
-      (1 + kValuesPerProbe * static_cast<int64_t>(checked.scene.probes.size()) + kTrailingValues +
-       force_values);
+      checked.frames * FrameRowSize(static_cast<int64_t>(checked.scene.probes.size()),
+                                    static_cast<int64_t>(checked.scene.cables.size()),
+                                    static_cast<int64_t>(checked.scene.bodies.size())) +
+      checked.frames * force_values;
   if (values > limits.max_trajectory_values) {
     return absl::ResourceExhaustedError(absl::StrFormat(
-        "probes: %d frames of %d probes make %d numbers, the server's limit is %d "
+        "probes: %d frames of %d probes (with the energy per part) make %d numbers, the server's "
+        "limit is %d "
         "(max_trajectory_values)",
         checked.frames, checked.scene.probes.size(), values, limits.max_trajectory_values));
   }
@@ -149,6 +151,22 @@ absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimi
   absl::StatusOr<ModelInfo> info = DescribeModel(checked.scene);
   if (!info.ok()) return info.status();
   checked.info = std::move(*info);
+  if (checked.info.shape) {
+    // output.shape adds x, y, z of every node to every row.
+    const int64_t shape_values =
+        checked.frames *
+        (FrameRowSize(static_cast<int64_t>(checked.scene.probes.size()),
+                      static_cast<int64_t>(checked.scene.cables.size()),
+                      static_cast<int64_t>(checked.scene.bodies.size())) +
+         force_values + 3 * static_cast<int64_t>(checked.info.node_s.size()));
+    if (shape_values > limits.max_trajectory_values) {
+      return absl::ResourceExhaustedError(absl::StrFormat(
+          "output.shape: %d frames of %d nodes make %d numbers, the server's limit is %d "
+          "(max_trajectory_values)",
+          checked.frames, checked.info.node_s.size(), shape_values,
+          limits.max_trajectory_values));
+    }
+  }
   if (checked.info.elements > limits.max_elements) {
     return absl::ResourceExhaustedError(absl::StrFormat(
         "cables: the model has %d elements, the server's limit is %d (max_elements)",

@@ -26,6 +26,12 @@ using ::testing::StartsWith;
 constexpr char kEnergyColumns[] =
     "energy.kinetic,energy.potential,energy.axial,energy.bending,energy.total,"
     "constraint.violation";
+// The energy per part of the sample scenes' one cable (README, "Energy per
+// part"), after the totals.
+constexpr char kCableEnergyColumns[] =
+    "cables[0].energy.kinetic,cables[0].energy.gravity,cables[0].energy.axial,"
+    "cables[0].energy.bending";
+constexpr char kLoadsColumn[] = "loads.energy.potential";
 
 struct Process {
   int exit_code = -1;
@@ -106,7 +112,8 @@ void ExpectTimes(const Csv& csv, size_t rows, double first, double last) {
 
 TEST(CliEndToEndTest, FallingPendulum) {
   const Csv csv = RunSample("falling-pendulum.json");
-  EXPECT_EQ(csv.header, absl::StrCat("t,", ProbeColumns("tip"), ",", kEnergyColumns));
+  EXPECT_EQ(csv.header, absl::StrCat("t,", ProbeColumns("tip"), ",", kEnergyColumns, ",",
+                                     kCableEnergyColumns, ",", kLoadsColumn));
   ExpectTimes(csv, 1 + 1000, 0.0, 1.0);  // 1 s every 0.001 s
   // Starts horizontal at rest: the tip at (1.2, 0).
   EXPECT_NEAR(csv.rows.front()[1], 1.2, 1e-12);
@@ -115,14 +122,18 @@ TEST(CliEndToEndTest, FallingPendulum) {
 
 TEST(CliEndToEndTest, CableWithEndCylinder) {
   const Csv csv = RunSample("cable-with-end-cylinder.json");
-  EXPECT_EQ(csv.header, absl::StrCat("t,", ProbeColumns("cylinder"), ",", kEnergyColumns));
+  EXPECT_EQ(csv.header,
+            absl::StrCat("t,", ProbeColumns("cylinder"), ",", kEnergyColumns, ",",
+                         kCableEnergyColumns,
+                         ",bodies[0].energy.kinetic,bodies[0].energy.gravity,", kLoadsColumn));
   ExpectTimes(csv, 1 + 2000, 0.0, 20.0);  // 20 s every 0.01 s
   EXPECT_NEAR(csv.rows.front()[1], 0.55, 1e-12);
 }
 
 TEST(CliEndToEndTest, CantileverLargeDeflection) {
   const Csv csv = RunSample("cantilever-large-deflection.json");
-  EXPECT_EQ(csv.header, absl::StrCat("t,", ProbeColumns("tip"), ",", kEnergyColumns));
+  EXPECT_EQ(csv.header, absl::StrCat("t,", ProbeColumns("tip"), ",", kEnergyColumns, ",",
+                                     kCableEnergyColumns, ",", kLoadsColumn));
   // STATIC: one row per load increment, t the load factor in (0, 1].
   ExpectTimes(csv, 20, 1.0 / 20, 1.0);
   // The tip load bends the rod down.
@@ -132,7 +143,8 @@ TEST(CliEndToEndTest, CantileverLargeDeflection) {
 TEST(CliEndToEndTest, SpatialPendulum) {
   const Csv csv = RunSample("spatial-pendulum.json");
   EXPECT_EQ(csv.header,
-            absl::StrCat("t,", ProbeColumns("tip"), ",", ProbeColumns("middle"), ",", kEnergyColumns));
+            absl::StrCat("t,", ProbeColumns("tip"), ",", ProbeColumns("middle"), ",", kEnergyColumns,
+                         ",", kCableEnergyColumns, ",", kLoadsColumn));
   ExpectTimes(csv, 1 + 2000, 0.0, 2.0);  // 2 s every 0.001 s
   // Spun at 4 rad/s about +y from along +x: the tip starts at (1, 0, 0)
   // moving at w x r = (0, 0, -4) m/s, and the z columns carry the motion.

@@ -65,6 +65,14 @@ constexpr char kTinyScene[] = R"({
   "solver": {"duration": 0.02, "step": 0.005, "output_interval": 0.01}
 })";
 
+// The model of a scene with one cable, named "c", and these probes.
+ModelInfo OneCable(std::vector<std::string> probes) {
+  ModelInfo info;
+  info.probe_names = std::move(probes);
+  info.cable_names = {"c"};
+  return info;
+}
+
 TEST(CliTest, NoArgumentsIsAUsageError) {
   const CliResult r = Cli({});
   EXPECT_EQ(r.code, 2);
@@ -124,7 +132,8 @@ TEST(CliTest, EnergyCsvUsesTheRunCsvColumnNames) {
   ASSERT_EQ(lines.size(), 4u);  // header and 3 frames
   EXPECT_EQ(lines[0],
             "t,energy.kinetic,energy.potential,energy.axial,energy.bending,energy.total,"
-            "constraint.violation");
+            "constraint.violation,cables[0].energy.kinetic,cables[0].energy.gravity,"
+            "cables[0].energy.axial,cables[0].energy.bending,loads.energy.potential");
 }
 
 TEST(CliTest, MissingFileIsBadInput) {
@@ -216,7 +225,7 @@ TEST(CliTest, RunWritesSummaryAndCsv) {
     EXPECT_THAT(r.out, HasSubstr(R"("model":"planar")"));
     const std::vector<std::string> lines = ReadLines(csv);
     ASSERT_EQ(lines.size(), 4);  // header and t = 0, 0.01, 0.02
-    EXPECT_EQ(lines[0], CsvWriter::Header({"end"}));
+    EXPECT_EQ(lines[0], CsvWriter::Header(OneCable({"end"})));
     EXPECT_THAT(lines[1], StartsWith("0,"));
     const std::vector<std::string> last = absl::StrSplit(lines[3], ',');
     EXPECT_NEAR(std::stod(last[0]), 0.02, 1e-12);
@@ -269,7 +278,7 @@ TEST(CliTest, NumericalFailureExitsWith3AndKeepsTheCsv) {
   EXPECT_THAT(r.err, StartsWith("cablesim: numerical failure at t = "));
   const std::vector<std::string> lines = ReadLines(csv);
   ASSERT_GE(lines.size(), 2);  // the header and the frame at t = 0
-  EXPECT_EQ(lines[0], CsvWriter::Header({}));
+  EXPECT_EQ(lines[0], CsvWriter::Header(OneCable({})));
   EXPECT_THAT(lines[1], StartsWith("0,"));
   std::remove(csv.c_str());
   std::remove(scene.c_str());

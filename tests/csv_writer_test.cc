@@ -44,13 +44,48 @@ Frame FrameWithProbes(double t, int probes) {
 }
 
 TEST(CsvWriterTest, Header) {
-  EXPECT_EQ(CsvWriter::Header({}),
+  EXPECT_EQ(CsvWriter::Header(ModelInfo()),
             "t,energy.kinetic,energy.potential,energy.axial,energy.bending,energy.total,"
-            "constraint.violation");
-  EXPECT_EQ(CsvWriter::Header({"tip"}),
+            "constraint.violation,loads.energy.potential");
+  EXPECT_EQ(CsvWriter::Header(InfoWithProbes({"tip"})),
             "t,tip.x,tip.y,tip.z,tip.vx,tip.vy,tip.vz,tip.ax,tip.ay,tip.az,"
             "energy.kinetic,energy.potential,energy.axial,energy.bending,energy.total,"
-            "constraint.violation");
+            "constraint.violation,loads.energy.potential");
+  // The parts after every existing column, named by index (names are free
+  // text: the comma here would break a column named after it).
+  ModelInfo parts = InfoWithProbes({"tip"});
+  parts.cable_names = {"rope, main", "b"};
+  parts.body_names = {"b"};
+  EXPECT_EQ(CsvWriter::Header(parts),
+            "t,tip.x,tip.y,tip.z,tip.vx,tip.vy,tip.vz,tip.ax,tip.ay,tip.az,"
+            "energy.kinetic,energy.potential,energy.axial,energy.bending,energy.total,"
+            "constraint.violation,"
+            "cables[0].energy.kinetic,cables[0].energy.gravity,cables[0].energy.axial,"
+            "cables[0].energy.bending,"
+            "cables[1].energy.kinetic,cables[1].energy.gravity,cables[1].energy.axial,"
+            "cables[1].energy.bending,"
+            "bodies[0].energy.kinetic,bodies[0].energy.gravity,loads.energy.potential");
+}
+
+TEST(CsvWriterTest, PartsAreWrittenAfterTheTotals) {
+  std::ostringstream out;
+  ModelInfo info = InfoWithProbes({});
+  info.cable_names = {"c"};
+  info.body_names = {"b"};
+  CsvWriter writer(&out, "memory");
+  ASSERT_TRUE(writer.OnStart(info).ok());
+  Frame frame = FrameWithProbes(0, 0);
+  frame.energy_parts.cables = {{1, 2, 3, 4}};
+  frame.energy_parts.bodies = {{5, 6, 0, 0}};
+  frame.energy_parts.loads = 7;
+  ASSERT_TRUE(writer.OnFrame(frame).ok());
+  const std::vector<std::string> lines = absl::StrSplit(out.str(), '\n');
+  ASSERT_EQ(lines.size(), 3);
+  EXPECT_EQ(lines[1],
+            "0,0.10000000000000001,-0.20000000000000001,0.29999999999999999,"
+            "0.40000000000000002,0.59999999999999998,9.9999999999999998e-13,1,2,3,4,5,6,7");
+  // A frame without the parts of the header is refused.
+  EXPECT_FALSE(writer.OnFrame(FrameWithProbes(0.1, 0)).ok());
 }
 
 TEST(CsvWriterTest, RowsRoundTrip) {
@@ -65,13 +100,13 @@ TEST(CsvWriterTest, RowsRoundTrip) {
   }
   const std::vector<std::string> lines = absl::StrSplit(out.str(), '\n');
   ASSERT_EQ(lines.size(), 4);  // header, 2 rows, empty after the last newline
-  EXPECT_EQ(lines[0], CsvWriter::Header({"a", "b"}));
+  EXPECT_EQ(lines[0], CsvWriter::Header(InfoWithProbes({"a", "b"})));
   EXPECT_EQ(lines[1],
             "0,1,2,3,4,5,6,7,8,9,2,2,3,4,5,6,7,8,9,0.10000000000000001,"
             "-0.20000000000000001,0.29999999999999999,0.40000000000000002,"
-            "0.59999999999999998,9.9999999999999998e-13");
+            "0.59999999999999998,9.9999999999999998e-13,0");
   const std::vector<std::string> cells = absl::StrSplit(lines[2], ',');
-  ASSERT_EQ(cells.size(), 1 + 2 * 9 + 6);
+  ASSERT_EQ(cells.size(), 1 + 2 * 9 + 6 + 1);
   EXPECT_EQ(std::stod(cells[0]), 0.1);  // 17 digits read back exactly
   EXPECT_EQ(lines[3], "");
 }

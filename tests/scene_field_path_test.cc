@@ -6,6 +6,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "convert/run_proto.h"
 #include "server/energy_report.h"
 #include "server/request_checks.h"
@@ -74,8 +76,13 @@ TEST(EnergyReportTest, ReportFollowsItsDefinition) {
   // bending, total, violation). The report's numbers follow by hand:
   // scale = max(kinetic + axial + bending) = 4 + 1 + 0.5 = 5.5,
   // drift = (final - initial) / scale = (-0.5 - 0) / 5.5.
+  // The columns of a trajectory stored before the energy per part was
+  // recorded: no part series, the report the same.
   v1::RunHeader header;
-  for (const std::string& c : FrameColumns({})) header.add_columns(c);
+  for (const char* c : {"t", "energy.kinetic", "energy.potential", "energy.axial",
+                        "energy.bending", "energy.total", "constraint.violation"}) {
+    header.add_columns(c);
+  }
   const std::vector<double> rows = {0,   0,   0, 0,   0,   0,    0,     //
                                     0.5, 4,   -5, 1,  0.5, 0.5,  1e-9,  //
                                     1.0, 2.0, -3, 0.4, 0.1, -0.5, 2e-10};
@@ -94,6 +101,45 @@ TEST(EnergyReportTest, ReportFollowsItsDefinition) {
   EXPECT_DOUBLE_EQ(e.relative_drift(), -0.5 / 5.5);
   EXPECT_EQ(e.max_constraint_violation(), 1e-9);
   EXPECT_EQ(e.energy_dissipated(), 0.5);
+  EXPECT_EQ(r.cables_size(), 0);
+  EXPECT_EQ(r.loads_size(), 0);
+}
+
+TEST(EnergyReportTest, SeriesAreFoundByName) {
+  // A cable and a body, the columns in a scrambled order (a reader that
+  // went by position would read other numbers): each series is its column.
+  ModelInfo info;
+  info.cable_names = {"rope"};
+  info.body_names = {"weight"};
+  std::vector<std::string> columns = FrameColumns(info);
+  std::reverse(columns.begin(), columns.end());
+  v1::RunHeader header;
+  *header.mutable_info() = ModelInfoToProto(info);
+  for (const std::string& c : columns) header.add_columns(c);
+  std::vector<double> rows;
+  for (int r = 0; r < 2; ++r)
+    for (size_t c = 0; c < columns.size(); ++c) rows.push_back(100 * r + static_cast<double>(c));
+  const v1::EnergyResponse e = EnergyFromTrajectory(header, rows, v1::RunSummary());
+  auto column = [&](const std::string& name, int r) {
+    return 100.0 * r + (std::find(columns.begin(), columns.end(), name) - columns.begin());
+  };
+  ASSERT_EQ(e.t_size(), 2);
+  ASSERT_EQ(e.cables_size(), 1);
+  ASSERT_EQ(e.bodies_size(), 1);
+  EXPECT_EQ(e.cables(0).name(), "rope");
+  EXPECT_EQ(e.bodies(0).name(), "weight");
+  EXPECT_EQ(e.bodies(0).axial_size(), 0);
+  for (int r = 0; r < 2; ++r) {
+    EXPECT_EQ(e.t(r), column("t", r));
+    EXPECT_EQ(e.total(r), column("energy.total", r));
+    EXPECT_EQ(e.cables(0).kinetic(r), column("cables[0].energy.kinetic", r));
+    EXPECT_EQ(e.cables(0).gravity(r), column("cables[0].energy.gravity", r));
+    EXPECT_EQ(e.cables(0).axial(r), column("cables[0].energy.axial", r));
+    EXPECT_EQ(e.cables(0).bending(r), column("cables[0].energy.bending", r));
+    EXPECT_EQ(e.bodies(0).kinetic(r), column("bodies[0].energy.kinetic", r));
+    EXPECT_EQ(e.bodies(0).gravity(r), column("bodies[0].energy.gravity", r));
+    EXPECT_EQ(e.loads(r), column("loads.energy.potential", r));
+  }
 }
 
 }  // namespace

@@ -13,12 +13,14 @@
 #include "client/csv_writer.h"
 #include "convert/run_proto.h"
 #include "convert/scene_from_proto.h"
+#include "engine/frame_columns.h"
 #include "server_test_util.h"
 #include "test_util.h"
 
 namespace cablesim {
 namespace {
 
+using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 using testing::Pendulum;
 using testing::ServerProcess;
@@ -78,6 +80,15 @@ class ServerTest : public ::testing::Test {
   static ServerProcess* server_;
   static testing::JobGate* gate_;  // for jobs named "gated..."
 };
+
+// The model of Pendulum(): one cable "beam", the probe "tip".
+ModelInfo PendulumInfo() {
+  ModelInfo info;
+  info.probe_names = {"tip"};
+  info.cable_names = {"beam"};
+  return info;
+}
+
 ServerProcess* ServerTest::server_ = nullptr;
 testing::JobGate* ServerTest::gate_ = nullptr;
 
@@ -94,17 +105,24 @@ TEST_F(ServerTest, RunStreamsTheSameFramesAsTheEngine) {
   // Header: the model and the CSV columns.
   EXPECT_EQ(s.header.info().model(), "planar");
   EXPECT_EQ(s.header.info().elements(), 12);
-  EXPECT_EQ(absl::StrJoin(s.header.columns(), ","), CsvWriter::Header({"tip"}));
+  EXPECT_EQ(absl::StrJoin(s.header.columns(), ","), CsvWriter::Header(PendulumInfo()));
+  EXPECT_THAT(s.header.info().cable_names(), ElementsAre("beam"));
   // Frames: 51, in batches of 16; bit-identical to the engine's.
   const int columns = s.header.columns_size();
   ASSERT_EQ(s.values.size(), reference.frames().size() * columns);
   EXPECT_EQ(s.batches, 4);
+  const std::vector<std::string> names(s.header.columns().begin(), s.header.columns().end());
+  const FrameReader reader(ModelInfoFromProto(s.header.info()), names);
   for (size_t r = 0; r < reference.frames().size(); ++r) {
     Frame frame;
-    FrameFromRow(absl::MakeConstSpan(s.values.data() + r * columns, columns), 1, &frame);
-    EXPECT_EQ(frame.t, reference.frames()[r].t);
-    EXPECT_EQ(frame.probes[0].position_m, reference.frames()[r].probes[0].position_m);
-    EXPECT_EQ(frame.energy.total, reference.frames()[r].energy.total);
+    reader.Read(absl::MakeConstSpan(s.values.data() + r * columns, columns), &frame);
+    const Frame& expected_frame = reference.frames()[r];
+    EXPECT_EQ(frame.t, expected_frame.t);
+    EXPECT_EQ(frame.probes[0].position_m, expected_frame.probes[0].position_m);
+    EXPECT_EQ(frame.energy.total, expected_frame.energy.total);
+    ASSERT_EQ(frame.energy_parts.cables.size(), 1u);
+    EXPECT_EQ(frame.energy_parts.cables[0].kinetic, expected_frame.energy_parts.cables[0].kinetic);
+    EXPECT_EQ(frame.energy_parts.cables[0].bending, expected_frame.energy_parts.cables[0].bending);
   }
   ASSERT_TRUE(s.summary.has_value());
   EXPECT_EQ(s.summary->status(), "ok");
@@ -411,9 +429,10 @@ TEST_F(ServerTest, ThirtyTwoClientsStreamAtOnce) {
     ASSERT_TRUE(results[i].status.ok()) << i << ": " << results[i].status.error_message();
     ASSERT_TRUE(results[i].summary.has_value());
     EXPECT_EQ(results[i].summary->frames(), 101);
-    ASSERT_EQ(results[i].header.columns_size(), 16) << i;
+    // t, 9 for the tip, 6 totals, 4 for the cable, loads.
+    ASSERT_EQ(results[i].header.columns_size(), 21) << i;
     // Every client gets the same, complete trajectory.
-    EXPECT_EQ(results[i].values.size(), 101u * 16);
+    EXPECT_EQ(results[i].values.size(), 101u * 21);
     EXPECT_EQ(results[i].values, results[0].values) << i;
   }
 }
@@ -462,6 +481,28 @@ TEST_F(ServerTest, JobRunsAndKeepsItsTrajectoryAndEnergy) {
     EXPECT_NEAR(energy.total(i), sum, 1e-12 * (1 + std::abs(energy.potential(i))));
     EXPECT_LE(r.min(), energy.total(i));
     EXPECT_GE(r.max(), energy.total(i));
+  }
+  // The series per part: the pendulum's one cable holds all of it (no
+  // body, no load), so its series equal the totals' to rounding (its
+  // gravity summed element by element, the total's as one dot product:
+  // 1e-12 of the largest component).
+  ASSERT_EQ(energy.cables_size(), 1);
+  EXPECT_EQ(energy.bodies_size(), 0);
+  const v1::PartEnergySeries& beam = energy.cables(0);
+  EXPECT_EQ(beam.name(), "beam");
+  EXPECT_EQ(beam.index(), 0);
+  ASSERT_EQ(beam.kinetic_size(), 21);
+  ASSERT_EQ(beam.gravity_size(), 21);
+  ASSERT_EQ(beam.axial_size(), 21);
+  ASSERT_EQ(beam.bending_size(), 21);
+  ASSERT_EQ(energy.loads_size(), 21);
+  for (int i = 0; i < 21; ++i) {
+    const double tol = 1e-12 * (1 + std::abs(energy.potential(i)) + energy.kinetic(i));
+    EXPECT_NEAR(beam.kinetic(i), energy.kinetic(i), tol) << i;
+    EXPECT_NEAR(beam.gravity(i) + energy.loads(i), energy.potential(i), tol) << i;
+    EXPECT_NEAR(beam.axial(i), energy.axial(i), tol) << i;
+    EXPECT_NEAR(beam.bending(i), energy.bending(i), tol) << i;
+    EXPECT_EQ(energy.loads(i), 0) << i;
   }
   // Backward Euler only removes energy from the falling pendulum.
   EXPECT_LT(r.relative_drift(), 0);
@@ -536,7 +577,7 @@ TEST_F(ServerTest, SweepSetsTheFieldsOfEachItem) {
   v1::SweepResults results;
   ASSERT_TRUE(stub->GetSweepResults(&rc, get, &results).ok());
   ASSERT_EQ(results.items_size(), 4);
-  EXPECT_EQ(absl::StrJoin(results.final_columns(), ","), CsvWriter::Header({"tip"}));
+  EXPECT_EQ(absl::StrJoin(results.final_columns(), ","), CsvWriter::Header(PendulumInfo()));
   for (int i = 0; i < 4; ++i) {
     const v1::SweepItem& item = results.items(i);
     EXPECT_EQ(item.index(), i);

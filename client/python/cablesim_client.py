@@ -14,7 +14,8 @@ PYTHONPATH.
         scenes/falling-pendulum.json --png pendulum.png
 
 streams a run into numpy arrays and plots the first probe's path and the
-energy components to a PNG.
+energy components to a PNG; `--animate cable.gif` also asks for the
+cable's shape (Scene.output.shape) and draws the cables moving.
 """
 
 import argparse
@@ -26,6 +27,7 @@ import grpc
 from cablesim.client import read_token  # noqa: F401 (part of this module's API)
 from cablesim.client import open_channel
 from cablesim.results import Result as RunResult  # noqa: F401
+from cablesim.animation import animate  # noqa: F401 (part of this module's API)
 from cablesim.results import result_from_events
 from cablesim.v1 import scene_pb2, service_pb2, service_pb2_grpc  # noqa: F401
 
@@ -82,13 +84,18 @@ def main(argv):
     parser.add_argument("scene", help="scene file (protobuf JSON)")
     parser.add_argument("--server", default="127.0.0.1:50051")
     parser.add_argument("--png", help="plot the first probe's path and the energies here")
+    parser.add_argument("--animate", help="draw the cables (GIF, or MP4 with ffmpeg) here; "
+                        "asks the server for the cable's shape")
     parser.add_argument("--tls-ca", help="TLS: the CA certificate (PEM) the server's is checked against")
     parser.add_argument("--token-file", help="send the token in this file (its first word)")
     args = parser.parse_args(argv)
     stub = connect(args.server, tls_ca=args.tls_ca,
                    token=read_token(args.token_file) if args.token_file else None)
     try:
-        result = run(stub, load_scene(args.scene))
+        scene = load_scene(args.scene)
+        if args.animate:
+            scene.output.shape = True
+        result = run(stub, scene)
     except grpc.RpcError as e:
         print("cablesim_client: %s: %s" % (e.code().name, e.details()), file=sys.stderr)
         return 2 if e.code() == grpc.StatusCode.INVALID_ARGUMENT else 1
@@ -97,6 +104,8 @@ def main(argv):
                       "status": result.summary.status}))
     if args.png:
         plot(result, args.png)
+    if args.animate:
+        animate(result, args.animate)
     return 0 if result.summary.status == "ok" else 3
 
 

@@ -43,7 +43,8 @@ class ClientTest(unittest.TestCase):
         scene = self.scene()
         result = cablesim_client.run(self.stub, scene, frames_per_batch=7)
         self.assertEqual(result.summary.status, "ok")
-        self.assertEqual(result.data.shape, (101, 16))  # 0.1 s every 1 ms; t, 9 tip, 6
+        # 0.1 s every 1 ms; t, 9 tip, 6 totals, 4 for the cable, loads.
+        self.assertEqual(result.data.shape, (101, 21))
         # Reference: `cablesim run` in-process, written as CSV (17 digits
         # read back exactly).
         scene_path = os.path.join(self.tmp.name, "scene.json")
@@ -73,6 +74,52 @@ class ClientTest(unittest.TestCase):
         kept = cablesim_client.job_result(self.stub, job_id)
         np.testing.assert_array_equal(kept.data, streamed.data)
         self.assertEqual(kept.summary.frames, 101)
+
+    def test_shape_animates_to_a_gif(self):
+        # The sample scene with output.shape (two cables, 13 nodes), 0.2 s:
+        # 11 frames; drawn at 5 chosen times, then at every frame.
+        scene = cablesim_client.load_scene(
+            os.path.join(SOURCE, "scenes", "kinked-string-shape.json"))
+        scene.solver.duration = 0.2
+        result = cablesim_client.run(self.stub, scene)
+        self.assertEqual(result.summary.status, "ok")
+        string, tail = result.cable_nodes(0), result.cable_nodes(1)
+        self.assertEqual(string.shape, (11, 9, 3))
+        self.assertEqual(tail.shape, (11, 4, 3))
+        # The probe at the kink (s = 1) is node 4 of the string.
+        np.testing.assert_array_equal(string[:, 4, 0], result.column("kink.x"))
+        np.testing.assert_array_equal(string[:, 4, 1], result.column("kink.y"))
+        try:
+            from PIL import Image
+            import matplotlib  # noqa: F401
+        except ImportError as e:
+            self.skipTest("GIF needs Debian's python3-matplotlib and python3-pil: %s" % e)
+        gif = os.path.join(self.tmp.name, "shape.gif")
+        written = cablesim_client.animate(result, gif, times=[0, 0.05, 0.1, 0.15, 0.2])
+        self.assertEqual(written, 5)
+        with Image.open(gif) as image:
+            self.assertEqual(image.format, "GIF")
+            self.assertEqual(image.n_frames, 5)
+        cablesim_client.animate(result, gif)
+        with Image.open(gif) as image:
+            self.assertEqual(image.n_frames, 11)
+        # Without the shape there is nothing to draw.
+        plain = cablesim_client.run(self.stub, self.scene())
+        with self.assertRaises(ValueError):
+            plain.cable_nodes(0)
+
+    def test_shape_animates_to_an_mp4_with_ffmpeg(self):
+        import shutil
+        if shutil.which("ffmpeg") is None:
+            self.skipTest("MP4 needs Debian's ffmpeg (not installed)")
+        scene = cablesim_client.load_scene(
+            os.path.join(SOURCE, "scenes", "kinked-string-shape.json"))
+        scene.solver.duration = 0.1
+        result = cablesim_client.run(self.stub, scene)
+        mp4 = os.path.join(self.tmp.name, "shape.mp4")
+        self.assertEqual(cablesim_client.animate(result, mp4), 6)
+        with open(mp4, "rb") as f:
+            self.assertEqual(f.read(12)[4:8], b"ftyp")
 
     def test_invalid_scene_names_the_field(self):
         scene = self.scene()

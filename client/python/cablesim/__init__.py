@@ -17,9 +17,10 @@ __path__ = __import__("pkgutil").extend_path(__path__, __name__)
 
 __version__ = "0.15.0"
 
+from cablesim.animation import animate  # noqa: E402
 from cablesim.client import Client, Error, open_channel, read_token  # noqa: E402
 from cablesim.results import Energy, Job, Record, Result, SweepResult  # noqa: E402
 from cablesim.scenes import load_scene, scene_to_dict  # noqa: E402
 
-__all__ = ["Client", "Energy", "Error", "Job", "Record", "Result", "SweepResult", "load_scene",
+__all__ = ["animate", "Client", "Energy", "Error", "Job", "Record", "Result", "SweepResult", "load_scene",
            "open_channel", "read_token", "scene_to_dict"]

@@ -88,6 +88,21 @@ class Result:
         """The trajectory as a pandas DataFrame with the same columns."""
         return _pandas().DataFrame(self.data, columns=self.columns)
 
+    def cable_nodes(self, cable: int) -> np.ndarray:
+        """The positions [m] of cable `cable`'s nodes (its index in the scene)
+        in every frame, frames x nodes x 3: the columns cables[i].nodes[k].x,
+        .y, .z that a scene with `output.shape: true` adds (README, "The
+        cable's shape"). Raises ValueError without them."""
+        prefix = "cables[%d].nodes[" % cable
+        first = [i for i, name in enumerate(self.columns)
+                 if name.startswith(prefix) and name.endswith("].x")]
+        if not first:
+            raise ValueError("no node columns for cables[%d]: run the scene with "
+                             "output.shape: true" % cable)
+        index = np.array([[i, self.columns.index(self.columns[i][:-1] + "y"),
+                           self.columns.index(self.columns[i][:-1] + "z")] for i in first])
+        return self.data[:, index]
+
     def plot(self, png_path: str, probe: Optional[str] = None) -> None:
         """Plots the path of `probe` (default: the first) and the energy
         components against time to `png_path` (matplotlib, Agg)."""

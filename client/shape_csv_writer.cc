@@ -1,0 +1,63 @@
+#include "client/shape_csv_writer.h"
+
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "client/csv_writer.h"
+
+namespace cablesim {
+
+absl::StatusOr<std::unique_ptr<ShapeCsvWriter>> ShapeCsvWriter::Create(const std::string& path) {
+  absl::StatusOr<std::unique_ptr<std::ofstream>> file = OpenForWriting(path);
+  if (!file.ok()) return file.status();
+  return std::unique_ptr<ShapeCsvWriter>(new ShapeCsvWriter(std::move(*file), path));
+}
+
+absl::Status ShapeCsvWriter::Check(const char* what) {
+  if (status_.ok() && !*file_) {
+    status_ = absl::DataLossError(absl::StrCat(path_, ": ", what, " failed"));
+  }
+  return status_;
+}
+
+absl::Status ShapeCsvWriter::OnStart(const ModelInfo& info) {
+  if (!info.shape) {
+    status_ = absl::FailedPreconditionError(
+        absl::StrCat(path_, ": the run has no shape (the scene's output.shape is false)"));
+    return status_;
+  }
+  info_ = info;
+  *file_ << kHeader << '\n';
+  return Check("writing the header");
+}
+
+absl::Status ShapeCsvWriter::OnFrame(const Frame& frame) {
+  if (!status_.ok()) return status_;
+  if (frame.nodes.size() != info_.node_s.size()) {
+    status_ = absl::InternalError(absl::StrCat(path_, ": frame has ", frame.nodes.size(),
+                                               " nodes, the model ", info_.node_s.size()));
+    return status_;
+  }
+  row_.clear();
+  size_t n = 0;
+  for (size_t c = 0; c < info_.cable_nodes.size(); ++c) {
+    for (int k = 0; k < info_.cable_nodes[c]; ++k, ++n) {
+      const Eigen::Vector3d& r = frame.nodes[n];
+      absl::StrAppendFormat(&row_, "%.17g,%d,%d,%.17g,%.17g,%.17g,%.17g\n", frame.t, c, k,
+                            info_.node_s[n], r.x(), r.y(), r.z());
+    }
+  }
+  file_->write(row_.data(), static_cast<std::streamsize>(row_.size()));
+  return Check("writing a frame");
+}
+
+absl::Status ShapeCsvWriter::Finish() {
+  if (file_->is_open()) {
+    file_->close();
+    Check("closing").IgnoreError();
+  }
+  return status_;
+}
+
+}  // namespace cablesim
