@@ -53,6 +53,7 @@ std::string EnergyJson(const std::string& source, const v1::EnergyResponse& r) {
       .Add("relative_drift", e.relative_drift())
       .Add("scale", e.scale())
       .Add("energy_dissipated", e.energy_dissipated())
+      .Add("energy_damped", e.energy_damped())
       .Add("max_constraint_violation", e.max_constraint_violation())
       .ToString();
 }
@@ -63,9 +64,9 @@ absl::Status WriteEnergyCsv(const std::string& path, const v1::EnergyResponse& r
   // The run CSV's names for the same quantities (FrameColumns without probes).
   file << absl::StrJoin(FrameColumns({}), ",") << "\n";
   for (int i = 0; i < r.t_size(); ++i) {
-    file << absl::StrFormat("%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", r.t(i), r.kinetic(i),
-                            r.potential(i), r.axial(i), r.bending(i), r.total(i),
-                            r.constraint_violation(i));
+    file << absl::StrFormat("%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", r.t(i),
+                            r.kinetic(i), r.potential(i), r.axial(i), r.bending(i), r.total(i),
+                            r.constraint_violation(i), i < r.damped_size() ? r.damped(i) : 0.0);
   }
   file.close();
   if (!file) return absl::DataLossError(absl::StrCat(path, ": write failed"));

@@ -13,7 +13,8 @@ namespace {
 constexpr const char* kProbeColumns[] = {"x", "y", "z", "vx", "vy", "vz", "ax", "ay", "az"};
 constexpr const char* kTrailingColumns[] = {"energy.kinetic", "energy.potential",
                                             "energy.axial",   "energy.bending",
-                                            "energy.total",   "constraint.violation"};
+                                            "energy.total",   "constraint.violation",
+                                            "energy.damped"};
 
 void AppendNumber(std::string* row, double value) { absl::StrAppendFormat(row, ",%.17g", value); }
 
@@ -96,7 +97,8 @@ absl::Status CsvWriter::OnFrame(const Frame& frame) {
   }
   const EnergySample& e = frame.energy;
   for (const double value :
-       {e.kinetic, e.potential, e.axial, e.bending, e.total, frame.constraint_violation}) {
+       {e.kinetic, e.potential, e.axial, e.bending, e.total, frame.constraint_violation,
+        e.damped}) {
     AppendNumber(&row, value);
   }
   row += '\n';

@@ -48,6 +48,7 @@ v1::RunSummary SummaryToProto(const RunSummary& s) {
   p.set_energy_initial(s.energy_initial);
   p.set_energy_final(s.energy_final);
   p.set_energy_dissipated(s.energy_dissipated);
+  p.set_energy_damped(s.energy_damped);
   p.set_energy_max_increase(s.energy_max_increase);
   p.set_max_constraint_violation(s.max_constraint_violation);
   p.set_max_newton_residual(s.max_newton_residual);
@@ -87,6 +88,7 @@ RunSummary SummaryFromProto(const v1::RunSummary& p) {
   s.energy_initial = p.energy_initial();
   s.energy_final = p.energy_final();
   s.energy_dissipated = p.energy_dissipated();
+  s.energy_damped = p.energy_damped();
   s.energy_max_increase = p.energy_max_increase();
   s.max_constraint_violation = p.max_constraint_violation();
   s.max_newton_residual = p.max_newton_residual();
@@ -114,7 +116,7 @@ std::vector<std::string> FrameColumns(const std::vector<std::string>& probe_name
     }
   }
   for (const char* c : {"energy.kinetic", "energy.potential", "energy.axial", "energy.bending",
-                        "energy.total", "constraint.violation"}) {
+                        "energy.total", "constraint.violation", "energy.damped"}) {
     columns.push_back(c);
   }
   return columns;
@@ -134,6 +136,7 @@ void AppendFrameRow(const Frame& frame, google::protobuf::RepeatedField<double>*
   values->Add(e.bending);
   values->Add(e.total);
   values->Add(frame.constraint_violation);
+  values->Add(e.damped);
 }
 
 void FrameFromRow(absl::Span<const double> row, int probes, Frame* frame) {
@@ -152,6 +155,7 @@ void FrameFromRow(absl::Span<const double> row, int probes, Frame* frame) {
   e.bending = row[i++];
   e.total = row[i++];
   frame->constraint_violation = row[i++];
+  e.damped = row[i++];
 }
 
 }  // namespace cablesim

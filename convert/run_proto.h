@@ -30,7 +30,7 @@ RunSummary SummaryFromProto(const v1::RunSummary& proto);
 
 // Numbers per probe in a row, and after the probes.
 inline constexpr int kValuesPerProbe = 9;
-inline constexpr int kTrailingValues = 6;
+inline constexpr int kTrailingValues = 7;
 
 // The column names of a frame row for these probes.
 std::vector<std::string> FrameColumns(const std::vector<std::string>& probe_names);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -392,6 +393,18 @@ class SceneConverter {
         !std::isfinite(cable->second_moment_m4)) {
       return Invalid(Sub(path, "diameter"), "section properties out of range");
     }
+    if (c.has_damping()) {
+      const v1::CableDamping& d = c.damping();
+      const std::string damping_path = Sub(path, "damping");
+      for (const auto& [name, value, out] :
+           {std::tuple{"axial_time", d.axial_time(), &cable->axial_damping_s},
+            std::tuple{"bending_time", d.bending_time(), &cable->bending_damping_s},
+            std::tuple{"rayleigh_alpha", d.rayleigh_alpha(), &cable->rayleigh_alpha_1_s},
+            std::tuple{"rayleigh_beta", d.rayleigh_beta(), &cable->rayleigh_beta_s}}) {
+        CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(damping_path, name), value));
+        *out = value;
+      }
+    }
     return absl::OkStatus();
   }
 
@@ -452,6 +465,15 @@ class SceneConverter {
     body->axis = Eigen::Vector3d::UnitX();
     if (b.has_axis()) {
       CABLESIM_ASSIGN_OR_RETURN(body->axis, Direction(Sub(path, "axis"), b.axis()));
+    }
+    if (b.has_damping()) {
+      const std::string damping_path = Sub(path, "damping");
+      CABLESIM_RETURN_IF_ERROR(
+          CheckNonNegative(Sub(damping_path, "linear"), b.damping().linear()));
+      CABLESIM_RETURN_IF_ERROR(
+          CheckNonNegative(Sub(damping_path, "angular"), b.damping().angular()));
+      body->linear_damping_n_s_m = b.damping().linear();
+      body->angular_damping_n_m_s = b.damping().angular();
     }
     return absl::OkStatus();
   }

@@ -92,11 +92,36 @@ class AncfCableElement {
   void ElasticForce(const Coords& e, Coords* force, Matrix* tangent,
                     Coords* roundoff = nullptr) const;
 
+  // Kelvin-Voigt damping: adds to `c` the symmetric positive semi-definite
+  // matrix C(e) of the damping force Q_d = C(e) edot [N s/m] derived from
+  // the dissipation function per unit length
+  //
+  //   D = EA axial_s / 2 (d eps/dt)^2 + EI bending_s / 2 |d k/dt|^2,
+  //
+  // d eps/dt = u.udot, k = u x w / |u|^3 the curvature vector (a scalar in
+  // the plane; |k| is the EXACT model's curvature), so that
+  // C = int B^T (EA axial_s u u^T + EI bending_s G^T G) B dx with
+  // G = dk/d(u, w). This is exactly axial_s times the material part of the
+  // axial tangent stiffness and bending_s times the material part of the
+  // EXACT bending tangent (the tangent without its stress-times-curvature
+  // geometric terms), which is why Rayleigh's beta adds to both times.
+  // It vanishes on rigid motion in the plane and on rigid translation in
+  // space; in space the rotation of a curved cable turns k and is damped
+  // by EI bending_s |omega x k|^2 per unit length (zero for a straight
+  // one). With bending NONE (EI = 0) only the axial term acts.
+  void AddDampingMatrix(const Coords& e, double axial_s, double bending_s, Matrix* c) const;
+
  private:
   // B maps e to (u, w) at Gauss point g: rows 0..D-1 are S', rows D..2D-1
   // are S''.
   using BMatrix = Eigen::Matrix<double, 2 * D, kCoords>;
   BMatrix B(int g) const;
+  // tangent += wl B_g^T [huu huw; huw^T hww] B_g on the upper node blocks
+  // (k <= m); the caller mirrors them.
+  using Block = Eigen::Matrix<double, D, D>;
+  void AddUpperBlocks(int g, double wl, const Block& huu, const Block& huw, const Block& hww,
+                      Matrix* tangent) const;
+  static void MirrorUpperBlocks(Matrix* tangent);
 
   double length_ = 0;
   double ea_ = 0;

@@ -195,6 +195,9 @@ absl::Status ModelBuilder::InitialCoordinates() {
     MultibodyModel::BodyData data;
     data.coord = i;
     data.mass = body.mass_kg;
+    data.linear_damping = body.linear_damping_n_s_m;
+    data.angular_damping = body.angular_damping_n_m_s;
+    if (data.linear_damping != 0 || data.angular_damping != 0) model_.has_damping_ = true;
     const Vector3d& inertia = body.inertia_kg_m2;
     if (D == 2) {
       q0_.segment<2>(i + 2) = frame0_[b].col(0).head<2>();
@@ -519,6 +522,10 @@ void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* 
       e.first_coord = NodeCoord(k);
       e.mass_per_length = mpl;
       e.gravity = e.element.GravityForce(mpl, g);
+      e.axial_damping_s = cable.axial_damping_s + cable.rayleigh_beta_s;
+      e.bending_damping_s = cable.bending_damping_s + cable.rayleigh_beta_s;
+      e.alpha_1_s = cable.rayleigh_alpha_1_s;
+      if (e.damped()) model_.has_damping_ = true;
       const auto me = e.element.MassMatrix(mpl);
       for (int a = 0; a < 4; ++a)
         for (int b = 0; b < 4; ++b) e.mbar(a, b) = me(D * a, D * b);
@@ -682,6 +689,10 @@ void ModelBuilder::ConstraintPattern() {
 MultibodyModel ModelBuilder::Finish() {
   model_.scratch_full_ = VectorXd::Zero(q0_.size());
   model_.scratch_roundoff_ = VectorXd::Zero(q0_.size());
+  if (model_.has_damping_) {
+    model_.scratch_damping_ = VectorXd::Zero(q0_.size());
+    model_.scratch_damping_roundoff_ = VectorXd::Zero(q0_.size());
+  }
   model_.ProjectInitialVelocity();
   return std::move(model_);
 }

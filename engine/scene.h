@@ -47,6 +47,16 @@ struct CableSpec {
   double area_m2 = 0;
   double second_moment_m4 = 0;
   BendingModel bending = BendingModel::kExact;
+  // Damping (MultibodyModel::DampingForce; 0: none). Kelvin-Voigt
+  // retardation times [s]: axial stress E (eps + axial_damping_s deps/dt),
+  // bending moment EI (kappa + bending_damping_s dkappa/dt). Rayleigh:
+  // mass-proportional alpha [1/s] (force -alpha M qdot) and
+  // stiffness-proportional beta [s], applied to the material stiffness,
+  // that is added to both retardation times.
+  double axial_damping_s = 0;
+  double bending_damping_s = 0;
+  double rayleigh_alpha_1_s = 0;
+  double rayleigh_beta_s = 0;
 };
 
 struct BodySpec {
@@ -59,6 +69,10 @@ struct BodySpec {
   // normalize(e_z x axis) (normalize(e_x x axis) when the axis is along z),
   // and z = x x y; the principal moments refer to these axes.
   Eigen::Vector3d axis = Eigen::Vector3d::UnitX();
+  // Damping (0: none): force -linear c v on the centre of mass [N s/m],
+  // torque -angular c omega [N m s/rad].
+  double linear_damping_n_s_m = 0;
+  double angular_damping_n_m_s = 0;
 };
 
 // A place on a cable (cable >= 0), on a body (body >= 0), or the ground

@@ -15,9 +15,11 @@ v1::EnergyResponse EnergyFromTrajectory(const v1::RunHeader& header,
   const int columns = header.columns_size();
   v1::EnergyReport* report = response.mutable_report();
   report->set_energy_dissipated(summary.energy_dissipated());
+  report->set_energy_damped(summary.energy_damped());
   if (columns < 1 + kTrailingValues) return response;
   const size_t rows = values.size() / columns;
-  // The trailing columns: kinetic, potential, axial, bending, total, violation.
+  // The trailing columns: kinetic, potential, axial, bending, total,
+  // violation, damped.
   const int e0 = columns - kTrailingValues;
   double scale = 0, lo = INFINITY, hi = -INFINITY, violation = 0;
   for (size_t r = 0; r < rows; ++r) {
@@ -29,6 +31,7 @@ v1::EnergyResponse EnergyFromTrajectory(const v1::RunHeader& header,
     response.add_bending(row[e0 + 3]);
     response.add_total(row[e0 + 4]);
     response.add_constraint_violation(row[e0 + 5]);
+    response.add_damped(row[e0 + 6]);
     scale = std::max(scale, row[e0] + row[e0 + 2] + row[e0 + 3]);
     lo = std::min(lo, row[e0 + 4]);
     hi = std::max(hi, row[e0 + 4]);
