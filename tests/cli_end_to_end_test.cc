@@ -25,7 +25,7 @@ using ::testing::StartsWith;
 
 constexpr char kEnergyColumns[] =
     "energy.kinetic,energy.potential,energy.axial,energy.bending,energy.total,"
-    "constraint.violation";
+    "constraint.violation,energy.damped";
 
 struct Process {
   int exit_code = -1;

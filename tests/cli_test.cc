@@ -124,7 +124,7 @@ TEST(CliTest, EnergyCsvUsesTheRunCsvColumnNames) {
   ASSERT_EQ(lines.size(), 4u);  // header and 3 frames
   EXPECT_EQ(lines[0],
             "t,energy.kinetic,energy.potential,energy.axial,energy.bending,energy.total,"
-            "constraint.violation");
+            "constraint.violation,energy.damped");
 }
 
 TEST(CliTest, MissingFileIsBadInput) {

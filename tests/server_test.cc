@@ -411,9 +411,9 @@ TEST_F(ServerTest, ThirtyTwoClientsStreamAtOnce) {
     ASSERT_TRUE(results[i].status.ok()) << i << ": " << results[i].status.error_message();
     ASSERT_TRUE(results[i].summary.has_value());
     EXPECT_EQ(results[i].summary->frames(), 101);
-    ASSERT_EQ(results[i].header.columns_size(), 16) << i;
+    ASSERT_EQ(results[i].header.columns_size(), 17) << i;
     // Every client gets the same, complete trajectory.
-    EXPECT_EQ(results[i].values.size(), 101u * 16);
+    EXPECT_EQ(results[i].values.size(), 101u * 17);
     EXPECT_EQ(results[i].values, results[0].values) << i;
   }
 }

@@ -53,7 +53,7 @@ class ClientTest(unittest.TestCase):
         scene = self.scene()
         result = cablesim_client.run(self.stub, scene, frames_per_batch=7)
         self.assertEqual(result.summary.status, "ok")
-        self.assertEqual(result.data.shape, (101, 16))  # 0.1 s every 1 ms; t, 9 tip, 6
+        self.assertEqual(result.data.shape, (101, 17))  # 0.1 s every 1 ms; t, 9 tip, 7
         # Reference: `cablesim run` in-process, written as CSV (17 digits
         # read back exactly).
         scene_path = os.path.join(self.tmp.name, "scene.json")
