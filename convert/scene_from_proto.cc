@@ -262,6 +262,7 @@ class SceneConverter {
       CABLESIM_RETURN_IF_ERROR(ConvertProbe(i, &scene_.probes[i]));
     }
     CABLESIM_RETURN_IF_ERROR(ConvertInitialVelocity());
+    CABLESIM_RETURN_IF_ERROR(ConvertFluid());
     CABLESIM_RETURN_IF_ERROR(ConvertSolver());
     return std::move(scene_);
   }
@@ -392,6 +393,25 @@ class SceneConverter {
     if (!std::isfinite(cable->area_m2) || !(cable->area_m2 > 0) ||
         !std::isfinite(cable->second_moment_m4)) {
       return Invalid(Sub(path, "diameter"), "section properties out of range");
+    }
+    if (c.has_hydrodynamics()) {
+      const v1::Hydrodynamics& h = c.hydrodynamics();
+      const std::string hydro_path = Sub(path, "hydrodynamics");
+      if (!(proto_.fluid().density() > 0)) {
+        return Invalid(hydro_path, "needs a fluid around the cables (fluid.density > 0)");
+      }
+      for (const auto& [name, value, out] :
+           {std::tuple{"normal_drag", h.normal_drag(), &cable->normal_drag},
+            std::tuple{"tangential_drag", h.tangential_drag(), &cable->tangential_drag},
+            std::tuple{"added_mass", h.added_mass(), &cable->added_mass}}) {
+        CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(hydro_path, name), value));
+        *out = value;
+      }
+      if (h.has_diameter()) {
+        CABLESIM_RETURN_IF_ERROR(
+            CheckPositiveInRange(Sub(hydro_path, "diameter"), h.diameter(), plausible::kSize));
+        cable->hydro_diameter_m = h.diameter();
+      }
     }
     if (c.has_damping()) {
       const v1::CableDamping& d = c.damping();
@@ -576,6 +596,17 @@ class SceneConverter {
     at.set_body(p.body());
     if (p.has_point()) *at.mutable_point() = p.point();
     CABLESIM_ASSIGN_OR_RETURN(probe->at, ConvertAttachment(path, at, false));
+    return absl::OkStatus();
+  }
+
+  absl::Status ConvertFluid() {
+    const v1::Fluid& f = proto_.fluid();
+    CABLESIM_RETURN_IF_ERROR(CheckNonNegative("fluid.density", f.density()));
+    if (f.density() != 0)
+      CABLESIM_RETURN_IF_ERROR(CheckRange("fluid.density", f.density(), plausible::kDensity));
+    scene_.fluid.density_kg_m3 = f.density();
+    CABLESIM_ASSIGN_OR_RETURN(scene_.fluid.current_m_s,
+                              VectorInRange("fluid.current", f.current(), plausible::kVelocity));
     return absl::OkStatus();
   }
 

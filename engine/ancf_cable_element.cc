@@ -37,6 +37,7 @@ AncfCableElement<D>::AncfCableElement(double length_m, double ea_n, double ei_n_
     : length_(length_m), ea_(ea_n), ei_(ei_n_m2), bending_(bending),
       rule_(MakeGaussRule(gauss_points)) {
   for (int g = 0; g < rule_.n; ++g) {
+    Shape(rule_.xi[g], length_, s0_[g]);
     ShapeD1(rule_.xi[g], length_, d1_[g]);
     ShapeD2(rule_.xi[g], length_, d2_[g]);
   }
@@ -281,6 +282,35 @@ void AncfCableElement<D>::AddDampingMatrix(const Coords& e, double axial_s, doub
   }
   MirrorUpperBlocks(&upper);
   *c += upper;
+}
+
+template <int D>
+void AncfCableElement<D>::AddDrag(const Coords& e, const Coords& edot, const Point& current,
+                                  double kn, double kt, Coords* force, Matrix* c) const {
+  for (int g = 0; g < rule_.n; ++g) {
+    const double* s0 = s0_[g];
+    Point u = Point::Zero(), v = current;
+    for (int k = 0; k < 4; ++k) {
+      u += d1_[g][k] * e.template segment<D>(k * D);
+      v -= s0[k] * edot.template segment<D>(k * D);
+    }
+    const double un = u.norm();
+    if (!(un > 0)) continue;
+    const Point t = u / un;
+    const Point vt = t.dot(v) * t, vn = v - vt;
+    const double an = vn.norm(), at = vt.norm();
+    const Point q = kn * an * vn + kt * at * vt;
+    const double wl = rule_.weight[g] * length_;
+    for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s0[k]) * q;
+    if (!c) continue;
+    Block h = (2 * kt * at) * t * t.transpose();
+    if (an > 0) {
+      h += (kn * an) * (Block::Identity() - t * t.transpose()) + (kn / an) * vn * vn.transpose();
+    }
+    for (int k = 0; k < 4; ++k)
+      for (int m = 0; m < 4; ++m)
+        c->template block<D, D>(k * D, m * D) += (wl * s0[k] * s0[m]) * h;
+  }
 }
 
 template class AncfCableElement<2>;

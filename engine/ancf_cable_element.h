@@ -111,6 +111,23 @@ class AncfCableElement {
   // one). With bending NONE (EI = 0) only the axial term acts.
   void AddDampingMatrix(const Coords& e, double axial_s, double bending_s, Matrix* c) const;
 
+  // Morison drag (Morison et al., J. Petroleum Technology 2(5), 1950, the
+  // drag term; the cross-flow split of MoorDyn's and OrcaFlex's line
+  // models): at each Gauss point, with the relative velocity
+  // v_r = current - rdot, the unit tangent t = r' / |r'|, v_t = (v_r . t) t
+  // and v_n = v_r - v_t, the force per unit undeformed length
+  //
+  //   q = kn |v_n| v_n + kt |v_t| v_t   [N/m],
+  //
+  // kn = rho C_dn d / 2 and kt = rho C_dt pi d / 2 [kg/m^2] (normal drag on
+  // the projected diameter, tangential drag on the wetted perimeter).
+  // Adds Q = int S^T q dx to `force` and, when `c` is not null,
+  // -dQ/d(edot) = int S^T (kn (|v_n| P + v_n v_n^T / |v_n|)
+  // + 2 kt |v_t| t t^T) S dx to it (P = I - t t^T; symmetric positive
+  // semi-definite; the derivative through t in e is left out).
+  void AddDrag(const Coords& e, const Coords& edot, const Point& current, double kn, double kt,
+               Coords* force, Matrix* c) const;
+
  private:
   // B maps e to (u, w) at Gauss point g: rows 0..D-1 are S', rows D..2D-1
   // are S''.
@@ -130,6 +147,7 @@ class AncfCableElement {
   GaussRule rule_;
   // Shape-function derivatives at the Gauss points: d1_[g][k] = s_k'(x),
   // d2_[g][k] = s_k''(x), derivatives in x.
+  double s0_[GaussRule::kMaxPoints][4] = {};  // s_k(x), for drag
   double d1_[GaussRule::kMaxPoints][4] = {};
   double d2_[GaussRule::kMaxPoints][4] = {};
 };

@@ -305,13 +305,18 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
                                  e.bending_damping_s, &ce);
     if (e.alpha_1_s != 0) ce += e.alpha_1_s * e.element.MassMatrix(e.mass_per_length);
     const auto ve = qdot.segment<kN>(e.first_coord);
-    fe.noalias() = ce * ve;
-    if (power) *power += ve.dot(fe);
-    if (full) full->segment<kN>(e.first_coord) -= fe;
+    // fe: the damping force -C ve, plus the drag (which adds its own
+    // velocity derivative to ce).
+    fe.noalias() = -ce * ve;
+    if (e.drag_n != 0 || e.drag_t != 0)
+      e.element.AddDrag(q.segment<kN>(e.first_coord), ve, current_.head<D>(), e.drag_n, e.drag_t,
+                        &fe, &ce);
+    if (power) *power -= ve.dot(fe);
+    if (full) full->segment<kN>(e.first_coord) += fe;
     size = std::max(size, fe.template lpNorm<Eigen::Infinity>());
     if (roundoff)
       roundoff->segment<kN>(e.first_coord).noalias() +=
-          kSumRounding * (ce.cwiseAbs() * ve.cwiseAbs());
+          kSumRounding * (ce.cwiseAbs() * ve.cwiseAbs() + fe.cwiseAbs());
     if (!tangent) continue;
     const int* slots = &element_slots_[kN2 * k];
     const double* factors = &element_factors_[kN2 * k];
@@ -367,7 +372,7 @@ double MultibodyModel::DampingForce(const VectorXd& q, const VectorXd& qdot, Vec
 
 double MultibodyModel::DampingPower(const VectorXd& q, const VectorXd& qdot) const {
   if (!has_damping_) return 0;
-  double power = 0;
+  double power = 0;  // -Q_d . qdot
   if (dim_ == 2) {
     ElementDamping<2>(q, qdot, nullptr, nullptr, 0, nullptr, &power);
   } else {

@@ -123,7 +123,10 @@ class MultibodyModel {
   // mass and a torque -c omega, which in natural coordinates is the force
   // -c udot on the planar axis u, and -(c / 2) edot_k on each spatial axis
   // (for orthonormal axes |omega|^2 = (1/2) sum_k |edot_k|^2). All are
-  // Q_d = -C(q) qdot with C symmetric positive semi-definite.
+  // Q_d = -C(q) qdot with C symmetric positive semi-definite. Morison drag
+  // on cables in a fluid (AncfCableElement::AddDrag) is quadratic in the
+  // velocity relative to the current; C is then its velocity derivative,
+  // also symmetric positive semi-definite.
   bool has_damping() const { return has_damping_; }
 
   // Adds the damping force -C(q) qdot to the reduced force `f` (as
@@ -138,7 +141,9 @@ class MultibodyModel {
                       SkylineLdlt* tangent = nullptr, double tangent_scale = 0,
                       Eigen::VectorXd* roundoff = nullptr);
 
-  // The power the damping dissipates, qdot^T C(q) qdot >= 0 [W].
+  // The power the damping dissipates, -Q_d . qdot [W]: qdot^T C(q) qdot >= 0
+  // without drag; a current may make the drag's share negative (the
+  // current then does work on the cable).
   double DampingPower(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot) const;
 
   // The energy [J] below which a change of the total energy is rounding:
@@ -204,8 +209,11 @@ class MultibodyModel {
     // Damping: Kelvin-Voigt times [s] (Rayleigh beta included) and
     // Rayleigh alpha [1/s].
     double axial_damping_s = 0, bending_damping_s = 0, alpha_1_s = 0;
+    // Morison drag factors kn, kt [kg/m^2] (AncfCableElement::AddDrag).
+    double drag_n = 0, drag_t = 0;
     bool damped() const {
-      return axial_damping_s != 0 || bending_damping_s != 0 || alpha_1_s != 0;
+      return axial_damping_s != 0 || bending_damping_s != 0 || alpha_1_s != 0 ||
+             drag_n != 0 || drag_t != 0;
     }
   };
   struct BodyData {
@@ -290,6 +298,7 @@ class MultibodyModel {
   Eigen::VectorXd constant_force_;  // full: gravity and point loads
   double energy_roundoff_ = 0;
   bool has_damping_ = false;
+  Eigen::Vector3d current_ = Eigen::Vector3d::Zero();  // the fluid's [m/s]
 
   std::vector<Row> rows_;
   std::vector<int> row_coord_;

@@ -57,6 +57,14 @@ struct CableSpec {
   double bending_damping_s = 0;
   double rayleigh_alpha_1_s = 0;
   double rayleigh_beta_s = 0;
+  // Hydrodynamics in the scene's fluid (MultibodyModel::DampingForce,
+  // ModelBuilder::BuildElements): Morison drag coefficients normal and
+  // tangential [-], added-mass coefficient [-] and outer diameter [m]
+  // (0: that of a solid circle of the cable's area).
+  double normal_drag = 0;
+  double tangential_drag = 0;
+  double added_mass = 0;
+  double hydro_diameter_m = 0;
 };
 
 struct BodySpec {
@@ -100,6 +108,14 @@ struct LoadSpec {
 struct ProbeSpec {
   std::string name;
   Attachment at;
+};
+
+// A fluid filling the scene: density [kg/m^3] (0: none) and a uniform,
+// steady current [m/s]. Cables in it are buoyed (their displaced weight is
+// taken off their gravity) and feel their hydrodynamics.
+struct FluidSpec {
+  double density_kg_m3 = 0;
+  Eigen::Vector3d current_m_s = Eigen::Vector3d::Zero();
 };
 
 struct InitialVelocitySpec {
@@ -153,6 +169,7 @@ struct Scene {
   std::vector<ProbeSpec> probes;
   InitialVelocitySpec initial_velocity;
   SolverSettings solver;
+  FluidSpec fluid;
 };
 
 }  // namespace cablesim
