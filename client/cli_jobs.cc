@@ -53,6 +53,7 @@ std::string EnergyJson(const std::string& source, const v1::EnergyResponse& r) {
       .Add("relative_drift", e.relative_drift())
       .Add("scale", e.scale())
       .Add("energy_dissipated", e.energy_dissipated())
+      .Add("energy_damped", e.energy_damped())
       .Add("max_constraint_violation", e.max_constraint_violation())
       .ToString();
 }
@@ -71,9 +72,10 @@ absl::Status WriteEnergyCsv(const std::string& path, const v1::EnergyResponse& r
   if (!parts) columns.resize(1 + kTotalValues);
   file << absl::StrJoin(columns, ",") << "\n";
   for (int i = 0; i < r.t_size(); ++i) {
-    std::string row = absl::StrFormat("%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", r.t(i),
-                                      r.kinetic(i), r.potential(i), r.axial(i), r.bending(i),
-                                      r.total(i), r.constraint_violation(i));
+    std::string row = absl::StrFormat(
+        "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", r.t(i), r.kinetic(i), r.potential(i),
+        r.axial(i), r.bending(i), r.total(i), r.constraint_violation(i),
+        i < r.damped_size() ? r.damped(i) : 0.0);
     if (parts) {
       for (const v1::PartEnergySeries& c : r.cables()) {
         absl::StrAppendFormat(&row, ",%.17g,%.17g,%.17g,%.17g", c.kinetic(i), c.gravity(i),

@@ -29,6 +29,7 @@ std::string SummaryToJson(const RunSummary& summary) {
       .Add("energy_initial", summary.energy_initial)
       .Add("energy_final", summary.energy_final)
       .Add("energy_dissipated", summary.energy_dissipated)
+      .Add("energy_damped", summary.energy_damped)
       .Add("energy_max_increase", summary.energy_max_increase)
       .Add("max_constraint_violation", summary.max_constraint_violation)
       .Add("max_newton_residual", summary.max_newton_residual)

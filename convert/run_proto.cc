@@ -60,6 +60,7 @@ v1::RunSummary SummaryToProto(const RunSummary& s) {
   p.set_energy_initial(s.energy_initial);
   p.set_energy_final(s.energy_final);
   p.set_energy_dissipated(s.energy_dissipated);
+  p.set_energy_damped(s.energy_damped);
   p.set_energy_max_increase(s.energy_max_increase);
   p.set_max_constraint_violation(s.max_constraint_violation);
   p.set_max_newton_residual(s.max_newton_residual);
@@ -99,6 +100,7 @@ RunSummary SummaryFromProto(const v1::RunSummary& p) {
   s.energy_initial = p.energy_initial();
   s.energy_final = p.energy_final();
   s.energy_dissipated = p.energy_dissipated();
+  s.energy_damped = p.energy_damped();
   s.energy_max_increase = p.energy_max_increase();
   s.max_constraint_violation = p.max_constraint_violation();
   s.max_newton_residual = p.max_newton_residual();

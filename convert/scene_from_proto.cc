@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -325,6 +326,7 @@ class SceneConverter {
       CABLESIM_RETURN_IF_ERROR(ConvertProbe(i, &scene_.probes[i]));
     }
     CABLESIM_RETURN_IF_ERROR(ConvertInitialVelocity());
+    CABLESIM_RETURN_IF_ERROR(ConvertFluid());
     CABLESIM_RETURN_IF_ERROR(ConvertSolver());
     return std::move(scene_);
   }
@@ -456,6 +458,37 @@ class SceneConverter {
         !std::isfinite(cable->second_moment_m4)) {
       return Invalid(Sub(path, "diameter"), "section properties out of range");
     }
+    if (c.has_hydrodynamics()) {
+      const v1::Hydrodynamics& h = c.hydrodynamics();
+      const std::string hydro_path = Sub(path, "hydrodynamics");
+      if (!(proto_.fluid().density() > 0)) {
+        return Invalid(hydro_path, "needs a fluid around the cables (fluid.density > 0)");
+      }
+      for (const auto& [name, value, out] :
+           {std::tuple{"normal_drag", h.normal_drag(), &cable->normal_drag},
+            std::tuple{"tangential_drag", h.tangential_drag(), &cable->tangential_drag},
+            std::tuple{"added_mass", h.added_mass(), &cable->added_mass}}) {
+        CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(hydro_path, name), value));
+        *out = value;
+      }
+      if (h.has_diameter()) {
+        CABLESIM_RETURN_IF_ERROR(
+            CheckPositiveInRange(Sub(hydro_path, "diameter"), h.diameter(), plausible::kSize));
+        cable->hydro_diameter_m = h.diameter();
+      }
+    }
+    if (c.has_damping()) {
+      const v1::CableDamping& d = c.damping();
+      const std::string damping_path = Sub(path, "damping");
+      for (const auto& [name, value, out] :
+           {std::tuple{"axial_time", d.axial_time(), &cable->axial_damping_s},
+            std::tuple{"bending_time", d.bending_time(), &cable->bending_damping_s},
+            std::tuple{"rayleigh_alpha", d.rayleigh_alpha(), &cable->rayleigh_alpha_1_s},
+            std::tuple{"rayleigh_beta", d.rayleigh_beta(), &cable->rayleigh_beta_s}}) {
+        CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(damping_path, name), value));
+        *out = value;
+      }
+    }
     return absl::OkStatus();
   }
 
@@ -517,6 +550,15 @@ class SceneConverter {
     body->axis = Eigen::Vector3d::UnitX();
     if (b.has_axis()) {
       CABLESIM_ASSIGN_OR_RETURN(body->axis, Direction(Sub(path, "axis"), b.axis()));
+    }
+    if (b.has_damping()) {
+      const std::string damping_path = Sub(path, "damping");
+      CABLESIM_RETURN_IF_ERROR(
+          CheckNonNegative(Sub(damping_path, "linear"), b.damping().linear()));
+      CABLESIM_RETURN_IF_ERROR(
+          CheckNonNegative(Sub(damping_path, "angular"), b.damping().angular()));
+      body->linear_damping_n_s_m = b.damping().linear();
+      body->angular_damping_n_m_s = b.damping().angular();
     }
     return absl::OkStatus();
   }
@@ -700,6 +742,17 @@ class SceneConverter {
     at.set_body(p.body());
     if (p.has_point()) *at.mutable_point() = p.point();
     CABLESIM_ASSIGN_OR_RETURN(probe->at, ConvertAttachment(path, at, false));
+    return absl::OkStatus();
+  }
+
+  absl::Status ConvertFluid() {
+    const v1::Fluid& f = proto_.fluid();
+    CABLESIM_RETURN_IF_ERROR(CheckNonNegative("fluid.density", f.density()));
+    if (f.density() != 0)
+      CABLESIM_RETURN_IF_ERROR(CheckRange("fluid.density", f.density(), plausible::kDensity));
+    scene_.fluid.density_kg_m3 = f.density();
+    CABLESIM_ASSIGN_OR_RETURN(scene_.fluid.current_m_s,
+                              VectorInRange("fluid.current", f.current(), plausible::kVelocity));
     return absl::OkStatus();
   }
 

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/Geometry>
+
 namespace cablesim {
 namespace {
 
@@ -35,6 +37,7 @@ AncfCableElement<D>::AncfCableElement(double length_m, double ea_n, double ei_n_
     : length_(length_m), ea_(ea_n), ei_(ei_n_m2), bending_(bending),
       rule_(MakeGaussRule(gauss_points)) {
   for (int g = 0; g < rule_.n; ++g) {
+    Shape(rule_.xi[g], length_, s0_[g]);
     ShapeD1(rule_.xi[g], length_, d1_[g]);
     ShapeD2(rule_.xi[g], length_, d2_[g]);
   }
@@ -130,7 +133,6 @@ template <int D>
 void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* tangent,
                                        Coords* roundoff) const {
   using Id = Eigen::Matrix<double, D, D>;
-  using Block = Eigen::Matrix<double, D, D>;
   constexpr double kEps = std::numeric_limits<double>::epsilon();
   // For `roundoff`: |e_k| per node (once per element), and per node the
   // bound summed over the Gauss points (the same for each of its D entries).
@@ -206,27 +208,108 @@ void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* t
       const double dgw = wl * (nuw * du + nww * dw + kEps * gw.template lpNorm<1>());
       for (int k = 0; k < 4; ++k) node_bound[k] += std::abs(s1[k]) * dgu + std::abs(s2[k]) * dgw;
     }
-    if (tangent) {
-      // K += wl B^T H B, block by block: B's node block k is
-      // [s_k' I; s_k'' I], so block (k, m) is
-      // s_k' s_m' H_uu + s_k' s_m'' H_uw + s_k'' s_m' H_wu + s_k'' s_m'' H_ww.
-      for (int k = 0; k < 4; ++k) {
-        const double p1 = wl * s1[k], p2 = wl * s2[k];
-        for (int m = k; m < 4; ++m) {
-          const double q1 = s1[m], q2 = s2[m];
-          tangent->template block<D, D>(k * D, m * D) +=
-              (p1 * q1) * huu + (p1 * q2) * huw + (p2 * q1) * huw.transpose() + (p2 * q2) * hww;
-        }
-      }
-    }
+    if (tangent) AddUpperBlocks(g, wl, huu, huw, hww, tangent);
   }
   if (roundoff)
     for (int k = 0; k < 4; ++k) roundoff->template segment<D>(k * D).array() += node_bound[k];
-  if (tangent) {
+  if (tangent) MirrorUpperBlocks(tangent);
+}
+
+template <int D>
+void AncfCableElement<D>::AddUpperBlocks(int g, double wl, const Block& huu, const Block& huw,
+                                         const Block& hww, Matrix* tangent) const {
+  // B's node block k is [s_k' I; s_k'' I], so block (k, m) of B^T H B is
+  // s_k' s_m' H_uu + s_k' s_m'' H_uw + s_k'' s_m' H_wu + s_k'' s_m'' H_ww.
+  const double* s1 = d1_[g];
+  const double* s2 = d2_[g];
+  for (int k = 0; k < 4; ++k) {
+    const double p1 = wl * s1[k], p2 = wl * s2[k];
+    for (int m = k; m < 4; ++m) {
+      const double q1 = s1[m], q2 = s2[m];
+      tangent->template block<D, D>(k * D, m * D) +=
+          (p1 * q1) * huu + (p1 * q2) * huw + (p2 * q1) * huw.transpose() + (p2 * q2) * hww;
+    }
+  }
+}
+
+template <int D>
+void AncfCableElement<D>::MirrorUpperBlocks(Matrix* tangent) {
+  for (int k = 0; k < 4; ++k)
+    for (int m = k + 1; m < 4; ++m)
+      tangent->template block<D, D>(m * D, k * D) =
+          tangent->template block<D, D>(k * D, m * D).transpose();
+}
+
+template <int D>
+void AncfCableElement<D>::AddDampingMatrix(const Coords& e, double axial_s, double bending_s,
+                                           Matrix* c) const {
+  // Rows of the curvature vector: 1 in the plane, 3 in space.
+  constexpr int kRows = D == 2 ? 1 : 3;
+  using GBlock = Eigen::Matrix<double, kRows, D>;
+  const double ca = ea_ * axial_s, cb = bending_ == BendingModel::kNone ? 0.0 : ei_ * bending_s;
+  Matrix upper = Matrix::Zero();
+  for (int g = 0; g < rule_.n; ++g) {
+    Point u = Point::Zero(), w = Point::Zero();
+    for (int k = 0; k < 4; ++k) {
+      u += d1_[g][k] * e.template segment<D>(k * D);
+      w += d2_[g][k] * e.template segment<D>(k * D);
+    }
+    const double wl = rule_.weight[g] * length_;
+    Block huu = ca * u * u.transpose(), huw = Block::Zero(), hww = Block::Zero();
+    if (cb != 0) {
+      // k = u x w / a^(3/2), a = u.u: dk/dw = [u]x / a^(3/2),
+      // dk/du = -[w]x / a^(3/2) - 3 k u^T / a.
+      const double a = u.squaredNorm(), ia15 = 1 / (a * std::sqrt(a));
+      GBlock gu, gw;
+      if constexpr (D == 2) {
+        const double k = (u.x() * w.y() - u.y() * w.x()) * ia15;
+        gu << w.y() * ia15, -w.x() * ia15;
+        gu -= (3 * k / a) * u.transpose();
+        gw << -u.y() * ia15, u.x() * ia15;
+      } else {
+        const Point k = u.cross(w) * ia15;
+        Block wx, ux;
+        wx << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
+        ux << 0, -u.z(), u.y(), u.z(), 0, -u.x(), -u.y(), u.x(), 0;
+        gu = -ia15 * wx - (3 / a) * k * u.transpose();
+        gw = ia15 * ux;
+      }
+      huu += cb * gu.transpose() * gu;
+      huw = cb * gu.transpose() * gw;
+      hww = cb * gw.transpose() * gw;
+    }
+    AddUpperBlocks(g, wl, huu, huw, hww, &upper);
+  }
+  MirrorUpperBlocks(&upper);
+  *c += upper;
+}
+
+template <int D>
+void AncfCableElement<D>::AddDrag(const Coords& e, const Coords& edot, const Point& current,
+                                  double kn, double kt, Coords* force, Matrix* c) const {
+  for (int g = 0; g < rule_.n; ++g) {
+    const double* s0 = s0_[g];
+    Point u = Point::Zero(), v = current;
+    for (int k = 0; k < 4; ++k) {
+      u += d1_[g][k] * e.template segment<D>(k * D);
+      v -= s0[k] * edot.template segment<D>(k * D);
+    }
+    const double un = u.norm();
+    if (!(un > 0)) continue;
+    const Point t = u / un;
+    const Point vt = t.dot(v) * t, vn = v - vt;
+    const double an = vn.norm(), at = vt.norm();
+    const Point q = kn * an * vn + kt * at * vt;
+    const double wl = rule_.weight[g] * length_;
+    for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s0[k]) * q;
+    if (!c) continue;
+    Block h = (2 * kt * at) * t * t.transpose();
+    if (an > 0) {
+      h += (kn * an) * (Block::Identity() - t * t.transpose()) + (kn / an) * vn * vn.transpose();
+    }
     for (int k = 0; k < 4; ++k)
-      for (int m = k + 1; m < 4; ++m)
-        tangent->template block<D, D>(m * D, k * D) =
-            tangent->template block<D, D>(k * D, m * D).transpose();
+      for (int m = 0; m < 4; ++m)
+        c->template block<D, D>(k * D, m * D) += (wl * s0[k] * s0[m]) * h;
   }
 }
 

@@ -92,11 +92,53 @@ class AncfCableElement {
   void ElasticForce(const Coords& e, Coords* force, Matrix* tangent,
                     Coords* roundoff = nullptr) const;
 
+  // Kelvin-Voigt damping: adds to `c` the symmetric positive semi-definite
+  // matrix C(e) of the damping force Q_d = C(e) edot [N s/m] derived from
+  // the dissipation function per unit length
+  //
+  //   D = EA axial_s / 2 (d eps/dt)^2 + EI bending_s / 2 |d k/dt|^2,
+  //
+  // d eps/dt = u.udot, k = u x w / |u|^3 the curvature vector (a scalar in
+  // the plane; |k| is the EXACT model's curvature), so that
+  // C = int B^T (EA axial_s u u^T + EI bending_s G^T G) B dx with
+  // G = dk/d(u, w). This is exactly axial_s times the material part of the
+  // axial tangent stiffness and bending_s times the material part of the
+  // EXACT bending tangent (the tangent without its stress-times-curvature
+  // geometric terms), which is why Rayleigh's beta adds to both times.
+  // It vanishes on rigid motion in the plane and on rigid translation in
+  // space; in space the rotation of a curved cable turns k and is damped
+  // by EI bending_s |omega x k|^2 per unit length (zero for a straight
+  // one). With bending NONE (EI = 0) only the axial term acts.
+  void AddDampingMatrix(const Coords& e, double axial_s, double bending_s, Matrix* c) const;
+
+  // Morison drag (Morison et al., J. Petroleum Technology 2(5), 1950, the
+  // drag term; the cross-flow split of MoorDyn's and OrcaFlex's line
+  // models): at each Gauss point, with the relative velocity
+  // v_r = current - rdot, the unit tangent t = r' / |r'|, v_t = (v_r . t) t
+  // and v_n = v_r - v_t, the force per unit undeformed length
+  //
+  //   q = kn |v_n| v_n + kt |v_t| v_t   [N/m],
+  //
+  // kn = rho C_dn d / 2 and kt = rho C_dt pi d / 2 [kg/m^2] (normal drag on
+  // the projected diameter, tangential drag on the wetted perimeter).
+  // Adds Q = int S^T q dx to `force` and, when `c` is not null,
+  // -dQ/d(edot) = int S^T (kn (|v_n| P + v_n v_n^T / |v_n|)
+  // + 2 kt |v_t| t t^T) S dx to it (P = I - t t^T; symmetric positive
+  // semi-definite; the derivative through t in e is left out).
+  void AddDrag(const Coords& e, const Coords& edot, const Point& current, double kn, double kt,
+               Coords* force, Matrix* c) const;
+
  private:
   // B maps e to (u, w) at Gauss point g: rows 0..D-1 are S', rows D..2D-1
   // are S''.
   using BMatrix = Eigen::Matrix<double, 2 * D, kCoords>;
   BMatrix B(int g) const;
+  // tangent += wl B_g^T [huu huw; huw^T hww] B_g on the upper node blocks
+  // (k <= m); the caller mirrors them.
+  using Block = Eigen::Matrix<double, D, D>;
+  void AddUpperBlocks(int g, double wl, const Block& huu, const Block& huw, const Block& hww,
+                      Matrix* tangent) const;
+  static void MirrorUpperBlocks(Matrix* tangent);
 
   double length_ = 0;
   double ea_ = 0;
@@ -105,6 +147,7 @@ class AncfCableElement {
   GaussRule rule_;
   // Shape-function derivatives at the Gauss points: d1_[g][k] = s_k'(x),
   // d2_[g][k] = s_k''(x), derivatives in x.
+  double s0_[GaussRule::kMaxPoints][4] = {};  // s_k(x), for drag
   double d1_[GaussRule::kMaxPoints][4] = {};
   double d2_[GaussRule::kMaxPoints][4] = {};
 };

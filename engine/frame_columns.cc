@@ -15,7 +15,7 @@ std::vector<std::string> FrameColumns(const ModelInfo& info, bool with_nodes) {
     }
   }
   for (const char* c : {"energy.kinetic", "energy.potential", "energy.axial", "energy.bending",
-                        "energy.total", "constraint.violation"}) {
+                        "energy.total", "constraint.violation", "energy.damped"}) {
     columns.push_back(c);
   }
   for (size_t i = 0; i < info.cable_names.size(); ++i) {

@@ -8,7 +8,7 @@
 //   t
 //   per probe NAME.x NAME.y NAME.z NAME.vx NAME.vy NAME.vz NAME.ax NAME.ay NAME.az
 //   energy.kinetic energy.potential energy.axial energy.bending energy.total
-//   constraint.violation
+//   constraint.violation energy.damped
 //   per cable i  cables[i].energy.kinetic cables[i].energy.gravity
 //                cables[i].energy.axial cables[i].energy.bending
 //   per body j   bodies[j].energy.kinetic bodies[j].energy.gravity
@@ -39,8 +39,8 @@ namespace cablesim {
 inline constexpr int kValuesPerProbe = 9;
 inline constexpr int kValuesPerCable = 4;
 inline constexpr int kValuesPerBody = 2;
-// The totals and the constraint violation after the probes.
-inline constexpr int kTotalValues = 6;
+// The totals, the constraint violation and the damped work after the probes.
+inline constexpr int kTotalValues = 7;
 
 // The column names of a frame row of a model with `info`'s probes, cables
 // and bodies, and its nodes when info.shape and `with_nodes` (the run CSV
@@ -74,6 +74,7 @@ void ForEachFrameValue(FrameT& frame, Add&& add) {
   add(e.bending);
   add(e.total);
   add(frame.constraint_violation);
+  add(e.damped);
   for (auto& c : frame.energy_parts.cables) {
     add(c.kinetic);
     add(c.gravity);

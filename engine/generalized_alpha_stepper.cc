@@ -45,6 +45,8 @@ GeneralizedAlphaStepper::GeneralizedAlphaStepper(MultibodyModel* model,
   lambda1_.setZero(m_);
   phi_.setZero(m_);
   q_.setZero(model->coordinates());
+  qd_.setZero(model->coordinates());
+  v1_.setZero(n_);
   rhs_.setZero(n_ + m_);
   dx_.setZero(n_ + m_);
   z_old_ = z_;
@@ -55,6 +57,17 @@ GeneralizedAlphaStepper::GeneralizedAlphaStepper(MultibodyModel* model,
   g_old_ = g_;
 }
 
+double GeneralizedAlphaStepper::Forces(const Eigen::VectorXd& v, Eigen::VectorXd* f,
+                                       SkylineLdlt* a, double c, double cd,
+                                       Eigen::VectorXd* roundoff) {
+  double size = model_->NetForce(q_, 1.0, f, a, c, roundoff);
+  if (model_->has_damping()) {
+    model_->RateToFull(v, &qd_);
+    size = std::max(size, model_->DampingForce(q_, qd_, f, a, cd, roundoff));
+  }
+  return size;
+}
+
 void GeneralizedAlphaStepper::LoadMass() {
   const SkylineLdlt& mass = model_->mass();
   std::copy(mass.values(), mass.values() + mass.stored(), solver_.a().values());
@@ -63,7 +76,7 @@ void GeneralizedAlphaStepper::LoadMass() {
 bool GeneralizedAlphaStepper::Initialize(std::string* reason) {
   model_->SetTime(t_);
   model_->ToFull(z_, &q_);
-  model_->NetForce(q_, 1.0, &f_);
+  Forces(v_, &f_, nullptr, 0, 0, nullptr);
   model_->Constraints(q_, &phi_, &solver_.b());
   Eigen::VectorXd qdot(model_->coordinates()), gamma(m_);
   model_->RateToFull(v_, &qdot);
@@ -163,6 +176,9 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
     sv = h * gamma_;
   }
   const double c = w_ * s;
+  // The damping's share of the Newton matrix: d v_{n+1} / d zdd = s_v.
+  const double cd = w_ * sv;
+  const bool damping = model_->has_damping();
   // A kept matrix serves while c is within 20 % of its own (the last steps
   // shortened to end on the duration, or resized by the error controller): Newton
   // then still contracts by about that fraction, and the safeguard below
@@ -179,6 +195,7 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
   for (int it = 0; it <= settings_.max_newton_iterations; ++it) {
     z1_ = z_pred_ + s * zdd1_;
     model_->ToFull(z1_, &q_);
+    if (damping) v1_ = v_pred_ + sv * zdd1_;
     const bool checking = it > 0 && last_increment <= tol * (1 + z1_.lpNorm<Eigen::Infinity>());
     // The rounding floor is needed where convergence is judged (and for the
     // message of the last iteration), unless the residual is below tol.
@@ -189,13 +206,13 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
     double force_size;
     if (fresh && !checking) {
       LoadMass();
-      force_size = model_->NetForce(q_, 1.0, &f_, &a, c);
+      force_size = Forces(v1_, &f_, &a, c, cd, nullptr);
       assembled = true;
     } else {
       // The forces' rounding bound in the same pass when the last step was
       // accepted at its floor: this one most likely will be too.
       have_floor = judge && floor_expected_;
-      force_size = model_->NetForce(q_, 1.0, &f_, nullptr, 0, have_floor ? &floor_ : nullptr);
+      force_size = Forces(v1_, &f_, nullptr, 0, 0, have_floor ? &floor_ : nullptr);
     }
     model_->Constraints(q_, &phi_, &jac_);
     // R = M zdd + w (Phi_z^T lambda - f) + (1 - w) g_n.
@@ -232,7 +249,7 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
       // floor = w roundoff(f) + rounding of the other terms summed into R
       // (the forces once more for their bound, unless it came with them).
       if (!have_floor) {
-        model_->NetForce(q_, 1.0, &f_floor_, nullptr, 0, &floor_);
+        Forces(v1_, &f_floor_, nullptr, 0, 0, &floor_);
         abs_terms_.setZero();
         model_->mass().AddAbsMultiply(zdd1_.data(), abs_terms_.data());
       }
@@ -256,7 +273,7 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
     if (fresh) {
       if (!assembled) {
         LoadMass();
-        model_->NetForce(q_, 1.0, &f_, &a, c);
+        Forces(v1_, &f_, &a, c, cd, nullptr);
       }
       if (m_ > 0) model_->AddConstraintHessian(q_, lambda1_, c, &a);
       std::copy(jac_.value.begin(), jac_.value.end(), solver_.b().value.begin());

@@ -48,10 +48,11 @@
 // s = h^2 beta (1 - alpha_f) / (1 - alpha_m) (generalized-alpha) or
 // h^2 beta (HHT). Newton on (zdd, w lambda) solves the symmetric system
 //
-//   [ M + c (K_T + H_lambda)   Phi_z^T ] [ d zdd      ]     [ R       ]
-//   [ Phi_z                    0       ] [ w d lambda ] = - [ Phi / s ],
+//   [ M + w s_v C + c (K_T + H_lambda)   Phi_z^T ] [ d zdd      ]     [ R       ]
+//   [ Phi_z                              0       ] [ w d lambda ] = - [ Phi / s ],
 //
-// c = w s: the structure of backward Euler's (c = h^2 there), so the same
+// c = w s, C the damping matrix when the scene has damping (f then holds
+// the damping force at v_{n+1}, MultibodyModel::DampingForce): the structure of backward Euler's (c = h^2 there), so the same
 // SaddlePointSolver (MINRES, GMRES, DIRECT) serves. The scaling by 1/s of
 // the constraint rows is Arnold and Bruls' remedy (with Bottasso et al.'s) for
 // the O(h^-2) conditioning of index-3 Newton matrices.
@@ -116,6 +117,11 @@ class GeneralizedAlphaStepper final : public Stepper {
   // One Newton solve of the step; `fresh` forces a new Newton matrix first.
   StepStats Solve(double h, bool fresh);
   void LoadMass();
+  // f = f(q_, v) (elastic, applied and damping forces, the damping's
+  // velocity v) and, when `a` is not null, c K_T + cd C added to it; the
+  // force size (NetForce, DampingForce).
+  double Forces(const Eigen::VectorXd& v, Eigen::VectorXd* f, SkylineLdlt* a, double c,
+                double cd, Eigen::VectorXd* roundoff);
 
   MultibodyModel* model_;
   SolverSettings settings_;
@@ -130,7 +136,8 @@ class GeneralizedAlphaStepper final : public Stepper {
   Eigen::VectorXd acc_h_;  // a_n shifted to the current step (variable steps)
   Eigen::VectorXd z_old_, v_old_, zdd_old_, acc_old_, lambda_old_, g_old_;
   // Newton work vectors.
-  Eigen::VectorXd z_pred_, v_pred_, z1_, zdd1_, lambda1_, q_, f_, phi_, bt_lambda_, rhs_, dx_;
+  // v1_ and qd_: the iterate's velocity, with damping only.
+  Eigen::VectorXd z_pred_, v_pred_, z1_, v1_, zdd1_, lambda1_, q_, qd_, f_, phi_, bt_lambda_, rhs_, dx_;
   // The residual's rounding floor per unknown, and the terms summed into it.
   Eigen::VectorXd floor_, abs_terms_, f_floor_;
   // Whether the last accepted step needed the floor (its residual was above

@@ -21,6 +21,7 @@ ImplicitEulerStepper::ImplicitEulerStepper(MultibodyModel* model, const SolverSe
   v1_.setZero(n_);
   lambda1_.setZero(m_);
   q_.setZero(model->coordinates());
+  qd_.setZero(model->coordinates());
   f_.setZero(n_);
   phi_.setZero(m_);
   mdv_.setZero(n_);
@@ -54,7 +55,7 @@ double ImplicitEulerStepper::LocalErrorNorm(double h, double atol, double rtol) 
 bool ImplicitEulerStepper::Initialize(std::string* reason) {
   model_->SetTime(t_);
   model_->ToFull(z_, &q_);
-  model_->NetForce(q_, 1.0, &f_);
+  Forces(v_, &f_, nullptr, 0, nullptr);
   model_->Constraints(q_, &phi_, &solver_.b());
   Eigen::VectorXd qdot(model_->coordinates()), gamma(m_);
   model_->RateToFull(v_, &qdot);
@@ -86,9 +87,19 @@ void ImplicitEulerStepper::LoadMass() {
   std::copy(mass.values(), mass.values() + mass.stored(), solver_.a().values());
 }
 
+double ImplicitEulerStepper::Forces(const Eigen::VectorXd& v, Eigen::VectorXd* f,
+                                    SkylineLdlt* a, double h, Eigen::VectorXd* roundoff) {
+  double size = model_->NetForce(q_, 1.0, f, a, h * h, roundoff);
+  if (model_->has_damping()) {
+    model_->RateToFull(v, &qd_);
+    size = std::max(size, model_->DampingForce(q_, qd_, f, a, h, roundoff));
+  }
+  return size;
+}
+
 double ImplicitEulerStepper::AssembleForces(double h) {
   LoadMass();
-  return model_->NetForce(q_, 1.0, &f_, &solver_.a(), h * h);
+  return Forces(v1_, &f_, &solver_.a(), h, nullptr);
 }
 
 ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
@@ -113,7 +124,7 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
     // accepted at its floor: this one most likely will be too.
     const bool have_floor = checking && floor_expected_;
     const double force_size =
-        checking ? model_->NetForce(q_, 1.0, &f_, nullptr, 0, have_floor ? &floor_ : nullptr)
+        checking ? Forces(v1_, &f_, nullptr, h, have_floor ? &floor_ : nullptr)
                  : AssembleForces(h);
     model_->Constraints(q_, &phi_, &solver_.b());
     // R_v = M (v1 - v0) - h f + Phi_z^T (h lambda).
@@ -144,7 +155,7 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
       // floor = h roundoff(f) + rounding of the other terms summed into R_v
       // (M v1, M v0 and h Phi_z^T lambda); the forces once more, for their
       // bound, only where it matters, unless it came with them.
-      if (!have_floor) model_->NetForce(q_, 1.0, &f_floor_, nullptr, 0, &floor_);
+      if (!have_floor) Forces(v1_, &f_floor_, nullptr, h, &floor_);
       abs_terms_.setZero();
       model_->mass().AddAbsMultiply(v1_.data(), abs_terms_.data());
       model_->mass().AddAbsMultiply(v_.data(), abs_terms_.data());

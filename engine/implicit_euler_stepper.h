@@ -5,16 +5,17 @@
 // equations of motion,
 //
 //   v1 = v0 + h a1,   z1 = z0 + h v1,
-//   M (v1 - v0) + h (Q_k(z1) - Q_a(z1)) + Phi_z(z1)^T mu = 0,   mu = h lambda
-//   Phi(z1) / h = 0,
+//   M (v1 - v0) + h (Q_k(z1) - Q_a(z1) + C(z1) v1) + Phi_z(z1)^T mu = 0,
+//   mu = h lambda,   Phi(z1) / h = 0,
 //
 // solved by Newton on (v1, mu) from the predictor v1 = v0 + h a0. Each Newton
 // step solves the symmetric saddle-point system
 //
-//   [ M + h^2 (K_T + H_lambda)   Phi_z^T ] [dv ]     [ R_v ]
-//   [ Phi_z                      0       ] [dmu] = - [ R_c ]
+//   [ M + h C + h^2 (K_T + H_lambda)   Phi_z^T ] [dv ]     [ R_v ]
+//   [ Phi_z                            0       ] [dmu] = - [ R_c ]
 //
-// with MINRES (or GMRES) under SaddlePointSolver's preconditioner. Newton
+// (C the damping matrix, MultibodyModel::DampingForce; absent without
+// damping) with MINRES (or GMRES) under SaddlePointSolver's preconditioner. Newton
 // stops when the position increment h |dv|_inf is below
 // tol (1 + |z|_inf), the momentum residual below tol times its largest term
 // and |Phi|_inf below tol (1 + |z|_inf) (a residual left above tol while the
@@ -63,7 +64,13 @@ class ImplicitEulerStepper final : public Stepper {
  private:
   // Newton matrix block a = M.
   void LoadMass();
-  // a = M + h^2 K_T(q_) and f_ = f(q_) in one pass; returns the force size.
+  // f = f(q_, v) (elastic, applied and damping forces: the damping's
+  // velocity is v) and, when `a` is not null, h^2 K_T + h C added to it;
+  // the force size (NetForce, DampingForce).
+  double Forces(const Eigen::VectorXd& v, Eigen::VectorXd* f, SkylineLdlt* a, double h,
+                Eigen::VectorXd* roundoff);
+  // a = M + h^2 K_T(q_) + h C and f_ = f(q_, v1_) in one pass; returns the
+  // force size.
   double AssembleForces(double h);
 
   MultibodyModel* model_;
@@ -77,7 +84,7 @@ class ImplicitEulerStepper final : public Stepper {
   // t_{n+1}, where backward Euler imposes Phi(z_{n+1}, t_{n+1}) = 0).
   double t_ = 0, t_old_ = 0;
   // Newton work vectors.
-  Eigen::VectorXd z1_, v1_, lambda1_, q_, f_, phi_, mdv_, rhs_, dx_, bt_mu_;
+  Eigen::VectorXd z1_, v1_, lambda1_, q_, qd_, f_, phi_, mdv_, rhs_, dx_, bt_mu_;
   // The residual's rounding floor per unknown, and the terms summed into it.
   Eigen::VectorXd floor_, abs_terms_, f_floor_;
   // Whether the last accepted step needed the floor (its residual was above

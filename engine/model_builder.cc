@@ -20,6 +20,7 @@ using Eigen::VectorXd;
 
 // Relative tolerance for matching arc lengths to nodes.
 constexpr double kSnap = 1e-9;
+constexpr double kPi = 3.14159265358979323846;
 
 // The body frame at t = 0 from its x axis (scene.h): columns x, y, z.
 Eigen::Matrix3d BodyFrame(const Vector3d& axis) {
@@ -162,6 +163,9 @@ absl::Status ModelBuilder::InitialCoordinates() {
     MultibodyModel::BodyData data;
     data.coord = i;
     data.mass = body.mass_kg;
+    data.linear_damping = body.linear_damping_n_s_m;
+    data.angular_damping = body.angular_damping_n_m_s;
+    if (data.linear_damping != 0 || data.angular_damping != 0) model_.has_damping_ = true;
     const Vector3d& inertia = body.inertia_kg_m2;
     if (D == 2) {
       q0_.segment<2>(i + 2) = frame0_[b].col(0).head<2>();
@@ -522,6 +526,14 @@ void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* 
     const double ea = cable.youngs_modulus_pa * cable.area_m2;
     const double ei = cable.youngs_modulus_pa * cable.second_moment_m4;
     const double mpl = cable.density_kg_m3 * cable.area_m2;
+    // In a fluid: buoyancy (the displaced fluid's weight off gravity),
+    // isotropic added mass, and the drag factors of AddDrag.
+    const double rho_f = scene_.fluid.density_kg_m3;
+    const double dh = cable.hydro_diameter_m > 0 ? cable.hydro_diameter_m
+                                                 : std::sqrt(4 * cable.area_m2 / kPi);
+    const double displaced = rho_f > 0 ? rho_f * kPi * dh * dh / 4 : 0.0;  // [kg/m]
+    const double drag_n = 0.5 * rho_f * cable.normal_drag * dh;
+    const double drag_t = 0.5 * rho_f * cable.tangential_drag * kPi * dh;
     for (int k = first_node[c]; k + 1 < first_node[c + 1]; ++k) {
       if (mesh_.twin_of[k + 1] == k) continue;  // the two halves of a split node
       const int local = k - first_node[c];
@@ -533,9 +545,15 @@ void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* 
       const double strain = 16 * std::numeric_limits<double>::epsilon() * (1 + extent) / l;
       model_.energy_roundoff_ += (ea + ei / (l * l)) * l * strain * strain;
       e.first_coord = NodeCoord(k);
-      e.mass_per_length = mpl;
-      e.gravity = e.element.GravityForce(mpl, g);
-      const auto me = e.element.MassMatrix(mpl);
+      e.mass_per_length = mpl + cable.added_mass * displaced;
+      e.gravity = e.element.GravityForce(mpl - displaced, g);
+      e.drag_n = drag_n;
+      e.drag_t = drag_t;
+      e.axial_damping_s = cable.axial_damping_s + cable.rayleigh_beta_s;
+      e.bending_damping_s = cable.bending_damping_s + cable.rayleigh_beta_s;
+      e.alpha_1_s = cable.rayleigh_alpha_1_s;
+      if (e.damped()) model_.has_damping_ = true;
+      const auto me = e.element.MassMatrix(e.mass_per_length);
       for (int a = 0; a < 4; ++a)
         for (int b = 0; b < 4; ++b) e.mbar(a, b) = me(D * a, D * b);
       elements->push_back(e);
@@ -545,6 +563,7 @@ void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* 
 }
 
 void ModelBuilder::BuildElements() {
+  model_.current_ = scene_.fluid.current_m_s;
   if (model_.dim_ == 2) {
     BuildElementsOf<2>(&model_.elements2_);
   } else {
@@ -754,6 +773,10 @@ MultibodyModel ModelBuilder::Finish() {
   for (const MultibodyModel::TorqueLoad& t : model_.torques_)
     if (t.is_varying) model_.time_dependent_ = true;
   model_.SetTime(0);
+  if (model_.has_damping_) {
+    model_.scratch_damping_ = VectorXd::Zero(q0_.size());
+    model_.scratch_damping_roundoff_ = VectorXd::Zero(q0_.size());
+  }
   model_.ProjectInitialVelocity();
   return std::move(model_);
 }

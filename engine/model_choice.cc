@@ -59,6 +59,7 @@ std::string OutOfPlaneField(const Scene& scene) {
   const InitialVelocitySpec& iv = scene.initial_velocity;
   if (auto f = Z("initial_velocity.linear", iv.linear_m_s); !f.empty()) return f;
   if (auto f = NotAboutZ("initial_velocity.angular", iv.angular_rad_s); !f.empty()) return f;
+  if (auto f = Z("fluid.current", scene.fluid.current_m_s); !f.empty()) return f;
   return "";
 }
 

@@ -10,6 +10,7 @@
 
 #include "absl/status/status.h"
 #include "engine/model_builder.h"
+#include "engine/newton_convergence.h"
 
 namespace cablesim {
 namespace {
@@ -297,6 +298,104 @@ double MultibodyModel::NetForce(const VectorXd& q, double load_factor, VectorXd*
         (*roundoff)(j_[i]) += std::abs(s_(i)) * ((*full_roundoff)(i) + kEps * std::abs(full(i)));
   }
   return size;
+}
+
+template <int D>
+double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, VectorXd* full,
+                                      SkylineLdlt* tangent, double tangent_scale,
+                                      VectorXd* roundoff, double* power) const {
+  constexpr int kN = 4 * D, kN2 = kN * kN;
+  const auto& elements = Elements<D>();
+  typename AncfCableElement<D>::Matrix ce;
+  typename AncfCableElement<D>::Coords fe;
+  double size = 0;
+  double* values = tangent ? tangent->values() : nullptr;
+  for (size_t k = 0; k < elements.size(); ++k) {
+    const ElementData<D>& e = elements[k];
+    if (!e.damped()) continue;
+    ce.setZero();
+    if (e.axial_damping_s != 0 || e.bending_damping_s != 0)
+      e.element.AddDampingMatrix(q.segment<kN>(e.first_coord), e.axial_damping_s,
+                                 e.bending_damping_s, &ce);
+    if (e.alpha_1_s != 0) ce += e.alpha_1_s * e.element.MassMatrix(e.mass_per_length);
+    const auto ve = qdot.segment<kN>(e.first_coord);
+    // fe: the damping force -C ve, plus the drag (which adds its own
+    // velocity derivative to ce).
+    fe.noalias() = -ce * ve;
+    if (e.drag_n != 0 || e.drag_t != 0)
+      e.element.AddDrag(q.segment<kN>(e.first_coord), ve, current_.head<D>(), e.drag_n, e.drag_t,
+                        &fe, &ce);
+    if (power) *power -= ve.dot(fe);
+    if (full) full->segment<kN>(e.first_coord) += fe;
+    size = std::max(size, fe.template lpNorm<Eigen::Infinity>());
+    if (roundoff)
+      roundoff->segment<kN>(e.first_coord).noalias() +=
+          kSumRounding * (ce.cwiseAbs() * ve.cwiseAbs() + fe.cwiseAbs());
+    if (!tangent) continue;
+    const int* slots = &element_slots_[kN2 * k];
+    const double* factors = &element_factors_[kN2 * k];
+    const double* cv = ce.data();  // symmetric
+    for (int t = 0; t < kN2; ++t)
+      if (slots[t] >= 0) values[slots[t]] += tangent_scale * factors[t] * cv[t];
+  }
+  return size;
+}
+
+double MultibodyModel::BodyDampingCoefficient(const BodyData& b, int k) const {
+  if (k < dim_) return b.linear_damping;
+  // Planar: the torque -c omega on u is -c udot; spatial: -(c / 2) edot_k.
+  return dim_ == 2 ? b.angular_damping : 0.5 * b.angular_damping;
+}
+
+double MultibodyModel::DampingForce(const VectorXd& q, const VectorXd& qdot, VectorXd* f,
+                                    SkylineLdlt* tangent, double tangent_scale,
+                                    VectorXd* roundoff) {
+  if (!has_damping_) return 0;
+  constexpr double kEps = std::numeric_limits<double>::epsilon();
+  VectorXd& full = scratch_damping_;
+  full.setZero();
+  VectorXd* full_roundoff = nullptr;
+  if (roundoff) {
+    full_roundoff = &scratch_damping_roundoff_;
+    full_roundoff->setZero();
+  }
+  double size = dim_ == 2 ? ElementDamping<2>(q, qdot, &full, tangent, tangent_scale,
+                                              full_roundoff, nullptr)
+                          : ElementDamping<3>(q, qdot, &full, tangent, tangent_scale,
+                                              full_roundoff, nullptr);
+  for (const BodyData& b : bodies_) {
+    for (int k = 0; k < body_stride_; ++k) {
+      const double c = BodyDampingCoefficient(b, k);
+      if (c == 0) continue;
+      const int i = b.coord + k;
+      full(i) -= c * qdot(i);
+      size = std::max(size, std::abs(c * qdot(i)));
+      if (tangent && j_[i] >= 0)
+        tangent->values()[tangent->Slot(j_[i], j_[i])] += tangent_scale * s_(i) * s_(i) * c;
+    }
+  }
+  const int n = coordinates();
+  for (int i = 0; i < n; ++i) {
+    if (j_[i] < 0) continue;
+    (*f)(j_[i]) += s_(i) * full(i);
+    if (roundoff)
+      (*roundoff)(j_[i]) += std::abs(s_(i)) * ((*full_roundoff)(i) + kEps * std::abs(full(i)));
+  }
+  return size;
+}
+
+double MultibodyModel::DampingPower(const VectorXd& q, const VectorXd& qdot) const {
+  if (!has_damping_) return 0;
+  double power = 0;  // -Q_d . qdot
+  if (dim_ == 2) {
+    ElementDamping<2>(q, qdot, nullptr, nullptr, 0, nullptr, &power);
+  } else {
+    ElementDamping<3>(q, qdot, nullptr, nullptr, 0, nullptr, &power);
+  }
+  for (const BodyData& b : bodies_)
+    for (int k = 0; k < body_stride_; ++k)
+      power += BodyDampingCoefficient(b, k) * qdot(b.coord + k) * qdot(b.coord + k);
+  return power;
 }
 
 void MultibodyModel::Constraints(const VectorXd& q, VectorXd* phi, SparseRows* jac) const {

@@ -117,6 +117,36 @@ class MultibodyModel {
                   SkylineLdlt* stiffness = nullptr, double stiffness_scale = 0,
                   Eigen::VectorXd* roundoff = nullptr);
 
+  // Damping (velocity-dependent forces), only in a scene that asks for it:
+  // per cable Kelvin-Voigt and Rayleigh damping (AncfCableElement::
+  // AddDampingMatrix, with times axial_s + beta and bending_s + beta, plus
+  // alpha times the element mass matrix), per body -c v on the centre of
+  // mass and a torque -c omega, which in natural coordinates is the force
+  // -c udot on the planar axis u, and -(c / 2) edot_k on each spatial axis
+  // (for orthonormal axes |omega|^2 = (1/2) sum_k |edot_k|^2). All are
+  // Q_d = -C(q) qdot with C symmetric positive semi-definite. Morison drag
+  // on cables in a fluid (AncfCableElement::AddDrag) is quadratic in the
+  // velocity relative to the current; C is then its velocity derivative,
+  // also symmetric positive semi-definite.
+  bool has_damping() const { return has_damping_; }
+
+  // Adds the damping force -C(q) qdot to the reduced force `f` (as
+  // NetForce left it); when `tangent` is not null, adds tangent_scale * C
+  // (on z) to it: d(-f)/d(zdot). The derivative of C(q) qdot in q is not
+  // symmetric and is left out of the Newton matrix (Newton then contracts
+  // at a rate of order h |C'(q) qdot| / |M / h + C|, small unless the
+  // damping is strong and the motion fast). When `roundoff` is not null,
+  // adds a bound of the rounding of these terms (eps times the sums of
+  // absolute values). Returns the largest damping force entry [N].
+  double DampingForce(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, Eigen::VectorXd* f,
+                      SkylineLdlt* tangent = nullptr, double tangent_scale = 0,
+                      Eigen::VectorXd* roundoff = nullptr);
+
+  // The power the damping dissipates, -Q_d . qdot [W]: qdot^T C(q) qdot >= 0
+  // without drag; a current may make the drag's share negative (the
+  // current then does work on the cable).
+  double DampingPower(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot) const;
+
   // The energy [J] below which a change of the total energy is rounding:
   // sum over elements of (EA + EI / l^2) l d^2, d = 16 eps (1 + |q0|_inf) / l,
   // the strain energy of the strain (and curvature) that coordinates known
@@ -224,11 +254,22 @@ class MultibodyModel {
     double mass_per_length = 0;
     Eigen::Matrix<double, 4 * D, 1> gravity;
     Eigen::Matrix4d mbar;  // scalar mass matrix: M = mbar (x) I_D
+    // Damping: Kelvin-Voigt times [s] (Rayleigh beta included) and
+    // Rayleigh alpha [1/s].
+    double axial_damping_s = 0, bending_damping_s = 0, alpha_1_s = 0;
+    // Morison drag factors kn, kt [kg/m^2] (AncfCableElement::AddDrag).
+    double drag_n = 0, drag_t = 0;
+    bool damped() const {
+      return axial_damping_s != 0 || bending_damping_s != 0 || alpha_1_s != 0 ||
+             drag_n != 0 || drag_t != 0;
+    }
   };
   struct BodyData {
     int coord = 0;  // full index of r_c
     double mass = 0;
     Eigen::Vector3d jbar = Eigen::Vector3d::Zero();  // per axis [kg m^2]
+    double linear_damping = 0;   // [N s/m]
+    double angular_damping = 0;  // [N m s/rad]
   };
   // A torque load on a body [N m]: torque = base + varying(t).
   struct TorqueLoad {
@@ -274,6 +315,12 @@ class MultibodyModel {
   template <int D>
   double ElementForces(const Eigen::VectorXd& q, Eigen::VectorXd* full, SkylineLdlt* stiffness,
                        double stiffness_scale, Eigen::VectorXd* roundoff) const;
+  template <int D>
+  double ElementDamping(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
+                        Eigen::VectorXd* full, SkylineLdlt* tangent, double tangent_scale,
+                        Eigen::VectorXd* roundoff, double* power) const;
+  // Per body coordinate the damping coefficient c_i of its force -c_i qdot_i.
+  double BodyDampingCoefficient(const BodyData& b, int k) const;
   template <int D>
   void ElementEnergy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, EnergySample* en,
                      EnergyParts* parts) const;
@@ -333,6 +380,8 @@ class MultibodyModel {
   std::vector<int> cable_nodes_;
   std::vector<double> node_s_;
   double energy_roundoff_ = 0;
+  bool has_damping_ = false;
+  Eigen::Vector3d current_ = Eigen::Vector3d::Zero();  // the fluid's [m/s]
 
   std::vector<Row> rows_;
   std::vector<int> row_coord_;
@@ -370,6 +419,8 @@ class MultibodyModel {
   std::vector<VaryingForce> varying_forces_;
   // Work done by torques, time-varying loads and moving supports so far [J].
   double external_work_ = 0;
+  // Scratch (full size) for DampingForce (sized only when has_damping_).
+  Eigen::VectorXd scratch_damping_, scratch_damping_roundoff_;
 };
 
 }  // namespace cablesim

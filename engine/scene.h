@@ -50,6 +50,24 @@ struct CableSpec {
   double area_m2 = 0;
   double second_moment_m4 = 0;
   BendingModel bending = BendingModel::kExact;
+  // Damping (MultibodyModel::DampingForce; 0: none). Kelvin-Voigt
+  // retardation times [s]: axial stress E (eps + axial_damping_s deps/dt),
+  // bending moment EI (kappa + bending_damping_s dkappa/dt). Rayleigh:
+  // mass-proportional alpha [1/s] (force -alpha M qdot) and
+  // stiffness-proportional beta [s], applied to the material stiffness,
+  // that is added to both retardation times.
+  double axial_damping_s = 0;
+  double bending_damping_s = 0;
+  double rayleigh_alpha_1_s = 0;
+  double rayleigh_beta_s = 0;
+  // Hydrodynamics in the scene's fluid (MultibodyModel::DampingForce,
+  // ModelBuilder::BuildElements): Morison drag coefficients normal and
+  // tangential [-], added-mass coefficient [-] and outer diameter [m]
+  // (0: that of a solid circle of the cable's area).
+  double normal_drag = 0;
+  double tangential_drag = 0;
+  double added_mass = 0;
+  double hydro_diameter_m = 0;
 };
 
 struct BodySpec {
@@ -62,6 +80,10 @@ struct BodySpec {
   // normalize(e_z x axis) (normalize(e_x x axis) when the axis is along z),
   // and z = x x y; the principal moments refer to these axes.
   Eigen::Vector3d axis = Eigen::Vector3d::UnitX();
+  // Damping (0: none): force -linear c v on the centre of mass [N s/m],
+  // torque -angular c omega [N m s/rad].
+  double linear_damping_n_s_m = 0;
+  double angular_damping_n_m_s = 0;
 };
 
 // A place on a cable (cable >= 0), on a body (body >= 0), or the ground
@@ -104,6 +126,14 @@ struct LoadSpec {
 struct ProbeSpec {
   std::string name;
   Attachment at;
+};
+
+// A fluid filling the scene: density [kg/m^3] (0: none) and a uniform,
+// steady current [m/s]. Cables in it are buoyed (their displaced weight is
+// taken off their gravity) and feel their hydrodynamics.
+struct FluidSpec {
+  double density_kg_m3 = 0;
+  Eigen::Vector3d current_m_s = Eigen::Vector3d::Zero();
 };
 
 struct InitialVelocitySpec {
@@ -164,6 +194,7 @@ struct Scene {
   InitialVelocitySpec initial_velocity;
   SolverSettings solver;
   OutputSpec output;
+  FluidSpec fluid;
 };
 
 }  // namespace cablesim

@@ -47,25 +47,47 @@ class FrameRecorder {
     }
     if (model_->shape()) model_->NodePositions(q_, &frame_.nodes);
     frame_.energy = model_->Energy(q_, qd_, load_factor, &frame_.energy_parts);
+    frame_.energy.damped = Damped(t);
     frame_.angular_momentum = model_->AngularMomentum(q_, qd_);
     model_->Constraints(q_, &phi_, nullptr);
     frame_.constraint_violation = phi_.size() ? phi_.lpNorm<Eigen::Infinity>() : 0.0;
   }
   const Frame& frame() const { return frame_; }
 
-  // Energy of a state, without evaluating or delivering a frame.
-  EnergySample StateEnergy(const Eigen::VectorXd& z, const Eigen::VectorXd& v) {
+  // Energy of a state at time t, without evaluating or delivering a frame.
+  EnergySample StateEnergy(double t, const Eigen::VectorXd& z, const Eigen::VectorXd& v) {
     model_->ToFull(z, &q_);
     model_->RateToFull(v, &qd_);
-    return model_->Energy(q_, qd_, 1.0);
+    EnergySample e = model_->Energy(q_, qd_, 1.0);
+    e.damped = Damped(t);
+    return e;
+  }
+
+  // energy.damped: the trapezoidal rule on the dissipated power from the
+  // last accepted step's end (AdvanceDamping) to the state in q_, qd_ at t.
+  double Damped(double t) const {
+    if (!model_->has_damping()) return 0;
+    const double power = model_->DampingPower(q_, qd_);
+    return damped_ + 0.5 * (t - damped_t_) * (damped_power_ + power);
+  }
+  // Moves the start of that rule to an accepted step's end (t, z, v).
+  void AdvanceDamping(double t, const Eigen::VectorXd& z, const Eigen::VectorXd& v) {
+    if (!model_->has_damping()) return;
+    model_->ToFull(z, &q_);
+    model_->RateToFull(v, &qd_);
+    damped_ = Damped(t);
+    damped_t_ = t;
+    damped_power_ = model_->DampingPower(q_, qd_);
   }
 
   // Records the evaluated frame in the summary and delivers it.
   absl::Status Deliver() {
     if (summary_->frames == 0) summary_->energy_initial = frame_.energy.total;
     summary_->energy_final = frame_.energy.total;
+    summary_->energy_damped = frame_.energy.damped;
     summary_->energy_max_increase =
-        std::max(summary_->energy_max_increase, frame_.energy.total - summary_->energy_initial);
+        std::max(summary_->energy_max_increase,
+                 frame_.energy.total + frame_.energy.damped - summary_->energy_initial);
     summary_->max_constraint_violation =
         std::max(summary_->max_constraint_violation, frame_.constraint_violation);
     ++summary_->frames;
@@ -92,6 +114,8 @@ class FrameRecorder {
   Frame frame_;
   Eigen::VectorXd q_, qd_, qdd_, phi_;
   double energy_scale_ = 0;
+  // energy.damped at damped_t_ and the dissipated power there.
+  double damped_ = 0, damped_t_ = 0, damped_power_ = 0;
 };
 
 // Sums the work of torques, time-varying loads and moving supports over
@@ -126,9 +150,10 @@ class ExternalWork {
   double t_before_ = 0;
 };
 
-// Every scene conserves its total energy (gravity and constant loads are
-// potential; the work of torques, time-varying loads and moving supports is
-// counted in it, MultibodyModel::Energy), so a rise of more than this
+// Every scene conserves its total energy plus the work done against damping
+// (gravity and constant loads are potential; the work of torques,
+// time-varying loads and moving supports is counted in the total,
+// MultibodyModel::Energy), so a rise of that sum by more than this
 // fraction of the largest energy term is the stepper going unstable (the
 // second-order steppers can, on stiff nonlinear cables at large steps): the
 // run stops and says so rather than deliver it.
@@ -179,6 +204,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   }
   ExternalWork external_work(model);
   model->SetTime(0);
+  rec->AdvanceDamping(0, stepper.z(), stepper.v());
   if (absl::Status s = rec->Emit(0, 1, stepper.z(), &stepper.v(), &stepper.a(), &stepper.lambda());
       !s.ok()) {
     summary->status = "cancelled";
@@ -226,7 +252,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   };
   auto CheckAndDeliver = [&](double tf) {
     const EnergySample& e = rec->frame().energy;
-    const double rise = e.total - summary->energy_initial;
+    const double rise = e.total + e.damped - summary->energy_initial;
     const double scale = std::max({rec->energy_scale(), std::abs(e.kinetic),
                                    std::abs(e.potential), std::abs(e.axial) + std::abs(e.bending)});
     if (rise > kEnergyRiseLimit * scale + energy_floor) {
@@ -275,11 +301,12 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       // A step Newton found hard may have landed on a spurious root (an
       // element folded through itself: Green-Lagrange strain does not see
       // it); its energy says so. Take it back and halve the step.
-      const EnergySample e = rec->StateEnergy(stepper.z(), stepper.v());
+      const EnergySample e = rec->StateEnergy(t + h_try, stepper.z(), stepper.v());
       const double scale =
           std::max({rec->energy_scale(), std::abs(e.kinetic), std::abs(e.potential),
                     std::abs(e.axial) + std::abs(e.bending)});
-      if (e.total - summary->energy_initial > kEnergyRiseLimit * scale + energy_floor) {
+      if (e.total + e.damped - summary->energy_initial >
+          kEnergyRiseLimit * scale + energy_floor) {
         stepper.Restore();
         ++summary->rejected_steps;
         successes = 0;
@@ -289,7 +316,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
                absl::StrFormat("step from t = %.9g s raises the total energy by %.3g J down to "
                                "h = %.3g s: the stepper is unstable here; use a smaller "
                                "rho_infinity",
-                               t, e.total - summary->energy_initial, h_try));
+                               t, e.total + e.damped - summary->energy_initial, h_try));
           return;
         }
         continue;
@@ -351,6 +378,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
         if (!CheckAndDeliver(tf)) return;
         ++next_frame;
       }
+      rec->AdvanceDamping(t, stepper.z(), stepper.v());
       summary->end_time_s = t;
       continue;
     }
@@ -554,7 +582,8 @@ absl::StatusOr<RunSummary> RunScene(const Scene& scene, FrameSink* sink,
     }
   }
   if (settings.analysis == Analysis::kDynamic)
-    summary.energy_dissipated = summary.energy_initial - summary.energy_final;
+    summary.energy_dissipated =
+        summary.energy_initial - summary.energy_final - summary.energy_damped;
   summary.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return summary;
 }

@@ -52,13 +52,19 @@ struct ProbeSample {
 // Energy [J]. `potential` is that of gravity and of the constant applied
 // loads (both conservative) minus the work done so far by torques,
 // time-varying loads and moving supports (summed step by step), so `total`
-// is conserved by the exact solution.
+// is conserved by the exact solution without damping; with damping,
+// total + damped is.
 struct EnergySample {
   double kinetic = 0;
   double potential = 0;
   double axial = 0;
   double bending = 0;
-  double total = 0;
+  double total = 0;  // kinetic + potential + axial + bending
+  // Work done against damping since t = 0 (>= 0, not part of `total`): the
+  // dissipated power qdot^T C qdot (MultibodyModel::DampingPower) integrated
+  // by the trapezoidal rule over the accepted steps, and from a step's start
+  // to a frame inside it. 0 without damping.
+  double damped = 0;
 };
 
 // The energy of one cable or one body [J]. `gravity` is the potential of
@@ -138,8 +144,12 @@ struct RunSummary {
   // Energy the stepper removed: initial minus final total energy for a
   // scene without external work (gravity and constant loads included);
   // backward Euler's numerical damping.
+  // With damping: initial minus (final total + energy_damped), so the
+  // stepper's own dissipation stays apart from the damping's.
   double energy_dissipated = 0;
-  double energy_max_increase = 0;  // largest rise of the total above its start
+  double energy_damped = 0;  // the last frame's energy.damped [J]
+  // Largest rise of total + damped above its start.
+  double energy_max_increase = 0;
   double max_constraint_violation = 0;
   double max_newton_residual = 0;  // largest accepted Newton residual norm
   // The largest rounding floor of an accepted Newton residual, relative as

@@ -35,6 +35,7 @@ v1::EnergyResponse EnergyFromTrajectory(const v1::RunHeader& header,
   const int columns = header.columns_size();
   v1::EnergyReport* report = response.mutable_report();
   report->set_energy_dissipated(summary.energy_dissipated());
+  report->set_energy_damped(summary.energy_damped());
   // Every column by name (a trajectory stored before a column was added
   // lacks it; the columns after the totals have grown).
   const Columns find(header);
@@ -67,6 +68,7 @@ v1::EnergyResponse EnergyFromTrajectory(const v1::RunHeader& header,
   add_parts("cables", header.info().cable_names(), true, response.mutable_cables());
   add_parts("bodies", header.info().body_names(), false, response.mutable_bodies());
   const int loads = find("loads.energy.potential");
+  const int damped = find("energy.damped");
   const size_t rows = values.size() / columns;
   double scale = 0, lo = INFINITY, hi = -INFINITY, violation = 0;
   for (size_t r = 0; r < rows; ++r) {
@@ -78,6 +80,7 @@ v1::EnergyResponse EnergyFromTrajectory(const v1::RunHeader& header,
     response.add_bending(row[bending]);
     response.add_total(row[total]);
     response.add_constraint_violation(row[violation_column]);
+    if (damped >= 0) response.add_damped(row[damped]);
     scale = std::max(scale, row[kinetic] + row[axial] + row[bending]);
     lo = std::min(lo, row[total]);
     hi = std::max(hi, row[total]);

@@ -25,7 +25,7 @@ using ::testing::StartsWith;
 
 constexpr char kEnergyColumns[] =
     "energy.kinetic,energy.potential,energy.axial,energy.bending,energy.total,"
-    "constraint.violation";
+    "constraint.violation,energy.damped";
 // The energy per part of the sample scenes' one cable (README, "Energy per
 // part"), after the totals.
 constexpr char kCableEnergyColumns[] =

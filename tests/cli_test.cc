@@ -132,7 +132,7 @@ TEST(CliTest, EnergyCsvUsesTheRunCsvColumnNames) {
   ASSERT_EQ(lines.size(), 4u);  // header and 3 frames
   EXPECT_EQ(lines[0],
             "t,energy.kinetic,energy.potential,energy.axial,energy.bending,energy.total,"
-            "constraint.violation,cables[0].energy.kinetic,cables[0].energy.gravity,"
+            "constraint.violation,energy.damped,cables[0].energy.kinetic,cables[0].energy.gravity,"
             "cables[0].energy.axial,cables[0].energy.bending,loads.energy.potential");
 }
 

@@ -38,7 +38,7 @@ Frame FrameWithProbes(double t, int probes) {
     sample.acceleration_m_s2 = Eigen::Vector3d(7, 8, 9);
     frame.probes.push_back(sample);
   }
-  frame.energy = {0.1, -0.2, 0.3, 0.4, 0.6};
+  frame.energy = {0.1, -0.2, 0.3, 0.4, 0.6, 0.25};
   frame.constraint_violation = 1e-12;
   return frame;
 }
@@ -46,11 +46,11 @@ Frame FrameWithProbes(double t, int probes) {
 TEST(CsvWriterTest, Header) {
   EXPECT_EQ(CsvWriter::Header(ModelInfo()),
             "t,energy.kinetic,energy.potential,energy.axial,energy.bending,energy.total,"
-            "constraint.violation,loads.energy.potential");
+            "constraint.violation,energy.damped,loads.energy.potential");
   EXPECT_EQ(CsvWriter::Header(InfoWithProbes({"tip"})),
             "t,tip.x,tip.y,tip.z,tip.vx,tip.vy,tip.vz,tip.ax,tip.ay,tip.az,"
             "energy.kinetic,energy.potential,energy.axial,energy.bending,energy.total,"
-            "constraint.violation,loads.energy.potential");
+            "constraint.violation,energy.damped,loads.energy.potential");
   // The parts after every existing column, named by index (names are free
   // text: the comma here would break a column named after it).
   ModelInfo parts = InfoWithProbes({"tip"});
@@ -59,7 +59,7 @@ TEST(CsvWriterTest, Header) {
   EXPECT_EQ(CsvWriter::Header(parts),
             "t,tip.x,tip.y,tip.z,tip.vx,tip.vy,tip.vz,tip.ax,tip.ay,tip.az,"
             "energy.kinetic,energy.potential,energy.axial,energy.bending,energy.total,"
-            "constraint.violation,"
+            "constraint.violation,energy.damped,"
             "cables[0].energy.kinetic,cables[0].energy.gravity,cables[0].energy.axial,"
             "cables[0].energy.bending,"
             "cables[1].energy.kinetic,cables[1].energy.gravity,cables[1].energy.axial,"
@@ -83,7 +83,7 @@ TEST(CsvWriterTest, PartsAreWrittenAfterTheTotals) {
   ASSERT_EQ(lines.size(), 3);
   EXPECT_EQ(lines[1],
             "0,0.10000000000000001,-0.20000000000000001,0.29999999999999999,"
-            "0.40000000000000002,0.59999999999999998,9.9999999999999998e-13,1,2,3,4,5,6,7");
+            "0.40000000000000002,0.59999999999999998,9.9999999999999998e-13,0.25,1,2,3,4,5,6,7");
   // A frame without the parts of the header is refused.
   EXPECT_FALSE(writer.OnFrame(FrameWithProbes(0.1, 0)).ok());
 }
@@ -104,9 +104,9 @@ TEST(CsvWriterTest, RowsRoundTrip) {
   EXPECT_EQ(lines[1],
             "0,1,2,3,4,5,6,7,8,9,2,2,3,4,5,6,7,8,9,0.10000000000000001,"
             "-0.20000000000000001,0.29999999999999999,0.40000000000000002,"
-            "0.59999999999999998,9.9999999999999998e-13,0");
+            "0.59999999999999998,9.9999999999999998e-13,0.25,0");
   const std::vector<std::string> cells = absl::StrSplit(lines[2], ',');
-  ASSERT_EQ(cells.size(), 1 + 2 * 9 + 6 + 1);
+  ASSERT_EQ(cells.size(), 1 + 2 * 9 + 7 + 1);
   EXPECT_EQ(std::stod(cells[0]), 0.1);  // 17 digits read back exactly
   EXPECT_EQ(lines[3], "");
 }

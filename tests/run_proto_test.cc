@@ -39,6 +39,7 @@ RunSummary EveryFieldSet() {
   s.energy_initial = 19;
   s.energy_final = 20;
   s.energy_dissipated = 21;
+  s.energy_damped = 0.035;
   s.energy_max_increase = 22;
   s.max_constraint_violation = 23;
   s.max_newton_residual = 24;

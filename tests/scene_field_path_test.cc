@@ -73,25 +73,28 @@ TEST(SweepAxisValuesTest, LastAxisVariesFastest) {
 
 TEST(EnergyReportTest, ReportFollowsItsDefinition) {
   // Three hand-made frames without probes: (t, kinetic, potential, axial,
-  // bending, total, violation). The report's numbers follow by hand:
+  // bending, total, violation, damped). The report's numbers follow by hand:
   // scale = max(kinetic + axial + bending) = 4 + 1 + 0.5 = 5.5,
   // drift = (final - initial) / scale = (-0.5 - 0) / 5.5.
   // The columns of a trajectory stored before the energy per part was
   // recorded: no part series, the report the same.
   v1::RunHeader header;
   for (const char* c : {"t", "energy.kinetic", "energy.potential", "energy.axial",
-                        "energy.bending", "energy.total", "constraint.violation"}) {
+                        "energy.bending", "energy.total", "constraint.violation",
+                        "energy.damped"}) {
     header.add_columns(c);
   }
-  const std::vector<double> rows = {0,   0,   0, 0,   0,   0,    0,     //
-                                    0.5, 4,   -5, 1,  0.5, 0.5,  1e-9,  //
-                                    1.0, 2.0, -3, 0.4, 0.1, -0.5, 2e-10};
+  const std::vector<double> rows = {0,   0,   0, 0,   0,   0,    0,     0,    //
+                                    0.5, 4,   -5, 1,  0.5, 0.5,  1e-9,  0.25, //
+                                    1.0, 2.0, -3, 0.4, 0.1, -0.5, 2e-10, 0.5};
   v1::RunSummary summary;
   summary.set_energy_dissipated(0.5);
+  summary.set_energy_damped(0.75);
   const v1::EnergyResponse r = EnergyFromTrajectory(header, rows, summary);
   ASSERT_EQ(r.t_size(), 3);
   EXPECT_EQ(r.kinetic(1), 4);
   EXPECT_EQ(r.potential(2), -3);
+  EXPECT_EQ(r.damped(1), 0.25);
   const v1::EnergyReport& e = r.report();
   EXPECT_EQ(e.initial(), 0);
   EXPECT_EQ(e.final(), -0.5);
@@ -101,6 +104,7 @@ TEST(EnergyReportTest, ReportFollowsItsDefinition) {
   EXPECT_DOUBLE_EQ(e.relative_drift(), -0.5 / 5.5);
   EXPECT_EQ(e.max_constraint_violation(), 1e-9);
   EXPECT_EQ(e.energy_dissipated(), 0.5);
+  EXPECT_EQ(e.energy_damped(), 0.75);
   EXPECT_EQ(r.cables_size(), 0);
   EXPECT_EQ(r.loads_size(), 0);
 }
@@ -139,6 +143,7 @@ TEST(EnergyReportTest, SeriesAreFoundByName) {
     EXPECT_EQ(e.bodies(0).kinetic(r), column("bodies[0].energy.kinetic", r));
     EXPECT_EQ(e.bodies(0).gravity(r), column("bodies[0].energy.gravity", r));
     EXPECT_EQ(e.loads(r), column("loads.energy.potential", r));
+    EXPECT_EQ(e.damped(r), column("energy.damped", r));
   }
 }
 

@@ -429,6 +429,30 @@ TEST_F(StepperAllocationTest, SpatialCableWithSpunCylinderStepsDoNotAllocate) {
   ExpectStepsDoNotAllocate(scene, 0.005, 200);
 }
 
+// Damping (cable Kelvin-Voigt and Rayleigh, body linear and angular) in
+// every stepper, planar and spatial.
+TEST_F(StepperAllocationTest, DampedStepsDoNotAllocate) {
+  for (Integrator integrator :
+       {Integrator::kImplicitEuler, Integrator::kGeneralizedAlpha, Integrator::kHht}) {
+    for (bool spatial : {false, true}) {
+      SCOPED_TRACE(::testing::Message() << "integrator " << static_cast<int>(integrator)
+                                        << " spatial " << spatial);
+      Scene scene = CableWithEndCylinder(LinearSolverKind::kMinres);
+      ASSERT_FALSE(scene.bodies.empty());
+      scene.solver.integrator = integrator;
+      if (spatial) scene.initial_velocity.angular_rad_s = Eigen::Vector3d(0, 4, 0);
+      CableSpec& cable = scene.cables[0];
+      cable.axial_damping_s = 1e-3;
+      cable.bending_damping_s = 2e-3;
+      cable.rayleigh_alpha_1_s = 0.5;
+      cable.rayleigh_beta_s = 1e-4;
+      scene.bodies[0].linear_damping_n_s_m = 0.1;
+      scene.bodies[0].angular_damping_n_m_s = 1e-3;
+      ExpectStepsDoNotAllocate(scene, 0.005, 50);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace cablesim
 

@@ -43,8 +43,8 @@ class ClientTest(unittest.TestCase):
         scene = self.scene()
         result = cablesim_client.run(self.stub, scene, frames_per_batch=7)
         self.assertEqual(result.summary.status, "ok")
-        # 0.1 s every 1 ms; t, 9 tip, 6 totals, 4 for the cable, loads.
-        self.assertEqual(result.data.shape, (101, 21))
+        # 0.1 s every 1 ms; t, 9 tip, 6 totals and energy.damped, 4 for the cable, loads.
+        self.assertEqual(result.data.shape, (101, 1 + 9 + 7 + 4 + 1))
         # Reference: `cablesim run` in-process, written as CSV (17 digits
         # read back exactly).
         scene_path = os.path.join(self.tmp.name, "scene.json")

@@ -128,8 +128,9 @@ class PackageTest(unittest.TestCase):
             self.assertEqual(result.summary.status, "ok")
             self.assertEqual(result.summary["integrator"], scene["solver"]["integrator"])
             self.assertEqual(result.columns, header)
-            # 0.1 s every 1 ms; t, 9 tip, 6 totals, 4 energies of the cable, the loads'
-            self.assertEqual(result.data.shape, (101, 1 + 9 + 6 + 4 + 1))
+            # 0.1 s every 1 ms; t, 9 tip, 6 totals and energy.damped, 4 energies of the
+            # cable, the loads'
+            self.assertEqual(result.data.shape, (101, 1 + 9 + 7 + 4 + 1))
             # Same engine, same scene: identical doubles (the CSV has 17 digits).
             np.testing.assert_array_equal(result.data, reference)
             np.testing.assert_array_equal(result["tip.y"], reference[:, header.index("tip.y")])
