@@ -77,6 +77,46 @@ TEST(DragTest, CableInCurrentHangsAtTheClosedFormAngle) {
   EXPECT_GT(end.norm(), length);  // stretched by its wet weight
 }
 
+// The same cable towed through still water: its top is moved at -U along x
+// (a ramp from t = 0, scenes/towed-cable.json) instead of the water
+// flowing at +U. Drag depends only on the velocity relative to the water,
+// so the steady state seen from the tow point is the current's: the
+// straight line at the same closed-form angle. The tow force (the probe on
+// the moving support) is then the line's tension at the top, which
+// carries the whole wet weight along the line: |F| = w L cos(theta), with
+// horizontal part w L cos(theta) sin(theta) against the tow.
+TEST(DragTest, CableTowedThroughStillWaterTrailsAtTheClosedFormAngle) {
+  const double cdn = 1.2, u = 0.5, length = 10;
+  auto proto = ReadSceneFile(absl::StrCat(CABLESIM_SOURCE_DIR, "/scenes/towed-cable.json"));
+  ASSERT_TRUE(proto.ok()) << proto.status();
+  auto scene = SceneFromProto(*proto);
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  CollectingSink sink;
+  RunOk(*scene, &sink);
+  const double k = 0.5 * kRhoWater * cdn * kD * u * u / kWetWeight;
+  const double theta = std::asin((std::sqrt(1 + 4 * k * k) - 1) / (2 * k));
+  const Frame& last = sink.frames().back();
+  const Eigen::Vector3d tow = last.probes[0].position_m;
+  // The tow point is where the ramp put it (a PIN holds it to 1e-9 m).
+  EXPECT_NEAR(tow.x(), -u * scene->solver.duration_s, 1e-9);
+  const Eigen::Vector3d mid = last.probes[1].position_m - tow;
+  const Eigen::Vector3d end = last.probes[2].position_m - tow;
+  // Tolerance 1e-6 rad, as in the current: the same overdamped creep to
+  // the angle (time constant about 10 s) over 200 s; backward Euler is
+  // exact for the uniform translation the steady state adds.
+  EXPECT_NEAR(std::atan2(end.x(), -end.y()), theta, 1e-6) << "theta " << theta;
+  EXPECT_NEAR(std::atan2(mid.x(), -mid.y()), theta, 1e-6);
+  // Steady: the end moves with the tow point.
+  EXPECT_NEAR(last.probes[2].velocity_m_s.x(), -u, 1e-6);
+  ASSERT_EQ(last.support_forces.size(), 1u);
+  const Eigen::Vector3d force = last.support_forces[0];
+  const double tension = kWetWeight * length * std::cos(theta);
+  // Tolerance 1e-6 relative: the angle's tolerance carried into sin and cos.
+  EXPECT_NEAR(force.norm(), tension, 1e-6 * tension);
+  EXPECT_NEAR(force.x(), -tension * std::sin(theta), 1e-6 * tension);
+  EXPECT_NEAR(force.y(), tension * std::cos(theta), 1e-6 * tension);
+}
+
 // A free horizontal cable sinking in still water reaches the speed at which
 // its normal drag carries its wet weight: w = (1/2) rho C_dn d v^2. A
 // vertical one sinks along its axis at w = (1/2) rho C_dt pi d v^2
