@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <numbers>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -34,7 +35,7 @@
 namespace cablesim {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = std::numbers::pi;
 // Relative tolerance of the arc-length range check, so that `s` may be given
 // as the cable's length even when that length is a sum of segments.
 constexpr double kArcLengthTolerance = 1e-9;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <utility>
 
 #include <Eigen/Dense>
@@ -20,7 +21,7 @@ using Eigen::VectorXd;
 
 // Relative tolerance for matching arc lengths to nodes.
 constexpr double kSnap = 1e-9;
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = std::numbers::pi;
 
 // The body frame at t = 0 from its x axis (scene.h): columns x, y, z.
 Eigen::Matrix3d BodyFrame(const Vector3d& axis) {

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -28,7 +29,7 @@ using testing::CollectingSink;
 using testing::RunOk;
 using testing::SceneFromJson;
 
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = std::numbers::pi;
 
 // The sample scene: a 1 m steel rod (d = 10 mm) clamped at x = 0, released
 // straight under gravity, so it oscillates about its static sag (7.7 mm at

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -24,7 +25,7 @@ using testing::CollectingSink;
 using testing::RunOk;
 using testing::SceneFromJson;
 
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = std::numbers::pi;
 constexpr double kG = 9.81;
 // Cable and water of the tests: d = 2 cm, rho = 2000 kg/m^3 in water of
 // 1000 kg/m^3: wet weight w = (2000 - 1000) pi d^2 / 4 g = 3.08 N/m.

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include <gtest/gtest.h>
 
@@ -104,7 +105,7 @@ TEST(EnergyPartsTest, FreeFallMatchesTheClosedForm) {
   CollectingSink sink;
   RunOk(SceneFromJson(json), &sink);
   ASSERT_EQ(sink.frames().size(), 11u);
-  const double body_mass = 3, cable_mass = 1000 * M_PI * 0.01 * 0.01 / 4 * 1.0;
+  const double body_mass = 3, cable_mass = 1000 * std::numbers::pi * 0.01 * 0.01 / 4 * 1.0;
   for (const Frame& f : sink.frames()) {
     const double t = f.t, fall = 0.5 * kG * t * t;
     const PartEnergy& ball = f.energy_parts.bodies[0];
@@ -142,7 +143,7 @@ TEST(EnergyPartsTest, CableAtRestHoldsNoEnergy) {
   CollectingSink sink;
   RunOk(SceneFromJson(json), &sink);
   ASSERT_EQ(sink.frames().size(), 6u);
-  const double area = M_PI * 0.01 * 0.01 / 4, second_moment = M_PI * std::pow(0.01, 4) / 64;
+  const double area = std::numbers::pi * 0.01 * 0.01 / 4, second_moment = std::numbers::pi * std::pow(0.01, 4) / 64;
   const double l = 0.25, q0 = 2.0, eps = std::numeric_limits<double>::epsilon();
   const double d = 16 * eps * (1 + q0);
   const double strain_floor = 8 * (1e9 * area + 1e9 * second_moment / (l * l)) * l * (d / l) *

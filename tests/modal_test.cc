@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -30,7 +31,7 @@ using testing::CollectingSink;
 using testing::RunOk;
 using testing::SceneFromJson;
 
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = std::numbers::pi;
 
 // Steel rod, 1 m, d = 0.01 m: EI / (rho A) = E d^2 / (16 rho).
 constexpr double kE = 2e11, kRho = 7850, kD = 0.01, kL = 1.0;

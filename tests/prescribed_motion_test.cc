@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <numbers>
 #include <sstream>
 #include <string>
 
@@ -22,7 +23,7 @@ using testing::CollectingSink;
 using testing::RunOk;
 using testing::SceneFromJson;
 
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = std::numbers::pi;
 constexpr double kG = 9.81;
 
 // A rigid pendulum (point mass m = 1 kg with I = 0.01 kg m^2 about its

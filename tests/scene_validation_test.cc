@@ -3,6 +3,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <numbers>
 
 #include <cmath>
 #include <cstdlib>
@@ -26,7 +27,7 @@ namespace {
 using ::testing::HasSubstr;
 using ::testing::StartsWith;
 
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = std::numbers::pi;
 
 absl::StatusOr<Scene> ConvertJson(const std::string& json) {
   absl::StatusOr<v1::Scene> proto = ParseSceneJson(json);

@@ -2,6 +2,7 @@
 // the scene validation of prescribed motions and time-varying loads.
 
 #include <cmath>
+#include <numbers>
 #include <string>
 
 #include <gmock/gmock.h>
@@ -16,7 +17,7 @@ namespace {
 
 using ::testing::HasSubstr;
 
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = std::numbers::pi;
 
 TEST(TimeFunctionTest, ZeroByDefault) {
   const TimeFunction f;

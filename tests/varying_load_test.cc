@@ -5,6 +5,7 @@
 // balance.
 
 #include <cmath>
+#include <numbers>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -17,7 +18,7 @@
 namespace cablesim {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kPi = std::numbers::pi;
 
 using testing::CollectingSink;
 using testing::RunOk;
