@@ -698,6 +698,25 @@ class SceneConverter {
         }
       }
     }
+    if (j.has_rotation()) {
+      const std::string rotation = Sub(path, "rotation");
+      CABLESIM_ASSIGN_OR_RETURN(joint->rotation, ConvertTimeFunction(rotation, j.rotation()));
+      if (joint->HasRotation() && (!b.IsGround() || joint->type != JointType::kFixed)) {
+        return Invalid(rotation,
+                       "only a FIXED joint to ground turns (a PIN holds no direction; side b "
+                       "must be the ground)");
+      }
+      if (const double start = joint->rotation(0); std::abs(start) > 1e-12) {
+        return Invalid(rotation, absl::StrCat("must be 0 at t = 0 (the scene places the joint at "
+                                              "its start; got ",
+                                              Num(start), " rad)"));
+      }
+    }
+    if (j.has_rotation_axis()) {
+      const std::string axis = Sub(path, "rotation_axis");
+      if (!j.has_rotation()) return Invalid(axis, "only with rotation");
+      CABLESIM_ASSIGN_OR_RETURN(joint->rotation_axis, Direction(axis, j.rotation_axis()));
+    }
     return absl::OkStatus();
   }
 

@@ -258,10 +258,13 @@ absl::Status ModelBuilder::Joints() {
           absl::StrCat("joints[", ji, "].a: a joint needs a cable or a body on one side"));
     }
     const bool fixed = joint.type == JointType::kFixed;
-    if (b.IsGround() && joint.HasMotion()) {
+    if (b.IsGround() && (joint.HasMotion() || joint.HasRotation())) {
       // A moving support: its point stays as rows (below); FIXED keeps the
-      // orientation by elimination, as a fixed support does.
-      if (fixed && a.cable >= 0) {
+      // orientation by elimination, as a fixed support does, or, when the
+      // support turns, by rows whose normals turn with it.
+      if (joint.HasRotation()) {
+        AddTurningRows(ji, a);
+      } else if (fixed && a.cable >= 0) {
         const int node = mesh_.Node(a);
         elimination_.clamped[node] = true;
         elimination_.clamp_dir[node] = AtStart(NodeSlope(node)).normalized();
@@ -327,6 +330,48 @@ absl::Status ModelBuilder::Joints() {
   return absl::OkStatus();
 }
 
+void ModelBuilder::AddTurningRows(int ji, Attachment a) {
+  const int D = model_.dim_;
+  // One row n . x = 0 per pair (x, n) of a held direction x and a normal
+  // n of its initial direction: a clamped slope r_x keeps n . r_x = 0 for
+  // the D - 1 normals of d0 (its length, the stretch, stays free); a body
+  // keeps u . v0 = 0 (planar) or u . v0 = u . w0 = v . w0 = 0 (spatial),
+  // which with its unit and orthogonality rows fix its axes to R(t) e0.
+  auto add = [&](int coord, const Vector3d& n0) {
+    LinearForm f;
+    for (int d = 0; d < D; ++d) f.terms[coord + d] = 1;  // placeholders
+    PendingRow row{QuadraticForm::FromLinear(f), Row::kDirection, ji, -1};
+    row.turn_coord = coord;
+    row.turn_n0 = n0;
+    pending_.push_back(row);
+  };
+  auto at_start = [&](int coord) {
+    Vector3d x = Vector3d::Zero();
+    x.head(D) = q0_.segment(coord, D);
+    return x;
+  };
+  if (a.cable >= 0) {
+    const int slope = NodeCoord(mesh_.Node(a)) + D;
+    const Vector3d d0 = at_start(slope).normalized();
+    if (D == 2) {
+      add(slope, Vector3d(-d0.y(), d0.x(), 0));
+    } else {
+      const Vector3d n1 = d0.unitOrthogonal();
+      add(slope, n1);
+      add(slope, d0.cross(n1));
+    }
+    return;
+  }
+  const int c = BodyCoord(a.body);
+  if (D == 2) {
+    add(c + 2, Vector3d(-q0_(c + 3), q0_(c + 2), 0));
+  } else {
+    add(c + 3, at_start(c + 6));
+    add(c + 3, at_start(c + 9));
+    add(c + 6, at_start(c + 9));
+  }
+}
+
 absl::Status ModelBuilder::AddOrientationRows(int ji, Attachment a, Attachment b) {
   const int D = model_.dim_;
   if (a.cable < 0 && b.cable >= 0) std::swap(a, b);  // a node first
@@ -381,7 +426,9 @@ absl::Status ModelBuilder::CheckJointsAtStart() const {
   for (const PendingRow& r : pending_) {
     const double v = r.f.Evaluate(q0_);
     if (r.kind == Row::kPosition) gap2[r.joint] += v * v;
-    if (r.kind == Row::kDirection && std::abs(v) > 1e-6) {
+    // (A turning support's rows hold at t = 0 by construction; f holds
+    // placeholders until SetTime writes n(0).)
+    if (r.kind == Row::kDirection && r.turn_coord < 0 && std::abs(v) > 1e-6) {
       return absl::InvalidArgumentError(absl::StrFormat(
           "joints[%d]: FIXED needs the cable tangent parallel to the other side's axis at "
           "t = 0 (sine of the angle between them: %.6g)",
@@ -496,6 +543,15 @@ void ModelBuilder::KeepMovableRows() {
       moving.c0 = r.f.c;
       moving.motion = scene_.joints[r.joint].motion[r.motion_axis];
       m.moving_rows_.push_back(moving);
+    }
+    if (r.turn_coord >= 0) {
+      MultibodyModel::TurningRow turning;
+      turning.row = static_cast<int>(m.rows_.size()) - 1;
+      turning.coord = r.turn_coord;
+      turning.n0 = r.turn_n0;
+      turning.axis = scene_.joints[r.joint].rotation_axis;
+      turning.angle = scene_.joints[r.joint].rotation;
+      m.turning_rows_.push_back(turning);
     }
   }
 }
@@ -770,7 +826,8 @@ void ModelBuilder::ConstraintPattern() {
 MultibodyModel ModelBuilder::Finish() {
   model_.scratch_full_ = VectorXd::Zero(q0_.size());
   model_.scratch_roundoff_ = VectorXd::Zero(q0_.size());
-  model_.time_dependent_ = !model_.moving_rows_.empty() || !model_.varying_forces_.empty();
+  model_.time_dependent_ = !model_.moving_rows_.empty() || !model_.varying_forces_.empty() ||
+                          !model_.turning_rows_.empty();
   for (const MultibodyModel::TorqueLoad& t : model_.torques_)
     if (t.is_varying) model_.time_dependent_ = true;
   model_.SetTime(0);

@@ -61,6 +61,12 @@ class ModelBuilder {
     // A moving support's position row: the component of the joint's
     // motion subtracted from it in time (-1: none).
     int motion_axis = -1;
+    // A turning support's direction row n(t) . x = 0 (x the D coordinates
+    // from full index turn_coord: a clamped slope or a body axis; n(0) =
+    // turn_n0); f then holds placeholder coefficients on all of x so that
+    // the pattern has every slot n(t) may fill. -1: none.
+    int turn_coord = -1;
+    Eigen::Vector3d turn_n0 = Eigen::Vector3d::Zero();
   };
 
   explicit ModelBuilder(const Scene& scene) : scene_(scene) {}
@@ -192,6 +198,9 @@ class ModelBuilder {
   // cables welded end to end, a cable tangent along a body's x axis, or
   // two bodies' axes. Fails for two cables not parallel at t = 0.
   absl::Status AddOrientationRows(int joint, Attachment a, Attachment b);
+  // The direction rows of a FIXED joint to ground that turns (JointSpec::
+  // rotation), holding side `a`'s slope or axes.
+  void AddTurningRows(int joint, Attachment a);
   template <int D>
   void BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* elements);
   // The element scatter tables (per element, the (4D)^2 skyline slots

@@ -42,6 +42,10 @@ std::string OutOfPlaneField(const Scene& scene) {
     if (auto f = attachment(path + ".a", scene.joints[i].a); !f.empty()) return f;
     if (auto f = attachment(path + ".b", scene.joints[i].b); !f.empty()) return f;
     if (!scene.joints[i].motion[2].IsZero()) return path + ".motion.z";
+    if (scene.joints[i].HasRotation() &&
+        scene.joints[i].rotation_axis.head<2>().lpNorm<Eigen::Infinity>() != 0) {
+      return path + ".rotation_axis";
+    }
   }
   for (size_t i = 0; i < scene.loads.size(); ++i) {
     const std::string path = absl::StrCat("loads[", i, "]");

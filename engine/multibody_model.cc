@@ -18,6 +18,14 @@ namespace {
 using Eigen::Vector3d;
 using Eigen::VectorXd;
 
+// n . x with x the first D entries of v from index i (a plain loop: GCC
+// 12 warns falsely about head(D) of a fixed-size vector).
+double DotAt(const Vector3d& n, const VectorXd& v, int i, int D) {
+  double sum = 0;
+  for (int d = 0; d < D; ++d) sum += n(d) * v(i + d);
+  return sum;
+}
+
 }  // namespace
 
 void MultibodyModel::AddRow(const QuadraticForm& f, Row::Kind kind, int joint, int body) {
@@ -165,6 +173,8 @@ void MultibodyModel::ProjectInitialVelocity() {
   jac.Multiply(v0_.data(), jv.data());
   // Moving supports: Phi_z v + Phi_t = 0 with Phi_t = -motion'(t).
   for (const MovingRow& m : moving_rows_) jv(m.row) -= m.rate;
+  for (const TurningRow& r : turning_rows_)
+    jv(r.row) += DotAt(r.rate, q0, r.coord, dim_);
   if (jv.lpNorm<Eigen::Infinity>() <= 1e-14 * (1 + v0_.lpNorm<Eigen::Infinity>())) return;
   SkylineLdlt mass = mass_;
   if (!mass.Factor()) return;
@@ -430,7 +440,6 @@ void MultibodyModel::AddConstraintHessian(const VectorXd& q, const VectorXd& lam
 
 void MultibodyModel::ConstraintGamma(const VectorXd& q, const VectorXd& qdot,
                                      VectorXd* gamma) const {
-  (void)q;
   for (size_t i = 0; i < rows_.size(); ++i) {
     const Row& row = rows_[i];
     const int* coord = &row_coord_[row.coord_begin];
@@ -440,6 +449,23 @@ void MultibodyModel::ConstraintGamma(const VectorXd& q, const VectorXd& qdot,
     (*gamma)(i) = -2 * acc;
   }
   for (const MovingRow& m : moving_rows_) (*gamma)(m.row) += m.accel;
+  for (const TurningRow& r : turning_rows_) {
+    (*gamma)(r.row) -=
+        2 * DotAt(r.rate, qdot, r.coord, dim_) + DotAt(r.accel, q, r.coord, dim_);
+  }
+}
+
+Vector3d MultibodyModel::TurningRow::Normal(double t, Vector3d* rate_out,
+                                            Vector3d* accel_out) const {
+  const TimeFunction::Value v = angle.Evaluate(t);
+  const double c = std::cos(v.f), s = std::sin(v.f);
+  const Vector3d n = c * n0 + s * axis.cross(n0) + (1 - c) * axis.dot(n0) * axis;
+  if (rate_out != nullptr) {
+    const Vector3d an = axis.cross(n);
+    *rate_out = v.df * an;
+    *accel_out = v.ddf * an + v.df * v.df * axis.cross(an);
+  }
+  return n;
 }
 
 void MultibodyModel::SetTime(double t) {
@@ -450,6 +476,13 @@ void MultibodyModel::SetTime(double t) {
     rows_[m.row].c = m.c0 - v.f;
     m.rate = v.df;
     m.accel = v.ddf;
+  }
+  for (TurningRow& r : turning_rows_) {
+    r.n = r.Normal(t, &r.rate, &r.accel);
+    // Every coordinate of x has a slot in the row (AddTurningRows).
+    const Row& row = rows_[r.row];
+    for (int k = row.lin_begin; k < row.lin_end; ++k)
+      lin_value_[k] = r.n(row_coord_[row.coord_begin + lin_local_[k]] - r.coord);
   }
   for (VaryingForce& l : varying_forces_) l.value = Evaluate(l.force, t);
   for (TorqueLoad& tl : torques_)
@@ -544,6 +577,12 @@ void MultibodyModel::AccumulateExternalWork(const VectorXd& q_before, const Vect
   for (const MovingRow& m : moving_rows_) {
     const double lambda = 0.5 * (lambda_before(m.row) + lambda_after(m.row));
     external_work_ -= lambda * (m.motion(t_after) - m.motion(t_before));
+  }
+  for (const TurningRow& r : turning_rows_) {
+    const double lambda = 0.5 * (lambda_before(r.row) + lambda_after(r.row));
+    const Vector3d dn = r.Normal(t_after) - r.Normal(t_before);
+    external_work_ += lambda * 0.5 *
+                      (DotAt(dn, q_before, r.coord, dim_) + DotAt(dn, q_after, r.coord, dim_));
   }
   for (const TorqueLoad& tl : torques_) {
     const Vector3d torque =

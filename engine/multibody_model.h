@@ -163,11 +163,12 @@ class MultibodyModel {
   void AddConstraintHessian(const Eigen::VectorXd& q, const Eigen::VectorXd& lambda,
                             double scale, SkylineLdlt* a) const;
 
-  // gamma_i = -qdot^T (d^2 Phi_i / dq^2) qdot - d^2 Phi_i / dt^2, the
-  // right-hand side of the acceleration-level constraints Phi_z zdd =
-  // gamma (eq. 30), at the time of SetTime. Only the rows of moving
-  // supports depend on time: Phi_i = r_i - p_i - d_i(t), so their
-  // -Phi_tt = d_i''(t).
+  // gamma_i = -qdot^T (d^2 Phi_i / dq^2) qdot - 2 Phi_i,qt qdot -
+  // d^2 Phi_i / dt^2, the right-hand side of the acceleration-level
+  // constraints Phi_z zdd = gamma (eq. 30), at the time of SetTime. Only
+  // the rows of moving supports depend on time: Phi_i = r_i - p_i - d_i(t),
+  // so their -Phi_tt = d_i''(t); and those of turning supports, Phi_i =
+  // n(t) . x, so theirs is -2 n' . xdot - n'' . x.
   void ConstraintGamma(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
                        Eigen::VectorXd* gamma) const;
 
@@ -204,9 +205,15 @@ class MultibodyModel {
   //    x0), the trapezoidal rule (second order);
   //  - a moving support: the force it exerts on the system is -lambda_i
   //    along row i, and the support point moves by d_i(t1) - d_i(t0), so
-  //    W = -(lambda_i0 + lambda_i1) / 2 (d_i(t1) - d_i(t0)) (second order).
+  //    W = -(lambda_i0 + lambda_i1) / 2 (d_i(t1) - d_i(t0)) (second order);
+  //  - a turning support: generally the work of a rheonomic row is
+  //    int lambda_i Phi_i,t dt (since Phi_q qdot = -Phi_t), here
+  //    W = (lambda_i0 + lambda_i1) / 2 (n(t1) - n(t0)) . (x0 + x1) / 2
+  //    (second order; the moving support's formula is its case Phi_t =
+  //    -d').
   bool has_external_work() const {
-    return !torques_.empty() || !varying_forces_.empty() || !moving_rows_.empty();
+    return !torques_.empty() || !varying_forces_.empty() || !moving_rows_.empty() ||
+           !turning_rows_.empty();
   }
   void AccumulateExternalWork(const Eigen::VectorXd& q_before, const Eigen::VectorXd& q_after,
                               double t_before, double t_after,
@@ -298,6 +305,24 @@ class MultibodyModel {
     double c0 = 0;
     TimeFunction motion;
     double rate = 0, accel = 0;  // motion' and motion'' at time_
+  };
+  // A direction row of a turning support: n(t) . x = 0, x the D
+  // coordinates from full index `coord` (a clamped slope or a body axis),
+  // n(t) = R(angle(t)) n0 with R the rotation about the unit `axis`.
+  // SetTime writes n(t) into the row's linear coefficients, so Constraints
+  // and the Jacobian need nothing else; Phi_t = n' . x and Phi_tt = n'' . x
+  // enter the initial velocity and ConstraintGamma.
+  struct TurningRow {
+    int row = 0;
+    int coord = 0;
+    Eigen::Vector3d n0 = Eigen::Vector3d::Zero(), axis = Eigen::Vector3d::UnitZ();
+    TimeFunction angle;
+    Eigen::Vector3d n = Eigen::Vector3d::Zero(), rate = Eigen::Vector3d::Zero(),
+                    accel = Eigen::Vector3d::Zero();  // n, n', n'' at time_
+    // n at time t (Rodrigues' formula); with `rate` and `accel` not null,
+    // also n' = angle' a x n and n'' = angle'' a x n + angle'^2 a x (a x n).
+    Eigen::Vector3d Normal(double t, Eigen::Vector3d* rate = nullptr,
+                           Eigen::Vector3d* accel = nullptr) const;
   };
   // Constraint rows as flat quadratic forms over local coordinate lists:
   // phi = c + sum lin_val * q[coord[lin_local]] + sum w q[coord[a]] q[coord[b]].
@@ -416,6 +441,7 @@ class MultibodyModel {
   double time_ = 0;
   bool time_dependent_ = false;
   std::vector<MovingRow> moving_rows_;
+  std::vector<TurningRow> turning_rows_;
   std::vector<VaryingForce> varying_forces_;
   // Work done by torques, time-varying loads and moving supports so far [J].
   double external_work_ = 0;

@@ -111,6 +111,12 @@ struct JointSpec {
   // direction (the support translates). Zero: a fixed support.
   TimeVector motion;
   bool HasMotion() const { return !IsZero(motion); }
+  // FIXED joints to ground only: the support also turns by the angle
+  // rotation(t) [rad] (rotation(0) = 0) about the unit `rotation_axis`
+  // (world axes), and the held slope or body axes turn with it.
+  TimeFunction rotation;
+  Eigen::Vector3d rotation_axis = Eigen::Vector3d::UnitZ();
+  bool HasRotation() const { return !rotation.IsZero(); }
 };
 
 struct LoadSpec {
