@@ -176,7 +176,9 @@ absl::Status ModelBuilder::InitialCoordinates() {
         q0_.segment<3>(i + 3 + 3 * k) = frame0_[b].col(k);
       }
       data.jbar = Vector3d::Constant(inertia.sum() / 2) - inertia;
-      if (!(data.jbar.minCoeff() > 0)) {
+      // Relative: a plate's (0.1, 0.2, 0.3) leaves 6e-17 by rounding, a
+      // mass matrix singular in all but name.
+      if (!(data.jbar.minCoeff() > 1e-12 * inertia.maxCoeff())) {
         return absl::InvalidArgumentError(absl::StrFormat(
             "bodies[%d].inertia: the spatial model needs each principal moment to be less than "
             "the sum of the other two (a real body's mass lies off every axis); got "

@@ -54,7 +54,7 @@ TEST_F(SweepFileTest, BaseFileUnderTheDirectoryIsRead) {
 }
 
 TEST_F(SweepFileTest, BaseFileOutsideIsRefusedWithoutReadingIt) {
-  for (const std::string base :
+  for (const std::string& base :
        {std::string("../outside.json"), (root_ / "outside.json").string(),
         std::string("scenes/../../outside.json")}) {
     const auto request = Read(R"({"base_file": ")" + base + R"("})");
