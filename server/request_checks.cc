@@ -78,7 +78,8 @@ absl::StatusOr<v1::Scene> SceneOfRequest(bool has_scene, const v1::Scene& scene,
   return parsed;
 }
 
-absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimits& limits) {
+absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimits& limits,
+                                        const std::function<bool()>& should_stop) {
   CheckedScene checked;
   if (absl::Status s = CheckStringLengths(proto, limits); !s.ok()) return s;
   absl::StatusOr<Scene> scene = SceneFromProto(proto);
@@ -148,7 +149,7 @@ absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimi
         absl::StrFormat("cables: %d elements asked for, the server's limit is %d (max_elements)",
                         requested_elements, limits.max_elements));
   }
-  absl::StatusOr<ModelInfo> info = DescribeModel(checked.scene);
+  absl::StatusOr<ModelInfo> info = DescribeModel(checked.scene, should_stop);
   if (!info.ok()) return info.status();
   checked.info = std::move(*info);
   if (checked.info.shape) {
