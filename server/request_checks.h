@@ -85,7 +85,13 @@ absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimi
 // RunScene, with an allocation that fails (std::bad_alloc: the run needs
 // more memory than the server can get) answered as ResourceExhausted
 // naming the scene's size, instead of an exception that the RPC would
-// report as UNKNOWN (or that would end a job's worker thread).
+// report as UNKNOWN (or that would end a job's worker thread). The run
+// computes on a thread of its own, kComputeNice below the server's
+// priority, the caller waiting: under overload the threads that answer
+// calls (refusals, health checks, job status) still get the processor at
+// once rather than a share among every running computation
+// (bench/server_load_bench.cc).
+inline constexpr int kComputeNice = 10;
 absl::StatusOr<RunSummary> RunSceneWithinMemory(const Scene& scene, FrameSink* sink,
                                                 const RunControl& control);
 
