@@ -79,7 +79,8 @@ class ModalSolver {
   // its full loads. kAuto: dense up to kDenseDofs unknowns, else Lanczos.
   // `should_stop` (empty: never) is checked at every operator application
   // of the Lanczos iteration, so a caller's stop request ends it within
-  // one linear solve.
+  // one linear solve, and before and after the dense solve (at most
+  // kDenseDofs unknowns).
   static Result Solve(MultibodyModel* model, const Eigen::VectorXd& z_eq, int modes,
                       Method method = Method::kAuto,
                       const std::function<bool()>& should_stop = {});

@@ -580,6 +580,7 @@ void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* 
   const std::vector<int>& first_node = mesh_.first_node;
   model_.cable_element_begin_.assign(1, 0);
   for (int c = 0; c < static_cast<int>(scene_.cables.size()); ++c) {
+    if (Stopped()) return;
     const CableSpec& cable = scene_.cables[c];
     model_.cable_names_.push_back(cable.name);
     const double ea = cable.youngs_modulus_pa * cable.area_m2;
@@ -725,6 +726,7 @@ void ModelBuilder::SetupElementSlots(const std::vector<MultibodyModel::ElementDa
   m.element_slots_.resize(kN2 * elements.size());
   m.element_factors_.resize(kN2 * elements.size());
   for (size_t k = 0; k < elements.size(); ++k) {
+    if (k % 65536 == 0 && Stopped()) return;
     const MultibodyModel::ElementData<D>& e = elements[k];
     for (int a = 0; a < kN; ++a) {
       for (int b = 0; b < kN; ++b) {

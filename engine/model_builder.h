@@ -9,6 +9,8 @@
 // can read (tests/model_builder_test.cc).
 
 #include <array>
+#include <functional>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -69,7 +71,18 @@ class ModelBuilder {
     Eigen::Vector3d turn_n0 = Eigen::Vector3d::Zero();
   };
 
-  explicit ModelBuilder(const Scene& scene) : scene_(scene) {}
+  // `should_stop` (empty: never) is asked between cables and every 65,536
+  // elements of the two steps whose cost grows with the elements
+  // (BuildElements, EnvelopeAndMass): a stopped step returns early, and
+  // Stopped() tells the caller to give the builder up.
+  explicit ModelBuilder(const Scene& scene, std::function<bool()> should_stop = {})
+      : scene_(scene), should_stop_(std::move(should_stop)) {}
+
+  // Whether the caller asked to stop (once true, stays true).
+  bool Stopped() {
+    if (!stopped_ && should_stop_) stopped_ = should_stop_();
+    return stopped_;
+  }
 
   // Planar or spatial (ChooseDimension, model_choice.h), and with it the
   // strides of nodes (2 D coordinates) and bodies (4 or 12). Fails as
@@ -209,6 +222,8 @@ class ModelBuilder {
   void SetupElementSlots(const std::vector<MultibodyModel::ElementData<D>>& elements);
 
   const Scene& scene_;
+  std::function<bool()> should_stop_;
+  bool stopped_ = false;
   MultibodyModel model_;
   Mesh mesh_;
   Eigen::VectorXd q0_;

@@ -90,9 +90,12 @@ void MultibodyModel::RowGradient(const Row& row, const VectorXd& q, double* grad
   }
 }
 
-absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
+absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene,
+                                                    const std::function<bool()>& should_stop) {
   // The steps, what each computes and why, are in model_builder.h.
-  ModelBuilder builder(scene);
+  ModelBuilder builder(scene, should_stop);
+  const absl::Status stopped =
+      absl::CancelledError("stopped by the caller while building the model");
   if (absl::Status s = builder.ChooseDimension(); !s.ok()) return s;
   builder.MeshCables();
   if (absl::Status s = builder.InitialCoordinates(); !s.ok()) return s;
@@ -101,10 +104,13 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene) {
   builder.OrderUnknowns();
   builder.KeepMovableRows();
   if (absl::Status s = builder.CheckMovingRows(); !s.ok()) return s;
+  if (builder.Stopped()) return stopped;
   builder.BuildElements();
+  if (builder.Stopped()) return stopped;
   builder.ConstantForces();
   builder.Probes();
   builder.EnvelopeAndMass();
+  if (builder.Stopped()) return stopped;
   builder.ConstraintPattern();
   return builder.Finish();
 }

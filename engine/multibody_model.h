@@ -39,6 +39,7 @@
 // All vectors of size dofs() are "reduced"; of size coordinates() "full".
 
 #include <array>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -62,8 +63,11 @@ class MultibodyModel {
   // coordinate map, and the constraint pattern, by the steps of
   // ModelBuilder (model_builder.h), in order. InvalidArgument names the
   // scene field when the scene cannot be assembled (for example joint sides
-  // that do not coincide at t = 0).
-  static absl::StatusOr<MultibodyModel> Build(const Scene& scene);
+  // that do not coincide at t = 0). `should_stop` (empty: never) is asked
+  // between the steps and within the long ones (ModelBuilder): Cancelled
+  // when it said stop.
+  static absl::StatusOr<MultibodyModel> Build(const Scene& scene,
+                                              const std::function<bool()>& should_stop = {});
 
   // 2 (planar) or 3 (spatial), chosen by ChooseDimension (model_choice.h).
   int dimension() const { return dim_; }

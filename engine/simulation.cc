@@ -524,8 +524,9 @@ bool StartFromEquilibrium(MultibodyModel* model, const SolverSettings& settings,
 
 }  // namespace
 
-absl::StatusOr<ModelInfo> DescribeModel(const Scene& scene) {
-  absl::StatusOr<MultibodyModel> built = MultibodyModel::Build(scene);
+absl::StatusOr<ModelInfo> DescribeModel(const Scene& scene,
+                                        const std::function<bool()>& should_stop) {
+  absl::StatusOr<MultibodyModel> built = MultibodyModel::Build(scene, should_stop);
   if (!built.ok()) return built.status();
   if (scene.solver.analysis == Analysis::kModal) {
     if (absl::StatusOr<int> modes = ModalSolver::ModeCount(*built, scene.solver); !modes.ok())
@@ -537,7 +538,15 @@ absl::StatusOr<ModelInfo> DescribeModel(const Scene& scene) {
 absl::StatusOr<RunSummary> RunScene(const Scene& scene, FrameSink* sink,
                                     const RunControl& control) {
   const auto start = Clock::now();
-  absl::StatusOr<MultibodyModel> built = MultibodyModel::Build(scene);
+  absl::StatusOr<MultibodyModel> built = MultibodyModel::Build(scene, control.should_stop);
+  if (absl::IsCancelled(built.status())) {
+    RunSummary stopped;
+    stopped.status = "cancelled";
+    stopped.error = std::string(built.status().message());
+    stopped.analysis = std::string(AnalysisName(scene.solver.analysis));
+    stopped.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    return stopped;
+  }
   if (!built.ok()) return built.status();
   MultibodyModel& model = *built;
   RunSummary summary;

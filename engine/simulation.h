@@ -187,13 +187,17 @@ struct RunControl {
 };
 
 // Builds the model for `scene` without running it: what the engine would
-// build, or InvalidArgument naming the field that prevents it.
-absl::StatusOr<ModelInfo> DescribeModel(const Scene& scene);
+// build, or InvalidArgument naming the field that prevents it; Cancelled
+// when `should_stop` (asked during the build) said stop.
+absl::StatusOr<ModelInfo> DescribeModel(const Scene& scene,
+                                        const std::function<bool()>& should_stop = {});
 
 // Builds the model for `scene` and runs it. Returns InvalidArgument (naming
 // the scene field) when the scene cannot be modelled; a numerical failure is
 // not an error status: the summary's status is "failed" with the reason, and
-// every frame up to the last converged one has been delivered.
+// every frame up to the last converged one has been delivered. A stop
+// request (control.should_stop) while the model is built gives a summary
+// with status "cancelled" and no frame.
 absl::StatusOr<RunSummary> RunScene(const Scene& scene, FrameSink* sink,
                                     const RunControl& control = {});
 

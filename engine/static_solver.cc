@@ -72,6 +72,11 @@ StaticSolver::IncrementStats StaticSolver::Solve(double alpha, double tolerance)
   NewtonIterate iterate;
   const SkylineLdlt& mass = model_->mass();
   for (int it = 0; it <= kMaxIterations; ++it) {
+    if (should_stop_ && should_stop_()) {
+      st.stopped = true;
+      st.reason = "stopped by the caller";
+      return st;
+    }
     model_->ToFull(z1_, &q_);
     SkylineLdlt& a = solver_.a();
     a.SetZero();
@@ -251,6 +256,7 @@ bool FollowLoadPath(
     summary->failure_time_s = at;
     summary->error = what + reason;
   };
+  solver->set_should_stop(control.should_stop);
   const int n = settings.load_steps;
   const double min_increment = std::ldexp(1.0 / n, -settings.max_step_halvings);
   Eigen::VectorXd before;
@@ -275,6 +281,11 @@ bool FollowLoadPath(
       summary->newton_iterations += st.newton_iterations;
       summary->linear_iterations += st.linear_iterations;
       summary->max_linear_residual = std::max(summary->max_linear_residual, st.max_linear_residual);
+      if (st.stopped) {
+        summary->status = "cancelled";
+        summary->error = absl::StrFormat("%sstopped by the caller at load factor %.6g", what, alpha);
+        return false;
+      }
       if (st.converged) {
         alpha += d;
         if (on_increment) on_increment(before, solver->z(), alpha);

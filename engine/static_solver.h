@@ -42,6 +42,7 @@
 
 #include <functional>
 #include <string>
+#include <utility>
 
 #include <Eigen/Core>
 
@@ -61,6 +62,7 @@ class StaticSolver {
     double residual = 0;        // relative residual accepted
     double residual_floor = 0;  // its rounding floor, relative
     double max_linear_residual = 0;
+    bool stopped = false;  // the stop request of set_should_stop (then !converged)
     std::string reason;
   };
 
@@ -86,6 +88,12 @@ class StaticSolver {
   const Eigen::VectorXd& z() const { return z_; }
   const Eigen::VectorXd& lambda() const { return lambda_; }
 
+  // Asked before every Newton iteration of Solve (one increment may take
+  // hundreds): true ends the increment, not converged and `stopped`.
+  void set_should_stop(std::function<bool()> should_stop) {
+    should_stop_ = std::move(should_stop);
+  }
+
  private:
   // The pseudo-transient shift that moves the scene by kFirstMove of its
   // size in one step under the residual r.
@@ -105,6 +113,7 @@ class StaticSolver {
   Eigen::VectorXd z_, lambda_, z1_, lambda1_, q_, f_, phi_, rhs_, dx_, bt_l_, floor_, work_;
   Eigen::VectorXd trial_z_, trial_lambda_, qdot_zero_;
   double merit_size_ = 0;
+  std::function<bool()> should_stop_;
 };
 
 // Follows the load path 0 -> 1 in settings.load_steps increments (each one

@@ -323,7 +323,8 @@ grpc::Status CablesimServiceImpl::Validate(grpc::ServerContext* context,
   const absl::StatusOr<v1::Scene> scene =
       SceneOfRequest(request->has_scene(), request->scene(), request->scene_json());
   absl::StatusOr<CheckedScene> checked =
-      scene.ok() ? CheckScene(*scene, limits_) : absl::StatusOr<CheckedScene>(scene.status());
+      scene.ok() ? CheckScene(*scene, limits_, ControlFor(context, limits_).should_stop)
+                 : absl::StatusOr<CheckedScene>(scene.status());
   if (checked.ok()) {
     response->set_valid(true);
     *response->mutable_model() = ModelInfoToProto(checked->info);
@@ -360,7 +361,8 @@ grpc::Status CablesimServiceImpl::Run(grpc::ServerContext* context, const v1::Ru
   const absl::StatusOr<v1::Scene> scene =
       SceneOfRequest(request->has_scene(), request->scene(), request->scene_json());
   if (!scene.ok()) return ToGrpc(scene.status());
-  absl::StatusOr<CheckedScene> checked = CheckScene(*scene, limits_);
+  absl::StatusOr<CheckedScene> checked =
+      CheckScene(*scene, limits_, ControlFor(context, limits_).should_stop);
   if (!checked.ok()) return ToGrpc(checked.status());
   StreamingSink sink(writer, slot.watch(), BatchSize(request->frames_per_batch()),
                      checked->scene.name, checked->end_time_s);
@@ -388,7 +390,8 @@ grpc::Status CablesimServiceImpl::SubmitJob(grpc::ServerContext* context,
   const absl::StatusOr<v1::Scene> scene =
       SceneOfRequest(request->has_scene(), request->scene(), request->scene_json());
   if (!scene.ok()) return ToGrpc(scene.status());
-  absl::StatusOr<v1::Job> job = jobs_->Submit(*scene, ClientKey(context, tenant), tenant);
+  absl::StatusOr<v1::Job> job = jobs_->Submit(*scene, ClientKey(context, tenant), tenant,
+                                              ControlFor(context, limits_).should_stop);
   if (!job.ok()) return ToGrpc(job.status());
   *response = std::move(*job);
   if (log_) std::cerr << "cablesim-server: job " << response->id() << " queued\n";
@@ -558,7 +561,8 @@ grpc::Status CablesimServiceImpl::GetEnergy(grpc::ServerContext* context,
     if (!slot.acquired()) {
       return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, slot.refusal());
     }
-    absl::StatusOr<CheckedScene> checked = CheckScene(request->scene(), limits_);
+    absl::StatusOr<CheckedScene> checked =
+        CheckScene(request->scene(), limits_, ControlFor(context, limits_).should_stop);
     if (!checked.ok()) return ToGrpc(checked.status());
     StoredResult result;
     RowSink sink(&result);

@@ -112,8 +112,9 @@ void JobManager::WorkArrived() {
 }
 
 absl::StatusOr<v1::Job> JobManager::Submit(const v1::Scene& scene, const std::string& peer,
-                                           const std::string& tenant) {
-  absl::StatusOr<CheckedScene> checked = CheckScene(scene, limits_);
+                                           const std::string& tenant,
+                                           const std::function<bool()>& should_stop) {
+  absl::StatusOr<CheckedScene> checked = CheckScene(scene, limits_, should_stop);
   if (!checked.ok()) return checked.status();
   absl::StatusOr<v1::Job> job =
       store_->InsertJob(scene, checked->end_time_s, peer, limits_.max_queued_jobs_per_peer,

@@ -18,6 +18,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -46,9 +47,10 @@ class JobManager {
 
   // `peer`: the submitting client's address, for
   // limits().max_queued_jobs_per_peer.
-  // `tenant`: the owner (JobStore::InsertJob).
+  // `tenant`: the owner (JobStore::InsertJob). `should_stop`: CheckScene's.
   absl::StatusOr<v1::Job> Submit(const v1::Scene& scene, const std::string& peer = "",
-                                 const std::string& tenant = "");
+                                 const std::string& tenant = "",
+                                 const std::function<bool()>& should_stop = {});
   absl::StatusOr<v1::Sweep> SubmitSweep(const v1::SubmitSweepRequest& request,
                                         const std::string& peer = "",
                                         const std::string& tenant = "");

@@ -14,6 +14,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "server/postgres_job_store.h"
+#include "server/result_codec.h"
 #include "server/sqlite_job_store.h"
 
 namespace cablesim {
@@ -56,10 +57,24 @@ absl::StatusOr<std::string> RandomId() {
   return id;
 }
 
-std::vector<double> DoublesFromBlob(const std::string& blob) {
-  std::vector<double> v(blob.size() / sizeof(double));
-  if (!v.empty()) std::memcpy(v.data(), blob.data(), v.size() * sizeof(double));
-  return v;
+absl::StatusOr<StoredResult> CheckedResult(const std::string& id, const std::string& header,
+                                           const std::string& vals, int64_t checksum,
+                                           int64_t encoding) {
+  const absl::Status damaged = absl::DataLossError(absl::StrCat(
+      "job ", id, ": the stored result fails its checksum (the database is damaged)"));
+  StoredResult result;
+  if (ResultChecksum(header.data(), header.size(), vals.data(), vals.size()) != checksum ||
+      !result.header.ParseFromString(header)) {
+    return damaged;
+  }
+  absl::StatusOr<std::vector<double>> values =
+      DecodeValues(vals, encoding, result.header.columns_size());
+  if (!values.ok()) {
+    return absl::DataLossError(absl::StrCat("job ", id, ": ", values.status().message(),
+                                            " (the database is damaged)"));
+  }
+  result.values = std::move(*values);
+  return result;
 }
 
 absl::Status CreateDataDir(const std::string& dir) {

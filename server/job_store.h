@@ -190,12 +190,18 @@ std::string SweepId(int64_t seq);
 bool IsSweepId(const std::string& id);
 int64_t NowUnixMs();
 // Shared by the implementations: a new public id (`j-`/`s-` and 128
-// random bits), the CRC-32 of a result's header and values, the doubles
-// of a values blob, whether a state is final, 128 random bits as hex.
+// random bits), the CRC-32 of a result's header and values blob as
+// stored, a result read back, whether a state is final, 128 random bits
+// as hex.
 absl::StatusOr<std::string> NewPublicId(char prefix);
 int64_t ResultChecksum(const void* header, size_t header_bytes, const void* vals,
                        size_t vals_bytes);
-std::vector<double> DoublesFromBlob(const std::string& blob);
+// Job `id`'s result from its stored columns: DataLoss (never altered data)
+// unless `checksum` matches the header and values blob as stored and the
+// blob decodes by its `encoding` (result_codec.h).
+absl::StatusOr<StoredResult> CheckedResult(const std::string& id, const std::string& header,
+                                           const std::string& vals, int64_t checksum,
+                                           int64_t encoding);
 bool IsFinished(v1::JobState state);
 // ResourceExhausted: client `peer` has `unfinished` jobs and asks for
 // `adding` more beyond `max_unfinished` (max_queued_jobs_per_peer).

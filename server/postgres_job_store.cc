@@ -13,6 +13,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/time/clock.h"
+#include "server/result_codec.h"
 
 namespace cablesim {
 namespace {
@@ -59,7 +60,7 @@ CREATE INDEX jobs_by_peer ON jobs(peer, state);
 CREATE TABLE results (
   job_seq BIGINT PRIMARY KEY REFERENCES jobs(seq) ON DELETE CASCADE,
   header BYTEA NOT NULL,           -- cablesim.v1.RunHeader
-  vals BYTEA NOT NULL,             -- row-major doubles, little-endian
+  vals BYTEA NOT NULL,             -- row-major doubles, little-endian (encoding 0)
   checksum BIGINT NOT NULL);       -- CRC-32 of header then vals
 CREATE TABLE meta (
   key TEXT PRIMARY KEY,
@@ -71,6 +72,9 @@ ALTER TABLE jobs ADD COLUMN owner TEXT NOT NULL DEFAULT '';
 ALTER TABLE jobs ADD COLUMN lease_until_ms BIGINT NOT NULL DEFAULT 0;
 ALTER TABLE jobs ADD COLUMN cancel_requested BOOLEAN NOT NULL DEFAULT FALSE;
 ALTER TABLE jobs ADD COLUMN progress_time_s DOUBLE PRECISION NOT NULL DEFAULT 0;
+)sql"},
+    {3, "results compressed: how each row's vals are encoded (result_codec.h)", R"sql(
+ALTER TABLE results ADD COLUMN encoding INTEGER NOT NULL DEFAULT 0;  -- 0: raw doubles, 1: zstd
 )sql"},
 };
 
@@ -677,9 +681,9 @@ absl::StatusOr<bool> PostgresJobStore::Finish(const std::string& id, v1::JobStat
                                               const v1::RunSummary& summary,
                                               const StoredResult& result, int attempt) {
   const std::string header = result.header.SerializeAsString();
-  const size_t vals_bytes = result.values.size() * sizeof(double);
+  const EncodedValues vals = EncodeValues(result.values, result.header.columns_size());
   const int64_t checksum =
-      ResultChecksum(header.data(), header.size(), result.values.data(), vals_bytes);
+      ResultChecksum(header.data(), header.size(), vals.blob.data(), vals.blob.size());
   absl::MutexLock lock(&mu_);
   EnsureConnected();
   Transaction tx(conn_);
@@ -700,13 +704,14 @@ absl::StatusOr<bool> PostgresJobStore::Finish(const std::string& id, v1::JobStat
   PgResult r(Params()
                  .Int(u.Int(0, 0))
                  .Bytes(header)
-                 .Bytes(result.values.data(), vals_bytes)
+                 .Bytes(vals.blob)
                  .Int(checksum)
+                 .Int(vals.encoding)
                  .Run(conn_,
-                      "INSERT INTO results (job_seq, header, vals, checksum) VALUES "
-                      "($1::bigint, $2, $3, $4::bigint) ON CONFLICT (job_seq) DO UPDATE SET "
-                      "header = EXCLUDED.header, vals = EXCLUDED.vals, checksum = "
-                      "EXCLUDED.checksum"));
+                      "INSERT INTO results (job_seq, header, vals, checksum, encoding) VALUES "
+                      "($1::bigint, $2, $3, $4::bigint, $5::int) ON CONFLICT (job_seq) DO "
+                      "UPDATE SET header = EXCLUDED.header, vals = EXCLUDED.vals, checksum = "
+                      "EXCLUDED.checksum, encoding = EXCLUDED.encoding"));
   if (!r.ok()) return (r.status());
   Notify();
   if (absl::Status st = tx.Commit(); !st.ok()) return st;
@@ -717,19 +722,12 @@ absl::StatusOr<StoredResult> PostgresJobStore::GetResult(const std::string& id) 
   absl::MutexLock lock(&mu_);
   EnsureConnected();
   PgResult r(Params().Text(id).Run(conn_,
-                                   "SELECT r.header, r.vals, r.checksum FROM results r JOIN jobs "
+                                   "SELECT r.header, r.vals, r.checksum, r.encoding FROM "
+                                   "results r JOIN jobs "
                                    "j ON j.seq = r.job_seq WHERE j.pid = $1"));
   if (!r.ok()) return r.status();
   if (r.rows() == 0) return absl::NotFoundError(absl::StrCat("job \"", id, "\" has no result"));
-  const std::string header = r.Bytes(0, 0), vals = r.Bytes(0, 1);
-  StoredResult result;
-  if (ResultChecksum(header.data(), header.size(), vals.data(), vals.size()) != r.Int(0, 2) ||
-      vals.size() % sizeof(double) != 0 || !result.header.ParseFromString(header)) {
-    return absl::DataLossError(absl::StrCat(
-        "job ", id, ": the stored result fails its checksum (the database is damaged)"));
-  }
-  result.values = DoublesFromBlob(vals);
-  return result;
+  return CheckedResult(id, r.Bytes(0, 0), r.Bytes(0, 1), r.Int(0, 2), r.Int(0, 3));
 }
 
 absl::StatusOr<v1::Sweep> PostgresJobStore::GetSweep(const std::string& id) {

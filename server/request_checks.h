@@ -7,6 +7,7 @@
 // expands to valid items (errors naming `axes[i]`).
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -75,13 +76,22 @@ absl::StatusOr<v1::Scene> SceneOfRequest(bool has_scene, const v1::Scene& scene,
 // summed over all cables before anything is built, then the model's
 // elements and coordinates and, for MODAL, the modes and their memory.
 // The one costing of a scene: Validate, Run, SubmitJob, sweeps and
-// GetEnergy all call it.
-absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimits& limits);
+// GetEnergy all call it. `should_stop` (empty: never) is asked while the
+// model is built (a scene of many elements takes seconds): Cancelled when
+// it said stop.
+absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimits& limits,
+                                        const std::function<bool()>& should_stop = {});
 
 // RunScene, with an allocation that fails (std::bad_alloc: the run needs
 // more memory than the server can get) answered as ResourceExhausted
 // naming the scene's size, instead of an exception that the RPC would
-// report as UNKNOWN (or that would end a job's worker thread).
+// report as UNKNOWN (or that would end a job's worker thread). The run
+// computes on a thread of its own, kComputeNice below the server's
+// priority, the caller waiting: under overload the threads that answer
+// calls (refusals, health checks, job status) still get the processor at
+// once rather than a share among every running computation
+// (bench/server_load_bench.cc).
+inline constexpr int kComputeNice = 10;
 absl::StatusOr<RunSummary> RunSceneWithinMemory(const Scene& scene, FrameSink* sink,
                                                 const RunControl& control);
 

@@ -20,6 +20,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "server/result_codec.h"
 
 namespace cablesim {
 namespace {
@@ -53,8 +54,9 @@ CREATE INDEX IF NOT EXISTS jobs_by_sweep ON jobs(sweep_seq, sweep_index);
 CREATE TABLE IF NOT EXISTS results (
   job_seq INTEGER PRIMARY KEY REFERENCES jobs(seq),
   header BLOB NOT NULL,         -- cablesim.v1.RunHeader
-  vals BLOB NOT NULL,           -- row-major doubles, native byte order
-  checksum INTEGER);            -- ResultChecksum(header, vals)
+  vals BLOB NOT NULL,           -- the values as `encoding` says (result_codec.h)
+  checksum INTEGER,             -- ResultChecksum(header, vals)
+  encoding INTEGER NOT NULL DEFAULT 0);  -- 0: raw row-major doubles, 1: zstd
 CREATE TABLE IF NOT EXISTS meta (
   key TEXT PRIMARY KEY,
   value TEXT NOT NULL);         -- 'store_id': as in DIR/store-id
@@ -295,6 +297,20 @@ absl::Status SqliteJobStore::CheckAndMigrate(const std::string& dir) {
   }
   if (!has_checksum) {
     if (absl::Status s = Exec("ALTER TABLE results ADD COLUMN checksum INTEGER"); !s.ok()) return s;
+  }
+  // Databases from before compression: their results stay raw doubles
+  // (encoding 0), read as they are.
+  bool has_encoding = false;
+  {
+    Stmt columns(db_, "PRAGMA table_info(results)");
+    while (columns.Step() == SQLITE_ROW) has_encoding |= columns.Text(1) == "encoding";
+  }
+  if (!has_encoding) {
+    if (absl::Status s =
+            Exec("ALTER TABLE results ADD COLUMN encoding INTEGER NOT NULL DEFAULT 0");
+        !s.ok()) {
+      return s;
+    }
   }
   // Databases from before random ids: their rows keep the ids they had.
   for (const auto& [table, prefix] : {std::pair{"jobs", "j"}, std::pair{"sweeps", "s"}}) {
@@ -605,6 +621,7 @@ absl::StatusOr<bool> SqliteJobStore::Finish(const std::string& id, v1::JobState 
                                             const StoredResult& result, int attempt) {
   const std::string summary_blob = summary.SerializeAsString();
   const std::string header_blob = result.header.SerializeAsString();
+  const EncodedValues vals = EncodeValues(result.values, result.header.columns_size());
   absl::MutexLock lock(&mu_);
   const int64_t seq = LookUpSeq(id);
   if (absl::Status st = Exec("BEGIN IMMEDIATE"); !st.ok()) return st;
@@ -627,13 +644,14 @@ absl::StatusOr<bool> SqliteJobStore::Finish(const std::string& id, v1::JobState 
     return false;
   }
   Stmt r(db_,
-         "INSERT OR REPLACE INTO results (job_seq, header, vals, checksum) VALUES (?1,?2,?3,?4)");
-  const size_t vals_bytes = result.values.size() * sizeof(double);
+         "INSERT OR REPLACE INTO results (job_seq, header, vals, checksum, encoding) VALUES "
+         "(?1,?2,?3,?4,?5)");
   r.Bind(1, seq)
       .BindBlob(2, header_blob.data(), header_blob.size())
-      .BindBlob(3, result.values.data(), vals_bytes)
-      .Bind(4, ResultChecksum(header_blob.data(), header_blob.size(), result.values.data(),
-                              vals_bytes));
+      .BindBlob(3, vals.blob.data(), vals.blob.size())
+      .Bind(4, ResultChecksum(header_blob.data(), header_blob.size(), vals.blob.data(),
+                              vals.blob.size()))
+      .Bind(5, vals.encoding);
   if (absl::Status st = r.Done(); !st.ok()) return rollback(st);
   if (absl::Status st = Exec("COMMIT"); !st.ok()) return rollback(st);
   return true;
@@ -641,7 +659,7 @@ absl::StatusOr<bool> SqliteJobStore::Finish(const std::string& id, v1::JobState 
 
 absl::StatusOr<StoredResult> SqliteJobStore::GetResult(const std::string& id) {
   absl::MutexLock lock(&mu_);
-  Stmt s(db_, "SELECT header, vals, checksum FROM results WHERE job_seq = ?1");
+  Stmt s(db_, "SELECT header, vals, checksum, encoding FROM results WHERE job_seq = ?1");
   s.Bind(1, LookUpSeq(id));
   const int rc = s.Step();
   if (rc == SQLITE_DONE) return absl::NotFoundError(absl::StrCat("job \"", id, "\" has no result"));
@@ -649,14 +667,7 @@ absl::StatusOr<StoredResult> SqliteJobStore::GetResult(const std::string& id) {
   const std::string header = s.Blob(0), vals = s.Blob(1);
   // Never serve altered data: the checksum written with the result must
   // still match.
-  StoredResult result;
-  if (ResultChecksum(header.data(), header.size(), vals.data(), vals.size()) != s.Int(2) ||
-      vals.size() % sizeof(double) != 0 || !result.header.ParseFromString(header)) {
-    return absl::DataLossError(absl::StrCat(
-        "job ", id, ": the stored result fails its checksum (the database is damaged)"));
-  }
-  result.values = DoublesFromBlob(vals);
-  return result;
+  return CheckedResult(id, header, vals, s.Int(2), s.Int(3));
 }
 
 absl::StatusOr<v1::Sweep> SqliteJobStore::GetSweep(const std::string& id) {

@@ -170,11 +170,13 @@ TEST(DynamicsTest, NumericalFailureIsReportedWithTimeAndKeepsConvergedFrames) {
 }
 
 TEST(RunControlTest, StopRequestCancelsAtTheNextStepAndKeepsEarlierFrames) {
-  // 1 s at h = 1e-3 with a frame per millisecond: stop after 100 checks.
+  // 1 s at h = 1e-3 with a frame per millisecond: stop after 100 checks
+  // of the steps (the frame at t = 0 comes once the model is built, which
+  // asks too).
   int checks = 0;
-  RunControl control;
-  control.should_stop = [&checks] { return ++checks > 100; };
   CollectingSink sink;
+  RunControl control;
+  control.should_stop = [&] { return !sink.frames().empty() && ++checks > 100; };
   auto summary = RunScene(SceneFromJson(FallingPendulum(4, 1e-3, 1.0)), &sink, control);
   ASSERT_TRUE(summary.ok()) << summary.status();
   EXPECT_EQ(summary->status, "cancelled");
@@ -182,6 +184,22 @@ TEST(RunControlTest, StopRequestCancelsAtTheNextStepAndKeepsEarlierFrames) {
   // The frame at t = 0 and one per accepted step, nothing after the stop.
   EXPECT_EQ(sink.frames().size(), 101u);
   EXPECT_NEAR(sink.frames().back().t, 0.1, 1e-12);
+}
+
+TEST(RunControlTest, StopRequestDuringTheModelBuildCancelsBeforeAnyFrame) {
+  // The first question comes from the model build (ModelBuilder), before
+  // the sink hears of the model: the run ends there, cancelled.
+  int checks = 0;
+  CollectingSink sink;
+  RunControl control;
+  control.should_stop = [&] { return ++checks >= 1; };
+  auto summary = RunScene(SceneFromJson(FallingPendulum(4, 1e-3, 1.0)), &sink, control);
+  ASSERT_TRUE(summary.ok()) << summary.status();
+  EXPECT_EQ(summary->status, "cancelled");
+  EXPECT_NE(summary->error.find("building the model"), std::string::npos) << summary->error;
+  EXPECT_EQ(checks, 1);
+  EXPECT_TRUE(sink.frames().empty());
+  EXPECT_EQ(sink.info().coordinates, 0);
 }
 
 TEST(RunControlTest, StepLimitFailsTheRunAndSaysWhy) {

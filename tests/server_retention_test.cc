@@ -18,16 +18,7 @@ namespace {
 using ::testing::HasSubstr;
 using testing::Pendulum;
 using testing::ServerProcess;
-
-v1::Job Submit(v1::CablesimService::Stub* stub, const v1::Scene& scene) {
-  grpc::ClientContext context;
-  v1::SubmitJobRequest request;
-  *request.mutable_scene() = scene;
-  v1::Job job;
-  const grpc::Status s = stub->SubmitJob(&context, request, &job);
-  EXPECT_TRUE(s.ok()) << s.error_message();
-  return job;
-}
+using testing::Submit;
 
 grpc::Status GetJob(v1::CablesimService::Stub* stub, const std::string& id, v1::Job* job) {
   grpc::ClientContext context;

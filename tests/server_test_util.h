@@ -258,6 +258,17 @@ class JobGate {
   std::string dir_;
 };
 
+// SubmitJob of `scene`, expected to succeed; the job queued.
+inline v1::Job Submit(v1::CablesimService::Stub* stub, const v1::Scene& scene) {
+  grpc::ClientContext context;
+  v1::SubmitJobRequest request;
+  *request.mutable_scene() = scene;
+  v1::Job job;
+  const grpc::Status s = stub->SubmitJob(&context, request, &job);
+  EXPECT_TRUE(s.ok()) << s.error_message();
+  return job;
+}
+
 // Waits (WatchJob) until job `id` is in `state` or finished; returns the
 // job as last seen.
 inline v1::Job WaitForState(v1::CablesimService::Stub* stub, const std::string& id,

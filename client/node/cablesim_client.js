@@ -20,8 +20,21 @@ const protoLoader = require('@grpc/proto-loader');
 
 const PROTO_DIR = path.join(__dirname, '..', '..', 'proto');
 
-// A CablesimService stub for `address` (host:port), without TLS.
-function connect(address) {
+// The token in a token file: the first word of its first line that is not
+// a # comment (as `cablesim --token-file` and the Python client read it).
+function readToken(file) {
+  for (const raw of require('fs').readFileSync(file, 'utf8').split('\n')) {
+    const line = raw.trim();
+    if (line && !line.startsWith('#')) return line.split(/\s+/)[0];
+  }
+  throw new Error(`${file}: no token`);
+}
+
+// A CablesimService stub for `address` (host:port). Options: `tlsCa`, a CA
+// certificate file (PEM) the server's certificate is checked against (TLS;
+// without it, plaintext); `token` or `tokenFile`, a bearer token sent with
+// every call (metadata `authorization: Bearer TOKEN`).
+function connect(address, {tlsCa, token, tokenFile} = {}) {
   const definition = protoLoader.loadSync('cablesim/v1/service.proto', {
     includeDirs: [PROTO_DIR],
     keepCase: true,  // field names as in the .proto (scene_json, frames_per_batch)
@@ -30,13 +43,25 @@ function connect(address) {
     defaults: true,
   });
   const cablesim = grpc.loadPackageDefinition(definition).cablesim.v1;
-  return new cablesim.CablesimService(address, grpc.credentials.createInsecure());
+  if (tokenFile) token = readToken(tokenFile);
+  const credentials = tlsCa ? grpc.credentials.createSsl(require('fs').readFileSync(tlsCa))
+                            : grpc.credentials.createInsecure();
+  const client = new cablesim.CablesimService(address, credentials);
+  client.cablesimToken = token;  // sent with every call (metadataFor)
+  return client;
+}
+
+// Per-call metadata: the bearer token, if any.
+function metadataFor(client) {
+  const metadata = new grpc.Metadata();
+  if (client.cablesimToken) metadata.add('authorization', `Bearer ${client.cablesimToken}`);
+  return metadata;
 }
 
 // Validate: resolves to the ValidateResponse ({valid, model, errors}).
 function validate(client, sceneJson) {
   return new Promise((resolve, reject) => {
-    client.Validate({scene_json: sceneJson}, (error, response) =>
+    client.Validate({scene_json: sceneJson}, metadataFor(client), (error, response) =>
       error ? reject(error) : resolve(response));
   });
 }
@@ -47,7 +72,7 @@ function validate(client, sceneJson) {
 function run(client, sceneJson) {
   return new Promise((resolve, reject) => {
     const result = {columns: [], rows: [], summary: null};
-    const call = client.Run({scene_json: sceneJson});
+    const call = client.Run({scene_json: sceneJson}, metadataFor(client));
     call.on('data', (event) => {
       if (event.header) {
         result.columns = event.header.columns;
@@ -66,4 +91,35 @@ function run(client, sceneJson) {
   });
 }
 
-module.exports = {connect, validate, run};
+module.exports = {connect, readToken, validate, run};
+
+// As a program: node cablesim_client.js (validate | run) SCENE.json
+//   --server HOST:PORT [--tls-ca CA.pem] [--token-file FILE]
+// prints the ValidateResponse, or the run's summary, as one JSON line;
+// exit 1 when the call fails, 2 on a usage error.
+if (require.main === module) {
+  const args = process.argv.slice(2);
+  const flags = {};
+  const rest = [];
+  for (let i = 0; i < args.length; ++i) {
+    const m = /^--(server|tls-ca|token-file)(?:=(.*))?$/.exec(args[i]);
+    if (m) {
+      flags[m[1]] = m[2] !== undefined ? m[2] : args[++i];
+    } else {
+      rest.push(args[i]);
+    }
+  }
+  if (rest.length !== 2 || !['validate', 'run'].includes(rest[0]) || !flags.server) {
+    console.error('usage: node cablesim_client.js (validate | run) SCENE.json --server HOST:PORT ' +
+                  '[--tls-ca CA.pem] [--token-file FILE]');
+    process.exit(2);
+  }
+  const client = connect(flags.server, {tlsCa: flags['tls-ca'], tokenFile: flags['token-file']});
+  const text = require('fs').readFileSync(rest[1], 'utf8');
+  (rest[0] === 'validate' ? validate(client, text) : run(client, text).then((r) => r.summary))
+      .then((out) => console.log(JSON.stringify(out)))
+      .catch((error) => {
+        console.error(`cablesim: ${error.message}`);
+        process.exit(1);
+      });
+}
