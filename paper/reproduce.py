@@ -76,7 +76,7 @@ class Runner:
                 print("  %-34s reused (%s)" % (key, summary.get("status")), flush=True)
                 if summary.get("status") != "ok":
                     self.failures.append("%s: %s" % (key, summary.get("error", "failed")))
-                self.total_wall += summary.get("_wall", 0)
+                self.total_wall += summary.get("_wall", summary.get("wall_seconds", 0))
                 summary["_settings"] = settings_line(scene)
                 self.results[key] = (read_csv(out), summary)
                 return self.results[key]
