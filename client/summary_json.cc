@@ -42,6 +42,8 @@ std::string SummaryToJson(const RunSummary& summary) {
         .Add("max_step_s", summary.max_step_s)
         .Add("factorizations", summary.factorizations)
         .Add("direct_fallbacks", summary.direct_fallbacks)
+        .Add("linear_solves", summary.linear_solves)
+        .Add("inexact_linear_solves", summary.inexact_linear_solves)
         .Add("adaptive", summary.adaptive);
     if (summary.integrator != "IMPLICIT_EULER") json.Add("rho_infinity", summary.rho_infinity);
     if (summary.has_error_estimate) {

@@ -61,6 +61,8 @@ v1::RunSummary SummaryToProto(const RunSummary& s) {
   p.set_energy_final(s.energy_final);
   p.set_energy_dissipated(s.energy_dissipated);
   p.set_energy_damped(s.energy_damped);
+  p.set_linear_solves(s.linear_solves);
+  p.set_inexact_linear_solves(s.inexact_linear_solves);
   p.set_energy_max_increase(s.energy_max_increase);
   p.set_max_constraint_violation(s.max_constraint_violation);
   p.set_max_newton_residual(s.max_newton_residual);
@@ -101,6 +103,8 @@ RunSummary SummaryFromProto(const v1::RunSummary& p) {
   s.energy_final = p.energy_final();
   s.energy_dissipated = p.energy_dissipated();
   s.energy_damped = p.energy_damped();
+  s.linear_solves = p.linear_solves();
+  s.inexact_linear_solves = p.inexact_linear_solves();
   s.energy_max_increase = p.energy_max_increase();
   s.max_constraint_violation = p.max_constraint_violation();
   s.max_newton_residual = p.max_newton_residual();

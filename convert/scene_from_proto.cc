@@ -858,6 +858,21 @@ class SceneConverter {
         s.has_max_linear_iterations() ? s.max_linear_iterations() : kDefaultMaxLinearIterations;
     CABLESIM_RETURN_IF_ERROR(CheckIntRange("solver.max_linear_iterations",
                                            out.max_linear_iterations, 1, kMaxLinearIterations));
+    switch (s.preconditioner()) {
+      case v1::Solver::PRECONDITIONER_UNSPECIFIED:
+      case v1::Solver::BLOCK:
+        out.preconditioner = PreconditionerKind::kBlock;
+        break;
+      case v1::Solver::JACOBI:
+        out.preconditioner = PreconditionerKind::kJacobi;
+        break;
+      case v1::Solver::NONE:
+        out.preconditioner = PreconditionerKind::kNone;
+        break;
+      default:
+        return Invalid("solver.preconditioner", "unknown value");
+    }
+    out.accept_inexact_solves = s.accept_inexact_solves();
     if (s.has_modes()) {
       if (out.analysis != Analysis::kModal) {
         return Invalid("solver.modes", absl::StrCat("is only for MODAL analysis (solver.analysis is ",
@@ -961,7 +976,7 @@ absl::StatusOr<BendingModel> BendingFromProto(v1::Bending bending, std::string_v
       return BendingModel::kExact;
     case v1::LINEAR:
       return BendingModel::kLinear;
-    case v1::NONE:
+    case v1::Solver::NONE:
       return BendingModel::kNone;
     default:
       return UnknownEnumValue(path, bending, "EXACT, LINEAR or NONE");

@@ -31,6 +31,7 @@ GeneralizedAlphaStepper::GeneralizedAlphaStepper(MultibodyModel* model,
   n_ = model->dofs();
   m_ = model->multipliers();
   solver_.Resize(model->envelope(), model->jacobian_pattern());
+  solver_.Configure(settings.preconditioner, settings.accept_inexact_solves);
   jac_ = model->jacobian_pattern();
   z_ = model->initial_z();
   v_ = model->initial_v();
@@ -296,6 +297,8 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
     st.linear_iterations += ls.iterations;
     st.max_linear_residual = std::max(st.max_linear_residual, ls.relative_residual);
     st.direct_fallbacks += ls.fallback ? 1 : 0;
+    ++st.linear_solves;
+    st.inexact_solves += LinearSolveInexact(ls) ? 1 : 0;
     if (!LinearSolveGoodEnough(ls)) {
       st.reason = LinearSolveFailure(ls, settings_.linear_solver);
       if (reuse) refresh_ = true;

@@ -13,6 +13,7 @@ ImplicitEulerStepper::ImplicitEulerStepper(MultibodyModel* model, const SolverSe
   n_ = model->dofs();
   m_ = model->multipliers();
   solver_.Resize(model->envelope(), model->jacobian_pattern());
+  solver_.Configure(settings.preconditioner, settings.accept_inexact_solves);
   z_ = model->initial_z();
   v_ = model->initial_v();
   a_.setZero(n_);
@@ -189,6 +190,8 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
     st.linear_iterations += ls.iterations;
     st.max_linear_residual = std::max(st.max_linear_residual, ls.relative_residual);
     st.direct_fallbacks += ls.fallback ? 1 : 0;
+    ++st.linear_solves;
+    st.inexact_solves += LinearSolveInexact(ls) ? 1 : 0;
     if (!LinearSolveGoodEnough(ls)) {
       st.reason = LinearSolveFailure(ls, settings_.linear_solver);
       return st;

@@ -90,8 +90,15 @@ inline std::string NewtonFailure(int iterations, const NewtonIterate& it) {
 // inexact solve still gives a descent direction, a bad one does not.
 constexpr double kMaxLinearResidual = 1e-6;
 
+// A solve above that residual (a Krylov solve stopped by max_linear_iterations)
+// is inexact: refused unless solver.accept_inexact_solves (then it must at
+// least be finite), and counted either way.
+inline bool LinearSolveInexact(const SaddlePointSolver::Stats& ls) {
+  return !(ls.relative_residual <= kMaxLinearResidual);
+}
+
 inline bool LinearSolveGoodEnough(const SaddlePointSolver::Stats& ls) {
-  return ls.relative_residual <= kMaxLinearResidual;
+  return !LinearSolveInexact(ls) || (ls.accept_inexact && std::isfinite(ls.relative_residual));
 }
 
 inline std::string LinearSolveFailure(const SaddlePointSolver::Stats& ls,

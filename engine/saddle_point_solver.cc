@@ -21,6 +21,7 @@ void SaddlePointSolver::Resize(const std::vector<int>& envelope,
     schur_l_.setZero(m, m);
   }
   schur_diag_.setZero(m);
+  jacobi_.setZero(n);
   col_.setZero(n);
   tmp_.setZero(n + m);
   residual_.setZero(n + m);
@@ -77,6 +78,12 @@ bool SaddlePointSolver::Prepare() {
   // With positive pivots, (L|D|L^T)^{-1} = A^{-1}: the preconditioner's
   // blocks are the exact elimination's.
   const bool definite = a_.negative_pivots() == 0 && a_.small_pivots() == 0;
+  if (preconditioner_ == PreconditionerKind::kJacobi) {
+    for (int j = 0; j < a_.size(); ++j) {
+      const double d = std::abs(a_.values()[a_.Slot(j, j)]);
+      jacobi_(j) = d > 0 ? 1 / d : 1;
+    }
+  }
   const int m = b_.rows();
   if (m == 0) {
     direct_ready_ = definite;
@@ -103,7 +110,8 @@ bool SaddlePointSolver::Prepare() {
     schur_l_ = schur_;
     if (!CholeskyInPlace(schur_l_)) return false;
     direct_ready_ = definite;
-  } else {
+  }
+  if (!schur_dense_ || preconditioner_ == PreconditionerKind::kJacobi) {
     // diag(B diag(|A|)^{-1} B^T) as a cheap positive approximation.
     for (int r = 0; r < m; ++r) {
       double acc = 0;
@@ -128,6 +136,12 @@ void SaddlePointSolver::Multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) c
 void SaddlePointSolver::Precondition(const Eigen::VectorXd& r, Eigen::VectorXd& z) const {
   const int n = a_.size(), m = b_.rows();
   z = r;
+  if (preconditioner_ == PreconditionerKind::kNone) return;
+  if (preconditioner_ == PreconditionerKind::kJacobi) {
+    z.head(n).array() *= jacobi_.array();
+    if (m > 0) z.segment(n, m).array() /= schur_diag_.array();
+    return;
+  }
   a_.SolveAbs(z.data());
   if (m == 0) return;
   auto z2 = z.segment(n, m);
@@ -176,6 +190,7 @@ SaddlePointSolver::Stats SaddlePointSolver::Solve(LinearSolverKind kind_in,
                                                   int max_iterations, Eigen::VectorXd* x) {
   LinearSolverKind kind = Resolve(kind_in);
   Stats stats;
+  stats.accept_inexact = accept_inexact_;
   if (kind == LinearSolverKind::kDirect && !direct_ready_) {
     kind = LinearSolverKind::kMinres;
     stats.fallback = true;

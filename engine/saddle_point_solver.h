@@ -20,6 +20,12 @@
 // iterations whatever the step and the stiffness. After every solve the
 // true residual is computed and returned, never only the estimate.
 //
+// Preconditioner JACOBI replaces P by diag(|A_ii|, diag(B diag(|A|)^{-1}
+// B^T)), and NONE by the identity (plain MINRES or GMRES, as the paper ran
+// them); A is still factored (DIRECT needs it). Without the block
+// preconditioner a stiff system may need far more iterations than allowed:
+// Stats::accept_inexact tells the caller whether such a solve may be used.
+//
 // DIRECT is exact block elimination with the same two factorizations: when
 // A = L D L^T has only positive pivots (A positive definite, the usual case
 // for M + h^2 K_T) and the Schur complement S = B A^{-1} B^T is dense
@@ -55,7 +61,15 @@ class SaddlePointSolver {
     bool converged = false;
     bool fallback = false;  // DIRECT/AUTO could not eliminate: MINRES ran
     bool direct = false;    // solved by block elimination
+    bool accept_inexact = false;  // as configured (newton_convergence.h)
   };
+
+  // MINRES and GMRES preconditioner, and whether callers may accept a solve
+  // that stopped above their residual bound. Default BLOCK, false.
+  void Configure(PreconditionerKind preconditioner, bool accept_inexact) {
+    preconditioner_ = preconditioner;
+    accept_inexact_ = accept_inexact;
+  }
 
   void Resize(const std::vector<int>& envelope, const SparseRows& jacobian_pattern);
 
@@ -102,6 +116,9 @@ class SaddlePointSolver {
   // Eigen's LLT allocates a workspace for large matrices.
   Eigen::MatrixXd schur_l_;
   double gamma_ = 0;
+  PreconditionerKind preconditioner_ = PreconditionerKind::kBlock;
+  bool accept_inexact_ = false;
+  Eigen::VectorXd jacobi_;  // 1 / |A_ii| (JACOBI)
   Eigen::VectorXd augmented_rhs_;
   bool schur_dense_ = true;
   bool direct_ready_ = false;

@@ -28,6 +28,8 @@ enum class Integrator { kImplicitEuler, kGeneralizedAlpha, kHht };
 // kDirect: exact block elimination (skyline LDL^T of the Newton block and a
 // dense Schur complement); kAuto: picked per scene (SaddlePointSolver).
 enum class LinearSolverKind { kMinres, kGmres, kDirect, kAuto };
+// What preconditions MINRES and GMRES (engine/saddle_point_solver.h).
+enum class PreconditionerKind { kBlock, kJacobi, kNone };
 // Where a DYNAMIC run starts: the scene as laid out, or its static
 // equilibrium under gravity and loads (StaticSolver).
 enum class InitialState { kAsGiven, kStatic };
@@ -161,6 +163,12 @@ struct SolverSettings {
   int max_step_halvings = 12;
   double linear_tolerance = 1e-10;
   int max_linear_iterations = 200;
+  // MINRES and GMRES: the preconditioner, and whether a DYNAMIC Newton step
+  // may use a solve whose true relative residual stayed above
+  // kMaxLinearResidual (engine/newton_convergence.h) after
+  // max_linear_iterations; such solves are counted in the summary.
+  PreconditionerKind preconditioner = PreconditionerKind::kBlock;
+  bool accept_inexact_solves = false;
   // MODAL: number of lowest modes; 0 means the default (10, or every degree
   // of freedom when there are fewer).
   int modes = 0;

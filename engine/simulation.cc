@@ -296,6 +296,8 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     summary->linear_iterations += st.linear_iterations;
     summary->factorizations += st.factorizations;
     summary->direct_fallbacks += st.direct_fallbacks;
+    summary->linear_solves += st.linear_solves;
+    summary->inexact_linear_solves += st.inexact_solves;
     summary->max_linear_residual = std::max(summary->max_linear_residual, st.max_linear_residual);
     if (st.converged && check_steps && st.newton_iterations >= kEnergyCheckNewton) {
       // A step Newton found hard may have landed on a spurious root (an

@@ -163,6 +163,12 @@ struct RunSummary {
   std::string linear_solver_used;  // what AUTO resolved to (else linear_solver)
   int64_t factorizations = 0;      // Newton matrices assembled and factored
   int64_t direct_fallbacks = 0;    // DIRECT solves that had to run MINRES
+  // Newton-step linear solves (linear_iterations / linear_solves is the
+  // Krylov cost per solve), and those whose true relative residual stayed
+  // above 1e-6: accepted with solver.accept_inexact_solves, else refused
+  // (the step was halved).
+  int64_t linear_solves = 0;
+  int64_t inexact_linear_solves = 0;
   double max_step_s = 0;           // largest step taken
   bool adaptive = false;
   double rho_infinity = 0;         // GENERALIZED_ALPHA and HHT

@@ -34,6 +34,8 @@ class Stepper {
     int linear_iterations = 0;
     int factorizations = 0;            // Newton matrices assembled and factored
     int direct_fallbacks = 0;          // DIRECT solves that had to run MINRES
+    int linear_solves = 0;             // Newton-step linear solves
+    int inexact_solves = 0;            // accepted above kMaxLinearResidual
     double residual = 0;               // relative momentum residual accepted
     double residual_floor = 0;         // its rounding floor (newton_convergence.h)
     double max_linear_residual = 0;    // largest true relative residual
