@@ -19,6 +19,7 @@ v1::ModelInfo ModelInfoToProto(const ModelInfo& info) {
   for (const int n : info.cable_nodes) p.add_cable_nodes(n);
   for (const double s : info.node_s) p.add_node_arc_lengths(s);
   p.set_shape(info.shape);
+  p.set_contact(info.contact);
   return p;
 }
 
@@ -37,6 +38,7 @@ ModelInfo ModelInfoFromProto(const v1::ModelInfo& p) {
   info.cable_nodes.assign(p.cable_nodes().begin(), p.cable_nodes().end());
   info.node_s.assign(p.node_arc_lengths().begin(), p.node_arc_lengths().end());
   info.shape = p.shape();
+  info.contact = p.contact();
   return info;
 }
 

@@ -328,6 +328,7 @@ class SceneConverter {
     }
     CABLESIM_RETURN_IF_ERROR(ConvertInitialVelocity());
     CABLESIM_RETURN_IF_ERROR(ConvertFluid());
+    CABLESIM_RETURN_IF_ERROR(ConvertSeabed());
     CABLESIM_RETURN_IF_ERROR(ConvertSolver());
     return std::move(scene_);
   }
@@ -773,6 +774,36 @@ class SceneConverter {
     scene_.fluid.density_kg_m3 = f.density();
     CABLESIM_ASSIGN_OR_RETURN(scene_.fluid.current_m_s,
                               VectorInRange("fluid.current", f.current(), plausible::kVelocity));
+    return absl::OkStatus();
+  }
+
+  absl::Status ConvertSeabed() {
+    if (!proto_.has_seabed()) return absl::OkStatus();
+    const v1::Seabed& b = proto_.seabed();
+    SeabedSpec& spec = scene_.seabed;
+    spec.enabled = true;
+    CABLESIM_RETURN_IF_ERROR(CheckRange("seabed.depth", b.depth(), plausible::kCoordinate));
+    spec.depth_m = b.depth();
+    if (b.has_normal()) {
+      CABLESIM_ASSIGN_OR_RETURN(spec.normal, Direction("seabed.normal", b.normal()));
+    } else if (scene_.gravity_m_s2.norm() > 0) {
+      spec.normal = -scene_.gravity_m_s2.normalized();
+    } else {
+      return Invalid("seabed.normal", "must be given when gravity is zero");
+    }
+    CABLESIM_RETURN_IF_ERROR(CheckPositive("seabed.stiffness", b.stiffness()));
+    spec.stiffness_n_m2 = b.stiffness();
+    CABLESIM_RETURN_IF_ERROR(CheckNonNegative("seabed.damping", b.damping()));
+    spec.damping_n_s_m2 = b.damping();
+    CABLESIM_RETURN_IF_ERROR(CheckNonNegative("seabed.friction_axial", b.friction_axial()));
+    spec.friction_axial = b.friction_axial();
+    CABLESIM_RETURN_IF_ERROR(
+        CheckNonNegative("seabed.friction_transverse", b.friction_transverse()));
+    spec.friction_transverse = b.friction_transverse();
+    if (b.friction_speed() != 0) {
+      CABLESIM_RETURN_IF_ERROR(CheckPositive("seabed.friction_speed", b.friction_speed()));
+      spec.friction_speed_m_s = b.friction_speed();
+    }
     return absl::OkStatus();
   }
 

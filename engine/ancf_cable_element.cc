@@ -5,31 +5,9 @@
 
 #include <Eigen/Geometry>
 
+#include "engine/hermite_shape.h"
+
 namespace cablesim {
-namespace {
-
-// Cubic Hermite functions (eq. 3) and their x-derivatives (eq. 25, 26).
-void Shape(double xi, double l, double s[4]) {
-  const double xi2 = xi * xi, xi3 = xi2 * xi;
-  s[0] = 1 - 3 * xi2 + 2 * xi3;
-  s[1] = l * (xi - 2 * xi2 + xi3);
-  s[2] = 3 * xi2 - 2 * xi3;
-  s[3] = l * (xi3 - xi2);
-}
-void ShapeD1(double xi, double l, double s[4]) {
-  s[0] = (-6 * xi + 6 * xi * xi) / l;
-  s[1] = 1 - 4 * xi + 3 * xi * xi;
-  s[2] = (6 * xi - 6 * xi * xi) / l;
-  s[3] = 3 * xi * xi - 2 * xi;
-}
-void ShapeD2(double xi, double l, double s[4]) {
-  s[0] = (-6 + 12 * xi) / (l * l);
-  s[1] = (-4 + 6 * xi) / l;
-  s[2] = (6 - 12 * xi) / (l * l);
-  s[3] = (6 * xi - 2) / l;
-}
-
-}  // namespace
 
 template <int D>
 AncfCableElement<D>::AncfCableElement(double length_m, double ea_n, double ei_n_m2,
@@ -37,9 +15,9 @@ AncfCableElement<D>::AncfCableElement(double length_m, double ea_n, double ei_n_
     : length_(length_m), ea_(ea_n), ei_(ei_n_m2), bending_(bending),
       rule_(MakeGaussRule(gauss_points)) {
   for (int g = 0; g < rule_.n; ++g) {
-    Shape(rule_.xi[g], length_, s0_[g]);
-    ShapeD1(rule_.xi[g], length_, d1_[g]);
-    ShapeD2(rule_.xi[g], length_, d2_[g]);
+    HermiteShape(rule_.xi[g], length_, s0_[g]);
+    HermiteShapeD1(rule_.xi[g], length_, d1_[g]);
+    HermiteShapeD2(rule_.xi[g], length_, d2_[g]);
   }
 }
 
@@ -78,7 +56,7 @@ template <int D>
 typename AncfCableElement<D>::Point AncfCableElement<D>::Position(const Coords& e,
                                                                   double xi) const {
   double s[4];
-  Shape(xi, length_, s);
+  HermiteShape(xi, length_, s);
   Point r = Point::Zero();
   for (int k = 0; k < 4; ++k) r += s[k] * e.template segment<D>(k * D);
   return r;
@@ -88,7 +66,7 @@ template <int D>
 typename AncfCableElement<D>::Point AncfCableElement<D>::Slope(const Coords& e,
                                                                double xi) const {
   double s[4];
-  ShapeD1(xi, length_, s);
+  HermiteShapeD1(xi, length_, s);
   Point r = Point::Zero();
   for (int k = 0; k < 4; ++k) r += s[k] * e.template segment<D>(k * D);
   return r;

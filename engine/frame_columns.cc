@@ -32,6 +32,7 @@ std::vector<std::string> FrameColumns(const ModelInfo& info, bool with_nodes) {
   for (const std::string& name : info.force_probe_names) {
     for (const char* c : {"fx", "fy", "fz"}) columns.push_back(absl::StrCat(name, ".", c));
   }
+  if (info.contact) columns.push_back("energy.contact");
   if (!info.shape || !with_nodes) return columns;
   for (size_t i = 0; i < info.cable_nodes.size(); ++i) {
     for (int k = 0; k < info.cable_nodes[i]; ++k) {
@@ -56,7 +57,8 @@ FrameReader::FrameReader(const ModelInfo& info, absl::Span<const std::string> co
       cables_(static_cast<int>(info.cable_names.size())),
       bodies_(static_cast<int>(info.body_names.size())),
       forces_(static_cast<int>(info.force_probe_names.size())),
-      nodes_(info.shape ? static_cast<int>(info.node_s.size()) : 0) {
+      nodes_(info.shape ? static_cast<int>(info.node_s.size()) : 0),
+      contact_(info.contact) {
   absl::flat_hash_map<std::string_view, int> column;
   for (size_t i = 0; i < columns.size(); ++i) column.emplace(columns[i], static_cast<int>(i));
   for (const std::string& name : FrameColumns(info)) {
@@ -71,6 +73,7 @@ void FrameReader::Read(absl::Span<const double> row, Frame* frame) const {
   frame->energy_parts.bodies.resize(bodies_);
   frame->support_forces.resize(forces_);
   frame->nodes.resize(nodes_);
+  frame->has_contact = contact_;
   size_t k = 0;
   auto read = [&](double& value) {
     const int i = index_[k++];

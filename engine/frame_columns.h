@@ -15,6 +15,7 @@
 //   loads.energy.potential
 //   per probe on a moving support (ModelInfo::force_probe_names)
 //                NAME.fx NAME.fy NAME.fz
+//   with a seabed (ModelInfo::contact)  energy.contact
 //   with output.shape (ModelInfo::shape), per cable i and node k
 //                cables[i].nodes[k].x cables[i].nodes[k].y cables[i].nodes[k].z
 //
@@ -50,10 +51,11 @@ std::vector<std::string> FrameColumns(const ModelInfo& info, bool with_nodes = t
 
 // The numbers in a row.
 // `force_probes` are the probes on a moving support (3 numbers each).
+// `contact`: the scene has a seabed (one more number, energy.contact).
 inline int64_t FrameRowSize(int64_t probes, int64_t cables, int64_t bodies,
-                            int64_t force_probes = 0) {
+                            int64_t force_probes = 0, bool contact = false) {
   return 1 + kValuesPerProbe * probes + kTotalValues + kValuesPerCable * cables +
-         kValuesPerBody * bodies + 1 + 3 * force_probes;
+         kValuesPerBody * bodies + 1 + 3 * force_probes + (contact ? 1 : 0);
 }
 
 // Calls add(value) for every number of `frame`'s row, in column order.
@@ -89,6 +91,7 @@ void ForEachFrameValue(FrameT& frame, Add&& add) {
   for (auto& f : frame.support_forces) {
     for (int k = 0; k < 3; ++k) add(f[k]);
   }
+  if (frame.has_contact) add(e.contact);
 }
 
 // Calls add(value) for x, y, z of every node of `frame` (empty without
@@ -122,6 +125,7 @@ class FrameReader {
  private:
   int row_size_ = 0;
   int probes_ = 0, cables_ = 0, bodies_ = 0, forces_ = 0, nodes_ = 0;
+  bool contact_ = false;
   // The column of every number of ForEachFrameValue's and then
   // ForEachNodeValue's order, or -1.
   std::vector<int> index_;

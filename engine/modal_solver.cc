@@ -443,6 +443,7 @@ void RunModalAnalysis(MultibodyModel* model, const SolverSettings& settings, int
   frame.energy = model->Energy(q, zero, 1.0, &frame.energy_parts);
   // MODAL reports no support forces: their columns hold 0.
   frame.support_forces.assign(model->force_probe_count(), Eigen::Vector3d::Zero());
+  frame.has_contact = model->seabed() != nullptr;
   frame.constraint_violation = phi.size() ? phi.lpNorm<Eigen::Infinity>() : 0.0;
   summary->energy_initial = summary->energy_final = frame.energy.total;
   summary->max_constraint_violation = frame.constraint_violation;
@@ -482,6 +483,7 @@ void RunModalAnalysis(MultibodyModel* model, const SolverSettings& settings, int
     mode.energy_parts.cables.resize(frame.energy_parts.cables.size());
     mode.energy_parts.bodies.resize(frame.energy_parts.bodies.size());
     mode.support_forces.assign(model->force_probe_count(), Eigen::Vector3d::Zero());
+    mode.has_contact = frame.has_contact;
     mode.probes.resize(samples.size());
     for (size_t p = 0; p < samples.size(); ++p)
       mode.probes[p].position_m = scale * samples[p].velocity_m_s;

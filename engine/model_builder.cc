@@ -624,6 +624,10 @@ void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* 
 
 void ModelBuilder::BuildElements() {
   model_.current_ = scene_.fluid.current_m_s;
+  if (scene_.seabed.enabled) {
+    model_.seabed_.emplace(scene_.seabed);
+    if (model_.seabed_->dissipates()) model_.has_damping_ = true;
+  }
   if (model_.dim_ == 2) {
     BuildElementsOf<2>(&model_.elements2_);
   } else {

@@ -64,6 +64,8 @@ std::string OutOfPlaneField(const Scene& scene) {
   if (auto f = Z("initial_velocity.linear", iv.linear_m_s); !f.empty()) return f;
   if (auto f = NotAboutZ("initial_velocity.angular", iv.angular_rad_s); !f.empty()) return f;
   if (auto f = Z("fluid.current", scene.fluid.current_m_s); !f.empty()) return f;
+  if (scene.seabed.enabled)
+    if (auto f = Z("seabed.normal", scene.seabed.normal); !f.empty()) return f;
   return "";
 }
 

@@ -213,6 +213,7 @@ ModelInfo MultibodyModel::Info() const {
   info.cable_nodes = cable_nodes_;
   info.node_s = node_s_;
   info.shape = shape_;
+  info.contact = seabed_.has_value();
   return info;
 }
 
@@ -243,6 +244,10 @@ double MultibodyModel::ElementForces(const VectorXd& q, VectorXd* full, SkylineL
     if (roundoff) re.setZero();
     e.element.ElasticForce(q.segment<kN>(e.first_coord), &fe, stiffness ? &ke : nullptr,
                            roundoff ? &re : nullptr);
+    // The seabed's force, like the elastic one, is the gradient of an energy.
+    if (seabed_)
+      seabed_->AddPotential<D>(q.segment<kN>(e.first_coord), e.element.length(), &fe,
+                               stiffness ? &ke : nullptr, roundoff ? &re : nullptr);
     full->segment<kN>(e.first_coord) -= fe;
     // The element's own bound, and the rounding of adding it to the node.
     if (roundoff) roundoff->segment<kN>(e.first_coord) += re + kEps * fe.cwiseAbs();
@@ -326,9 +331,10 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
   typename AncfCableElement<D>::Coords fe;
   double size = 0;
   double* values = tangent ? tangent->values() : nullptr;
+  const bool bed = seabed_ && seabed_->dissipates();
   for (size_t k = 0; k < elements.size(); ++k) {
     const ElementData<D>& e = elements[k];
-    if (!e.damped()) continue;
+    if (!e.damped() && !bed) continue;
     ce.setZero();
     if (e.axial_damping_s != 0 || e.bending_damping_s != 0)
       e.element.AddDampingMatrix(q.segment<kN>(e.first_coord), e.axial_damping_s,
@@ -341,6 +347,8 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
     if (e.drag_n != 0 || e.drag_t != 0)
       e.element.AddDrag(q.segment<kN>(e.first_coord), ve, current_.head<D>(), e.drag_n, e.drag_t,
                         &fe, &ce);
+    if (bed)
+      seabed_->AddDissipation<D>(q.segment<kN>(e.first_coord), ve, e.element.length(), &fe, &ce);
     if (power) *power -= ve.dot(fe);
     if (full) full->segment<kN>(e.first_coord) += fe;
     size = std::max(size, fe.template lpNorm<Eigen::Infinity>());
@@ -513,6 +521,7 @@ void MultibodyModel::ElementEnergy(const VectorXd& q, const VectorXd& qdot, Ener
     en->kinetic += kinetic;
     en->axial += se.axial;
     en->bending += se.bending;
+    if (seabed_) en->contact += seabed_->Energy<D>(qe, e.element.length());
     if (parts == nullptr) continue;
     while (static_cast<int>(k) >= cable_element_begin_[cable + 1]) ++cable;
     PartEnergy* part = &parts->cables[cable];
@@ -560,7 +569,7 @@ EnergySample MultibodyModel::Energy(const VectorXd& q, const VectorXd& qdot, dou
   // Torques, time-varying loads, moving supports: their work so far
   // (AccumulateExternalWork).
   en.potential -= external_work_;
-  en.total = en.kinetic + en.potential + en.axial + en.bending;
+  en.total = en.kinetic + en.potential + en.axial + en.bending + en.contact;
   if (parts != nullptr) {
     // The element gravity above is at load factor 1 (statics scales it).
     for (PartEnergy& part : parts->cables) part.gravity *= load_factor;
@@ -653,6 +662,37 @@ Eigen::Vector3d MultibodyModel::AngularMomentum(const VectorXd& q, const VectorX
     }
   }
   return l;
+}
+
+template <int D>
+Eigen::Vector3d MultibodyModel::CablePositionOf(const VectorXd& q, int cable, double s,
+                                                Vector3d* slope) const {
+  constexpr int kN = 4 * D;
+  const auto& elements = Elements<D>();
+  Vector3d r = Vector3d::Zero();
+  const int begin = cable_element_begin_[cable], end = cable_element_begin_[cable + 1];
+  double start = 0;
+  for (int k = begin; k < end; ++k) {
+    const ElementData<D>& e = elements[k];
+    const double l = e.element.length();
+    if (s <= start + l || k + 1 == end) {
+      const double xi = std::clamp((s - start) / l, 0.0, 1.0);
+      r.head<D>() = e.element.Position(q.segment<kN>(e.first_coord), xi);
+      if (slope) {
+        slope->setZero();
+        slope->head<D>() = e.element.Slope(q.segment<kN>(e.first_coord), xi);
+      }
+      return r;
+    }
+    start += l;
+  }
+  return r;
+}
+
+Eigen::Vector3d MultibodyModel::CablePosition(const VectorXd& q, int cable, double s,
+                                              Vector3d* slope) const {
+  return dim_ == 2 ? CablePositionOf<2>(q, cable, s, slope)
+                   : CablePositionOf<3>(q, cable, s, slope);
 }
 
 void MultibodyModel::NodePositions(const VectorXd& q, std::vector<Vector3d>* out) const {

@@ -40,6 +40,7 @@
 
 #include <array>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,7 @@
 
 #include "absl/status/statusor.h"
 #include "engine/ancf_cable_element.h"
+#include "engine/forces/seabed.h"
 #include "engine/quadratic_form.h"
 #include "engine/scene.h"
 #include "engine/simulation.h"
@@ -233,6 +235,16 @@ class MultibodyModel {
   // m r_c x rdot_c + sum_k Jb_k e_k x edot_k. Planar models return (0, 0, L_z).
   Eigen::Vector3d AngularMomentum(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot) const;
 
+  // The position [m] at undeformed arc length s [m] along cable `cable`
+  // (scene order), from full coordinates q: the element's cubic there;
+  // its slope dr/ds [-] into `slope` when not null.
+  Eigen::Vector3d CablePosition(const Eigen::VectorXd& q, int cable, double s,
+                                Eigen::Vector3d* slope = nullptr) const;
+
+  // The scene's seabed (engine/forces/seabed.h), or null: a scene without
+  // one holds no seabed object, and its force loops only test this.
+  const Seabed* seabed() const { return seabed_ ? &*seabed_ : nullptr; }
+
   // Whether frames carry the nodes' positions (the scene's output.shape).
   bool shape() const { return shape_; }
   // Every cable node's position [m] from full coordinates q (a split node
@@ -354,6 +366,9 @@ class MultibodyModel {
   void ElementEnergy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, EnergySample* en,
                      EnergyParts* parts) const;
   template <int D>
+  Eigen::Vector3d CablePositionOf(const Eigen::VectorXd& q, int cable, double s,
+                                  Eigen::Vector3d* slope) const;
+  template <int D>
   Eigen::Vector3d ElementAngularMomentum(const Eigen::VectorXd& q,
                                          const Eigen::VectorXd& qdot) const;
   double RowValue(const Row& row, const Eigen::VectorXd& q) const;
@@ -411,6 +426,7 @@ class MultibodyModel {
   double energy_roundoff_ = 0;
   bool has_damping_ = false;
   Eigen::Vector3d current_ = Eigen::Vector3d::Zero();  // the fluid's [m/s]
+  std::optional<Seabed> seabed_;  // only in a scene with a seabed
 
   std::vector<Row> rows_;
   std::vector<int> row_coord_;

@@ -144,6 +144,23 @@ struct FluidSpec {
   Eigen::Vector3d current_m_s = Eigen::Vector3d::Zero();
 };
 
+// A seabed the cables lie on (MultibodyModel, engine/forces/seabed.h): the
+// plane of points r with normal . r = -depth_m, the normal pointing out of
+// the bed into the water. Contact is a distributed spring and damper per
+// unit undeformed cable length; Coulomb friction acts in the bed's plane.
+struct SeabedSpec {
+  bool enabled = false;  // false: no seabed (and no seabed object)
+  double depth_m = 0;
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitY();  // unit
+  double stiffness_n_m2 = 0;   // [N/m per m of penetration per m of cable]
+  double damping_n_s_m2 = 0;   // [N s/m per m of cable]
+  double friction_axial = 0;       // Coulomb coefficient along the cable [-]
+  double friction_transverse = 0;  // across the cable, in the bed's plane [-]
+  // Sliding speed [m/s] below which friction is regularised (the friction
+  // force grows as v / sqrt(v^2 + friction_speed^2)).
+  double friction_speed_m_s = 1e-3;
+};
+
 struct InitialVelocitySpec {
   Eigen::Vector3d linear_m_s = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_rad_s = Eigen::Vector3d::Zero();
@@ -209,6 +226,7 @@ struct Scene {
   SolverSettings solver;
   OutputSpec output;
   FluidSpec fluid;
+  SeabedSpec seabed;
 };
 
 }  // namespace cablesim

@@ -41,6 +41,8 @@ struct ModelInfo {
   std::vector<double> node_s;
   // Whether frames carry Frame::nodes (the scene's output.shape).
   bool shape = false;
+  // Whether the scene has a seabed: frames then carry energy.contact.
+  bool contact = false;
 };
 
 struct ProbeSample {
@@ -59,12 +61,16 @@ struct EnergySample {
   double potential = 0;
   double axial = 0;
   double bending = 0;
-  double total = 0;  // kinetic + potential + axial + bending
+  double total = 0;  // kinetic + potential + axial + bending + contact
   // Work done against damping since t = 0 (>= 0, not part of `total`): the
   // dissipated power qdot^T C qdot (MultibodyModel::DampingPower) integrated
   // by the trapezoidal rule over the accepted steps, and from a step's start
   // to a frame inside it. 0 without damping.
   double damped = 0;
+  // Elastic energy stored in the seabed (engine/forces/seabed.h), part of
+  // `total`; 0 without one. (Last, so that aggregate initialisers of the
+  // fields above keep their meaning.)
+  double contact = 0;
 };
 
 // The energy of one cable or one body [J]. `gravity` is the potential of
@@ -113,6 +119,8 @@ struct Frame {
   // In a MODAL shape frame, the nodes' displacement in the mode (scaled as
   // the probes').
   std::vector<Eigen::Vector3d> nodes;
+  // Whether the row carries energy.contact (ModelInfo::contact).
+  bool has_contact = false;
 };
 
 class FrameSink {

@@ -1,0 +1,121 @@
+#include "engine/forces/waves.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <random>
+
+namespace cablesim {
+
+double WaveField::Wavenumber(double omega, double depth, double g) {
+  if (!(omega > 0)) return 0;
+  const double w2 = omega * omega;
+  // g k tanh(k h) lies below both g k and g h k^2, so the root lies above
+  // both their roots (f(lo) <= 0); hi doubles until f(hi) > 0. Newton,
+  // falling back to bisection when it leaves the bracket.
+  auto f = [&](double k) { return g * k * std::tanh(k * depth) - w2; };
+  double lo = std::max(w2 / g, omega / std::sqrt(g * depth)), hi = 2 * lo;
+  while (f(hi) <= 0) hi *= 2;
+  double k = lo;
+  for (int it = 0; it < 200; ++it) {
+    const double th = std::tanh(k * depth);
+    const double fk = g * k * th - w2;
+    if (std::abs(fk) <= 1e-14 * w2) return k;
+    if (fk > 0) {
+      hi = k;
+    } else {
+      lo = k;
+    }
+    const double df = g * th + g * k * depth * (1 - th * th);
+    double next = k - fk / df;
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    k = next;
+  }
+  return k;
+}
+
+double WaveField::JonswapShape(double omega, double omega_p, double gamma, double g) {
+  if (!(omega > 0)) return 0;
+  const double sigma = omega <= omega_p ? 0.07 : 0.09;
+  const double x = (omega - omega_p) / (sigma * omega_p);
+  const double r = std::exp(-0.5 * x * x);
+  const double ratio = omega_p / omega;
+  return g * g / std::pow(omega, 5) * std::exp(-1.25 * std::pow(ratio, 4)) * std::pow(gamma, r);
+}
+
+WaveField::WaveField(const Eigen::Vector3d& up, double surface, double depth, double g,
+                     double ramp_s)
+    : up_(up.normalized()), surface_(surface), depth_(depth), g_(g), ramp_s_(ramp_s) {}
+
+Eigen::Vector3d WaveField::Horizontal(const Eigen::Vector3d& direction) const {
+  const Eigen::Vector3d d = direction - up_.dot(direction) * up_;
+  return d.normalized();
+}
+
+void WaveField::AddRegular(double height_m, double period_s, const Eigen::Vector3d& direction,
+                           double phase_rad) {
+  Component c;
+  c.amplitude_m = 0.5 * height_m;
+  c.omega_rad_s = 2 * std::numbers::pi / period_s;
+  c.wavenumber_1_m = Wavenumber(c.omega_rad_s, depth_, g_);
+  c.direction = Horizontal(direction);
+  c.phase_rad = phase_rad;
+  components_.push_back(c);
+}
+
+void WaveField::AddJonswap(double hs_m, double tp_s, double gamma,
+                           const Eigen::Vector3d& direction, int components, uint64_t seed) {
+  const double omega_p = 2 * std::numbers::pi / tp_s;
+  const double lo = 0.5 * omega_p, hi = 3.5 * omega_p;
+  const double dw = (hi - lo) / components;
+  double m0 = 0;  // sum S_i dw at alpha = 1
+  for (int i = 0; i < components; ++i)
+    m0 += JonswapShape(lo + (i + 0.5) * dw, omega_p, gamma, g_) * dw;
+  const double alpha = hs_m * hs_m / (16 * m0);
+  std::mt19937_64 random(seed);
+  const Eigen::Vector3d d = Horizontal(direction);
+  for (int i = 0; i < components; ++i) {
+    Component c;
+    c.omega_rad_s = lo + (i + 0.5) * dw;
+    c.amplitude_m = std::sqrt(2 * alpha * JonswapShape(c.omega_rad_s, omega_p, gamma, g_) * dw);
+    c.wavenumber_1_m = Wavenumber(c.omega_rad_s, depth_, g_);
+    c.direction = d;
+    // 53 random bits, uniform in [0, 1).
+    c.phase_rad = 2 * std::numbers::pi * static_cast<double>(random() >> 11) * 0x1.0p-53;
+    components_.push_back(c);
+  }
+}
+
+WaveField::Kinematics WaveField::At(const Eigen::Vector3d& r, double t) const {
+  Kinematics out;
+  double ramp = 1, ramp_rate = 0;
+  if (ramp_s_ > 0 && t < ramp_s_) {
+    if (t <= 0) return out;
+    const double x = std::numbers::pi * t / ramp_s_;
+    ramp = 0.5 * (1 - std::cos(x));
+    ramp_rate = 0.5 * std::numbers::pi / ramp_s_ * std::sin(x);
+  }
+  const double z = std::clamp(up_.dot(r) - surface_, -depth_, 0.0);
+  Eigen::Vector3d u = Eigen::Vector3d::Zero(), a = Eigen::Vector3d::Zero();
+  double eta = 0;
+  for (const Component& c : components_) {
+    const double k = c.wavenumber_1_m, w = c.omega_rad_s;
+    const double theta = k * c.direction.dot(r) - w * t + c.phase_rad;
+    const double cs = std::cos(theta), sn = std::sin(theta);
+    // cosh(k (z + h)) / sinh(k h) and sinh(k (z + h)) / sinh(k h) in a form
+    // that neither overflows in deep water nor loses digits.
+    const double e1 = std::exp(k * z), e2 = std::exp(-2 * k * (z + depth_)),
+                 e3 = std::exp(-2 * k * depth_);
+    const double ch = e1 * (1 + e2) / (1 - e3), sh = e1 * (1 - e2) / (1 - e3);
+    const double aw = c.amplitude_m * w;
+    eta += c.amplitude_m * cs;
+    u += (aw * ch * cs) * c.direction + (aw * sh * sn) * up_;
+    a += (aw * w * ch * sn) * c.direction - (aw * w * sh * cs) * up_;
+  }
+  out.elevation_m = ramp * eta;
+  out.velocity_m_s = ramp * u;
+  out.acceleration_m_s2 = ramp * a + ramp_rate * u;
+  return out;
+}
+
+}  // namespace cablesim

@@ -1,0 +1,105 @@
+#ifndef CABLESIM_ENGINE_FORCES_WAVES_H_
+#define CABLESIM_ENGINE_FORCES_WAVES_H_
+
+// Linear (Airy) wave kinematics at finite depth: the fluid velocity and
+// acceleration under a sum of regular wave components (Dean and Dalrymple,
+// Water Wave Mechanics for Engineers and Scientists, 1991, ch. 3-4).
+//
+// Geometry: `up` is the unit vertical (the opposite of gravity), the still
+// water level is up . r = surface, the bed is at depth h below it. A point
+// r has elevation z = up . r - surface in [-h, 0] (points above the still
+// level are evaluated at z = 0, points below the bed at z = -h: no
+// stretching). Each component i has amplitude a_i [m], angular frequency
+// omega_i [rad/s], wavenumber k_i from the dispersion relation
+//
+//   omega^2 = g k tanh(k h)                               (Dean eq. 4.22)
+//
+// solved by Newton to a relative residual below 1e-10, a horizontal unit
+// direction d_i and a phase phi_i; with theta = k d . x - omega t + phi
+// (x the horizontal position),
+//
+//   eta  = a cos(theta)
+//   u_h  = a omega cosh(k (z + h)) / sinh(k h) cos(theta) d
+//   u_z  = a omega sinh(k (z + h)) / sinh(k h) sin(theta) up
+//   du/dt: the time derivative at the fixed point, a omega^2 (...) sin and
+//          -a omega^2 (...) cos.                           (Dean eq. 4.13)
+//
+// A ramp-in over T_r multiplies everything by R(t) = (1 - cos(pi t / T_r)) / 2
+// for t < T_r (and adds R'(t) u to the acceleration).
+//
+// Irregular seas: JONSWAP (Hasselmann et al. 1973; DNV-RP-C205 eq. 3.5.5)
+//
+//   S(omega) = alpha g^2 omega^-5 exp(-5/4 (omega_p / omega)^4) gamma^r,
+//   r = exp(-(omega - omega_p)^2 / (2 sigma^2 omega_p^2)),
+//   sigma = 0.07 (omega <= omega_p), 0.09 (above),
+//
+// with alpha scaled so that 4 sqrt(m0) = Hs over the components; N
+// components at the midpoints of equal bins over [0.5, 3.5] omega_p, each of
+// amplitude sqrt(2 S(omega_i) d omega) and a phase uniform in [0, 2 pi)
+// from a seeded 64-bit Mersenne twister (std::mt19937_64, whose output is
+// fixed by the C++ standard, so a seed gives the same sea everywhere).
+//
+// Units SI.
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace cablesim {
+
+class WaveField {
+ public:
+  struct Component {
+    double amplitude_m = 0;
+    double omega_rad_s = 0;
+    double wavenumber_1_m = 0;
+    Eigen::Vector3d direction = Eigen::Vector3d::UnitX();  // horizontal, unit
+    double phase_rad = 0;
+  };
+  struct Kinematics {
+    Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();
+    Eigen::Vector3d acceleration_m_s2 = Eigen::Vector3d::Zero();
+    double elevation_m = 0;  // of the surface above the point's (x, y)
+  };
+
+  // The wavenumber k [1/m] of angular frequency omega [rad/s] in water of
+  // depth h [m] under gravity g [m/s^2]: omega^2 = g k tanh(k h), by Newton
+  // from the deep-water value, to a relative residual below 1e-10.
+  static double Wavenumber(double omega, double depth, double g);
+
+  // The JONSWAP spectral density [m^2 s] without its alpha scaling (alpha =
+  // 1), peak angular frequency omega_p, peak factor gamma.
+  static double JonswapShape(double omega, double omega_p, double gamma, double g);
+
+  // `up` the unit vertical, `surface` the still water level along it [m],
+  // `depth` h [m], `g` [m/s^2], `ramp_s` T_r (0: none).
+  WaveField(const Eigen::Vector3d& up, double surface, double depth, double g, double ramp_s);
+
+  // A regular wave of height H = 2 a [m], period [s], horizontal direction
+  // (projected onto the horizontal plane and normalised) and phase [rad].
+  void AddRegular(double height_m, double period_s, const Eigen::Vector3d& direction,
+                  double phase_rad);
+
+  // A JONSWAP sea of significant height Hs [m], peak period Tp [s], peak
+  // factor gamma (3.3 typical), along `direction`, from `components`
+  // components and `seed`.
+  void AddJonswap(double hs_m, double tp_s, double gamma, const Eigen::Vector3d& direction,
+                  int components, uint64_t seed);
+
+  const std::vector<Component>& components() const { return components_; }
+
+  // The kinematics at point r [m] and time t [s]. Allocates nothing.
+  Kinematics At(const Eigen::Vector3d& r, double t) const;
+
+ private:
+  Eigen::Vector3d Horizontal(const Eigen::Vector3d& direction) const;
+
+  Eigen::Vector3d up_;
+  double surface_ = 0, depth_ = 0, g_ = 9.81, ramp_s_ = 0;
+  std::vector<Component> components_;
+};
+
+}  // namespace cablesim
+
+#endif  // CABLESIM_ENGINE_FORCES_WAVES_H_
