@@ -154,5 +154,25 @@ TEST(SlidingJointTest, ValidationNamesTheField) {
   EXPECT_THAT(summary.status().message(), HasSubstr("joints[2]: the body point is"));
 }
 
+// The sample zip line runs; its trolley descends along the line past the
+// middle, and friction's work (energy.damped) is what the run lost beyond
+// HHT's own numerical dissipation: total + damped never exceeds the
+// initial energy (1e-9 relative: rounding).
+TEST(SlidingJointTest, ZipLineSceneRuns) {
+  auto proto = ReadSceneFile(absl::StrCat(CABLESIM_SOURCE_DIR, "/scenes/zip-line.json"));
+  ASSERT_TRUE(proto.ok()) << proto.status();
+  auto scene = SceneFromProto(*proto);
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  CollectingSink sink;
+  RunOk(*scene, &sink);
+  const int p = ProbeIndex(sink.info(), "trolley");
+  ASSERT_GE(p, 0);
+  EXPECT_GT(sink.frames().back().probes[p].position_m.x(), 20);
+  const double initial = sink.frames().front().energy.total;
+  for (const Frame& f : sink.frames())
+    EXPECT_LE(f.energy.total + f.energy.damped, initial + 1e-9 * std::abs(initial)) << f.t;
+  EXPECT_GT(sink.frames().back().energy.damped, 0);
+}
+
 }  // namespace
 }  // namespace cablesim
