@@ -14,6 +14,7 @@
 #include "convert/scene_from_proto.h"
 #include "engine/multibody_model.h"
 #include "engine/simulation.h"
+#include "engine/sliding_joint.h"
 #include "test_util.h"
 
 namespace cablesim {
@@ -172,6 +173,48 @@ TEST(SlidingJointTest, ZipLineSceneRuns) {
   for (const Frame& f : sink.frames())
     EXPECT_LE(f.energy.total + f.energy.damped, initial + 1e-9 * std::abs(initial)) << f.t;
   EXPECT_GT(sink.frames().back().energy.damped, 0);
+}
+
+// The penalty's force is minus the gradient of its energy and its
+// stiffness the derivative of minus the force (the Schur complement of the
+// minimization over s), by central differences (step 1e-6: truncation
+// ~1e-12 relative, rounding ~1e-10 relative of k |d|; tolerance 1e-6
+// relative to the largest entry). Two curved planar elements (nodes at
+// x = 0, 1, 2 with bent slopes), a body point 1e-3 m off the cable near
+// s = 0.9 (inside the first element; its nearest point is found from a
+// start at s = 1.6, in the second).
+TEST(SlidingJointTest, ForceAndStiffnessAreDerivativesOfTheEnergy) {
+  // Full q: 3 nodes x [r(2), r_x(2)], then the body [r_c(2), u(2)].
+  Eigen::VectorXd q(16);
+  q << 0, 0, 1, 0.2, 1, 0.1, 1, -0.1, 2, -0.1, 0.9, 0.3,
+       0.9, 0.101, 1, 0;
+  std::vector<SlidingJoint::Segment> segments = {{0, 0, 1}, {4, 1, 1}};
+  const SlidingJoint slider(2, segments, 12, 4, Eigen::Vector3d(0.01, 0.002, 0), 1e4, 0, 1e-3,
+                            1.6);
+  SlidingJoint::Local local;
+  slider.Penalty(q, &local, true);
+  EXPECT_LT(slider.s(), 1.0);
+  EXPECT_GT(slider.s(), 0.5);
+  const int n = local.n;
+  ASSERT_EQ(n, 12);
+  const double h = 1e-6;
+  const double fmax = local.force.cwiseAbs().maxCoeff();
+  const double kmax = local.matrix.cwiseAbs().maxCoeff();
+  for (int i = 0; i < n; ++i) {
+    Eigen::VectorXd qp = q, qm = q;
+    qp(local.coord[i]) += h;
+    qm(local.coord[i]) -= h;
+    const double dv = (slider.Penalty(qp, nullptr, false) - slider.Penalty(qm, nullptr, false)) /
+                      (2 * h);
+    EXPECT_NEAR(local.force(i), -dv, 1e-6 * fmax) << i;
+    SlidingJoint::Local lp, lm;
+    slider.Penalty(qp, &lp, false);
+    slider.Penalty(qm, &lm, false);
+    ASSERT_EQ(lp.coord[0], local.coord[0]);  // still on the same element
+    for (int k = 0; k < n; ++k)
+      EXPECT_NEAR(local.matrix(k, i), -(lp.force(k) - lm.force(k)) / (2 * h), 1e-6 * kmax)
+          << k << " " << i;
+  }
 }
 
 }  // namespace
