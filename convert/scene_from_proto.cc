@@ -683,6 +683,7 @@ class SceneConverter {
       return Invalid(Sub(path, "b"),
                      absl::StrCat("joins body \"", scene_.bodies[a.body].name, "\" to itself"));
     }
+    CABLESIM_RETURN_IF_ERROR(ConvertSlide(path, j, joint));
     if (j.has_motion()) {
       const std::string motion = Sub(path, "motion");
       CABLESIM_ASSIGN_OR_RETURN(joint->motion, ConvertTimeVector(motion, j.motion()));
@@ -718,6 +719,33 @@ class SceneConverter {
       if (!j.has_rotation()) return Invalid(axis, "only with rotation");
       CABLESIM_ASSIGN_OR_RETURN(joint->rotation_axis, Direction(axis, j.rotation_axis()));
     }
+    return absl::OkStatus();
+  }
+
+  // A SLIDE joint: a body on one side, a cable on the other, no motion;
+  // `slide` only with SLIDE.
+  absl::Status ConvertSlide(const std::string& path, const v1::Joint& j, JointSpec* joint) const {
+    const std::string slide = Sub(path, "slide");
+    if (joint->type != JointType::kSlide) {
+      if (j.has_slide()) return Invalid(slide, "only with type SLIDE");
+      return absl::OkStatus();
+    }
+    const Attachment& a = joint->a;
+    const Attachment& b = joint->b;
+    if (!((a.body >= 0 && b.cable >= 0) || (a.cable >= 0 && b.body >= 0))) {
+      return Invalid(Sub(path, "b"), "SLIDE joins a body on one side to a cable on the other");
+    }
+    if (j.has_motion()) return Invalid(Sub(path, "motion"), "not with type SLIDE");
+    const v1::Slide& p = j.slide();
+    if (!(p.friction() >= 0) || !std::isfinite(p.friction()))
+      return Invalid(Sub(slide, "friction"), "must be >= 0");
+    if (!(p.stiffness() >= 0) || !std::isfinite(p.stiffness()))
+      return Invalid(Sub(slide, "stiffness"), "must be >= 0");
+    if (!(p.stick_velocity() >= 0) || !std::isfinite(p.stick_velocity()))
+      return Invalid(Sub(slide, "stick_velocity"), "must be > 0");
+    joint->slide.friction = p.friction();
+    joint->slide.stiffness_n_m = p.stiffness();
+    if (p.stick_velocity() > 0) joint->slide.stick_velocity_m_s = p.stick_velocity();
     return absl::OkStatus();
   }
 
@@ -1021,8 +1049,10 @@ absl::StatusOr<JointType> JointTypeFromProto(v1::JointType type, std::string_vie
       return JointType::kPin;
     case v1::FIXED:
       return JointType::kFixed;
+    case v1::SLIDE:
+      return JointType::kSlide;
     default:
-      return Invalid(path, "must be PIN or FIXED");
+      return Invalid(path, "must be PIN, FIXED or SLIDE");
   }
 }
 

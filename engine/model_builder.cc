@@ -77,7 +77,9 @@ void ModelBuilder::MeshCables() {
   auto require = [&](const Attachment& at) {
     if (at.cable >= 0) node_s[at.cable].push_back(at.s_m);
   };
-  for (const JointSpec& j : scene_.joints) require(j.a), require(j.b);
+  // A sliding joint needs no node: it moves along the cable.
+  for (const JointSpec& j : scene_.joints)
+    if (j.type != JointType::kSlide) require(j.a), require(j.b);
   for (const LoadSpec& l : scene_.loads) require(l.at);
   for (const ProbeSpec& p : scene_.probes) require(p.at);
   // Where a bending-free cable kinks (a PIN or a load inside it) and where
@@ -89,6 +91,7 @@ void ModelBuilder::MeshCables() {
     return at.s_m > tol && at.s_m < len - tol;
   };
   for (const JointSpec& j : scene_.joints) {
+    if (j.type == JointType::kSlide) continue;
     for (const Attachment* at : {&j.a, &j.b}) {
       if (!interior(*at)) continue;
       (j.type == JointType::kPin ? kink_s : smooth_s)[at->cable].push_back(at->s_m);
@@ -253,6 +256,15 @@ absl::Status ModelBuilder::Joints() {
   pending_.clear();
   for (int ji = 0; ji < static_cast<int>(scene_.joints.size()); ++ji) {
     const JointSpec& joint = scene_.joints[ji];
+    if (joint.type == JointType::kSlide) {
+      // A force (Sliders), not rows: one side a body, the other a cable.
+      if (!((joint.a.body >= 0 && joint.b.cable >= 0) ||
+            (joint.b.body >= 0 && joint.a.cable >= 0))) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "joints[", ji, "].type: SLIDE joins a body (one side) to a cable (the other)"));
+      }
+      continue;
+    }
     Attachment a = joint.a, b = joint.b;
     if (a.IsGround()) std::swap(a, b);
     if (a.IsGround()) {
@@ -472,6 +484,8 @@ void ModelBuilder::OrderUnknowns() {
   };
   std::vector<std::vector<int>> bodies_at_node(m.num_nodes_);
   for (const JointSpec& joint : scene_.joints) {
+    // A slider's body goes last (SlidingJoint: a bordered band).
+    if (joint.type == JointType::kSlide) continue;
     if (joint.a.cable >= 0 && joint.b.body >= 0)
       bodies_at_node[mesh_.Node(joint.a)].push_back(joint.b.body);
     if (joint.b.cable >= 0 && joint.a.body >= 0)
@@ -635,6 +649,43 @@ void ModelBuilder::BuildElements() {
   }
 }
 
+absl::Status ModelBuilder::Sliders() {
+  MultibodyModel& m = model_;
+  for (int ji = 0; ji < static_cast<int>(scene_.joints.size()); ++ji) {
+    const JointSpec& joint = scene_.joints[ji];
+    if (joint.type != JointType::kSlide) continue;
+    const Attachment& on_cable = joint.a.cable >= 0 ? joint.a : joint.b;
+    const Attachment& on_body = joint.a.body >= 0 ? joint.a : joint.b;
+    const int cable = on_cable.cable;
+    const CableSpec& spec = scene_.cables[cable];
+    std::vector<SlidingJoint::Segment> segments;
+    double s0 = 0;
+    for (int k = m.cable_element_begin_[cable]; k < m.cable_element_begin_[cable + 1]; ++k) {
+      const int first = m.dim_ == 2 ? m.elements2_[k].first_coord : m.elements3_[k].first_coord;
+      const double l =
+          m.dim_ == 2 ? m.elements2_[k].element.length() : m.elements3_[k].element.length();
+      segments.push_back({first, s0, l});
+      s0 += l;
+    }
+    // Default stiffness: the axial stiffness EA / l_e of one element.
+    double k = joint.slide.stiffness_n_m;
+    if (k == 0) k = spec.youngs_modulus_pa * spec.area_m2 * spec.elements / spec.length_m;
+    SlidingJoint slider(m.dim_, std::move(segments), BodyCoord(on_body.body), m.body_stride_,
+                        on_body.point_body_m, k, joint.slide.friction,
+                        joint.slide.stick_velocity_m_s, on_cable.s_m);
+    const double gap = slider.Gap(q0_);
+    if (gap > 1e-6) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "joints[%d]: the body point is %.6g m from the cable at t = 0 (a sliding joint starts "
+          "on its cable)",
+          ji, gap));
+    }
+    if (slider.has_friction()) m.has_damping_ = true;
+    m.sliders_.push_back(std::move(slider));
+  }
+  return absl::OkStatus();
+}
+
 void ModelBuilder::ConstantForces() {
   MultibodyModel& m = model_;
   const int D = m.dim_;
@@ -782,6 +833,28 @@ void ModelBuilder::EnvelopeAndMass() {
   }
   for (const Row& row : m.rows_) {
     couple(&m.row_coord_[row.coord_begin], row.coord_end - row.coord_begin);
+  }
+
+  // A slider couples its body with every element of its cable.
+  for (const JointSpec& joint : scene_.joints) {
+    if (joint.type != JointType::kSlide) continue;
+    const int cable = joint.a.cable >= 0 ? joint.a.cable : joint.b.cable;
+    const int body = joint.a.body >= 0 ? joint.a.body : joint.b.body;
+    int cable_lo = std::numeric_limits<int>::max(), body_lo = cable_lo;
+    const int first = NodeCoord(mesh_.first_node[cable]);
+    const int last = NodeCoord(mesh_.first_node[cable + 1]);
+    for (int i = first; i < last; ++i)
+      if (m.j_[i] >= 0) cable_lo = std::min(cable_lo, m.j_[i]);
+    for (int k = 0; k < bs; ++k)
+      if (m.j_[BodyCoord(body) + k] >= 0) body_lo = std::min(body_lo, m.j_[BodyCoord(body) + k]);
+    for (int k = 0; k < bs; ++k) {
+      const int j = m.j_[BodyCoord(body) + k];
+      if (j >= 0) m.envelope_[j] = std::min(m.envelope_[j], cable_lo);
+    }
+    for (int i = first; i < last; ++i) {
+      const int j = m.j_[i];
+      if (j >= 0 && j > body_lo) m.envelope_[j] = std::min(m.envelope_[j], body_lo);
+    }
   }
 
   // The reduced mass matrix, with the element scatter tables.

@@ -153,6 +153,12 @@ class ModelBuilder {
   // (for the energy per cable).
   void BuildElements();
 
+  // The sliding joints (SlidingJoint, a penalty force; no rows), each
+  // over its cable's elements, with its stiffness (default EA / l_e of
+  // its cable, l_e = length / elements). Fails when a slider's body point
+  // is more than 1e-6 m from its cable at t = 0 (names the joint).
+  absl::Status Sliders();
+
   // The constant generalized force [N, or N m per unit slope]: element and
   // body gravity and each load's force at its point (the loads' also
   // apart, for the energy per part); the torques on bodies, kept apart

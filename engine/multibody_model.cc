@@ -90,6 +90,30 @@ void MultibodyModel::RowGradient(const Row& row, const VectorXd& q, double* grad
   }
 }
 
+void MultibodyModel::ScatterSlider(const SlidingJoint::Local& local, VectorXd* full,
+                                   VectorXd* roundoff, double scale, SkylineLdlt* a) const {
+  constexpr double kEps = std::numeric_limits<double>::epsilon();
+  for (int k = 0; k < local.n; ++k) {
+    (*full)(local.coord[k]) += local.force(k);
+    if (roundoff)
+      (*roundoff)(local.coord[k]) += kEps * std::abs(local.force(k)) + local.rounding;
+  }
+  if (a == nullptr) return;
+  double* values = a->values();
+  // Lower triangle on z: pairs with j_a > j_b once, with j_a == j_b all
+  // (the symmetric local matrix then sums both transposes).
+  for (int i = 0; i < local.n; ++i) {
+    const int ji = j_[local.coord[i]];
+    if (ji < 0) continue;
+    for (int k = 0; k < local.n; ++k) {
+      const int jk = j_[local.coord[k]];
+      if (jk < 0 || jk > ji) continue;
+      values[a->Slot(ji, jk)] +=
+          scale * s_(local.coord[i]) * s_(local.coord[k]) * local.matrix(i, k);
+    }
+  }
+}
+
 absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene,
                                                     const std::function<bool()>& should_stop) {
   // The steps, what each computes and why, are in model_builder.h.
@@ -107,6 +131,7 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene,
   if (builder.Stopped()) return stopped;
   builder.BuildElements();
   if (builder.Stopped()) return stopped;
+  if (absl::Status s = builder.Sliders(); !s.ok()) return s;
   builder.ConstantForces();
   builder.Probes();
   builder.EnvelopeAndMass();
@@ -309,6 +334,12 @@ double MultibodyModel::NetForce(const VectorXd& q, double load_factor, VectorXd*
                                                      full_roundoff)
                                   : ElementForces<3>(q, &full, stiffness, stiffness_scale,
                                                      full_roundoff));
+  for (const SlidingJoint& slider : sliders_) {
+    SlidingJoint::Local local;
+    slider.Penalty(q, &local, stiffness != nullptr);
+    ScatterSlider(local, &full, full_roundoff, stiffness_scale, stiffness);
+    size = std::max(size, local.force.lpNorm<Eigen::Infinity>());
+  }
   f->setZero();
   for (int i = 0; i < n; ++i)
     if (j_[i] >= 0) (*f)(j_[i]) += s_(i) * full(i);
@@ -398,6 +429,13 @@ double MultibodyModel::DampingForce(const VectorXd& q, const VectorXd& qdot, Vec
         tangent->values()[tangent->Slot(j_[i], j_[i])] += tangent_scale * s_(i) * s_(i) * c;
     }
   }
+  for (const SlidingJoint& slider : sliders_) {
+    if (!slider.has_friction()) continue;
+    SlidingJoint::Local local;
+    slider.Friction(q, qdot, &local, tangent != nullptr);
+    ScatterSlider(local, &full, full_roundoff, tangent_scale, tangent);
+    size = std::max(size, local.force.lpNorm<Eigen::Infinity>());
+  }
   const int n = coordinates();
   for (int i = 0; i < n; ++i) {
     if (j_[i] < 0) continue;
@@ -419,6 +457,8 @@ double MultibodyModel::DampingPower(const VectorXd& q, const VectorXd& qdot) con
   for (const BodyData& b : bodies_)
     for (int k = 0; k < body_stride_; ++k)
       power += BodyDampingCoefficient(b, k) * qdot(b.coord + k) * qdot(b.coord + k);
+  for (const SlidingJoint& slider : sliders_)
+    if (slider.has_friction()) power += slider.Friction(q, qdot, nullptr, false);
   return power;
 }
 
@@ -569,11 +609,15 @@ EnergySample MultibodyModel::Energy(const VectorXd& q, const VectorXd& qdot, dou
   // Torques, time-varying loads, moving supports: their work so far
   // (AccumulateExternalWork).
   en.potential -= external_work_;
+  // Sliding joints: their penalty energy (counted with the loads' part).
+  double slider_energy = 0;
+  for (const SlidingJoint& slider : sliders_) slider_energy += slider.Penalty(q, nullptr, false);
+  en.potential += slider_energy;
   en.total = en.kinetic + en.potential + en.axial + en.bending + en.contact;
   if (parts != nullptr) {
     // The element gravity above is at load factor 1 (statics scales it).
     for (PartEnergy& part : parts->cables) part.gravity *= load_factor;
-    parts->loads = -external_work_;
+    parts->loads = slider_energy - external_work_;
     if (load_force_.size() > 0) parts->loads -= load_factor * load_force_.dot(q);
   }
   return en;

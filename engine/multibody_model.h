@@ -53,6 +53,7 @@
 #include "engine/scene.h"
 #include "engine/simulation.h"
 #include "engine/skyline_ldlt.h"
+#include "engine/sliding_joint.h"
 #include "engine/sparse_rows.h"
 
 namespace cablesim {
@@ -262,6 +263,12 @@ class MultibodyModel {
   // The number of probes on a moving support (ProbeForces' size).
   int force_probe_count() const { return static_cast<int>(force_probes_.size()); }
 
+  // Sliding joints (SlidingJoint, a penalty force): their number, and
+  // where each slider is now, its arc length on its cable [m] as of the
+  // last evaluation.
+  int sliders() const { return static_cast<int>(sliders_.size()); }
+  double SliderArcLength(int i) const { return sliders_[i].s(); }
+
   // Which joint a constraint row belongs to (for messages), or -1 for a
   // body's own axis constraints.
   int RowJoint(int row) const { return rows_[row].joint; }
@@ -375,6 +382,10 @@ class MultibodyModel {
   // Local gradient of a row: grad[k] for coordinate row_coord_[begin + k].
   void RowGradient(const Row& row, const Eigen::VectorXd& q, double* grad) const;
   void AddRow(const QuadraticForm& f, Row::Kind kind, int joint, int body);
+  // Adds a slider's local force to the full vector `full` (and its rounding
+  // to `roundoff`) and scale times its matrix, mapped onto z, to `a`.
+  void ScatterSlider(const SlidingJoint::Local& local, Eigen::VectorXd* full, Eigen::VectorXd* roundoff,
+                     double scale, SkylineLdlt* a) const;
   void ProjectInitialVelocity();
   // The scene's rigid initial velocity at full configuration q (all nodes
   // and bodies; fixed coordinates are dropped by Reduce).
@@ -465,6 +476,8 @@ class MultibodyModel {
   std::vector<VaryingForce> varying_forces_;
   // Work done by torques, time-varying loads and moving supports so far [J].
   double external_work_ = 0;
+  // Sliding joints (empty in most scenes: then nothing is evaluated).
+  std::vector<SlidingJoint> sliders_;
   // Scratch (full size) for DampingForce (sized only when has_damping_).
   Eigen::VectorXd scratch_damping_, scratch_damping_roundoff_;
 };

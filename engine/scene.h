@@ -22,7 +22,9 @@ namespace cablesim {
 // AUTO: planar when the whole scene lies in the x-y plane (model_choice.h).
 enum class ModelChoice { kAuto, kPlanar, kSpatial };
 enum class BendingModel { kExact, kLinear, kNone };
-enum class JointType { kPin, kFixed };
+// kSlide: a body point kept on a cable, free to slide along it
+// (SlidingJoint; JointSpec::slide).
+enum class JointType { kPin, kFixed, kSlide };
 enum class Analysis { kDynamic, kStatic, kModal };
 enum class Integrator { kImplicitEuler, kGeneralizedAlpha, kHht };
 // kDirect: exact block elimination (skyline LDL^T of the Newton block and a
@@ -104,6 +106,13 @@ bool IsZero(const TimeVector& v);
 // Its value, first or second derivative (order 0, 1, 2) at t.
 Eigen::Vector3d Evaluate(const TimeVector& v, double t, int order = 0);
 
+// A sliding joint's parameters (SlidingJoint).
+struct SlideSpec {
+  double friction = 0;        // Coulomb coefficient mu [-]
+  double stiffness_n_m = 0;   // penalty stiffness [N/m]; 0: EA / l_e of the cable
+  double stick_velocity_m_s = 1e-3;  // friction regularization v_s [m/s]
+};
+
 struct JointSpec {
   JointType type = JointType::kPin;
   Attachment a;  // never ground
@@ -112,6 +121,7 @@ struct JointSpec {
   // its place at t = 0 (motion(0) = 0); a FIXED joint keeps its initial
   // direction (the support translates). Zero: a fixed support.
   TimeVector motion;
+  SlideSpec slide;  // SLIDE only
   bool HasMotion() const { return !IsZero(motion); }
   // FIXED joints to ground only: the support also turns by the angle
   // rotation(t) [rad] (rotation(0) = 0) about the unit `rotation_axis`

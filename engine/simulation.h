@@ -88,7 +88,8 @@ struct PartEnergy {
 // bending are the totals' and gravity plus `loads` is the total potential:
 //   potential = sum gravity + loads,
 // `loads` being the potential of the applied point forces (-F . r) minus
-// the work torques have done so far.
+// the work torques have done so far, plus the sliding joints' penalty
+// energy (SlidingJoint).
 struct EnergyParts {
   std::vector<PartEnergy> cables;  // in scene order
   std::vector<PartEnergy> bodies;  // in scene order

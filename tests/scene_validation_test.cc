@@ -183,7 +183,7 @@ std::vector<InvalidCase> InvalidCases() {
       {"JointNegativeS", Scene1(R"("joints": [{"type": "PIN", "a": {"cable": "c", "s": -0.1}}], )"),
        "joints[0].a.s: ", "must be in [0, 1]"},
       {"JointTypeMissing", Scene1(R"("joints": [{"a": {"cable": "c"}}], )"),
-       "joints[0].type: ", "must be PIN or FIXED"},
+       "joints[0].type: ", "must be PIN, FIXED or SLIDE"},
       {"JointSideAGround", Scene1(R"("joints": [{"type": "PIN", "b": {"cable": "c"}}], )"),
        "joints[0].a: ", "must name a cable or a body"},
       {"JointSideCableAndBody", Scene1(R"("bodies": [{"name": "b", "mass": 2, "inertia": {"z": 1}}],
