@@ -49,6 +49,8 @@ RunSummary EveryFieldSet() {
   s.linear_solver_used = "DIRECT";
   s.factorizations = 28;
   s.direct_fallbacks = 29;
+  s.linear_solves = 41;
+  s.inexact_linear_solves = 42;
   s.max_step_s = 0.03;
   s.adaptive = true;
   s.rho_infinity = 0.31;
