@@ -24,7 +24,7 @@ enum class ModelChoice { kAuto, kPlanar, kSpatial };
 enum class BendingModel { kExact, kLinear, kNone };
 enum class JointType { kPin, kFixed };
 enum class Analysis { kDynamic, kStatic, kModal };
-enum class Integrator { kImplicitEuler, kGeneralizedAlpha, kHht };
+enum class Integrator { kImplicitEuler, kGeneralizedAlpha, kHht, kEnergyMomentum };
 // kDirect: exact block elimination (skyline LDL^T of the Newton block and a
 // dense Schur complement); kAuto: picked per scene (SaddlePointSolver).
 enum class LinearSolverKind { kMinres, kGmres, kDirect, kAuto };
