@@ -1082,8 +1082,11 @@ absl::StatusOr<Integrator> IntegratorFromProto(v1::Integrator integrator,
     case v1::INTEGRATOR_UNSPECIFIED:
     case v1::HHT:
       return Integrator::kHht;
+    case v1::ENERGY_MOMENTUM:
+      return Integrator::kEnergyMomentum;
     default:
-      return UnknownEnumValue(path, integrator, "IMPLICIT_EULER, GENERALIZED_ALPHA or HHT");
+      return UnknownEnumValue(path, integrator,
+                              "IMPLICIT_EULER, GENERALIZED_ALPHA, HHT or ENERGY_MOMENTUM");
   }
 }
 

@@ -291,6 +291,83 @@ void AncfCableElement<D>::AddDrag(const Coords& e, const Coords& edot, const Poi
   }
 }
 
+namespace {
+
+// The element's Gram matrix G = E^T E (module doc of
+// AddDiscreteGradientCorrection) and E.
+template <int D>
+void GramOf(const Eigen::Matrix<double, 4 * D, 1>& e, double l, Eigen::Matrix<double, D, 3>* ev,
+            Eigen::Matrix3d* g) {
+  ev->col(0) = (e.template segment<D>(2 * D) - e.template segment<D>(0)) / l;
+  ev->col(1) = e.template segment<D>(D);
+  ev->col(2) = e.template segment<D>(3 * D);
+  *g = ev->transpose() * *ev;
+}
+
+}  // namespace
+
+template <int D>
+void AncfCableElement<D>::AddDiscreteGradientCorrection(const Coords& e0, const Coords& e1,
+                                                        Coords* correction) const {
+  using EMatrix = Eigen::Matrix<double, D, 3>;
+  const double l = length_;
+  EMatrix ev0, ev1, evm;
+  Eigen::Matrix3d g0, g1, gm;
+  GramOf<D>(e0, l, &ev0, &g0);
+  GramOf<D>(e1, l, &ev1, &g1);
+  const Coords em = 0.5 * (e0 + e1);
+  GramOf<D>(em, l, &evm, &gm);  // the Gram matrix of the midpoint
+  // p_dg: the discrete gradient in G; p_mid: dUt/dG at G(em).
+  Eigen::Matrix3d p_dg = Eigen::Matrix3d::Zero(), p_mid = Eigen::Matrix3d::Zero();
+  const bool exact = bending_ == BendingModel::kExact;
+  const double k = 0.5 * ei_;
+  for (int gp = 0; gp < rule_.n; ++gp) {
+    const Eigen::Vector3d al(l * d1_[gp][2], d1_[gp][1], d1_[gp][3]);
+    const Eigen::Vector3d be(l * d2_[gp][2], d2_[gp][1], d2_[gp][3]);
+    const Eigen::Matrix3d aa = al * al.transpose(), bb = be * be.transpose();
+    const Eigen::Matrix3d ab = 0.5 * (al * be.transpose() + be * al.transpose());
+    const double wl = rule_.weight[gp] * l;
+    auto abc = [&](const Eigen::Matrix3d& g, double* a, double* b, double* c) {
+      *a = al.dot(g * al);
+      *b = al.dot(g * be);
+      *c = be.dot(g * be);
+    };
+    double a0, b0, c0, a1, b1, c1, am, bm, cm;
+    abc(g0, &a0, &b0, &c0);
+    abc(g1, &a1, &b1, &c1);
+    abc(gm, &am, &bm, &cm);
+    // Axial psi_a = EA (a - 1) / 4 (linear in a: exact at the mean) and
+    // LINEAR bending psi_c = EI / 2 (constant).
+    double fa = 0.25 * ea_ * (0.5 * (a0 + a1) - 1), fb = 0, fc = 0;
+    double ga = 0.25 * ea_ * (am - 1), gb = 0, gc = 0;
+    if (bending_ == BendingModel::kLinear) fc = gc = k;
+    if (exact) {
+      // psi = k (c A(a) - b^2 B(a)), A = a^-2, B = a^-3: the discrete
+      // product rule with the exact difference quotients of A and B.
+      const double i0 = 1 / a0, i1 = 1 / a1;
+      const double abar = 0.5 * (i0 * i0 + i1 * i1), bbar = 0.5 * (i0 * i0 * i0 + i1 * i1 * i1);
+      const double da = -(a0 + a1) * (i0 * i0) * (i1 * i1);
+      const double db = -(a0 * a0 + a0 * a1 + a1 * a1) * (i0 * i0 * i0) * (i1 * i1 * i1);
+      fa += k * (0.5 * (c0 + c1) * da - 0.5 * (b0 * b0 + b1 * b1) * db);
+      fb += k * (-(b0 + b1) * bbar);
+      fc += k * abar;
+      const double ia = 1 / am, ia2 = ia * ia, ia3 = ia2 * ia, ia4 = ia2 * ia2;
+      ga += k * (-2 * cm * ia3 + 3 * bm * bm * ia4);
+      gb += k * (-2 * bm * ia3);
+      gc += k * ia2;
+    }
+    p_dg += wl * (fa * aa + fb * ab + fc * bb);
+    p_mid += wl * (ga * aa + gb * ab + gc * bb);
+  }
+  // Force on the three vectors 2 E P; on the coordinates through
+  // d / l = (r_A - r_O) / l.
+  const EMatrix fv = 2 * evm * (p_dg - p_mid);
+  correction->template segment<D>(0) -= fv.col(0) / l;
+  correction->template segment<D>(D) += fv.col(1);
+  correction->template segment<D>(2 * D) += fv.col(0) / l;
+  correction->template segment<D>(3 * D) += fv.col(2);
+}
+
 template class AncfCableElement<2>;
 template class AncfCableElement<3>;
 

@@ -92,6 +92,43 @@ class AncfCableElement {
   void ElasticForce(const Coords& e, Coords* force, Matrix* tangent,
                     Coords* roundoff = nullptr) const;
 
+  // The energy-momentum stepper's discrete gradient of the strain energy:
+  // adds to `correction` DG U(e0, e1) - dU/de(em), em = (e0 + e1) / 2, so
+  // that the force dU/de(em) (ElasticForce at em) plus it is a discrete
+  // gradient in Gonzalez's sense (J. Nonlinear Sci. 6:449-467, 1996,
+  // section 3): DG U(e0, e1) . (e1 - e0) = U(e1) - U(e0) to rounding,
+  // DG U(e, e) = dU/de, and symmetric in (e0, e1), hence second order.
+  //
+  // Invariants (Gonzalez's section 4): U depends on e only through the
+  // Gram matrix G = E^T E of E = [(r_A - r_O) / l, r_O,x, r_A,x], since at
+  // a Gauss point u = E alpha, w = E beta (alpha, beta from the shape
+  // functions), so a = alpha^T G alpha, b = alpha^T G beta, c = beta^T G
+  // beta are linear in G and quadratic in e, and G1 - G0 = Em^T dE +
+  // dE^T Em exactly. Per Gauss point the discrete derivative of psi(a, b,
+  // c) is taken in (a, b, c):
+  //  - axial: psi_a = EA (a - 1) / 4 at the mean a (psi is quadratic in
+  //    a: exact; the strain at the mean of its end values, Simo and
+  //    Tarnow, ZAMP 43:757-792, 1992);
+  //  - LINEAR bending: psi = EI c / 2 is linear: exact;
+  //  - EXACT bending, psi = k (c A(a) - b^2 B(a)), k = EI / 2, A = a^-2,
+  //    B = a^-3, by the discrete product rule
+  //      Delta(c A) = Abar Delta c + cbar Delta A,
+  //      Delta(b^2 B) = 2 bbar Bbar Delta b + (b^2)bar Delta B,
+  //    with the exact difference quotients Delta A / Delta a =
+  //    -(a0 + a1) / (a0^2 a1^2) and Delta B / Delta a = -(a0^2 + a0 a1 +
+  //    a1^2) / (a0^3 a1^3) (no cancellation as a1 -> a0). Gonzalez's own
+  //    correction [U(e1) - U(e0) - grad U . de] de / |de|^2 was tried
+  //    first: its numerator is a difference of energies that cancels to
+  //    rounding for small steps, and the quotient by |de|^2 turned that
+  //    rounding into force noise above the Newton tolerance (the falling
+  //    pendulum's first steps did not converge at any step size).
+  // The force on the three vectors is 2 Em P with P = sum over Gauss points
+  // of the discrete derivatives times aa^T, (al be^T + be al^T) / 2 and
+  // be be^T: P symmetric makes its moment sum_k Em_k x (2 Em P)_k vanish,
+  // and the two node forces are opposite, so the discrete gradient keeps
+  // linear and angular momentum as dU/de does. Allocates nothing.
+  void AddDiscreteGradientCorrection(const Coords& e0, const Coords& e1, Coords* correction) const;
+
   // Kelvin-Voigt damping: adds to `c` the symmetric positive semi-definite
   // matrix C(e) of the damping force Q_d = C(e) edot [N s/m] derived from
   // the dissipation function per unit length

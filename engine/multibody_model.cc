@@ -353,6 +353,32 @@ double MultibodyModel::NetForce(const VectorXd& q, double load_factor, VectorXd*
 }
 
 template <int D>
+void MultibodyModel::ElementDiscreteGradientCorrection(const VectorXd& q0, const VectorXd& q1,
+                                                       VectorXd* full) const {
+  constexpr int kN = 4 * D;
+  typename AncfCableElement<D>::Coords ce;
+  for (const ElementData<D>& e : Elements<D>()) {
+    ce.setZero();
+    e.element.AddDiscreteGradientCorrection(q0.segment<kN>(e.first_coord),
+                                            q1.segment<kN>(e.first_coord), &ce);
+    full->segment<kN>(e.first_coord) += ce;
+  }
+}
+
+void MultibodyModel::SubtractDiscreteGradientCorrection(const VectorXd& q0, const VectorXd& q1,
+                                                        VectorXd* f) {
+  VectorXd& full = scratch_full_;
+  full.setZero(c_.size());
+  if (dim_ == 2) {
+    ElementDiscreteGradientCorrection<2>(q0, q1, &full);
+  } else {
+    ElementDiscreteGradientCorrection<3>(q0, q1, &full);
+  }
+  for (int i = 0; i < full.size(); ++i)
+    if (j_[i] >= 0) (*f)(j_[i]) -= s_(i) * full(i);
+}
+
+template <int D>
 double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, VectorXd* full,
                                       SkylineLdlt* tangent, double tangent_scale,
                                       VectorXd* roundoff, double* power) const {

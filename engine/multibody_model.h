@@ -124,6 +124,14 @@ class MultibodyModel {
                   SkylineLdlt* stiffness = nullptr, double stiffness_scale = 0,
                   Eigen::VectorXd* roundoff = nullptr);
 
+  // The energy-momentum stepper's elastic force (energy_momentum_stepper.h):
+  // with f = NetForce(qm) at qm = (q0 + q1) / 2, subtracting the cable
+  // elements' AncfCableElement::AddDiscreteGradientCorrection(q0, q1) from
+  // the reduced f turns its elastic part into the discrete gradient of the
+  // strain energy. Allocates nothing.
+  void SubtractDiscreteGradientCorrection(const Eigen::VectorXd& q0, const Eigen::VectorXd& q1,
+                                          Eigen::VectorXd* f);
+
   // Damping (velocity-dependent forces), only in a scene that asks for it:
   // per cable Kelvin-Voigt and Rayleigh damping (AncfCableElement::
   // AddDampingMatrix, with times axial_s + beta and bending_s + beta, plus
@@ -363,6 +371,9 @@ class MultibodyModel {
   template <int D>
   double ElementForces(const Eigen::VectorXd& q, Eigen::VectorXd* full, SkylineLdlt* stiffness,
                        double stiffness_scale, Eigen::VectorXd* roundoff) const;
+  template <int D>
+  void ElementDiscreteGradientCorrection(const Eigen::VectorXd& q0, const Eigen::VectorXd& q1,
+                                         Eigen::VectorXd* full) const;
   template <int D>
   double ElementDamping(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
                         Eigen::VectorXd* full, SkylineLdlt* tangent, double tangent_scale,

@@ -35,6 +35,8 @@ std::string_view IntegratorName(Integrator integrator) {
       return "GENERALIZED_ALPHA";
     case Integrator::kHht:
       return "HHT";
+    case Integrator::kEnergyMomentum:
+      return "ENERGY_MOMENTUM";
   }
   return "UNKNOWN";
 }

@@ -26,7 +26,7 @@ enum class BendingModel { kExact, kLinear, kNone };
 // (SlidingJoint; JointSpec::slide).
 enum class JointType { kPin, kFixed, kSlide };
 enum class Analysis { kDynamic, kStatic, kModal };
-enum class Integrator { kImplicitEuler, kGeneralizedAlpha, kHht };
+enum class Integrator { kImplicitEuler, kGeneralizedAlpha, kHht, kEnergyMomentum };
 // kDirect: exact block elimination (skyline LDL^T of the Newton block and a
 // dense Schur complement); kAuto: picked per scene (SaddlePointSolver).
 enum class LinearSolverKind { kMinres, kGmres, kDirect, kAuto };

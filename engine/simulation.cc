@@ -567,7 +567,8 @@ absl::StatusOr<RunSummary> RunScene(const Scene& scene, FrameSink* sink,
   summary.linear_solver_used = std::string(LinearSolverName(
       SaddlePointSolver::Resolve(settings.linear_solver, model.dofs(), model.multipliers())));
   summary.adaptive = settings.adaptive;
-  if (settings.integrator != Integrator::kImplicitEuler)
+  if (settings.integrator == Integrator::kGeneralizedAlpha ||
+      settings.integrator == Integrator::kHht)
     summary.rho_infinity = settings.rho_infinity;
   const bool estimate = settings.analysis == Analysis::kDynamic && settings.error_estimate;
   ProbeRecordingSink recording(sink);

@@ -1,9 +1,56 @@
 #include "engine/stepper.h"
 
+#include <algorithm>
+
+#include "absl/strings/str_format.h"
+#include "engine/energy_momentum_stepper.h"
 #include "engine/generalized_alpha_stepper.h"
 #include "engine/implicit_euler_stepper.h"
+#include "engine/newton_convergence.h"
 
 namespace cablesim {
+
+bool SolveInitialAcceleration(SaddlePointSolver* solver, const SolverSettings& settings,
+                              const Eigen::VectorXd& f, const Eigen::VectorXd& gamma,
+                              Eigen::VectorXd* rhs, Eigen::VectorXd* dx, std::string* reason) {
+  if (!solver->Prepare()) {
+    *reason = "the mass matrix could not be factorized";
+    return false;
+  }
+  const Eigen::Index n = f.size();
+  rhs->head(n) = f;
+  if (gamma.size() > 0) rhs->tail(gamma.size()) = gamma;
+  const auto stats = solver->Solve(settings.linear_solver, *rhs, 1e-12,
+                                   std::max(settings.max_linear_iterations, 1000), dx);
+  if (!(stats.relative_residual <= 1e-8)) {
+    *reason = absl::StrFormat(
+        "the initial acceleration solve did not converge (relative residual %.3g)",
+        stats.relative_residual);
+    return false;
+  }
+  return true;
+}
+
+bool NewtonCorrection(SaddlePointSolver* solver, const SolverSettings& settings,
+                      Eigen::VectorXd* rhs, Eigen::VectorXd* dx, Stepper::StepStats* st) {
+  if (!solver->Prepare()) {
+    st->reason = "the Newton matrix has a non-finite pivot";
+    return false;
+  }
+  *rhs = -*rhs;
+  ++st->factorizations;
+  const auto ls = solver->Solve(settings.linear_solver, *rhs, settings.linear_tolerance,
+                                settings.max_linear_iterations, dx);
+  ++st->newton_iterations;
+  st->linear_iterations += ls.iterations;
+  st->max_linear_residual = std::max(st->max_linear_residual, ls.relative_residual);
+  st->direct_fallbacks += ls.fallback ? 1 : 0;
+  if (!LinearSolveGoodEnough(ls)) {
+    st->reason = LinearSolveFailure(ls, settings.linear_solver);
+    return false;
+  }
+  return true;
+}
 
 std::unique_ptr<Stepper> MakeStepper(MultibodyModel* model, const SolverSettings& settings) {
   switch (settings.integrator) {
@@ -13,6 +60,8 @@ std::unique_ptr<Stepper> MakeStepper(MultibodyModel* model, const SolverSettings
     case Integrator::kHht:
       return std::make_unique<GeneralizedAlphaStepper>(model, settings,
                                                        GeneralizedAlphaStepper::Variant::kHht);
+    case Integrator::kEnergyMomentum:
+      return std::make_unique<EnergyMomentumStepper>(model, settings);
     case Integrator::kImplicitEuler:
       break;
   }

@@ -12,7 +12,8 @@
 // multipliers lambda.
 //
 // Implementations: ImplicitEulerStepper (the paper's backward Euler) and
-// GeneralizedAlphaStepper (generalized-alpha and HHT). Step() allocates
+// GeneralizedAlphaStepper (generalized-alpha and HHT), EnergyMomentumStepper
+// (midpoint rule with a discrete gradient). Step() allocates
 // nothing.
 
 #include <memory>
@@ -20,6 +21,7 @@
 
 #include <Eigen/Core>
 
+#include "engine/saddle_point_solver.h"
 #include "engine/scene.h"
 
 namespace cablesim {
@@ -70,6 +72,22 @@ class Stepper {
   virtual const Eigen::VectorXd& a() const = 0;
   virtual const Eigen::VectorXd& lambda() const = 0;
 };
+
+// Shared pieces of the steppers' Newton solves (used by
+// EnergyMomentumStepper; the older steppers still carry their own copies).
+//
+// The consistent initial acceleration: with solver->a() holding M and
+// solver->b() Phi_z, solves [M Phi_z^T; Phi_z 0] [a; lambda] = [f; gamma]
+// into dx (rhs is scratch of size n + m). False with `reason` on failure.
+bool SolveInitialAcceleration(SaddlePointSolver* solver, const SolverSettings& settings,
+                              const Eigen::VectorXd& f, const Eigen::VectorXd& gamma,
+                              Eigen::VectorXd* rhs, Eigen::VectorXd* dx, std::string* reason);
+// One Newton correction: factors solver->a() (with solver->b()), solves
+// for dx = -(Newton matrix)^-1 rhs (rhs is negated in place) and counts the
+// factorization, iteration and linear statistics in `st`. False with
+// st->reason when the matrix or the linear solve fails.
+bool NewtonCorrection(SaddlePointSolver* solver, const SolverSettings& settings,
+                      Eigen::VectorXd* rhs, Eigen::VectorXd* dx, Stepper::StepStats* st);
 
 // The stepper `settings.integrator` names, for `model` (which must outlive it).
 std::unique_ptr<Stepper> MakeStepper(MultibodyModel* model, const SolverSettings& settings);

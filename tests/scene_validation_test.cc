@@ -337,7 +337,7 @@ std::vector<InvalidCase> InvalidCases() {
        "solver.error_estimate: ", "DYNAMIC analysis only"},
       {"UnknownIntegrator",
        absl::StrCat(R"({"cables": [)", kCable, R"(], "solver": {"duration": 1, "integrator": 9}})"),
-       "solver.integrator: ", "IMPLICIT_EULER, GENERALIZED_ALPHA or HHT"},
+       "solver.integrator: ", "IMPLICIT_EULER, GENERALIZED_ALPHA, HHT or ENERGY_MOMENTUM"},
       {"UnknownLinearSolver",
        absl::StrCat(R"({"cables": [)", kCable,
                     R"(], "solver": {"duration": 1, "linear_solver": 9}})"),
