@@ -156,10 +156,13 @@ absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimi
       }
     }
   }
+  // A seabed adds energy.contact to every row.
+  const bool contact = checked.scene.seabed.enabled;
   const int64_t values =
       checked.frames * FrameRowSize(static_cast<int64_t>(checked.scene.probes.size()),
                                     static_cast<int64_t>(checked.scene.cables.size()),
-                                    static_cast<int64_t>(checked.scene.bodies.size())) +
+                                    static_cast<int64_t>(checked.scene.bodies.size()),
+                                    /*force_probes=*/0, contact) +
       checked.frames * force_values;
   if (values > limits.max_trajectory_values) {
     return absl::ResourceExhaustedError(absl::StrFormat(
@@ -184,7 +187,8 @@ absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimi
         checked.frames *
         (FrameRowSize(static_cast<int64_t>(checked.scene.probes.size()),
                       static_cast<int64_t>(checked.scene.cables.size()),
-                      static_cast<int64_t>(checked.scene.bodies.size())) +
+                      static_cast<int64_t>(checked.scene.bodies.size()), /*force_probes=*/0,
+                      contact) +
          force_values + 3 * static_cast<int64_t>(checked.info.node_s.size()));
     if (shape_values > limits.max_trajectory_values) {
       return absl::ResourceExhaustedError(absl::StrFormat(
