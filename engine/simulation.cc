@@ -251,20 +251,30 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     a_i = (1 - th) * a_0 + th * s.a();
     lambda_i = (1 - th) * lambda_0 + th * s.lambda();
   };
-  auto CheckAndDeliver = [&](double tf) {
-    const EnergySample& e = rec->frame().energy;
+  // The energy guard on a state the stepper reached (a step's end): false
+  // (with the summary failed) when its energy rose beyond the limit.
+  auto EnergyHolds = [&](const EnergySample& e, double t_state) {
     const double rise = e.total + e.damped - summary->energy_initial;
     const double scale = std::max({rec->energy_scale(), std::abs(e.kinetic),
                                    std::abs(e.potential), std::abs(e.axial) + std::abs(e.bending)});
     if (rise > kEnergyRiseLimit * scale + energy_floor) {
-      Fail(summary, tf,
+      Fail(summary, t_state,
            absl::StrFormat("the total energy rose by %.3g J (more than %g %% of the largest "
                            "energy term, %.3g J) by t = %.9g s: the stepper is unstable at this "
                            "step; use a smaller solver.step, adaptive steps or a smaller "
                            "rho_infinity",
-                           rise, 100 * kEnergyRiseLimit, scale, tf));
+                           rise, 100 * kEnergyRiseLimit, scale, t_state));
       return false;
     }
+    return true;
+  };
+  // Delivers the evaluated frame; `guard`: it is a step's end state, whose
+  // energy is checked first. An interpolated frame is not guarded: its
+  // energy carries the interpolant's error (the stretch modes of a stiff
+  // cable oscillate within a step and a cubic does not follow them), which
+  // is not the stepper's; the step's end state that follows it is guarded.
+  auto CheckAndDeliver = [&](double tf, bool guard = true) {
+    if (guard && !EnergyHolds(rec->frame().energy, tf)) return false;
     if (absl::Status st = rec->Deliver(); !st.ok()) {
       summary->status = "cancelled";
       summary->error = std::string(st.message());
@@ -357,14 +367,21 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       summary->max_newton_residual = std::max(summary->max_newton_residual, st.residual);
       summary->max_residual_floor = std::max(summary->max_residual_floor, st.residual_floor);
       summary->end_time_s = t;
-      // After a run of good steps, go back up towards the nominal step.
+      // After a run of good steps, go back up towards the nominal step, at
+      // a time on the doubled step's grid (a multiple of 2 h), so that steps
+      // return to the nominal grid and the frames on it are step ends again
+      // rather than interpolated.
       if (!settings.adaptive && h < h_nominal && ++successes >= 4) {
-        h = std::min(h_nominal, 2 * h);
-        successes = 0;
+        const double cells = t / (2 * h);
+        if (std::abs(cells - std::round(cells)) <= 1e-6) {
+          h = std::min(h_nominal, 2 * h);
+          successes = 0;
+        }
       }
       // Every frame this step reached: the step's end state where the
       // frame is its end (within 1e-6 of the step, which also keeps t on
       // the frames' grid), otherwise interpolated (dense output).
+      bool end_checked = false;
       while (next_frame <= frames) {
         const double tf = frame_time(next_frame);
         const bool at_end = std::abs(tf - t) <= 1e-6 * h_try;
@@ -374,11 +391,17 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
           model->SetTime(tf);
           rec->Evaluate(tf, 1, stepper.z(), &stepper.v(), &stepper.a(), &stepper.lambda());
         } else {
+          // The step's end is guarded before any frame inside it goes out.
+          if (!end_checked) {
+            model->SetTime(t);
+            if (!EnergyHolds(rec->StateEnergy(t, stepper.z(), stepper.v()), t)) return;
+            end_checked = true;
+          }
           Interpolate((tf - t0) / h_try, h_try, stepper);
           model->SetTime(tf);
           rec->Evaluate(tf, 1, z_i, &v_i, &a_i, &lambda_i);
         }
-        if (!CheckAndDeliver(tf)) return;
+        if (!CheckAndDeliver(tf, /*guard=*/at_end)) return;
         ++next_frame;
       }
       rec->AdvanceDamping(t, stepper.z(), stepper.v());

@@ -15,6 +15,7 @@
 
 #include "absl/strings/str_format.h"
 #include "engine/ancf_cable_element.h"
+#include "tests/energy_momentum_scenes.h"
 #include "tests/test_util.h"
 
 namespace cablesim {
@@ -149,16 +150,7 @@ TEST(EnergyMomentumStepperTest, SpatialPendulumKeepsVerticalAngularMomentumToRou
 }
 
 std::string FallingPendulum(double duration, double step, const std::string& extra) {
-  return absl::StrFormat(R"({
-    "gravity": {"y": -9.81},
-    "cables": [{"name": "beam", "length": 1.2, "elements": 12, "direction": {"x": 1},
-                "density": 5540, "youngs_modulus": 0.7e6,
-                "area": 0.0018, "second_moment": 1.215e-8, "bending": "EXACT"}],
-    "joints": [{"type": "PIN", "a": {"cable": "beam", "s": 0}}],
-    "probes": [{"name": "tip", "cable": "beam", "s": 1.2}],
-    "solver": {"duration": %g, "step": %g, "output_interval": 0.01,
-               "integrator": "ENERGY_MOMENTUM" %s}})",
-                         duration, step, extra);
+  return testing::EnergyMomentumFallingPendulum(duration, step, extra);
 }
 
 TEST(EnergyMomentumStepperTest, FallingPendulumKeepsItsEnergyToTheNewtonTolerance) {
