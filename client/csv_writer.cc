@@ -1,6 +1,7 @@
 #include "client/csv_writer.h"
 
 #include <cerrno>
+#include <charconv>
 #include <cstring>
 #include <utility>
 
@@ -12,7 +13,18 @@
 namespace cablesim {
 namespace {
 
-void AppendNumber(std::string* row, double value) { absl::StrAppendFormat(row, ",%.17g", value); }
+// ",%.17g" (17 significant digits: every double reads back exactly), by
+// std::to_chars, which the standard defines as printf's conversion in the C
+// locale (the same characters) but which runs several times faster than a
+// format string; frames every millisecond made formatting a visible part
+// of a run's wall time.
+void AppendNumber(std::string* row, double value) {
+  char buf[32];
+  buf[0] = ',';
+  const std::to_chars_result r =
+      std::to_chars(buf + 1, buf + sizeof(buf), value, std::chars_format::general, 17);
+  row->append(buf, r.ptr);
+}
 
 }  // namespace
 

@@ -582,7 +582,13 @@ void MultibodyModel::ElementEnergy(const VectorXd& q, const VectorXd& qdot, Ener
     const ElementData<D>& e = elements[k];
     const auto qe = q.segment<kN>(e.first_coord);
     const auto ve = qdot.segment<kN>(e.first_coord);
-    const double kinetic = 0.5 * ve.dot(e.element.MassMatrix(e.mass_per_length) * ve);
+    // T = 1/2 ve^T (mbar (x) I_D) ve, from the element's 4 x 4 scalar mass
+    // matrix (not its full mass matrix, rebuilt by quadrature each call).
+    double kinetic = 0;
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b)
+        kinetic += e.mbar(a, b) * ve.template segment<D>(D * a).dot(ve.template segment<D>(D * b));
+    kinetic *= 0.5;
     const auto se = e.element.StrainEnergy(qe);
     en->kinetic += kinetic;
     en->axial += se.axial;
