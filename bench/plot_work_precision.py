@@ -53,15 +53,22 @@ def plot_scene(scene, rows, out_dir):
         series.setdefault(key, []).append((wall, err, r))
     if not series:
         return None
-    fig, ax = plt.subplots(figsize=(8, 5.5))
-    markers = "os^vD<>pP*Xh"
+    fig, ax = plt.subplots(figsize=(10, 5.5))
+    # One colour per stepper, one marker per linear solver, solid lines for
+    # fixed steps and dashed for adaptive ones.
+    integrators = sorted({k[0] for k in series})
+    solvers = sorted({k[1] for k in series})
+    palette = plt.get_cmap("tab10").colors
+    colour = {name: palette[i % len(palette)] for i, name in enumerate(integrators)}
+    markers = dict(zip(solvers, "osD^vP*Xh<>p"))
     annotated_modes = set()
-    for i, (key, points) in enumerate(series.items()):
+    for key, points in series.items():
         points.sort(key=lambda p: p[0])
         integrator, solver, mode = key
         style = "-" if mode == "fixed" else "--"
-        ax.plot([p[0] for p in points], [p[1] for p in points], style,
-                marker=markers[i % len(markers)], label=f"{integrator} + {solver} ({mode})")
+        ax.plot([p[0] for p in points], [p[1] for p in points], style, color=colour[integrator],
+                marker=markers[solver], markersize=5, lw=1,
+                label=f"{integrator} + {solver} ({mode})")
         if mode in annotated_modes:
             continue  # label the steps (tolerances) of one series per mode only
         annotated_modes.add(mode)
@@ -90,7 +97,8 @@ def plot_scene(scene, rows, out_dir):
     if footnote:
         fig.text(0.01, 0.005, "\n".join(footnote), fontsize=6, va="bottom", wrap=True)
     ax.grid(True, which="both", lw=0.3)
-    ax.legend(fontsize=7)
+    # The legend outside the data, to the right.
+    ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
     fig.tight_layout(rect=(0, 0.05, 1, 1))
     path = os.path.join(out_dir, f"work_precision_{scene}.png")
     fig.savefig(path, dpi=110)
