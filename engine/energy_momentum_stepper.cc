@@ -15,6 +15,7 @@ EnergyMomentumStepper::EnergyMomentumStepper(MultibodyModel* model,
   m_ = model->multipliers();
   solver_.Resize(model->envelope(), model->jacobian_pattern());
   jac1_ = model->jacobian_pattern();
+  jacm_ = model->jacobian_pattern();
   z_ = model->initial_z();
   v_ = model->initial_v();
   for (Eigen::VectorXd* x : {&a_, &abar_, &z1_, &v1_, &f_, &mdv_, &bt_mu_, &floor_, &abs_terms_,
@@ -97,8 +98,16 @@ double EnergyMomentumStepper::Forces(double h, Eigen::VectorXd* f, SkylineLdlt* 
 }
 
 Stepper::StepStats EnergyMomentumStepper::Step(double h) {
+  return SolveWithFreshRetry(settings_.reuse_factorization, kept_.refresh,
+                             [&](bool fresh) { return Solve(h, fresh); });
+}
+
+Stepper::StepStats EnergyMomentumStepper::Solve(double h, bool fresh) {
   StepStats st;
   const double tol = settings_.newton_tolerance;
+  const bool reuse = settings_.reuse_factorization;
+  const double c = 0.25 * h * h;
+  if (kept_.Stale(c)) fresh = true;
   // Predictor: the mean acceleration of the last step.
   v1_ = v_ + h * abar_;
   lambda1_ = lambda_;
@@ -113,19 +122,20 @@ Stepper::StepStats EnergyMomentumStepper::Step(double h) {
     const bool checking = it > 0 && last_increment <= tol * (1 + z1_.lpNorm<Eigen::Infinity>());
     const bool judge = checking || it == settings_.max_newton_iterations;
     const bool have_floor = checking && floor_expected_;
-    if (!checking) LoadMass();
-    const double force_size = Forces(h, &f_, checking ? nullptr : &a,
+    const bool assemble = fresh && !checking;
+    if (assemble) LoadMass();
+    const double force_size = Forces(h, &f_, assemble ? &a : nullptr,
                                      have_floor ? &floor_ : nullptr);
     // Phi(z1, t + h) (jac1_ only as its scratch), and Phi_z(zm).
     model_->SetTime(t_ + h);
     model_->Constraints(q1_, &phi_, &jac1_);
-    model_->Constraints(qm_, &phim_, &solver_.b());
+    model_->Constraints(qm_, &phim_, &jacm_);
     // R_v = M (v1 - v0) - h f + Phi_z(zm)^T (h lambda).
     mdv_ = v1_ - v_;
     model_->mass().Multiply(mdv_.data(), rhs_.data());
     auto rv = rhs_.head(n_);
     bt_mu_.setZero();
-    solver_.b().AddTransposeMultiply(lambda1_.data(), bt_mu_.data());
+    jacm_.AddTransposeMultiply(lambda1_.data(), bt_mu_.data());
     bt_mu_ *= h;
     const double scale = std::max({rv.lpNorm<Eigen::Infinity>(), h * force_size,
                                    bt_mu_.lpNorm<Eigen::Infinity>(), 1e-300});
@@ -149,7 +159,7 @@ Stepper::StepStats EnergyMomentumStepper::Step(double h) {
       abs_terms_.setZero();
       model_->mass().AddAbsMultiply(v1_.data(), abs_terms_.data());
       model_->mass().AddAbsMultiply(v_.data(), abs_terms_.data());
-      solver_.b().AddAbsTransposeMultiply(lambda1_.data(), abs_terms_.data(), h);
+      jacm_.AddAbsTransposeMultiply(lambda1_.data(), abs_terms_.data(), h);
       floor_ = h * floor_ + kSumRounding * abs_terms_;
       MeasureResidual(rv, floor_, scale, &iterate);
       previous_at_floor = iterate.excess <= tol;
@@ -163,22 +173,35 @@ Stepper::StepStats EnergyMomentumStepper::Step(double h) {
     }
     if (it == settings_.max_newton_iterations) {
       st.reason = NewtonFailure(it, iterate);
+      if (reuse) kept_.refresh = true;
       return st;
     }
-    if (checking) {
-      LoadMass();
-      Forces(h, &f_floor_, &a, nullptr);
+    if (fresh) {
+      if (!assemble) {
+        LoadMass();
+        Forces(h, &f_floor_, &a, nullptr);
+      }
+      if (m_ > 0) model_->AddConstraintHessian(qm_, lambda1_, c, &a);
+      if (!FactorNewtonMatrix(&solver_, jacm_, c, &kept_, &st)) return st;
+      // Keep this matrix for the next iterations only when asked to.
+      fresh = !reuse;
     }
-    if (m_ > 0) model_->AddConstraintHessian(qm_, lambda1_, 0.25 * h * h, &a);
-    if (!NewtonCorrection(&solver_, settings_, &rhs_, &dx_, &st)) return st;
+    if (!SolveNewtonSystem(&solver_, settings_, &rhs_, &dx_, &st)) {
+      if (reuse) kept_.refresh = true;
+      return st;
+    }
     v1_ += dx_.head(n_);
     if (m_ > 0) lambda1_ += dx_.tail(m_) / h;
-    previous_increment = last_increment;
-    last_increment = 0.5 * h * dx_.head(n_).lpNorm<Eigen::Infinity>();
-    if (!std::isfinite(last_increment) || last_increment > 1e6 * iterate.zscale) {
+    const double increment = 0.5 * h * dx_.head(n_).lpNorm<Eigen::Infinity>();
+    if (!std::isfinite(increment) || increment > 1e6 * iterate.zscale) {
       st.reason = "Newton diverged";
+      if (reuse) kept_.refresh = true;
       return st;
     }
+    // Safeguard of the kept matrix: slow contraction asks for a fresh one.
+    if (reuse && it > 0 && increment > 0.5 * last_increment) fresh = true;
+    previous_increment = last_increment;
+    last_increment = increment;
   }
   z_old_.swap(z_);
   v_old_.swap(v_);

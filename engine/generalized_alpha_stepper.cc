@@ -83,7 +83,7 @@ bool GeneralizedAlphaStepper::Initialize(std::string* reason) {
   model_->RateToFull(v_, &qdot);
   model_->ConstraintGamma(q_, qdot, &gamma);
   LoadMass();
-  have_factor_ = false;
+  kept_.have = false;
   if (!solver_.Prepare()) {
     *reason = "the mass matrix could not be factorized";
     return false;
@@ -133,20 +133,9 @@ double GeneralizedAlphaStepper::LocalErrorNorm(double h, double atol, double rto
 }
 
 Stepper::StepStats GeneralizedAlphaStepper::Step(double h) {
-  const bool reuse = settings_.reuse_factorization;
   model_->SetTime(t_ + h);
-  StepStats st = Solve(h, !reuse || refresh_);
-  if (!st.converged && reuse && st.reason.find("non-finite pivot") == std::string::npos) {
-    // Safeguard: a kept Newton matrix may be what failed; retry once fresh.
-    StepStats again = Solve(h, true);
-    again.newton_iterations += st.newton_iterations;
-    again.linear_iterations += st.linear_iterations;
-    again.factorizations += st.factorizations;
-    again.direct_fallbacks += st.direct_fallbacks;
-    again.max_linear_residual = std::max(again.max_linear_residual, st.max_linear_residual);
-    st = std::move(again);
-  }
-  return st;
+  return SolveWithFreshRetry(settings_.reuse_factorization, kept_.refresh,
+                             [&](bool fresh) { return Solve(h, fresh); });
 }
 
 Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
@@ -184,7 +173,7 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
   // shortened to end on the duration, or resized by the error controller): Newton
   // then still contracts by about that fraction, and the safeguard below
   // catches it when it does not.
-  if (!have_factor_ || !(std::abs(c - factor_c_) <= 0.2 * factor_c_)) fresh = true;
+  if (kept_.Stale(c)) fresh = true;
   // Predictor: the acceleration extrapolated linearly from the last two
   // steps (constant on the first step and after Restore()).
   zdd1_ = zdd_;
@@ -268,7 +257,7 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
     }
     if (it == settings_.max_newton_iterations) {
       st.reason = NewtonFailure(it, iterate);
-      if (reuse) refresh_ = true;
+      if (reuse) kept_.refresh = true;
       return st;
     }
     if (fresh) {
@@ -277,31 +266,12 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
         Forces(v1_, &f_, &a, c, cd, nullptr);
       }
       if (m_ > 0) model_->AddConstraintHessian(q_, lambda1_, c, &a);
-      std::copy(jac_.value.begin(), jac_.value.end(), solver_.b().value.begin());
-      ++st.factorizations;
-      have_factor_ = false;
-      if (!solver_.Prepare()) {
-        st.reason = "the Newton matrix has a non-finite pivot";
-        return st;
-      }
-      have_factor_ = true;
-      factor_c_ = c;
-      refresh_ = false;
+      if (!FactorNewtonMatrix(&solver_, jac_, c, &kept_, &st)) return st;
       // Keep this matrix for the next iterations only when asked to.
       fresh = !reuse;
     }
-    rhs_ = -rhs_;
-    const auto ls = solver_.Solve(settings_.linear_solver, rhs_, settings_.linear_tolerance,
-                                  settings_.max_linear_iterations, &dx_);
-    ++st.newton_iterations;
-    st.linear_iterations += ls.iterations;
-    st.max_linear_residual = std::max(st.max_linear_residual, ls.relative_residual);
-    st.direct_fallbacks += ls.fallback ? 1 : 0;
-    ++st.linear_solves;
-    st.inexact_solves += LinearSolveInexact(ls) ? 1 : 0;
-    if (!LinearSolveGoodEnough(ls)) {
-      st.reason = LinearSolveFailure(ls, settings_.linear_solver);
-      if (reuse) refresh_ = true;
+    if (!SolveNewtonSystem(&solver_, settings_, &rhs_, &dx_, &st)) {
+      if (reuse) kept_.refresh = true;
       return st;
     }
     zdd1_ += dx_.head(n_);
@@ -309,7 +279,7 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
     const double increment = s * dx_.head(n_).lpNorm<Eigen::Infinity>();
     if (!std::isfinite(increment) || increment > 1e6 * iterate.zscale) {
       st.reason = "Newton diverged";
-      if (reuse) refresh_ = true;
+      if (reuse) kept_.refresh = true;
       return st;
     }
     // Safeguard of the kept matrix: slow contraction asks for a fresh one.

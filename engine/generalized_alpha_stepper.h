@@ -144,10 +144,8 @@ class GeneralizedAlphaStepper final : public Stepper {
   // tol): the next step's checking iteration then bounds the forces'
   // rounding in the same pass as the forces.
   bool floor_expected_ = false;
-  // The kept factorization: its c = w s, and whether it must be refreshed.
-  bool have_factor_ = false;
-  double factor_c_ = 0;
-  bool refresh_ = true;
+  // The kept factorization (c = w s).
+  KeptNewtonMatrix kept_;
   // The last step's size (0: none yet) and the one before, for the predictor.
   double h_last_ = 0, h_old_ = 0;
   // Time [s] of the state, and before the last step. Every step sets the

@@ -213,7 +213,9 @@ struct SolverSettings {
   bool error_estimate = false;
   // Newton economy: keep the factorized Newton matrix across iterations and
   // steps while Newton contracts fast enough (a fresh one otherwise).
-  bool reuse_factorization = true;  // GENERALIZED_ALPHA and HHT only
+  // GENERALIZED_ALPHA, HHT, ENERGY_MOMENTUM (convert/ defaults it off for
+  // ENERGY_MOMENTUM: see README).
+  bool reuse_factorization = true;
   InitialState initial_state = InitialState::kAsGiven;  // DYNAMIC only
 };
 

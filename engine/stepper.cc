@@ -31,25 +31,47 @@ bool SolveInitialAcceleration(SaddlePointSolver* solver, const SolverSettings& s
   return true;
 }
 
-bool NewtonCorrection(SaddlePointSolver* solver, const SolverSettings& settings,
-                      Eigen::VectorXd* rhs, Eigen::VectorXd* dx, Stepper::StepStats* st) {
+bool FactorNewtonMatrix(SaddlePointSolver* solver, const SparseRows& jac, double c,
+                        KeptNewtonMatrix* kept, Stepper::StepStats* st) {
+  std::copy(jac.value.begin(), jac.value.end(), solver->b().value.begin());
+  ++st->factorizations;
+  kept->have = false;
   if (!solver->Prepare()) {
     st->reason = "the Newton matrix has a non-finite pivot";
     return false;
   }
+  kept->have = true;
+  kept->c = c;
+  kept->refresh = false;
+  return true;
+}
+
+bool SolveNewtonSystem(SaddlePointSolver* solver, const SolverSettings& settings,
+                       Eigen::VectorXd* rhs, Eigen::VectorXd* dx, Stepper::StepStats* st) {
   *rhs = -*rhs;
-  ++st->factorizations;
   const auto ls = solver->Solve(settings.linear_solver, *rhs, settings.linear_tolerance,
                                 settings.max_linear_iterations, dx);
   ++st->newton_iterations;
+  ++st->linear_solves;
   st->linear_iterations += ls.iterations;
   st->max_linear_residual = std::max(st->max_linear_residual, ls.relative_residual);
   st->direct_fallbacks += ls.fallback ? 1 : 0;
+  st->inexact_solves += LinearSolveInexact(ls) ? 1 : 0;
   if (!LinearSolveGoodEnough(ls)) {
     st->reason = LinearSolveFailure(ls, settings.linear_solver);
     return false;
   }
   return true;
+}
+
+void AddFailedAttempt(const Stepper::StepStats& first, Stepper::StepStats* retry) {
+  retry->newton_iterations += first.newton_iterations;
+  retry->linear_iterations += first.linear_iterations;
+  retry->factorizations += first.factorizations;
+  retry->direct_fallbacks += first.direct_fallbacks;
+  retry->linear_solves += first.linear_solves;
+  retry->inexact_solves += first.inexact_solves;
+  retry->max_linear_residual = std::max(retry->max_linear_residual, first.max_linear_residual);
 }
 
 std::unique_ptr<Stepper> MakeStepper(MultibodyModel* model, const SolverSettings& settings) {

@@ -16,6 +16,7 @@
 // (midpoint rule with a discrete gradient). Step() allocates
 // nothing.
 
+#include <cmath>
 #include <memory>
 #include <string>
 
@@ -73,8 +74,8 @@ class Stepper {
   virtual const Eigen::VectorXd& lambda() const = 0;
 };
 
-// Shared pieces of the steppers' Newton solves (used by
-// EnergyMomentumStepper; the older steppers still carry their own copies).
+// Shared pieces of the steppers' Newton solves (generalized-alpha, HHT and
+// energy-momentum; backward Euler still carries its own).
 //
 // The consistent initial acceleration: with solver->a() holding M and
 // solver->b() Phi_z, solves [M Phi_z^T; Phi_z 0] [a; lambda] = [f; gamma]
@@ -82,12 +83,50 @@ class Stepper {
 bool SolveInitialAcceleration(SaddlePointSolver* solver, const SolverSettings& settings,
                               const Eigen::VectorXd& f, const Eigen::VectorXd& gamma,
                               Eigen::VectorXd* rhs, Eigen::VectorXd* dx, std::string* reason);
-// One Newton correction: factors solver->a() (with solver->b()), solves
-// for dx = -(Newton matrix)^-1 rhs (rhs is negated in place) and counts the
-// factorization, iteration and linear statistics in `st`. False with
-// st->reason when the matrix or the linear solve fails.
-bool NewtonCorrection(SaddlePointSolver* solver, const SolverSettings& settings,
-                      Eigen::VectorXd* rhs, Eigen::VectorXd* dx, Stepper::StepStats* st);
+
+// The factored Newton matrix a stepper keeps across iterations and steps
+// with solver.reuse_factorization: valid while its stiffness coefficient c
+// (the factor of K_T in it) stays within 20 % of the current one, so that
+// Newton still contracts by about that fraction (the steppers refresh it
+// when an increment shrinks by less than half, and retry a failed step
+// once fresh).
+struct KeptNewtonMatrix {
+  bool have = false;    // a factor is in the solver
+  double c = 0;         // its stiffness coefficient
+  bool refresh = true;  // the next step starts with a fresh one
+  bool Stale(double c_now) const { return !have || !(std::abs(c_now - c) <= 0.2 * c); }
+};
+
+// Copies the constraint Jacobian `jac` into solver->b(), factors it with
+// solver->a() (the Newton matrix assembled with coefficient c), records it
+// in `kept` and counts it in `st`. False with st->reason on a non-finite
+// pivot.
+bool FactorNewtonMatrix(SaddlePointSolver* solver, const SparseRows& jac, double c,
+                        KeptNewtonMatrix* kept, Stepper::StepStats* st);
+
+// With the factor in place, solves for dx = -(Newton matrix)^-1 rhs (rhs
+// negated in place) and counts the iteration and the linear statistics in
+// `st`. False with st->reason when the linear solve is not good enough.
+bool SolveNewtonSystem(SaddlePointSolver* solver, const SolverSettings& settings,
+                       Eigen::VectorXd* rhs, Eigen::VectorXd* dx, Stepper::StepStats* st);
+
+// Adds the counts of a failed first attempt at a step to its retry's.
+void AddFailedAttempt(const Stepper::StepStats& first, Stepper::StepStats* retry);
+
+// A step's Newton solve, solve(fresh) (fresh: start with a new Newton
+// matrix). With a kept matrix (`reuse`) the first attempt starts fresh only
+// when `refresh`; a failure other than a non-finite pivot is then retried
+// once fresh (the kept matrix may be what failed), both attempts counted.
+template <typename Solve>
+Stepper::StepStats SolveWithFreshRetry(bool reuse, bool refresh, Solve solve) {
+  Stepper::StepStats st = solve(!reuse || refresh);
+  if (!st.converged && reuse && st.reason.find("non-finite pivot") == std::string::npos) {
+    Stepper::StepStats again = solve(true);
+    AddFailedAttempt(st, &again);
+    return again;
+  }
+  return st;
+}
 
 // The stepper `settings.integrator` names, for `model` (which must outlive it).
 std::unique_ptr<Stepper> MakeStepper(MultibodyModel* model, const SolverSettings& settings);

@@ -304,7 +304,7 @@ std::vector<InvalidCase> InvalidCases() {
        absl::StrCat(R"({"cables": [)", kCable,
                     R"(], "solver": {"duration": 1, "integrator": "IMPLICIT_EULER",
                                      "reuse_factorization": true}})"),
-       "solver.reuse_factorization: ", "GENERALIZED_ALPHA and HHT only"},
+       "solver.reuse_factorization: ", "GENERALIZED_ALPHA, HHT and ENERGY_MOMENTUM only"},
       {"ToleranceWithoutAdaptive",
        absl::StrCat(R"({"cables": [)", kCable,
                     R"(], "solver": {"duration": 1, "tolerance": 1e-4}})"),

@@ -528,6 +528,27 @@ TEST_F(StepperAllocationTest, AlphaSteppersDoNotAllocate) {
   }
 }
 
+// The energy-momentum stepper likewise, every linear solver, with and
+// without keeping its Newton matrix.
+TEST_F(StepperAllocationTest, EnergyMomentumStepperDoesNotAllocate) {
+  for (LinearSolverKind ls : {LinearSolverKind::kMinres, LinearSolverKind::kGmres,
+                              LinearSolverKind::kDirect, LinearSolverKind::kAuto}) {
+    for (bool reuse : {false, true}) {
+      SCOPED_TRACE(::testing::Message() << "solver " << static_cast<int>(ls) << " reuse "
+                                        << reuse);
+      Scene pendulum = FallingPendulum();
+      pendulum.solver.integrator = Integrator::kEnergyMomentum;
+      pendulum.solver.linear_solver = ls;
+      pendulum.solver.reuse_factorization = reuse;
+      ExpectStepsDoNotAllocate(pendulum, 1e-3, 50);
+      Scene cylinder = CableWithEndCylinder(ls);
+      cylinder.solver.integrator = Integrator::kEnergyMomentum;
+      cylinder.solver.reuse_factorization = reuse;
+      ExpectStepsDoNotAllocate(cylinder, 0.005, 50);
+    }
+  }
+}
+
 // Time dependence costs no allocation either: the crane sample (a support
 // moving harmonically in x and y, rheonomic rows re-evaluated each step)
 // with a time-varying force on the rope and a time-varying torque on the
@@ -549,7 +570,8 @@ TEST_F(StepperAllocationTest, MovingSupportAndVaryingLoadsDoNotAllocate) {
   torque.varying_torque_nm[2] = TimeFunction::Table({0, 1}, {0, 5});
   scene.loads.push_back(torque);
   for (Integrator integrator :
-       {Integrator::kImplicitEuler, Integrator::kGeneralizedAlpha, Integrator::kHht}) {
+       {Integrator::kImplicitEuler, Integrator::kGeneralizedAlpha, Integrator::kHht,
+        Integrator::kEnergyMomentum}) {
     SCOPED_TRACE(::testing::Message() << "integrator " << static_cast<int>(integrator));
     scene.solver.integrator = integrator;
     ExpectStepsDoNotAllocate(scene, 1e-3, 50);
