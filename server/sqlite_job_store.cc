@@ -362,6 +362,16 @@ absl::Status SqliteJobStore::CheckAndMigrate(const std::string& dir) {
       if (absl::Status s = set.Bind(1, sum).Bind(2, seq).Done(); !s.ok()) return s;
     }
   }
+  // The page-token secret (page_token.h): made once, kept with the jobs.
+  {
+    absl::StatusOr<std::string> fresh = NewPageTokenSecret();
+    if (!fresh.ok()) return fresh.status();
+    Stmt put(db_, "INSERT OR IGNORE INTO meta (key, value) VALUES ('page_token_secret', ?1)");
+    if (absl::Status s = put.Bind(1, *fresh).Done(); !s.ok()) return s;
+    Stmt get(db_, "SELECT value FROM meta WHERE key = 'page_token_secret'");
+    if (get.Step() != SQLITE_ROW) return SqlError(db_);
+    page_token_secret_ = get.Text(0);
+  }
   if (stored_id.empty()) {
     absl::StatusOr<std::string> id = RandomId();
     if (!id.ok()) return id.status();
@@ -520,18 +530,11 @@ absl::StatusOr<v1::Scene> SqliteJobStore::GetScene(const std::string& id) {
 }
 
 absl::StatusOr<std::vector<v1::Job>> SqliteJobStore::ListJobs(v1::JobState state,
-                                                        const std::string& sweep_id, int limit,
-                                                        const std::string& after_id,
-                                                        const std::string* tenant) {
+                                                              const std::string& sweep_id,
+                                                              int limit, int64_t after_key,
+                                                              const std::string* tenant,
+                                                              std::vector<int64_t>* keys) {
   absl::MutexLock lock(&mu_);
-  int64_t before_seq = std::numeric_limits<int64_t>::max();
-  if (!after_id.empty()) {
-    before_seq = IsSweepId(after_id) ? -1 : LookUpSeq(after_id);
-    if (before_seq < 0) {
-      return absl::InvalidArgumentError(
-          "page_token: not a token from a previous ListJobs response (or its job was deleted)");
-    }
-  }
   Stmt s(db_, absl::StrCat("SELECT ", kJobColumns,
                            " FROM jobs WHERE (?1 = 0 OR state = ?1) AND (?2 = 0 OR sweep_seq = ?2)"
                            " AND seq < ?4 AND (?5 = 0 OR tenant = ?6) ORDER BY seq DESC LIMIT ?3")
@@ -540,10 +543,14 @@ absl::StatusOr<std::vector<v1::Job>> SqliteJobStore::ListJobs(v1::JobState state
   s.Bind(1, int64_t{state})
       .Bind(2, sweep_id.empty() ? 0 : (IsSweepId(sweep_id) ? LookUpSeq(sweep_id) : -1))
       .Bind(3, int64_t{limit})
-      .Bind(4, before_seq);
+      .Bind(4, after_key > 0 ? after_key : std::numeric_limits<int64_t>::max());
   std::vector<v1::Job> jobs;
+  if (keys != nullptr) keys->clear();
   int rc;
-  while ((rc = s.Step()) == SQLITE_ROW) jobs.push_back(JobFromRow(s));
+  while ((rc = s.Step()) == SQLITE_ROW) {
+    jobs.push_back(JobFromRow(s));
+    if (keys != nullptr) keys->push_back(s.Int(0));
+  }
   if (rc != SQLITE_DONE) return SqlError(db_);
   return jobs;
 }

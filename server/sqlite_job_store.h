@@ -55,8 +55,10 @@ class SqliteJobStore final : public JobStore {
   absl::StatusOr<v1::Job> GetJob(const std::string& id) override;
   absl::StatusOr<v1::Scene> GetScene(const std::string& id) override;
   absl::StatusOr<std::vector<v1::Job>> ListJobs(v1::JobState state, const std::string& sweep_id,
-                                                int limit, const std::string& after_id,
-                                                const std::string* tenant) override;
+                                                int limit, int64_t after_key,
+                                                const std::string* tenant,
+                                                std::vector<int64_t>* keys) override;
+  const std::string& page_token_secret() const override { return page_token_secret_; }
   absl::StatusOr<std::string> Tenant(const std::string& id) override;
   absl::StatusOr<std::vector<std::string>> QueuedJobIds() override;
   absl::StatusOr<std::optional<Claim>> ClaimNext() override;
@@ -92,6 +94,7 @@ class SqliteJobStore final : public JobStore {
   sqlite3* db_;
   int lock_fd_;
   const std::string dir_;
+  std::string page_token_secret_;  // set by CheckAndMigrate
 };
 
 }  // namespace cablesim

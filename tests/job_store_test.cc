@@ -253,18 +253,59 @@ TEST_P(JobStoreTest, ListJobsPagesNewestFirstAndByTenant) {
                                    i % 2 ? "odd" : "even")
                       ->id());
   }
-  const std::vector<v1::Job> page = *store->ListJobs(v1::QUEUED, "", 2);
+  std::vector<int64_t> keys;
+  const std::vector<v1::Job> page = *store->ListJobs(v1::QUEUED, "", 2, 0, nullptr, &keys);
   ASSERT_EQ(page.size(), 2u);
+  ASSERT_EQ(keys.size(), 2u);
   EXPECT_EQ(page[0].id(), ids[4]);
-  const std::vector<v1::Job> next = *store->ListJobs(v1::QUEUED, "", 10, page[1].id());
+  EXPECT_GT(keys[0], keys[1]);  // newest first: keys fall
+  const std::vector<v1::Job> next = *store->ListJobs(v1::QUEUED, "", 10, keys[1]);
   ASSERT_EQ(next.size(), 3u);
   EXPECT_EQ(next[0].id(), ids[2]);
   const std::string odd = "odd";
-  EXPECT_EQ(store->ListJobs(v1::JOB_STATE_UNSPECIFIED, "", 10, "", &odd)->size(), 2u);
+  EXPECT_EQ(store->ListJobs(v1::JOB_STATE_UNSPECIFIED, "", 10, 0, &odd)->size(), 2u);
   EXPECT_EQ(*store->Tenant(ids[1]), "odd");
-  EXPECT_EQ(store->ListJobs(v1::QUEUED, "", 10, "j-nonesuch").status().code(),
-            absl::StatusCode::kInvalidArgument);
   EXPECT_TRUE(store->ListJobs(v1::RUNNING, "", 10)->empty());
+}
+
+TEST_P(JobStoreTest, PagingGoesOnWhenThePagesLastJobIsDeleted) {
+  // Keyset paging: the key of a deleted job still marks the place.
+  auto store = OpenStore(FreshSpec("page_delete"));
+  ASSERT_NE(store, nullptr);
+  std::vector<std::string> ids;
+  for (int i = 0; i < 6; ++i) {
+    const v1::Job job = *store->InsertJob(Named(absl::StrCat("n", i)), 1);
+    ASSERT_TRUE(*store->CancelQueued(job.id()));  // finished, so deletable
+    ids.push_back(job.id());
+  }
+  std::vector<int64_t> keys;
+  const std::vector<v1::Job> page =
+      *store->ListJobs(v1::JOB_STATE_UNSPECIFIED, "", 2, 0, nullptr, &keys);
+  ASSERT_EQ(page.size(), 2u);
+  EXPECT_EQ(page[1].id(), ids[4]);
+  ASSERT_TRUE(store->DeleteJob(ids[4]).ok());
+  ASSERT_TRUE(store->DeleteJob(ids[3]).ok());  // and the next page's first
+  const std::vector<v1::Job> next = *store->ListJobs(v1::JOB_STATE_UNSPECIFIED, "", 10, keys[1]);
+  std::vector<std::string> listed;
+  for (const v1::Job& job : next) listed.push_back(job.id());
+  EXPECT_THAT(listed, ::testing::ElementsAre(ids[2], ids[1], ids[0]));
+}
+
+TEST_P(JobStoreTest, ThePageTokenSecretIsRandomAndKeptAcrossOpens) {
+  const std::string spec = FreshSpec("secret");
+  std::string first;
+  {
+    auto store = OpenStore(spec);
+    ASSERT_NE(store, nullptr);
+    first = store->page_token_secret();
+  }
+  EXPECT_EQ(first.size(), 64u);  // 256 bits as hex
+  auto again = OpenStore(spec);
+  ASSERT_NE(again, nullptr);
+  EXPECT_EQ(again->page_token_secret(), first);
+  auto other = OpenStore(FreshSpec("secret_other"));
+  ASSERT_NE(other, nullptr);
+  EXPECT_NE(other->page_token_secret(), first);
 }
 
 TEST_P(JobStoreTest, OneClientCannotQueueBeyondItsLimit) {

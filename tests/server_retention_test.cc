@@ -18,6 +18,8 @@ namespace {
 using ::testing::HasSubstr;
 using testing::Pendulum;
 using testing::ServerProcess;
+using testing::DeleteJob;
+using testing::DeleteSweep;
 using testing::Submit;
 
 grpc::Status GetJob(v1::CablesimService::Stub* stub, const std::string& id, v1::Job* job) {
@@ -25,28 +27,6 @@ grpc::Status GetJob(v1::CablesimService::Stub* stub, const std::string& id, v1::
   v1::GetJobRequest request;
   request.set_id(id);
   return stub->GetJob(&context, request, job);
-}
-
-grpc::Status DeleteJob(v1::CablesimService::Stub* stub, const std::string& id,
-                       int64_t* freed = nullptr) {
-  grpc::ClientContext context;
-  v1::DeleteJobRequest request;
-  request.set_id(id);
-  v1::DeleteResponse response;
-  const grpc::Status s = stub->DeleteJob(&context, request, &response);
-  if (freed) *freed = response.freed_bytes();
-  return s;
-}
-
-grpc::Status DeleteSweep(v1::CablesimService::Stub* stub, const std::string& id,
-                         int64_t* freed = nullptr) {
-  grpc::ClientContext context;
-  v1::DeleteSweepRequest request;
-  request.set_id(id);
-  v1::DeleteResponse response;
-  const grpc::Status s = stub->DeleteSweep(&context, request, &response);
-  if (freed) *freed = response.freed_bytes();
-  return s;
 }
 
 v1::Sweep SubmitSweep(v1::CablesimService::Stub* stub, const v1::Scene& base) {
