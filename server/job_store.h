@@ -130,6 +130,10 @@ class JobStore {
   // `meta`), so that tokens survive restarts and every server of a shared
   // store accepts the others' tokens.
   virtual const std::string& page_token_secret() const = 0;
+  // Gives the disk space of deleted rows back to the file system, a bounded
+  // step at a time (SQLite: `PRAGMA incremental_vacuum`); true while more
+  // remains. Nothing for PostgreSQL, whose autovacuum reuses the space.
+  virtual absl::StatusOr<bool> ReclaimSpace() { return false; }
   // The tenant that owns job or sweep `id` (by its prefix); NotFound.
   virtual absl::StatusOr<std::string> Tenant(const std::string& id) = 0;
   // Ids of QUEUED jobs, oldest first.

@@ -63,6 +63,11 @@ CREATE TABLE IF NOT EXISTS meta (
 )sql";
 
 constexpr char kStoreIdFile[] = "store-id";
+// PRAGMA auto_vacuum's value for INCREMENTAL.
+constexpr int64_t kIncrementalVacuum = 2;
+// ReclaimSpace's step: free pages given back per call (16 MiB of 4 KiB
+// pages), so that other calls wait at most for one step.
+constexpr int kReclaimPages = 4096;
 
 
 
@@ -282,10 +287,29 @@ absl::Status SqliteJobStore::CheckAndMigrate(const std::string& dir) {
                  : ", the database has lost its schema and jobs",
         "); restore the database from a backup, or move the directory aside to start afresh"));
   }
+  // Deleted results give their disk space back (ReclaimSpace):
+  // auto_vacuum=INCREMENTAL keeps the page map that incremental_vacuum
+  // needs. A new database takes it before its first table; a database made
+  // before is rebuilt once by VACUUM (time in proportion to its size, at
+  // this start only).
+  int64_t vacuum_mode = -1;
+  {
+    Stmt mode(db_, "PRAGMA auto_vacuum");
+    if (mode.Step() != SQLITE_ROW) return SqlError(db_);
+    vacuum_mode = mode.Int(0);
+  }
+  if (vacuum_mode != kIncrementalVacuum) {
+    const char* sql = has_jobs || has_meta ? "PRAGMA auto_vacuum=INCREMENTAL; VACUUM"
+                                           : "PRAGMA auto_vacuum=INCREMENTAL";
+    if (absl::Status s = Exec(sql); !s.ok()) return absl::UnavailableError(s.message());
+  }
   // WAL: readers do not block the writer; synchronous=FULL: a committed
-  // transaction is on disk before the call returns.
-  for (const char* sql :
-       {"PRAGMA journal_mode=WAL", "PRAGMA synchronous=FULL", "PRAGMA foreign_keys=ON", kSchema}) {
+  // transaction is on disk before the call returns; journal_size_limit:
+  // after a checkpoint the log file keeps at most 16 MiB (not the size of
+  // the largest result ever written).
+  for (const char* sql : {"PRAGMA journal_mode=WAL", "PRAGMA synchronous=FULL",
+                          "PRAGMA journal_size_limit=16777216", "PRAGMA foreign_keys=ON",
+                          kSchema}) {
     if (absl::Status s = Exec(sql); !s.ok()) return absl::UnavailableError(s.message());
   }
   // Databases from before checksums: add the column and fill it from the
@@ -860,6 +884,30 @@ absl::StatusOr<RetentionReport> SqliteJobStore::ApplyRetention(int64_t older_tha
     report.bytes += c.bytes;
   }
   return report;
+}
+
+absl::StatusOr<bool> SqliteJobStore::ReclaimSpace() {
+  absl::MutexLock lock(&mu_);
+  auto free_pages = [this]() -> int64_t {
+    Stmt count(db_, "PRAGMA freelist_count");
+    return count.Step() == SQLITE_ROW ? count.Int(0) : -1;
+  };
+  const int64_t before = free_pages();
+  if (before < 0) return SqlError(db_);
+  if (before == 0) return false;
+  // Moves the pages at the end of the file into the free ones and cuts the
+  // file (in the write-ahead log until the checkpoint below).
+  if (absl::Status s = Exec(absl::StrCat("PRAGMA incremental_vacuum(", kReclaimPages, ")").c_str());
+      !s.ok()) {
+    return s;
+  }
+  const int64_t after = free_pages();
+  if (after < 0) return SqlError(db_);
+  if (after > 0) return true;
+  // Everything moved: the database file shrinks at this checkpoint, and
+  // the log is emptied.
+  if (absl::Status s = Exec("PRAGMA wal_checkpoint(TRUNCATE)"); !s.ok()) return s;
+  return false;
 }
 
 absl::StatusOr<std::string> SqliteJobStore::Tenant(const std::string& id) {
