@@ -9,7 +9,7 @@ packages=(
   libprotobuf-dev protobuf-compiler
   libgrpc++-dev protobuf-compiler-grpc
   libgtest-dev libgmock-dev libbenchmark-dev
-  libsqlite3-dev zlib1g-dev libzstd-dev
+  libsqlite3-dev zlib1g-dev libzstd-dev libssl-dev
   libpq-dev postgresql
   python3 python3-grpcio python3-protobuf python3-numpy python3-matplotlib python3-pil
   python3-venv python3-setuptools python3-wheel python3-pandas

@@ -256,6 +256,7 @@ grpc::Status CablesimServiceImpl::Authorize(grpc::ServerContext* context,
 CablesimServiceImpl::CablesimServiceImpl(JobManager* jobs, ServerLimits limits, bool log,
                                          std::map<std::string, std::string> tokens)
     : jobs_(jobs), limits_(limits), log_(log), tokens_(std::move(tokens)) {
+  if (jobs_ != nullptr) page_tokens_.emplace(jobs_->store()->page_token_secret());
   watchdog_ = std::thread([this] { Watchdog(); });
 }
 
@@ -419,12 +420,21 @@ grpc::Status CablesimServiceImpl::ListJobs(grpc::ServerContext* context,
   if (jobs_ == nullptr) return NoJobs();
   const int asked = request->page_size() > 0 ? request->page_size() : request->limit();
   const int limit = asked <= 0 ? 100 : std::min(asked, 10000);
-  // The page token is the id of the last job of the previous page.
+  // Keyset paging: the token hides and authenticates the order key of the
+  // last job listed (page_token.h), bound to the tenant and the filters.
+  const std::string query = absl::StrCat(static_cast<int>(request->state()), "/",
+                                         request->sweep_id());
+  int64_t after_key = 0;
+  if (!request->page_token().empty()) {
+    absl::StatusOr<int64_t> key = page_tokens_->Decode(request->page_token(), tenant, query);
+    if (!key.ok()) return ToGrpc(key.status());
+    after_key = *key;
+  }
   // One more than asked, to know whether another page follows.
+  std::vector<int64_t> keys;
   absl::StatusOr<std::vector<v1::Job>> jobs =
-      jobs_->store()->ListJobs(request->state(), request->sweep_id(), limit + 1,
-                               request->page_token(),
-                               tokens_.empty() ? nullptr : &tenant);
+      jobs_->store()->ListJobs(request->state(), request->sweep_id(), limit + 1, after_key,
+                               tokens_.empty() ? nullptr : &tenant, &keys);
   if (!jobs.ok()) return ToGrpc(jobs.status());
   // Never a response over the message limit: stop at half of it.
   const size_t budget = static_cast<size_t>(limits_.max_message_bytes) / 2;
@@ -435,7 +445,9 @@ grpc::Status CablesimServiceImpl::ListJobs(grpc::ServerContext* context,
     const size_t size = job.ByteSizeLong() + 8;
     const bool full = static_cast<int>(i) == limit || (i > 0 && bytes + size > budget);
     if (full) {
-      response->set_next_page_token(response->jobs(response->jobs_size() - 1).id());
+      absl::StatusOr<std::string> token = page_tokens_->Encode(keys[i - 1], tenant, query);
+      if (!token.ok()) return ToGrpc(token.status());
+      response->set_next_page_token(*token);
       break;
     }
     bytes += size;

@@ -15,12 +15,14 @@
 #include <atomic>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 
 #include "absl/synchronization/mutex.h"
 #include "cablesim/v1/service.grpc.pb.h"
 #include "server/job_manager.h"
+#include "server/page_token.h"
 #include "server/request_checks.h"
 
 namespace cablesim {
@@ -96,6 +98,8 @@ class CablesimServiceImpl final : public v1::CablesimService::Service {
   const ServerLimits limits_;
   const bool log_;
   const std::map<std::string, std::string> tokens_;
+  // ListJobs' page tokens, keyed by the store's secret (set with jobs_).
+  std::optional<PageTokenCodec> page_tokens_;
   absl::Mutex mu_;
   // Counted streams, in all and per peer (StreamSlot).
   int streams_ ABSL_GUARDED_BY(mu_) = 0;

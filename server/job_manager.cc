@@ -66,6 +66,8 @@ absl::Status JobManager::Start() {
   if (store_->shared()) store_->SetChangeListener([this] { WorkArrived(); });
   ApplyRetention();
   for (int i = 0; i < workers_; ++i) threads_.emplace_back([this] { Work(); });
+  SpaceFreed();  // whatever a previous run deleted and had not yet given back
+  threads_.emplace_back([this] { Reclaims(); });
   if (store_->shared()) threads_.emplace_back([this] { Heartbeats(); });
   return absl::OkStatus();
 }
@@ -98,6 +100,31 @@ void JobManager::WaitForChange(uint64_t seen, absl::Duration timeout) {
   absl::MutexLock lock(&mu_);
   auto changed = [&]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) { return version_ > seen || stopping_; };
   mu_.AwaitWithTimeout(absl::Condition(&changed), timeout);
+}
+
+void JobManager::SpaceFreed() {
+  absl::MutexLock lock(&mu_);
+  reclaim_ = true;
+}
+
+void JobManager::Reclaims() {
+  while (true) {
+    {
+      absl::MutexLock lock(&mu_);
+      auto due = [this]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) { return reclaim_ || stopping_; };
+      mu_.Await(absl::Condition(&due));
+      if (stopping_) return;
+      reclaim_ = false;
+    }
+    // A step at a time, so that the store serves other calls in between.
+    for (bool more = true; more && !shutting_down();) {
+      absl::StatusOr<bool> step = store_->ReclaimSpace();
+      if (!step.ok() && log_) {
+        std::cerr << "cablesim-server: giving deleted space back: " << step.status() << "\n";
+      }
+      more = step.ok() && *step;
+    }
+  }
 }
 
 void JobManager::Changed() {
@@ -166,13 +193,19 @@ absl::StatusOr<v1::Job> JobManager::Cancel(const std::string& id) {
 
 absl::StatusOr<int64_t> JobManager::DeleteJob(const std::string& id) {
   absl::StatusOr<int64_t> freed = store_->DeleteJob(id);
-  if (freed.ok()) Changed();
+  if (freed.ok()) {
+    Changed();
+    SpaceFreed();
+  }
   return freed;
 }
 
 absl::StatusOr<int64_t> JobManager::DeleteSweep(const std::string& id) {
   absl::StatusOr<int64_t> freed = store_->DeleteSweep(id);
-  if (freed.ok()) Changed();
+  if (freed.ok()) {
+    Changed();
+    SpaceFreed();
+  }
   return freed;
 }
 
@@ -194,6 +227,7 @@ void JobManager::ApplyRetention() {
                 << report->sweeps << " sweeps), " << report->bytes << " bytes of results\n";
     }
     Changed();
+    SpaceFreed();
   }
 }
 

@@ -15,6 +15,10 @@
 // claim was lost (its result would be refused). Idle workers wake on the
 // store's notifications and poll besides (twice a second), which also
 // retakes jobs whose server died once their lease has expired.
+//
+// Deleting jobs (DeleteJob, DeleteSweep, retention) wakes a thread that
+// gives their space back to the file system (JobStore::ReclaimSpace), so
+// that the call that deleted need not wait for it.
 
 #include <atomic>
 #include <cstdint>
@@ -100,6 +104,11 @@ class JobManager {
   void Heartbeats();
   void WaitAtTestGate(const std::string& id, const Running& running);
   void Changed();
+  // Deleted rows' space may be given back: wake Reclaims.
+  void SpaceFreed();
+  // The thread that gives the space of deleted results back to the file
+  // system (JobStore::ReclaimSpace), off the request path.
+  void Reclaims();
 
   JobStore* store_;
   const int workers_;
@@ -116,6 +125,7 @@ class JobManager {
   uint64_t version_ ABSL_GUARDED_BY(mu_) = 0;
   uint64_t work_ ABSL_GUARDED_BY(mu_) = 0;
   bool stopping_ ABSL_GUARDED_BY(mu_) = false;
+  bool reclaim_ ABSL_GUARDED_BY(mu_) = false;
   std::vector<std::thread> threads_;
 };
 

@@ -57,6 +57,14 @@ absl::StatusOr<std::string> RandomId() {
   return id;
 }
 
+absl::StatusOr<std::string> NewPageTokenSecret() {
+  absl::StatusOr<std::string> a = RandomId();
+  if (!a.ok()) return a.status();
+  absl::StatusOr<std::string> b = RandomId();
+  if (!b.ok()) return b.status();
+  return absl::StrCat(*a, *b);
+}
+
 absl::StatusOr<StoredResult> CheckedResult(const std::string& id, const std::string& header,
                                            const std::string& vals, int64_t checksum,
                                            int64_t encoding) {

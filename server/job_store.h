@@ -118,11 +118,22 @@ class JobStore {
   virtual absl::StatusOr<v1::Job> GetJob(const std::string& id) = 0;
   virtual absl::StatusOr<v1::Scene> GetScene(const std::string& id) = 0;
   // Newest first, at most `limit`, and with `tenant`, only that tenant's.
-  // Paging: only jobs older than job `after_id` (InvalidArgument when no
-  // such job).
+  // Keyset paging: each job has an order key (its internal row number,
+  // larger for newer jobs, never reused); with `after_key` > 0, only jobs
+  // whose key is smaller (whether or not the job of `after_key` still
+  // exists). `keys`, when given, receives the listed jobs' keys.
   virtual absl::StatusOr<std::vector<v1::Job>> ListJobs(
-      v1::JobState state, const std::string& sweep_id, int limit,
-      const std::string& after_id = "", const std::string* tenant = nullptr) = 0;
+      v1::JobState state, const std::string& sweep_id, int limit, int64_t after_key = 0,
+      const std::string* tenant = nullptr, std::vector<int64_t>* keys = nullptr) = 0;
+  // The secret that authenticates this store's page tokens (page_token.h):
+  // 32 random bytes made when the store was created and kept in it (table
+  // `meta`), so that tokens survive restarts and every server of a shared
+  // store accepts the others' tokens.
+  virtual const std::string& page_token_secret() const = 0;
+  // Gives the disk space of deleted rows back to the file system, a bounded
+  // step at a time (SQLite: `PRAGMA incremental_vacuum`); true while more
+  // remains. Nothing for PostgreSQL, whose autovacuum reuses the space.
+  virtual absl::StatusOr<bool> ReclaimSpace() { return false; }
   // The tenant that owns job or sweep `id` (by its prefix); NotFound.
   virtual absl::StatusOr<std::string> Tenant(const std::string& id) = 0;
   // Ids of QUEUED jobs, oldest first.
@@ -208,6 +219,8 @@ bool IsFinished(v1::JobState state);
 absl::Status PeerLimitExceeded(const std::string& peer, int64_t unfinished, int64_t adding,
                                int64_t max_unfinished);
 absl::StatusOr<std::string> RandomId();
+// A new store's page-token secret: 256 random bits as hex.
+absl::StatusOr<std::string> NewPageTokenSecret();
 // Creates directory `dir` (0700; missing parents with the default mode)
 // unless it exists; FailedPrecondition naming it and the reason when it
 // cannot, or when `dir` is not a directory.

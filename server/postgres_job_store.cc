@@ -279,6 +279,20 @@ absl::StatusOr<std::unique_ptr<PostgresJobStore>> PostgresJobStore::Open(
   if (absl::Status s = store->Migrate(); !s.ok()) {
     return absl::Status(s.code(), absl::StrCat(store->describe_, ": ", s.message()));
   }
+  // The page-token secret (page_token.h): the first server to start makes
+  // it, every server reads the same one.
+  absl::StatusOr<std::string> fresh = NewPageTokenSecret();
+  if (!fresh.ok()) return fresh.status();
+  PgResult put(Params().Text(*fresh).Run(
+      store->conn_,
+      "INSERT INTO meta (key, value) VALUES ('page_token_secret', $1) ON CONFLICT (key) DO "
+      "NOTHING"));
+  if (!put.ok()) return put.status();
+  PgResult get(
+      Params().Run(store->conn_, "SELECT value FROM meta WHERE key = 'page_token_secret'"));
+  if (!get.ok()) return get.status();
+  if (get.rows() != 1) return absl::InternalError("meta.page_token_secret missing");
+  store->page_token_secret_ = get.Bytes(0, 0);
   return store;
 }
 
@@ -514,21 +528,12 @@ absl::StatusOr<v1::Scene> PostgresJobStore::GetScene(const std::string& id) {
 
 absl::StatusOr<std::vector<v1::Job>> PostgresJobStore::ListJobs(v1::JobState state,
                                                                 const std::string& sweep_id,
-                                                                int limit,
-                                                                const std::string& after_id,
-                                                                const std::string* tenant) {
+                                                                int limit, int64_t after_key,
+                                                                const std::string* tenant,
+                                                                std::vector<int64_t>* keys) {
   absl::MutexLock lock(&mu_);
   EnsureConnected();
-  int64_t before_seq = std::numeric_limits<int64_t>::max();
-  if (!after_id.empty()) {
-    PgResult r(Params().Text(after_id).Run(conn_, "SELECT seq FROM jobs WHERE pid = $1"));
-    if (!r.ok()) return r.status();
-    if (IsSweepId(after_id) || r.rows() == 0) {
-      return absl::InvalidArgumentError(
-          "page_token: not a token from a previous ListJobs response (or its job was deleted)");
-    }
-    before_seq = r.Int(0, 0);
-  }
+  const int64_t before_seq = after_key > 0 ? after_key : std::numeric_limits<int64_t>::max();
   int64_t sweep_seq = 0;
   if (!sweep_id.empty()) {
     sweep_seq = -1;
@@ -553,7 +558,11 @@ absl::StatusOr<std::vector<v1::Job>> PostgresJobStore::ListJobs(v1::JobState sta
                                  "ORDER BY j.seq DESC LIMIT $3::bigint")));
   if (!r.ok()) return r.status();
   std::vector<v1::Job> jobs;
-  for (int i = 0; i < r.rows(); ++i) jobs.push_back(JobFromRow(r, i));
+  if (keys != nullptr) keys->clear();
+  for (int i = 0; i < r.rows(); ++i) {
+    jobs.push_back(JobFromRow(r, i));
+    if (keys != nullptr) keys->push_back(r.Int(i, 0));
+  }
   return jobs;
 }
 

@@ -73,8 +73,10 @@ class PostgresJobStore final : public JobStore {
   absl::StatusOr<v1::Job> GetJob(const std::string& id) override;
   absl::StatusOr<v1::Scene> GetScene(const std::string& id) override;
   absl::StatusOr<std::vector<v1::Job>> ListJobs(v1::JobState state, const std::string& sweep_id,
-                                                int limit, const std::string& after_id,
-                                                const std::string* tenant) override;
+                                                int limit, int64_t after_key,
+                                                const std::string* tenant,
+                                                std::vector<int64_t>* keys) override;
+  const std::string& page_token_secret() const override { return page_token_secret_; }
   absl::StatusOr<std::string> Tenant(const std::string& id) override;
   absl::StatusOr<std::vector<std::string>> QueuedJobIds() override;
   absl::StatusOr<std::optional<Claim>> ClaimNext() override;
@@ -121,6 +123,7 @@ class PostgresJobStore final : public JobStore {
   std::function<void()> listener_ ABSL_GUARDED_BY(listener_mu_);
   std::atomic<bool> stop_{false};
   std::thread listen_thread_;
+  std::string page_token_secret_;  // set by Open
 
 };
 

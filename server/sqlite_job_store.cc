@@ -63,6 +63,11 @@ CREATE TABLE IF NOT EXISTS meta (
 )sql";
 
 constexpr char kStoreIdFile[] = "store-id";
+// PRAGMA auto_vacuum's value for INCREMENTAL.
+constexpr int64_t kIncrementalVacuum = 2;
+// ReclaimSpace's step: free pages given back per call (16 MiB of 4 KiB
+// pages), so that other calls wait at most for one step.
+constexpr int kReclaimPages = 4096;
 
 
 
@@ -282,10 +287,29 @@ absl::Status SqliteJobStore::CheckAndMigrate(const std::string& dir) {
                  : ", the database has lost its schema and jobs",
         "); restore the database from a backup, or move the directory aside to start afresh"));
   }
+  // Deleted results give their disk space back (ReclaimSpace):
+  // auto_vacuum=INCREMENTAL keeps the page map that incremental_vacuum
+  // needs. A new database takes it before its first table; a database made
+  // before is rebuilt once by VACUUM (time in proportion to its size, at
+  // this start only).
+  int64_t vacuum_mode = -1;
+  {
+    Stmt mode(db_, "PRAGMA auto_vacuum");
+    if (mode.Step() != SQLITE_ROW) return SqlError(db_);
+    vacuum_mode = mode.Int(0);
+  }
+  if (vacuum_mode != kIncrementalVacuum) {
+    const char* sql = has_jobs || has_meta ? "PRAGMA auto_vacuum=INCREMENTAL; VACUUM"
+                                           : "PRAGMA auto_vacuum=INCREMENTAL";
+    if (absl::Status s = Exec(sql); !s.ok()) return absl::UnavailableError(s.message());
+  }
   // WAL: readers do not block the writer; synchronous=FULL: a committed
-  // transaction is on disk before the call returns.
-  for (const char* sql :
-       {"PRAGMA journal_mode=WAL", "PRAGMA synchronous=FULL", "PRAGMA foreign_keys=ON", kSchema}) {
+  // transaction is on disk before the call returns; journal_size_limit:
+  // after a checkpoint the log file keeps at most 16 MiB (not the size of
+  // the largest result ever written).
+  for (const char* sql : {"PRAGMA journal_mode=WAL", "PRAGMA synchronous=FULL",
+                          "PRAGMA journal_size_limit=16777216", "PRAGMA foreign_keys=ON",
+                          kSchema}) {
     if (absl::Status s = Exec(sql); !s.ok()) return absl::UnavailableError(s.message());
   }
   // Databases from before checksums: add the column and fill it from the
@@ -361,6 +385,16 @@ absl::Status SqliteJobStore::CheckAndMigrate(const std::string& dir) {
       Stmt set(db_, "UPDATE results SET checksum = ?1 WHERE job_seq = ?2");
       if (absl::Status s = set.Bind(1, sum).Bind(2, seq).Done(); !s.ok()) return s;
     }
+  }
+  // The page-token secret (page_token.h): made once, kept with the jobs.
+  {
+    absl::StatusOr<std::string> fresh = NewPageTokenSecret();
+    if (!fresh.ok()) return fresh.status();
+    Stmt put(db_, "INSERT OR IGNORE INTO meta (key, value) VALUES ('page_token_secret', ?1)");
+    if (absl::Status s = put.Bind(1, *fresh).Done(); !s.ok()) return s;
+    Stmt get(db_, "SELECT value FROM meta WHERE key = 'page_token_secret'");
+    if (get.Step() != SQLITE_ROW) return SqlError(db_);
+    page_token_secret_ = get.Text(0);
   }
   if (stored_id.empty()) {
     absl::StatusOr<std::string> id = RandomId();
@@ -520,18 +554,11 @@ absl::StatusOr<v1::Scene> SqliteJobStore::GetScene(const std::string& id) {
 }
 
 absl::StatusOr<std::vector<v1::Job>> SqliteJobStore::ListJobs(v1::JobState state,
-                                                        const std::string& sweep_id, int limit,
-                                                        const std::string& after_id,
-                                                        const std::string* tenant) {
+                                                              const std::string& sweep_id,
+                                                              int limit, int64_t after_key,
+                                                              const std::string* tenant,
+                                                              std::vector<int64_t>* keys) {
   absl::MutexLock lock(&mu_);
-  int64_t before_seq = std::numeric_limits<int64_t>::max();
-  if (!after_id.empty()) {
-    before_seq = IsSweepId(after_id) ? -1 : LookUpSeq(after_id);
-    if (before_seq < 0) {
-      return absl::InvalidArgumentError(
-          "page_token: not a token from a previous ListJobs response (or its job was deleted)");
-    }
-  }
   Stmt s(db_, absl::StrCat("SELECT ", kJobColumns,
                            " FROM jobs WHERE (?1 = 0 OR state = ?1) AND (?2 = 0 OR sweep_seq = ?2)"
                            " AND seq < ?4 AND (?5 = 0 OR tenant = ?6) ORDER BY seq DESC LIMIT ?3")
@@ -540,10 +567,14 @@ absl::StatusOr<std::vector<v1::Job>> SqliteJobStore::ListJobs(v1::JobState state
   s.Bind(1, int64_t{state})
       .Bind(2, sweep_id.empty() ? 0 : (IsSweepId(sweep_id) ? LookUpSeq(sweep_id) : -1))
       .Bind(3, int64_t{limit})
-      .Bind(4, before_seq);
+      .Bind(4, after_key > 0 ? after_key : std::numeric_limits<int64_t>::max());
   std::vector<v1::Job> jobs;
+  if (keys != nullptr) keys->clear();
   int rc;
-  while ((rc = s.Step()) == SQLITE_ROW) jobs.push_back(JobFromRow(s));
+  while ((rc = s.Step()) == SQLITE_ROW) {
+    jobs.push_back(JobFromRow(s));
+    if (keys != nullptr) keys->push_back(s.Int(0));
+  }
   if (rc != SQLITE_DONE) return SqlError(db_);
   return jobs;
 }
@@ -853,6 +884,30 @@ absl::StatusOr<RetentionReport> SqliteJobStore::ApplyRetention(int64_t older_tha
     report.bytes += c.bytes;
   }
   return report;
+}
+
+absl::StatusOr<bool> SqliteJobStore::ReclaimSpace() {
+  absl::MutexLock lock(&mu_);
+  auto free_pages = [this]() -> int64_t {
+    Stmt count(db_, "PRAGMA freelist_count");
+    return count.Step() == SQLITE_ROW ? count.Int(0) : -1;
+  };
+  const int64_t before = free_pages();
+  if (before < 0) return SqlError(db_);
+  if (before == 0) return false;
+  // Moves the pages at the end of the file into the free ones and cuts the
+  // file (in the write-ahead log until the checkpoint below).
+  if (absl::Status s = Exec(absl::StrCat("PRAGMA incremental_vacuum(", kReclaimPages, ")").c_str());
+      !s.ok()) {
+    return s;
+  }
+  const int64_t after = free_pages();
+  if (after < 0) return SqlError(db_);
+  if (after > 0) return true;
+  // Everything moved: the database file shrinks at this checkpoint, and
+  // the log is emptied.
+  if (absl::Status s = Exec("PRAGMA wal_checkpoint(TRUNCATE)"); !s.ok()) return s;
+  return false;
 }
 
 absl::StatusOr<std::string> SqliteJobStore::Tenant(const std::string& id) {

@@ -19,6 +19,11 @@
 // replaced is refused (FAILED_PRECONDITION) instead of starting afresh
 // and reusing job ids.
 //
+// Disk space: the database is in auto_vacuum=INCREMENTAL mode (a database
+// made before is switched by one VACUUM at its next Open), so the space of
+// deleted results goes back to the file system through ReclaimSpace,
+// which the JobManager calls off the request path after deletions.
+//
 // Ids: job `j-` and sweep `s-` followed by 128 random bits (22 URL-safe
 // base64 characters), so that they cannot be guessed; rows stored before
 // random ids keep theirs (`j-000042`). Rows are numbered internally
@@ -55,8 +60,10 @@ class SqliteJobStore final : public JobStore {
   absl::StatusOr<v1::Job> GetJob(const std::string& id) override;
   absl::StatusOr<v1::Scene> GetScene(const std::string& id) override;
   absl::StatusOr<std::vector<v1::Job>> ListJobs(v1::JobState state, const std::string& sweep_id,
-                                                int limit, const std::string& after_id,
-                                                const std::string* tenant) override;
+                                                int limit, int64_t after_key,
+                                                const std::string* tenant,
+                                                std::vector<int64_t>* keys) override;
+  const std::string& page_token_secret() const override { return page_token_secret_; }
   absl::StatusOr<std::string> Tenant(const std::string& id) override;
   absl::StatusOr<std::vector<std::string>> QueuedJobIds() override;
   absl::StatusOr<std::optional<Claim>> ClaimNext() override;
@@ -72,6 +79,10 @@ class SqliteJobStore final : public JobStore {
   absl::StatusOr<int64_t> DeleteSweep(const std::string& id) override;
   absl::StatusOr<RetentionReport> ApplyRetention(int64_t older_than_unix_ms,
                                                  int64_t max_bytes) override;
+  // `PRAGMA incremental_vacuum` of at most 4096 pages (16 MiB), and once
+  // no free page is left, a checkpoint that truncates the database file
+  // and empties the write-ahead log.
+  absl::StatusOr<bool> ReclaimSpace() override;
 
  private:
   SqliteJobStore(sqlite3* db, int lock_fd, std::string dir)
@@ -92,6 +103,7 @@ class SqliteJobStore final : public JobStore {
   sqlite3* db_;
   int lock_fd_;
   const std::string dir_;
+  std::string page_token_secret_;  // set by CheckAndMigrate
 };
 
 }  // namespace cablesim

@@ -13,18 +13,22 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <libpq-fe.h>
+#include <sqlite3.h>
 #include <unistd.h>
 
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <iostream>
 #include <mutex>
+#include <random>
 #include <set>
 #include <thread>
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
 #include "server/postgres_job_store.h"
+#include "server/sqlite_job_store.h"
 #include "server/result_codec.h"
 #include "tests/postgres_test_util.h"
 
@@ -253,18 +257,59 @@ TEST_P(JobStoreTest, ListJobsPagesNewestFirstAndByTenant) {
                                    i % 2 ? "odd" : "even")
                       ->id());
   }
-  const std::vector<v1::Job> page = *store->ListJobs(v1::QUEUED, "", 2);
+  std::vector<int64_t> keys;
+  const std::vector<v1::Job> page = *store->ListJobs(v1::QUEUED, "", 2, 0, nullptr, &keys);
   ASSERT_EQ(page.size(), 2u);
+  ASSERT_EQ(keys.size(), 2u);
   EXPECT_EQ(page[0].id(), ids[4]);
-  const std::vector<v1::Job> next = *store->ListJobs(v1::QUEUED, "", 10, page[1].id());
+  EXPECT_GT(keys[0], keys[1]);  // newest first: keys fall
+  const std::vector<v1::Job> next = *store->ListJobs(v1::QUEUED, "", 10, keys[1]);
   ASSERT_EQ(next.size(), 3u);
   EXPECT_EQ(next[0].id(), ids[2]);
   const std::string odd = "odd";
-  EXPECT_EQ(store->ListJobs(v1::JOB_STATE_UNSPECIFIED, "", 10, "", &odd)->size(), 2u);
+  EXPECT_EQ(store->ListJobs(v1::JOB_STATE_UNSPECIFIED, "", 10, 0, &odd)->size(), 2u);
   EXPECT_EQ(*store->Tenant(ids[1]), "odd");
-  EXPECT_EQ(store->ListJobs(v1::QUEUED, "", 10, "j-nonesuch").status().code(),
-            absl::StatusCode::kInvalidArgument);
   EXPECT_TRUE(store->ListJobs(v1::RUNNING, "", 10)->empty());
+}
+
+TEST_P(JobStoreTest, PagingGoesOnWhenThePagesLastJobIsDeleted) {
+  // Keyset paging: the key of a deleted job still marks the place.
+  auto store = OpenStore(FreshSpec("page_delete"));
+  ASSERT_NE(store, nullptr);
+  std::vector<std::string> ids;
+  for (int i = 0; i < 6; ++i) {
+    const v1::Job job = *store->InsertJob(Named(absl::StrCat("n", i)), 1);
+    ASSERT_TRUE(*store->CancelQueued(job.id()));  // finished, so deletable
+    ids.push_back(job.id());
+  }
+  std::vector<int64_t> keys;
+  const std::vector<v1::Job> page =
+      *store->ListJobs(v1::JOB_STATE_UNSPECIFIED, "", 2, 0, nullptr, &keys);
+  ASSERT_EQ(page.size(), 2u);
+  EXPECT_EQ(page[1].id(), ids[4]);
+  ASSERT_TRUE(store->DeleteJob(ids[4]).ok());
+  ASSERT_TRUE(store->DeleteJob(ids[3]).ok());  // and the next page's first
+  const std::vector<v1::Job> next = *store->ListJobs(v1::JOB_STATE_UNSPECIFIED, "", 10, keys[1]);
+  std::vector<std::string> listed;
+  for (const v1::Job& job : next) listed.push_back(job.id());
+  EXPECT_THAT(listed, ::testing::ElementsAre(ids[2], ids[1], ids[0]));
+}
+
+TEST_P(JobStoreTest, ThePageTokenSecretIsRandomAndKeptAcrossOpens) {
+  const std::string spec = FreshSpec("secret");
+  std::string first;
+  {
+    auto store = OpenStore(spec);
+    ASSERT_NE(store, nullptr);
+    first = store->page_token_secret();
+  }
+  EXPECT_EQ(first.size(), 64u);  // 256 bits as hex
+  auto again = OpenStore(spec);
+  ASSERT_NE(again, nullptr);
+  EXPECT_EQ(again->page_token_secret(), first);
+  auto other = OpenStore(FreshSpec("secret_other"));
+  ASSERT_NE(other, nullptr);
+  EXPECT_NE(other->page_token_secret(), first);
 }
 
 TEST_P(JobStoreTest, OneClientCannotQueueBeyondItsLimit) {
@@ -336,6 +381,102 @@ std::unique_ptr<JobStore> OpenPostgres(const std::string& url, int64_t lease_ms)
   absl::StatusOr<std::unique_ptr<JobStore>> store = JobStore::Open(url, options);
   EXPECT_TRUE(store.ok()) << store.status();
   return store.ok() ? std::move(*store) : nullptr;
+}
+
+// Runs `sql` on DIR/cablesim.db through a connection of its own; returns
+// the first column of the last row (0 without one).
+int64_t SqliteQuery(const std::string& dir, const std::string& sql) {
+  sqlite3* db = nullptr;
+  EXPECT_EQ(sqlite3_open(absl::StrCat(dir, "/cablesim.db").c_str(), &db), SQLITE_OK);
+  int64_t value = 0;
+  sqlite3_exec(
+      db, sql.c_str(),
+      [](void* out, int columns, char** text, char**) {
+        if (columns > 0 && text[0] != nullptr) *static_cast<int64_t*>(out) = std::atoll(text[0]);
+        return 0;
+      },
+      &value, nullptr);
+  sqlite3_close(db);
+  return value;
+}
+
+// Bytes of DIR's database on disk, after a checkpoint has moved the
+// write-ahead log into it and emptied the log (so pages are not counted
+// twice).
+int64_t DatabaseBytes(const std::string& dir) {
+  SqliteQuery(dir, "PRAGMA wal_checkpoint(TRUNCATE)");
+  int64_t bytes = 0;
+  for (const char* file : {"/cablesim.db", "/cablesim.db-wal"}) {
+    std::error_code absent;
+    const auto size = std::filesystem::file_size(dir + file, absent);
+    if (!absent) bytes += static_cast<int64_t>(size);
+  }
+  return bytes;
+}
+
+TEST(SqliteJobStoreTest, DeletedResultsGiveTheirDiskSpaceBack) {
+  // A new database, and one made before incremental vacuum (auto_vacuum
+  // NONE, as older servers made them), which Open converts once.
+  for (const bool legacy : {false, true}) {
+    SCOPED_TRACE(legacy ? "a database from before" : "a new database");
+    const std::string dir = FreshDir(legacy ? "reclaim_legacy" : "reclaim");
+    if (legacy) {
+      ASSERT_TRUE(SqliteJobStore::Open(dir).ok());
+      SqliteQuery(dir, "PRAGMA auto_vacuum=NONE; VACUUM");
+      ASSERT_EQ(SqliteQuery(dir, "PRAGMA auto_vacuum"), 0);
+    }
+    absl::StatusOr<std::unique_ptr<SqliteJobStore>> opened = SqliteJobStore::Open(dir);
+    ASSERT_TRUE(opened.ok()) << opened.status();
+    std::unique_ptr<JobStore> store = std::move(*opened);
+    EXPECT_EQ(SqliteQuery(dir, "PRAGMA auto_vacuum"), 2);  // INCREMENTAL
+    // 8 results of 2^17 random doubles (1 MiB raw each; random mantissas
+    // do not compress, only the exponents' bytes do: stored 86% of raw):
+    // about 7 MB that deleting must give back.
+    std::mt19937_64 random(7);
+    std::uniform_real_distribution<double> uniform(-1, 1);
+    const int64_t empty = DatabaseBytes(dir);
+    std::vector<std::string> ids;
+    int64_t stored = 0;
+    for (int i = 0; i < 8; ++i) {
+      const std::string id = store->InsertJob(Named("big"), 1)->id();
+      ASSERT_TRUE(*store->MarkRunning(id));
+      StoredResult result;
+      result.header.add_columns("t");
+      result.values.resize(1 << 17);
+      for (double& v : result.values) v = uniform(random);
+      ASSERT_TRUE(*store->Finish(id, v1::SUCCEEDED, {}, result));
+      stored += store->GetJob(id)->stored_bytes();
+      ids.push_back(id);
+    }
+    // A small job kept, so that the space is not simply the file's end.
+    const std::string kept = store->InsertJob(Named("kept"), 1)->id();
+    const int64_t full = DatabaseBytes(dir);
+    EXPECT_GT(stored, 6 << 20);
+    EXPECT_GE(full - empty, stored);
+    int64_t freed = 0;
+    for (const std::string& id : ids) freed += *store->DeleteJob(id);
+    EXPECT_EQ(freed, stored);
+    // Freed pages stay in the file until they are given back.
+    EXPECT_GE(DatabaseBytes(dir), full - (1 << 20));
+    int steps = 0;
+    const absl::Time start = absl::Now();
+    while (*store->ReclaimSpace()) ASSERT_LT(++steps, 100);
+    const absl::Duration took = absl::Now() - start;
+    // 7 MB in steps of 16 MiB: one step.
+    EXPECT_EQ(steps, 0);
+    const int64_t after = DatabaseBytes(dir);
+    // Most of it back: all but pages of the tables' structure (the bound
+    // is 95% of the results' bytes; measured: more than 99%).
+    EXPECT_GE(full - after, stored * 95 / 100) << "full " << full << " after " << after;
+    std::cout << "results " << stored << " B; database " << full << " B with them, " << after
+              << " B after deleting them and ReclaimSpace: " << full - after << " B back ("
+              << 100.0 * static_cast<double>(full - after) / static_cast<double>(stored)
+              << "% of the results) in " << absl::FormatDuration(took) << "\n";
+    EXPECT_EQ(store->GetJob(kept)->state(), v1::QUEUED);
+    // Open's quick_check finds the moved pages sound.
+    store.reset();
+    EXPECT_TRUE(SqliteJobStore::Open(dir).ok());
+  }
 }
 
 TEST(PostgresJobStoreTest, StoresOnOneDatabaseNeverClaimTheSameJob) {

@@ -175,7 +175,15 @@ TEST(ServerListJobsTest, PagesStayUnderTheMessageLimitAndCoverEveryJob) {
   v1::ListJobsResponse response;
   ASSERT_TRUE(stub->ListJobs(&context, request, &response).ok());
   ASSERT_EQ(response.jobs_size(), 3);
-  EXPECT_EQ(response.next_page_token(), expected[2]);
+  ASSERT_FALSE(response.next_page_token().empty());
+  {
+    grpc::ClientContext next_context;
+    request.set_page_token(response.next_page_token());
+    v1::ListJobsResponse next;
+    ASSERT_TRUE(stub->ListJobs(&next_context, request, &next).ok());
+    ASSERT_EQ(next.jobs_size(), 3);
+    EXPECT_EQ(next.jobs(0).id(), expected[3]);
+  }
   grpc::ClientContext bad_context;
   request.set_page_token("not a token");
   EXPECT_EQ(stub->ListJobs(&bad_context, request, &response).error_code(),

@@ -2,14 +2,18 @@
 // DeleteJob / DeleteSweep free a finished job's or sweep's results and
 // refuse work still queued or running; --retention-max-age-s and
 // --retention-max-bytes delete the oldest finished results first; every
-// job shows the bytes its result takes.
+// job shows the bytes its result takes; the database file shrinks once
+// results are deleted.
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <sqlite3.h>
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
+#include "absl/time/clock.h"
 #include "server_test_util.h"
 
 namespace cablesim {
@@ -18,6 +22,8 @@ namespace {
 using ::testing::HasSubstr;
 using testing::Pendulum;
 using testing::ServerProcess;
+using testing::DeleteJob;
+using testing::DeleteSweep;
 using testing::Submit;
 
 grpc::Status GetJob(v1::CablesimService::Stub* stub, const std::string& id, v1::Job* job) {
@@ -25,28 +31,6 @@ grpc::Status GetJob(v1::CablesimService::Stub* stub, const std::string& id, v1::
   v1::GetJobRequest request;
   request.set_id(id);
   return stub->GetJob(&context, request, job);
-}
-
-grpc::Status DeleteJob(v1::CablesimService::Stub* stub, const std::string& id,
-                       int64_t* freed = nullptr) {
-  grpc::ClientContext context;
-  v1::DeleteJobRequest request;
-  request.set_id(id);
-  v1::DeleteResponse response;
-  const grpc::Status s = stub->DeleteJob(&context, request, &response);
-  if (freed) *freed = response.freed_bytes();
-  return s;
-}
-
-grpc::Status DeleteSweep(v1::CablesimService::Stub* stub, const std::string& id,
-                         int64_t* freed = nullptr) {
-  grpc::ClientContext context;
-  v1::DeleteSweepRequest request;
-  request.set_id(id);
-  v1::DeleteResponse response;
-  const grpc::Status s = stub->DeleteSweep(&context, request, &response);
-  if (freed) *freed = response.freed_bytes();
-  return s;
 }
 
 v1::Sweep SubmitSweep(v1::CablesimService::Stub* stub, const v1::Scene& base) {
@@ -194,6 +178,60 @@ TEST(ServerRetentionTest, FinishedWorkOlderThanTheMaximumAgeIsDeletedAtStartUp) 
   // Unfinished work is never deleted: the requeued job runs (and waits at
   // the gate again, so that nothing finishes while the test looks).
   EXPECT_EQ(testing::WaitForState(stub.get(), queued_id, v1::RUNNING).state(), v1::RUNNING);
+}
+
+// PRAGMA freelist_count of DIR/cablesim.db read through a connection of
+// the test's own (a reader beside the server's writer, WAL); -1 on error.
+int64_t FreePages(const std::string& dir) {
+  sqlite3* db = nullptr;
+  int64_t pages = -1;
+  if (sqlite3_open_v2((dir + "/cablesim.db").c_str(), &db, SQLITE_OPEN_READONLY, nullptr) ==
+      SQLITE_OK) {
+    sqlite3_stmt* s = nullptr;
+    if (sqlite3_prepare_v2(db, "PRAGMA freelist_count", -1, &s, nullptr) == SQLITE_OK &&
+        sqlite3_step(s) == SQLITE_ROW) {
+      pages = sqlite3_column_int64(s, 0);
+    }
+    sqlite3_finalize(s);
+  }
+  sqlite3_close(db);
+  return pages;
+}
+
+TEST(ServerRetentionTest, DeletedResultsShrinkTheDatabaseFile) {
+  const std::string dir = testing::FreshDir("retention_shrink");
+  ServerProcess server(dir, {"--workers=2"});
+  auto stub = server.Stub();
+  // Two long trajectories (every step a frame): a few MB stored.
+  std::vector<std::string> ids;
+  for (int i = 0; i < 2; ++i) ids.push_back(Submit(stub.get(), Pendulum(20, 1e-3, 1e-3)).id());
+  int64_t stored = 0;
+  for (const std::string& id : ids) {
+    v1::Job job;
+    ASSERT_EQ(testing::WaitForJob(stub.get(), id, &job), v1::SUCCEEDED);
+    stored += job.stored_bytes();
+  }
+  ASSERT_GT(stored, 1 << 20);
+  const std::string db = dir + "/cablesim.db";
+  // The results are on disk, in the file or still in the write-ahead log.
+  std::error_code no_log;
+  const auto log_bytes = std::filesystem::file_size(db + "-wal", no_log);
+  EXPECT_GE(static_cast<int64_t>(std::filesystem::file_size(db) + (no_log ? 0 : log_bytes)),
+            stored);
+  for (const std::string& id : ids) ASSERT_TRUE(DeleteJob(stub.get(), id).ok());
+  // The space comes back off the request path: wait for it (hang guard
+  // 60 s; it takes milliseconds).
+  const absl::Time give_up = absl::Now() + absl::Seconds(60);
+  while (FreePages(dir) != 0 && absl::Now() < give_up) absl::SleepFor(absl::Milliseconds(20));
+  EXPECT_EQ(FreePages(dir), 0);
+  // What remains is the schema and the other tables' pages: far less than
+  // the results that were deleted.
+  int64_t size = 0;
+  while ((size = static_cast<int64_t>(std::filesystem::file_size(db))) > stored / 4 &&
+         absl::Now() < give_up) {
+    absl::SleepFor(absl::Milliseconds(20));
+  }
+  EXPECT_LT(size, stored / 4) << "stored " << stored;
 }
 
 }  // namespace

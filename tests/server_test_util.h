@@ -269,6 +269,34 @@ inline v1::Job Submit(v1::CablesimService::Stub* stub, const v1::Scene& scene) {
   return job;
 }
 
+// DeleteJob of job `id`, or with `sweep` DeleteSweep of sweep `id`;
+// `freed`, when given, receives the bytes freed.
+inline grpc::Status Delete(v1::CablesimService::Stub* stub, const std::string& id, bool sweep,
+                           int64_t* freed) {
+  grpc::ClientContext context;
+  v1::DeleteResponse response;
+  grpc::Status s;
+  if (sweep) {
+    v1::DeleteSweepRequest request;
+    request.set_id(id);
+    s = stub->DeleteSweep(&context, request, &response);
+  } else {
+    v1::DeleteJobRequest request;
+    request.set_id(id);
+    s = stub->DeleteJob(&context, request, &response);
+  }
+  if (freed) *freed = response.freed_bytes();
+  return s;
+}
+inline grpc::Status DeleteJob(v1::CablesimService::Stub* stub, const std::string& id,
+                              int64_t* freed = nullptr) {
+  return Delete(stub, id, false, freed);
+}
+inline grpc::Status DeleteSweep(v1::CablesimService::Stub* stub, const std::string& id,
+                                int64_t* freed = nullptr) {
+  return Delete(stub, id, true, freed);
+}
+
 // Waits (WatchJob) until job `id` is in `state` or finished; returns the
 // job as last seen.
 inline v1::Job WaitForState(v1::CablesimService::Stub* stub, const std::string& id,

@@ -1,0 +1,212 @@
+// ListJobs page tokens against a real cablesim-server, on either store
+// (SQLite in the data directory; PostgreSQL the test starts on loopback,
+// tests/postgres_test_util.h): keyset paging that survives deleting the
+// page's last job, opaque tokens (neither a job id nor a count), tampered,
+// foreign-tenant and garbage tokens refused naming `page_token`, and tokens
+// that survive a restart (the secret is kept in the store; with
+// PostgreSQL, every server of the store accepts every other's tokens).
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "absl/strings/escaping.h"
+#include "absl/strings/str_cat.h"
+#include "postgres_test_util.h"
+#include "server_test_util.h"
+
+namespace cablesim {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::Pendulum;
+using testing::ServerProcess;
+
+struct Page {
+  grpc::Status status;
+  std::vector<std::string> ids;
+  std::string next;
+};
+
+Page List(v1::CablesimService::Stub* stub, int page_size, const std::string& token,
+          const std::string& bearer = "", v1::JobState state = v1::JOB_STATE_UNSPECIFIED) {
+  grpc::ClientContext context;
+  if (!bearer.empty()) context.AddMetadata("authorization", "Bearer " + bearer);
+  v1::ListJobsRequest request;
+  request.set_page_size(page_size);
+  request.set_page_token(token);
+  request.set_state(state);
+  v1::ListJobsResponse response;
+  Page page;
+  page.status = stub->ListJobs(&context, request, &response);
+  for (const v1::Job& job : response.jobs()) page.ids.push_back(job.id());
+  page.next = response.next_page_token();
+  return page;
+}
+
+grpc::StatusCode Delete(v1::CablesimService::Stub* stub, const std::string& id) {
+  return testing::DeleteJob(stub, id).error_code();
+}
+
+// `n` short jobs, run to the end; their ids oldest first.
+std::vector<std::string> FinishedJobs(v1::CablesimService::Stub* stub, int n) {
+  std::vector<std::string> ids;
+  for (int i = 0; i < n; ++i) {
+    ids.push_back(testing::Submit(stub, Pendulum(0.01, 1e-3, 1e-2)).id());
+  }
+  for (const std::string& id : ids) EXPECT_EQ(testing::WaitForJob(stub, id), v1::SUCCEEDED);
+  return ids;
+}
+
+// The server flags of a fresh store of kind `store`; "" when the test was
+// skipped or failed (PostgreSQL not installed or not starting).
+class ServerPageTokenTest : public ::testing::TestWithParam<std::string> {
+ protected:
+  std::vector<std::string> StoreFlags(const std::string& name) {
+    if (GetParam() == "sqlite") return {};
+    std::string why;
+    testing::TestPostgres* pg = testing::TestPostgres::Get(&why);
+    if (pg == nullptr) {
+      if (testing::TestPostgres::NotInstalled(why)) {
+        skipped_ = true;
+        return {};
+      }
+      ADD_FAILURE() << "PostgreSQL is installed but cannot start: " << why;
+      return {};
+    }
+    return {"--store=" + pg->NewDatabase(name)};
+  }
+  bool skipped_ = false;
+};
+
+TEST_P(ServerPageTokenTest, ThreePagesWithDeletionsListEveryRemainingJobOnceInOrder) {
+  std::vector<std::string> flags = StoreFlags("page_delete");
+  if (skipped_) GTEST_SKIP() << "PostgreSQL is not installed";
+  flags.push_back("--workers=2");
+  ServerProcess server(testing::FreshDir("page_delete_" + GetParam()), flags);
+  auto stub = server.Stub();
+  const std::vector<std::string> ids = FinishedJobs(stub.get(), 9);
+  // Newest first: 8 7 6 | 5 4 3 | 2 1 0 with pages of 3.
+  const Page first = List(stub.get(), 3, "");
+  ASSERT_TRUE(first.status.ok()) << first.status.error_message();
+  EXPECT_THAT(first.ids, ::testing::ElementsAre(ids[8], ids[7], ids[6]));
+  ASSERT_FALSE(first.next.empty());
+  // The token is opaque: no job id in it, 44 URL-safe characters.
+  EXPECT_THAT(first.next, ::testing::MatchesRegex("[A-Za-z0-9_-]{44}"));
+  for (const std::string& id : ids) EXPECT_EQ(first.next.find(id.substr(2)), std::string::npos);
+  // The page's last job and the next page's first are deleted in between.
+  ASSERT_EQ(Delete(stub.get(), ids[6]), grpc::StatusCode::OK);
+  ASSERT_EQ(Delete(stub.get(), ids[5]), grpc::StatusCode::OK);
+  const Page second = List(stub.get(), 3, first.next);
+  ASSERT_TRUE(second.status.ok()) << second.status.error_message();
+  EXPECT_THAT(second.ids, ::testing::ElementsAre(ids[4], ids[3], ids[2]));
+  ASSERT_FALSE(second.next.empty());
+  // Again, and a job already listed: nothing listed twice, nothing lost.
+  ASSERT_EQ(Delete(stub.get(), ids[2]), grpc::StatusCode::OK);
+  ASSERT_EQ(Delete(stub.get(), ids[7]), grpc::StatusCode::OK);
+  const Page third = List(stub.get(), 3, second.next);
+  ASSERT_TRUE(third.status.ok()) << third.status.error_message();
+  EXPECT_THAT(third.ids, ::testing::ElementsAre(ids[1], ids[0]));
+  EXPECT_TRUE(third.next.empty());
+  // The same place twice gives two different tokens (a fresh nonce), that
+  // both continue there: the token says nothing about how many jobs exist.
+  const Page again = List(stub.get(), 3, "");
+  ASSERT_TRUE(again.status.ok());
+  const Page once_more = List(stub.get(), 3, "");
+  EXPECT_NE(again.next, once_more.next);
+  EXPECT_EQ(List(stub.get(), 3, again.next).ids, List(stub.get(), 3, once_more.next).ids);
+}
+
+TEST_P(ServerPageTokenTest, AlteredOrGarbageOrOtherQueryTokensAreRefusedNamingTheField) {
+  std::vector<std::string> flags = StoreFlags("page_tamper");
+  if (skipped_) GTEST_SKIP() << "PostgreSQL is not installed";
+  ServerProcess server(testing::FreshDir("page_tamper_" + GetParam()), flags);
+  auto stub = server.Stub();
+  FinishedJobs(stub.get(), 3);
+  const Page first = List(stub.get(), 1, "");
+  ASSERT_TRUE(first.status.ok());
+  ASSERT_FALSE(first.next.empty());
+  EXPECT_TRUE(List(stub.get(), 1, first.next).status.ok());
+  std::vector<std::string> bad = {"not a token", "j-000001", "", first.next + "A",
+                                  first.next.substr(0, 43)};
+  bad[2] = absl::WebSafeBase64Escape(std::string(33, '\x01'));  // well formed, not signed
+  // Each byte of the token changed in turn (the base64 character for the
+  // byte's 6 bits flipped): every one detected.
+  for (size_t i = 0; i < first.next.size(); ++i) {
+    std::string altered = first.next;
+    altered[i] = altered[i] == 'A' ? 'B' : 'A';
+    bad.push_back(altered);
+  }
+  for (const std::string& token : bad) {
+    const Page page = List(stub.get(), 1, token);
+    EXPECT_EQ(page.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << token;
+    EXPECT_THAT(page.status.error_message(), HasSubstr("page_token")) << token;
+  }
+  // A token is for the query that made it: the state filter may not change.
+  const Page other_query = List(stub.get(), 1, first.next, "", v1::SUCCEEDED);
+  EXPECT_EQ(other_query.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(other_query.status.error_message(), HasSubstr("page_token"));
+}
+
+TEST_P(ServerPageTokenTest, AnotherTenantsTokenIsRefused) {
+  std::vector<std::string> flags = StoreFlags("page_tenant");
+  if (skipped_) GTEST_SKIP() << "PostgreSQL is not installed";
+  const std::string dir = testing::FreshDir("page_tenant_" + GetParam());
+  const std::string alice = "tok-alice-0123456789", bob = "tok-bob-0123456789ab";
+  std::ofstream(dir + "/tokens") << alice << " alice\n" << bob << " bob\n";
+  flags.push_back("--token-file=" + dir + "/tokens");
+  ServerProcess server(dir, flags);
+  auto stub = server.Stub();
+  for (const std::string& who : {alice, bob}) {
+    for (int i = 0; i < 2; ++i) {
+      grpc::ClientContext context;
+      context.AddMetadata("authorization", "Bearer " + who);
+      v1::SubmitJobRequest request;
+      *request.mutable_scene() = Pendulum(0.01, 1e-3, 1e-2);
+      v1::Job job;
+      ASSERT_TRUE(stub->SubmitJob(&context, request, &job).ok());
+    }
+  }
+  const Page alices = List(stub.get(), 1, "", alice);
+  ASSERT_TRUE(alices.status.ok()) << alices.status.error_message();
+  ASSERT_FALSE(alices.next.empty());
+  EXPECT_TRUE(List(stub.get(), 1, alices.next, alice).status.ok());
+  const Page stolen = List(stub.get(), 1, alices.next, bob);
+  EXPECT_EQ(stolen.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(stolen.status.error_message(), HasSubstr("page_token"));
+}
+
+TEST_P(ServerPageTokenTest, ATokenSurvivesARestart) {
+  std::vector<std::string> flags = StoreFlags("page_restart");
+  if (skipped_) GTEST_SKIP() << "PostgreSQL is not installed";
+  ServerProcess server(testing::FreshDir("page_restart_" + GetParam()), flags);
+  auto stub = server.Stub();
+  const std::vector<std::string> ids = FinishedJobs(stub.get(), 4);
+  const Page first = List(stub.get(), 2, "");
+  ASSERT_TRUE(first.status.ok());
+  ASSERT_FALSE(first.next.empty());
+  server.Kill(SIGKILL);
+  server.Restart();
+  stub = server.Stub();
+  const Page second = List(stub.get(), 2, first.next);
+  ASSERT_TRUE(second.status.ok()) << second.status.error_message();
+  EXPECT_THAT(second.ids, ::testing::ElementsAre(ids[1], ids[0]));
+  if (GetParam() != "postgresql") return;
+  // Another server of the same database continues the same listing.
+  ServerProcess other(testing::FreshDir("page_restart_other"), flags);
+  auto other_stub = other.Stub();
+  const Page elsewhere = List(other_stub.get(), 2, first.next);
+  ASSERT_TRUE(elsewhere.status.ok()) << elsewhere.status.error_message();
+  EXPECT_THAT(elsewhere.ids, ::testing::ElementsAre(ids[1], ids[0]));
+}
+
+INSTANTIATE_TEST_SUITE_P(BothStores, ServerPageTokenTest, ::testing::Values("sqlite", "postgresql"),
+                         [](const auto& info) { return info.param; });
+
+}  // namespace
+}  // namespace cablesim
