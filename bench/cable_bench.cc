@@ -31,6 +31,10 @@
 //   FallingPendulum_Spatial:  model and forced into the spatial one: what
 //                             "model only what the scene needs" saves (both
 //                             follow the same trajectory, tests/spatial_test.cc).
+//   CableInCurrent:           scenes/cable-in-current.json (10 elements, Morison
+//                             drag in a current, 200 s at h = 0.05, backward
+//                             Euler): the fluid-load path of a scene without
+//                             waves.
 
 #include <algorithm>
 #include <cmath>
@@ -406,6 +410,10 @@ void BM_FallingPendulum_Spatial(benchmark::State& state) {
 CABLESIM_RUN_BENCHMARK(BM_SpatialPendulum);
 CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_Planar);
 CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_Spatial);
+void BM_CableInCurrent(benchmark::State& state) {
+  RunSample(state, "cable-in-current.json", ModelChoice::kAuto);
+}
+CABLESIM_RUN_BENCHMARK(BM_CableInCurrent);
 BENCHMARK(BM_NewtonIteration_Direct)
     ->Unit(benchmark::kMicrosecond)
     ->UseRealTime()

@@ -59,6 +59,9 @@ constexpr int kDefaultMaxLinearIterations = 200;
 constexpr int kMaxLinearIterations = 100000;
 // MODAL: the engine also bounds modes by the scene's degrees of freedom.
 constexpr int kMaxModes = 100000;
+// JONSWAP components per sea (each costs a few exponentials per Gauss
+// point per force evaluation).
+constexpr int kMaxWaveComponents = 1000;
 
 absl::Status Invalid(absl::string_view path, absl::string_view rule) {
   return absl::InvalidArgumentError(absl::StrCat(path, ": ", rule));
@@ -802,6 +805,94 @@ class SceneConverter {
     scene_.fluid.density_kg_m3 = f.density();
     CABLESIM_ASSIGN_OR_RETURN(scene_.fluid.current_m_s,
                               VectorInRange("fluid.current", f.current(), plausible::kVelocity));
+    CABLESIM_RETURN_IF_ERROR(
+        CheckRange("fluid.still_water_level", f.still_water_level(), plausible::kCoordinate));
+    scene_.fluid.still_water_level_m = f.still_water_level();
+    CABLESIM_RETURN_IF_ERROR(CheckNonNegative("fluid.water_depth", f.water_depth()));
+    if (f.water_depth() != 0) {
+      CABLESIM_RETURN_IF_ERROR(
+          CheckRange("fluid.water_depth", f.water_depth(), plausible::kCableLength));
+    }
+    scene_.fluid.water_depth_m = f.water_depth();
+    return ConvertWaves();
+  }
+
+  // A wave's direction of travel: its part normal to gravity, normalised.
+  // Omitted: x (y when gravity is along x).
+  absl::StatusOr<Eigen::Vector3d> WaveDirection(absl::string_view path, bool given,
+                                                const v1::Vec3& v) {
+    const Eigen::Vector3d up = -scene_.gravity_m_s2.normalized();
+    Eigen::Vector3d d = Eigen::Vector3d::UnitX();
+    if (given) {
+      CABLESIM_ASSIGN_OR_RETURN(d, Direction(path, v));
+    } else if (std::abs(up.x()) > 0.99) {
+      d = Eigen::Vector3d::UnitY();
+    }
+    const Eigen::Vector3d horizontal = d - up.dot(d) * up;
+    if (!(horizontal.norm() >= 1e-6)) {
+      return Invalid(path, "must have a horizontal part (it is along gravity)");
+    }
+    return Eigen::Vector3d(horizontal.normalized());
+  }
+
+  absl::Status ConvertWaves() {
+    const v1::Fluid& f = proto_.fluid();
+    if (!f.has_waves()) return absl::OkStatus();
+    const v1::Waves& w = f.waves();
+    WavesSpec& spec = scene_.fluid.waves;
+    CABLESIM_RETURN_IF_ERROR(CheckNonNegative("fluid.waves.ramp_time", w.ramp_time()));
+    CABLESIM_RETURN_IF_ERROR(CheckRange("fluid.waves.ramp_time", w.ramp_time(), plausible::kDuration));
+    spec.ramp_s = w.ramp_time();
+    if (w.regular_size() == 0 && w.jonswap_size() == 0) return absl::OkStatus();
+    if (!(f.density() > 0)) return Invalid("fluid.waves", "needs a fluid (fluid.density > 0)");
+    if (!(f.water_depth() > 0)) {
+      return Invalid("fluid.water_depth", "must be > 0 with waves (their kinematics depend on it)");
+    }
+    if (!(scene_.gravity_m_s2.norm() > 0)) {
+      return Invalid("fluid.waves", "needs gravity (it sets the vertical and the waves' speed)");
+    }
+    for (int i = 0; i < w.regular_size(); ++i) {
+      const v1::Waves::Regular& r = w.regular(i);
+      const std::string path = Indexed("fluid.waves", "regular", i);
+      RegularWaveSpec out;
+      CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange(Sub(path, "height"), r.height(), plausible::kSize));
+      out.height_m = r.height();
+      CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange(Sub(path, "period"), r.period(), plausible::kStep));
+      out.period_s = r.period();
+      CABLESIM_ASSIGN_OR_RETURN(out.direction,
+                                WaveDirection(Sub(path, "direction"), r.has_direction(), r.direction()));
+      CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(path, "phase"), r.phase()));
+      out.phase_rad = r.phase();
+      spec.regular.push_back(out);
+    }
+    for (int i = 0; i < w.jonswap_size(); ++i) {
+      const v1::Waves::Jonswap& j = w.jonswap(i);
+      const std::string path = Indexed("fluid.waves", "jonswap", i);
+      JonswapSpec out;
+      CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange(Sub(path, "significant_height"),
+                                                    j.significant_height(), plausible::kSize));
+      out.significant_height_m = j.significant_height();
+      CABLESIM_RETURN_IF_ERROR(
+          CheckPositiveInRange(Sub(path, "peak_period"), j.peak_period(), plausible::kStep));
+      out.peak_period_s = j.peak_period();
+      if (j.peak_factor() != 0) {
+        CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(path, "peak_factor"), j.peak_factor()));
+        if (!(j.peak_factor() >= 1 && j.peak_factor() <= 100)) {
+          return Invalid(Sub(path, "peak_factor"),
+                         absl::StrCat("must be >= 1 and <= 100 (got ", Num(j.peak_factor()), ")"));
+        }
+        out.peak_factor = j.peak_factor();
+      }
+      out.seed = j.seed();
+      if (j.components() != 0) {
+        CABLESIM_RETURN_IF_ERROR(
+            CheckIntRange(Sub(path, "components"), j.components(), 1, kMaxWaveComponents));
+        out.components = j.components();
+      }
+      CABLESIM_ASSIGN_OR_RETURN(out.direction,
+                                WaveDirection(Sub(path, "direction"), j.has_direction(), j.direction()));
+      spec.jonswap.push_back(out);
+    }
     return absl::OkStatus();
   }
 

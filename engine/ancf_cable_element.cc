@@ -265,22 +265,47 @@ void AncfCableElement<D>::AddDampingMatrix(const Coords& e, double axial_s, doub
 template <int D>
 void AncfCableElement<D>::AddDrag(const Coords& e, const Coords& edot, const Point& current,
                                   double kn, double kt, Coords* force, Matrix* c) const {
-  for (int g = 0; g < rule_.n; ++g) {
+  for (int g = 0; g < rule_.n; ++g) AddFlowLoadAt(g, e, edot, current, nullptr, kn, kt, 0, force, c);
+}
+
+template <int D>
+typename AncfCableElement<D>::Point AncfCableElement<D>::GaussPosition(const Coords& e,
+                                                                       int g) const {
+  Point r = Point::Zero();
+  for (int k = 0; k < 4; ++k) r += s0_[g][k] * e.template segment<D>(k * D);
+  return r;
+}
+
+template <int D>
+void AncfCableElement<D>::AddMorison(const Coords& e, const Coords& edot,
+                                     const Point* flow_velocity, const Point* flow_acceleration,
+                                     double kn, double kt, double mi, Coords* force,
+                                     Matrix* c) const {
+  for (int g = 0; g < rule_.n; ++g)
+    AddFlowLoadAt(g, e, edot, flow_velocity[g], &flow_acceleration[g], kn, kt, mi, force, c);
+}
+
+template <int D>
+void AncfCableElement<D>::AddFlowLoadAt(int g, const Coords& e, const Coords& edot,
+                                        const Point& flow, const Point* accel, double kn,
+                                        double kt, double mi, Coords* force, Matrix* c) const {
+  {
     const double* s0 = s0_[g];
-    Point u = Point::Zero(), v = current;
+    Point u = Point::Zero(), v = flow;
     for (int k = 0; k < 4; ++k) {
       u += d1_[g][k] * e.template segment<D>(k * D);
       v -= s0[k] * edot.template segment<D>(k * D);
     }
     const double un = u.norm();
-    if (!(un > 0)) continue;
+    if (!(un > 0)) return;
     const Point t = u / un;
     const Point vt = t.dot(v) * t, vn = v - vt;
     const double an = vn.norm(), at = vt.norm();
-    const Point q = kn * an * vn + kt * at * vt;
+    Point q = kn * an * vn + kt * at * vt;
+    if (accel) q += mi * *accel;
     const double wl = rule_.weight[g] * length_;
     for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s0[k]) * q;
-    if (!c) continue;
+    if (!c) return;
     Block h = (2 * kt * at) * t * t.transpose();
     if (an > 0) {
       h += (kn * an) * (Block::Identity() - t * t.transpose()) + (kn / an) * vn * vn.transpose();

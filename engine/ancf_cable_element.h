@@ -165,6 +165,20 @@ class AncfCableElement {
   void AddDrag(const Coords& e, const Coords& edot, const Point& current, double kn, double kt,
                Coords* force, Matrix* c) const;
 
+  // The Gauss points of the element's rule and the position r(x_g) = S(x_g) e
+  // [m] at point g (WaveLoad evaluates the flow there).
+  int gauss_points() const { return rule_.n; }
+  Point GaussPosition(const Coords& e, int g) const;
+
+  // The Morison load in a flow that varies along the element
+  // (engine/forces/wave_load.h): AddDrag with the fluid's velocity
+  // flow_velocity[g] [m/s] at Gauss point g in place of the uniform current,
+  // plus the flow's inertia mi flow_acceleration[g] per unit length (mi
+  // [kg/m]); the inertia does not depend on edot, so `c` is AddDrag's.
+  void AddMorison(const Coords& e, const Coords& edot, const Point* flow_velocity,
+                  const Point* flow_acceleration, double kn, double kt, double mi,
+                  Coords* force, Matrix* c) const;
+
  private:
   // B maps e to (u, w) at Gauss point g: rows 0..D-1 are S', rows D..2D-1
   // are S''.
@@ -176,6 +190,11 @@ class AncfCableElement {
   void AddUpperBlocks(int g, double wl, const Block& huu, const Block& huw, const Block& hww,
                       Matrix* tangent) const;
   static void MirrorUpperBlocks(Matrix* tangent);
+  // The drag (and, with `accel` not null, the inertia mi accel) at Gauss
+  // point g for the flow velocity `flow`: AddDrag's and AddMorison's body.
+  void AddFlowLoadAt(int g, const Coords& e, const Coords& edot, const Point& flow,
+                     const Point* accel, double kn, double kt, double mi, Coords* force,
+                     Matrix* c) const;
 
   double length_ = 0;
   double ea_ = 0;

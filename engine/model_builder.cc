@@ -623,6 +623,11 @@ void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* 
       e.gravity = e.element.GravityForce(mpl - displaced, g);
       e.drag_n = drag_n;
       e.drag_t = drag_t;
+      if (model_.wave_load_) {
+        // The flow's inertia: Froude-Krylov plus added mass (WaveLoad).
+        e.fluid_inertia = (1 + cable.added_mass) * displaced;
+        if (e.fluid_inertia != 0) model_.has_damping_ = true;
+      }
       e.axial_damping_s = cable.axial_damping_s + cable.rayleigh_beta_s;
       e.bending_damping_s = cable.bending_damping_s + cable.rayleigh_beta_s;
       e.alpha_1_s = cable.rayleigh_alpha_1_s;
@@ -638,6 +643,20 @@ void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* 
 
 void ModelBuilder::BuildElements() {
   model_.current_ = scene_.fluid.current_m_s;
+  // Waves need a fluid, gravity (the vertical and the dispersion) and a
+  // depth; SceneFromProto refuses waves without them, naming the field.
+  const FluidSpec& fluid = scene_.fluid;
+  const double g = scene_.gravity_m_s2.norm();
+  if (fluid.waves.any() && fluid.density_kg_m3 > 0 && g > 0 && fluid.water_depth_m > 0) {
+    WaveField field(-scene_.gravity_m_s2 / g, fluid.still_water_level_m, fluid.water_depth_m, g,
+                    fluid.waves.ramp_s);
+    for (const RegularWaveSpec& r : fluid.waves.regular)
+      field.AddRegular(r.height_m, r.period_s, r.direction, r.phase_rad);
+    for (const JonswapSpec& j : fluid.waves.jonswap)
+      field.AddJonswap(j.significant_height_m, j.peak_period_s, j.peak_factor, j.direction,
+                       j.components, j.seed);
+    model_.wave_load_.emplace(std::move(field), fluid.current_m_s);
+  }
   if (scene_.seabed.enabled) {
     model_.seabed_.emplace(scene_.seabed);
     if (model_.seabed_->dissipates()) model_.has_damping_ = true;

@@ -391,7 +391,7 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
   const bool bed = seabed_ && seabed_->dissipates();
   for (size_t k = 0; k < elements.size(); ++k) {
     const ElementData<D>& e = elements[k];
-    if (!e.damped() && !bed) continue;
+    if (!e.damped() && !bed && e.fluid_inertia == 0) continue;
     ce.setZero();
     if (e.axial_damping_s != 0 || e.bending_damping_s != 0)
       e.element.AddDampingMatrix(q.segment<kN>(e.first_coord), e.axial_damping_s,
@@ -401,9 +401,14 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
     // fe: the damping force -C ve, plus the drag (which adds its own
     // velocity derivative to ce).
     fe.noalias() = -ce * ve;
-    if (e.drag_n != 0 || e.drag_t != 0)
+    if (wave_load_) {
+      if (e.drag_n != 0 || e.drag_t != 0 || e.fluid_inertia != 0)
+        wave_load_->Add<D>(e.element, q.segment<kN>(e.first_coord), ve, time_, e.drag_n, e.drag_t,
+                           e.fluid_inertia, &fe, &ce);
+    } else if (e.drag_n != 0 || e.drag_t != 0) {
       e.element.AddDrag(q.segment<kN>(e.first_coord), ve, current_.head<D>(), e.drag_n, e.drag_t,
                         &fe, &ce);
+    }
     if (bed)
       seabed_->AddDissipation<D>(q.segment<kN>(e.first_coord), ve, e.element.length(), &fe, &ce);
     if (power) *power -= ve.dot(fe);

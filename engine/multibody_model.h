@@ -49,6 +49,7 @@
 #include "absl/status/statusor.h"
 #include "engine/ancf_cable_element.h"
 #include "engine/forces/seabed.h"
+#include "engine/forces/wave_load.h"
 #include "engine/quadratic_form.h"
 #include "engine/scene.h"
 #include "engine/simulation.h"
@@ -142,7 +143,10 @@ class MultibodyModel {
   // Q_d = -C(q) qdot with C symmetric positive semi-definite. Morison drag
   // on cables in a fluid (AncfCableElement::AddDrag) is quadratic in the
   // velocity relative to the current; C is then its velocity derivative,
-  // also symmetric positive semi-definite.
+  // also symmetric positive semi-definite. With waves (WaveLoad) the drag
+  // is on the velocity relative to current plus waves, and the flow's
+  // inertia joins the force (not C: it does not depend on qdot); both are
+  // evaluated at the time of SetTime.
   bool has_damping() const { return has_damping_; }
 
   // Adds the damping force -C(q) qdot to the reduced force `f` (as
@@ -158,8 +162,8 @@ class MultibodyModel {
                       Eigen::VectorXd* roundoff = nullptr);
 
   // The power the damping dissipates, -Q_d . qdot [W]: qdot^T C(q) qdot >= 0
-  // without drag; a current may make the drag's share negative (the
-  // current then does work on the cable).
+  // without drag; a current or waves may make the fluid's share negative
+  // (the flow then does work on the cable). At the time of SetTime.
   double DampingPower(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot) const;
 
   // The energy [J] below which a change of the total energy is rounding:
@@ -250,6 +254,10 @@ class MultibodyModel {
   Eigen::Vector3d CablePosition(const Eigen::VectorXd& q, int cable, double s,
                                 Eigen::Vector3d* slope = nullptr) const;
 
+  // The scene's wave load (engine/forces/wave_load.h), or null: a scene
+  // without waves holds none and its elements take AddDrag's uniform current.
+  const WaveLoad* wave_load() const { return wave_load_ ? &*wave_load_ : nullptr; }
+
   // The scene's seabed (engine/forces/seabed.h), or null: a scene without
   // one holds no seabed object, and its force loops only test this.
   const Seabed* seabed() const { return seabed_ ? &*seabed_ : nullptr; }
@@ -297,6 +305,9 @@ class MultibodyModel {
     double axial_damping_s = 0, bending_damping_s = 0, alpha_1_s = 0;
     // Morison drag factors kn, kt [kg/m^2] (AncfCableElement::AddDrag).
     double drag_n = 0, drag_t = 0;
+    // With waves: the flow's inertia factor (1 + C_a) rho A [kg/m]
+    // (WaveLoad); 0 without waves.
+    double fluid_inertia = 0;
     bool damped() const {
       return axial_damping_s != 0 || bending_damping_s != 0 || alpha_1_s != 0 ||
              drag_n != 0 || drag_t != 0;
@@ -449,6 +460,8 @@ class MultibodyModel {
   bool has_damping_ = false;
   Eigen::Vector3d current_ = Eigen::Vector3d::Zero();  // the fluid's [m/s]
   std::optional<Seabed> seabed_;  // only in a scene with a seabed
+  // Only in a scene whose fluid has waves (then it carries the current too).
+  std::optional<WaveLoad> wave_load_;
 
   std::vector<Row> rows_;
   std::vector<int> row_coord_;

@@ -9,6 +9,7 @@
 // Units are SI: m, kg, s, N, Pa, rad.
 
 #include <array>
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -146,12 +147,47 @@ struct ProbeSpec {
   Attachment at;
 };
 
+// A regular linear (Airy) wave (WaveField::AddRegular): height H = 2 a
+// [m], period [s], horizontal unit direction of travel, phase [rad].
+struct RegularWaveSpec {
+  double height_m = 0;
+  double period_s = 0;
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
+  double phase_rad = 0;
+};
+
+// An irregular JONSWAP sea (WaveField::AddJonswap).
+struct JonswapSpec {
+  double significant_height_m = 0;
+  double peak_period_s = 0;
+  double peak_factor = 3.3;  // gamma [-]
+  uint64_t seed = 0;
+  int components = 100;
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitX();  // horizontal, unit
+};
+
+// Waves on the fluid's surface (engine/forces/waves.h, their load
+// engine/forces/wave_load.h): the sum of every component, ramped in over
+// ramp_s [s] (0: none).
+struct WavesSpec {
+  std::vector<RegularWaveSpec> regular;
+  std::vector<JonswapSpec> jonswap;
+  double ramp_s = 0;
+  bool any() const { return !regular.empty() || !jonswap.empty(); }
+};
+
 // A fluid filling the scene: density [kg/m^3] (0: none) and a uniform,
 // steady current [m/s]. Cables in it are buoyed (their displaced weight is
-// taken off their gravity) and feel their hydrodynamics.
+// taken off their gravity) and feel their hydrodynamics. Waves, when there
+// are any, are measured from the still water level (its height above the
+// origin along the vertical, the opposite of gravity [m]) in water of
+// water_depth_m [m] below it.
 struct FluidSpec {
   double density_kg_m3 = 0;
   Eigen::Vector3d current_m_s = Eigen::Vector3d::Zero();
+  double still_water_level_m = 0;
+  double water_depth_m = 0;
+  WavesSpec waves;
 };
 
 // A seabed the cables lie on (MultibodyModel, engine/forces/seabed.h): the

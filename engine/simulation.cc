@@ -57,6 +57,7 @@ class FrameRecorder {
 
   // Energy of a state at time t, without evaluating or delivering a frame.
   EnergySample StateEnergy(double t, const Eigen::VectorXd& z, const Eigen::VectorXd& v) {
+    model_->SetTime(t);  // the damping power of waves depends on it
     model_->ToFull(z, &q_);
     model_->RateToFull(v, &qd_);
     EnergySample e = model_->Energy(q_, qd_, 1.0);
@@ -74,6 +75,7 @@ class FrameRecorder {
   // Moves the start of that rule to an accepted step's end (t, z, v).
   void AdvanceDamping(double t, const Eigen::VectorXd& z, const Eigen::VectorXd& v) {
     if (!model_->has_damping()) return;
+    model_->SetTime(t);  // the damping power of waves depends on it
     model_->ToFull(z, &q_);
     model_->RateToFull(v, &qd_);
     damped_ = Damped(t);

@@ -176,36 +176,8 @@ TEST(DragTest, TangentIsMinusForceDerivativeInRates) {
   ASSERT_TRUE(built.ok()) << built.status();
   MultibodyModel& model = *built;
   ASSERT_TRUE(model.has_damping());
-  const int n = model.dofs(), nq = model.coordinates();
-  Eigen::VectorXd q(nq), qd(nq), zdot(n);
-  for (int i = 0; i < n; ++i) zdot(i) = 0.3 * std::sin(1.7 * i + 0.4);
-  model.ToFull(model.initial_z(), &q);
-  model.RateToFull(zdot, &qd);
-  SkylineLdlt c;
-  c.SetPattern(model.envelope());
-  c.SetZero();
-  Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
-  model.DampingForce(q, qd, &f, &c, 1.0);
-  EXPECT_NEAR(model.DampingPower(q, qd), -zdot.dot(f), 1e-12 * f.lpNorm<1>());
-  const double step = 1e-6;
-  double worst = 0, size = 0;
-  for (int j = 0; j < n; ++j) {
-    Eigen::VectorXd zp = zdot, zm = zdot, fp = Eigen::VectorXd::Zero(n),
-                    fm = Eigen::VectorXd::Zero(n);
-    zp(j) += step;
-    zm(j) -= step;
-    model.RateToFull(zp, &qd);
-    model.DampingForce(q, qd, &fp);
-    model.RateToFull(zm, &qd);
-    model.DampingForce(q, qd, &fm);
-    for (int i = 0; i < n; ++i) {
-      const int slot = i >= j ? c.Slot(i, j) : c.Slot(j, i);
-      const double cij = slot >= 0 ? c.values()[slot] : 0.0;
-      const double fd = -(fp(i) - fm(i)) / (2 * step);
-      worst = std::max(worst, std::abs(cij - fd));
-      size = std::max(size, std::abs(fd));
-    }
-  }
+  double size = 0;
+  const double worst = testing::DampingTangentError(model, {}, 1e-6, &size);
   EXPECT_GT(size, 0);
   // Central differences of a smooth function: O(step^2) = 1e-12 relative,
   // plus rounding eps |f| / step = 1e-10 relative.

@@ -370,13 +370,18 @@ Scene FallingPendulum() {
   return scene;
 }
 
-Scene CableWithEndCylinder(LinearSolverKind linear_solver) {
-  const std::string path = std::string(CABLESIM_SOURCE_DIR) + "/scenes/cable-with-end-cylinder.json";
+// A sample scene from scenes/.
+Scene SampleScene(const std::string& file) {
+  const std::string path = std::string(CABLESIM_SOURCE_DIR) + "/scenes/" + file;
   std::ifstream in(path);
   EXPECT_TRUE(in.good()) << "cannot read " << path;
   std::stringstream json;
   json << in.rdbuf();
-  Scene scene = testing::SceneFromJson(json.str());
+  return testing::SceneFromJson(json.str());
+}
+
+Scene CableWithEndCylinder(LinearSolverKind linear_solver) {
+  Scene scene = SampleScene("cable-with-end-cylinder.json");
   scene.solver.linear_solver = linear_solver;
   scene.solver.integrator = Integrator::kImplicitEuler;
   return scene;
@@ -554,12 +559,8 @@ TEST_F(StepperAllocationTest, EnergyMomentumStepperDoesNotAllocate) {
 // with a time-varying force on the rope and a time-varying torque on the
 // hook, in every stepper.
 TEST_F(StepperAllocationTest, MovingSupportAndVaryingLoadsDoNotAllocate) {
-  const std::string path = std::string(CABLESIM_SOURCE_DIR) + "/scenes/crane-trolley-hoist.json";
-  std::ifstream in(path);
-  ASSERT_TRUE(in) << path;
-  std::stringstream json;
-  json << in.rdbuf();
-  Scene scene = testing::SceneFromJson(json.str());
+  Scene scene = SampleScene("crane-trolley-hoist.json");
+  ASSERT_FALSE(scene.cables.empty());
   LoadSpec load;
   load.at.cable = 0;
   load.at.s_m = 5;
@@ -575,6 +576,29 @@ TEST_F(StepperAllocationTest, MovingSupportAndVaryingLoadsDoNotAllocate) {
     SCOPED_TRACE(::testing::Message() << "integrator " << static_cast<int>(integrator));
     scene.solver.integrator = integrator;
     ExpectStepsDoNotAllocate(scene, 1e-3, 50);
+  }
+}
+
+// Waves neither (engine/forces/wave_load.h: the flow at the Gauss points in
+// arrays on the stack): a buoyant riser pinned at the bed in a regular wave
+// and a JONSWAP sea, with drag and added mass, in every stepper.
+TEST_F(StepperAllocationTest, WavesDoNotAllocate) {
+  Scene scene = testing::SceneFromJson(R"({
+    "gravity": {"y": -9.81},
+    "fluid": {"density": 1025, "current": {"x": 0.2}, "water_depth": 20,
+              "waves": {"regular": [{"height": 2, "period": 8}],
+                        "jonswap": [{"significant_height": 1, "peak_period": 6, "components": 10}]}},
+    "cables": [{"name": "riser", "points": [{"y": -20}, {"y": -1}], "elements": 19,
+                "density": 500, "youngs_modulus": 1e9, "diameter": 0.1,
+                "hydrodynamics": {"normal_drag": 1.2, "tangential_drag": 0.1, "added_mass": 1}}],
+    "joints": [{"type": "PIN", "a": {"cable": "riser", "s": 0}}],
+    "solver": {"duration": 1}})");
+  ASSERT_TRUE(scene.fluid.waves.any());
+  for (Integrator integrator : {Integrator::kImplicitEuler, Integrator::kGeneralizedAlpha,
+                                Integrator::kHht, Integrator::kEnergyMomentum}) {
+    SCOPED_TRACE(::testing::Message() << "integrator " << static_cast<int>(integrator));
+    scene.solver.integrator = integrator;
+    ExpectStepsDoNotAllocate(scene, 0.01, 50);
   }
 }
 
