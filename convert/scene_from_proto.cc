@@ -923,6 +923,49 @@ class SceneConverter {
       CABLESIM_RETURN_IF_ERROR(CheckPositive("seabed.friction_speed", b.friction_speed()));
       spec.friction_speed_m_s = b.friction_speed();
     }
+    if (b.has_bathymetry()) CABLESIM_RETURN_IF_ERROR(ConvertBathymetry(b));
+    return absl::OkStatus();
+  }
+
+  // The grid replaces the plane: depth 0, the normal a coordinate axis.
+  absl::Status ConvertBathymetry(const v1::Seabed& b) {
+    const v1::Bathymetry& g = b.bathymetry();
+    BathymetrySpec& spec = scene_.seabed.bathymetry;
+    constexpr int kMaxNodes = 10000000;
+    if (b.depth() != 0)
+      return Invalid("seabed.depth", "must be 0 with a bathymetry grid (the grid gives the depths)");
+    const Eigen::Vector3d& n = scene_.seabed.normal;
+    if (n.cwiseAbs().maxCoeff() != 1.0)
+      return Invalid("seabed.normal",
+                     "must be along a coordinate axis with a bathymetry grid (the grid's up)");
+    CABLESIM_RETURN_IF_ERROR(CheckIntRange("seabed.bathymetry.nx", g.nx(), 1, kMaxNodes));
+    CABLESIM_RETURN_IF_ERROR(CheckIntRange("seabed.bathymetry.ny", g.ny(), 1, kMaxNodes));
+    const int64_t count = static_cast<int64_t>(g.nx()) * g.ny();
+    if (count > kMaxNodes)
+      return Invalid("seabed.bathymetry",
+                     absl::StrCat("at most ", kMaxNodes, " nodes (got nx*ny = ", count, ")"));
+    CABLESIM_RETURN_IF_ERROR(
+        CheckRange("seabed.bathymetry.origin_x", g.origin_x(), plausible::kCoordinate));
+    CABLESIM_RETURN_IF_ERROR(
+        CheckRange("seabed.bathymetry.origin_y", g.origin_y(), plausible::kCoordinate));
+    if (g.nx() > 1) CABLESIM_RETURN_IF_ERROR(CheckPositive("seabed.bathymetry.dx", g.dx()));
+    if (g.ny() > 1) CABLESIM_RETURN_IF_ERROR(CheckPositive("seabed.bathymetry.dy", g.dy()));
+    if (g.depths_size() != count)
+      return Invalid("seabed.bathymetry.depths", absl::StrCat("expected nx*ny = ", count,
+                                                              " values, got ", g.depths_size()));
+    spec.depths_m.resize(count);
+    for (int i = 0; i < g.depths_size(); ++i) {
+      CABLESIM_RETURN_IF_ERROR(CheckRange(absl::StrCat("seabed.bathymetry.depths[", i, "]"),
+                                          g.depths(i), plausible::kCoordinate));
+      spec.depths_m[i] = g.depths(i);
+    }
+    spec.enabled = true;
+    spec.origin_x_m = g.origin_x();
+    spec.origin_y_m = g.origin_y();
+    spec.dx_m = g.nx() > 1 ? g.dx() : 1.0;
+    spec.dy_m = g.ny() > 1 ? g.dy() : 1.0;
+    spec.nx = g.nx();
+    spec.ny = g.ny();
     return absl::OkStatus();
   }
 

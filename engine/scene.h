@@ -190,6 +190,18 @@ struct FluidSpec {
   WavesSpec waves;
 };
 
+// A bathymetry grid (engine/forces/bathymetry_grid.h): depths [m] below
+// the origin along the seabed's normal at nx x ny nodes u = origin_x + i dx,
+// v = origin_y + j dy on the two axes across the normal, row-major
+// (depths_m[j nx + i]), bilinear between them.
+struct BathymetrySpec {
+  bool enabled = false;  // false: the bed is the plane of SeabedSpec
+  double origin_x_m = 0, origin_y_m = 0;
+  double dx_m = 1, dy_m = 1;
+  int nx = 1, ny = 1;
+  std::vector<double> depths_m;
+};
+
 // A seabed the cables lie on (MultibodyModel, engine/forces/seabed.h): the
 // plane of points r with normal . r = -depth_m, the normal pointing out of
 // the bed into the water. Contact is a distributed spring and damper per
@@ -205,6 +217,9 @@ struct SeabedSpec {
   // Sliding speed [m/s] below which friction is regularised (the friction
   // force grows as v / sqrt(v^2 + friction_speed^2)).
   double friction_speed_m_s = 1e-3;
+  // When enabled, the bed is this grid instead of the plane (depth_m is
+  // then 0 and the normal a coordinate axis: the grid's "up").
+  BathymetrySpec bathymetry;
 };
 
 struct InitialVelocitySpec {

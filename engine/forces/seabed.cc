@@ -15,22 +15,6 @@ struct Cubic {
   double operator()(double x) const { return c[0] + x * (c[1] + x * (c[2] + x * c[3])); }
 };
 
-// The root of the monotone f on [a, b] (f(a), f(b) of opposite signs), by
-// bisection to the last bit.
-double Bisect(const Cubic& f, double a, double b) {
-  const bool rising = f(a) < 0;
-  for (int i = 0; i < 200; ++i) {
-    const double m = 0.5 * (a + b);
-    if (m <= a || m >= b) break;
-    if ((f(m) < 0) == rising) {
-      a = m;
-    } else {
-      b = m;
-    }
-  }
-  return 0.5 * (a + b);
-}
-
 // Calls f(wl, s, ds) at the 4 Gauss points of every contact piece: the
 // weight times the element length [m], the shape functions and their
 // x-derivatives there.
@@ -58,6 +42,68 @@ void AddShapeBlocks(double wl, const double* s, const Eigen::Matrix<double, D, D
     for (int j = 0; j < 4; ++j) m->template block<D, D>(k * D, j * D) += (wl * s[k] * s[j]) * h;
 }
 
+// The damping and friction per unit length at one point of a bed with unit
+// normal n (proj = I - n n^T) under the elastic normal force `normal_force`
+// [N/m], velocity v and tangent u: adds the force to *q and its velocity
+// tangent to *h; returns the power they dissipate per unit length [W/m].
+template <int D>
+double PointDissipation(const Eigen::Matrix<double, D, 1>& n,
+                        const Eigen::Matrix<double, D, D>& proj, double normal_force,
+                        const Eigen::Matrix<double, D, 1>& v,
+                        const Eigen::Matrix<double, D, 1>& u, double c, double mu_a, double mu_t,
+                        double v_s, Eigen::Matrix<double, D, 1>* q,
+                        Eigen::Matrix<double, D, D>* h) {
+  using Point = Eigen::Matrix<double, D, 1>;
+  using Block = Eigen::Matrix<double, D, D>;
+  const double vn = n.dot(v);
+  *q = (-c * vn) * n;
+  *h = c * n * n.transpose();
+  double power = c * vn * vn;
+  if ((mu_a != 0 || mu_t != 0) && normal_force > 0) {
+    const Point vb = v - vn * n;
+    Point t = proj * u;
+    const double tn = t.norm();
+    Block amat = mu_t * proj;  // the friction's A: q_f = -N A v_b / s
+    if (tn > 0) {
+      t /= tn;
+      amat += (mu_a - mu_t) * t * t.transpose();
+    }
+    const double sq = std::sqrt(vb.squaredNorm() + v_s * v_s);
+    const Point qf = (-normal_force / sq) * (amat * vb);
+    *q += qf;
+    *h += (normal_force / sq) * amat;
+    power -= qf.dot(vb);
+  }
+  return power;
+}
+
+// The cubic of coordinate `axis` along an element (AncfCableElement<D>
+// layout), in xi in [0, 1]; zero for an axis the element does not have.
+template <int D>
+Cubic CoordinateCubic(const Eigen::Matrix<double, 4 * D, 1>& e, double l, int axis) {
+  if (axis >= D) return Cubic{{0, 0, 0, 0}};
+  const double a0 = e(axis), b0 = e(D + axis), a1 = e(2 * D + axis), b1 = e(3 * D + axis);
+  return Cubic{{a0, l * b0, -3 * a0 - 2 * l * b0 + 3 * a1 - l * b1,
+                2 * a0 + l * b0 - 2 * a1 + l * b1}};
+}
+
+// The root of f on [a, b] (f(a) < 0 <= f(b) or the reverse, f continuous
+// and crossing once), by bisection to the last bit.
+template <typename F>
+double BisectSign(const F& f, double a, double b) {
+  const bool rising = f(a) < 0;
+  for (int i = 0; i < 200; ++i) {
+    const double m = 0.5 * (a + b);
+    if (m <= a || m >= b) break;
+    if ((f(m) < 0) == rising) {
+      a = m;
+    } else {
+      b = m;
+    }
+  }
+  return 0.5 * (a + b);
+}
+
 }  // namespace
 
 Seabed::Seabed(const SeabedSpec& spec)
@@ -67,7 +113,226 @@ Seabed::Seabed(const SeabedSpec& spec)
       c_(spec.damping_n_s_m2),
       mu_a_(spec.friction_axial),
       mu_t_(spec.friction_transverse),
-      v_s_(spec.friction_speed_m_s) {}
+      v_s_(spec.friction_speed_m_s) {
+  if (spec.bathymetry.enabled) {
+    int axis = 0;
+    normal_.cwiseAbs().maxCoeff(&axis);
+    grid_.emplace(spec.bathymetry, axis, normal_(axis) > 0 ? 1.0 : -1.0);
+  }
+}
+
+double Seabed::GridHeight(const Eigen::Vector3d& r) const {
+  const BathymetryGrid& g = *grid_;
+  return g.up_sign() * r(g.up_axis()) + g.At(r(g.u_axis()), r(g.v_axis())).depth;
+}
+
+template <int D>
+double Seabed::GridAt(const Eigen::Matrix<double, D, 1>& r, Eigen::Matrix<double, D, 1>* grad,
+                      Eigen::Matrix<double, D, D>* hess) const {
+  const BathymetryGrid& g = *grid_;
+  const int iu = g.u_axis(), iv = g.v_axis();
+  const BathymetryGrid::Sample b = g.At(iu < D ? r(iu) : 0.0, iv < D ? r(iv) : 0.0);
+  grad->setZero();
+  (*grad)(g.up_axis()) = g.up_sign();
+  if (iu < D) (*grad)(iu) = b.du;
+  if (iv < D) (*grad)(iv) = b.dv;
+  if (hess) {
+    hess->setZero();
+    if (iu < D && iv < D) (*hess)(iu, iv) = (*hess)(iv, iu) = b.duv;
+  }
+  return g.up_sign() * r(g.up_axis()) + b.depth;
+}
+
+template <int D, typename F, typename L>
+void Seabed::ForEachGridPiece(const Eigen::Matrix<double, 4 * D, 1>& e, double length, F&& f,
+                              L&& line_crossed) const {
+  const BathymetryGrid& grid = *grid_;
+  const Cubic w = CoordinateCubic<D>(e, length, grid.up_axis());
+  // g >= s w + min depth: most elements end here.
+  const double s = grid.up_sign();
+  if (s * w.c[0] - std::abs(w.c[1]) - std::abs(w.c[2]) - std::abs(w.c[3]) + grid.min_depth() > 0)
+    return;
+  const Cubic cu = CoordinateCubic<D>(e, length, grid.u_axis());
+  const Cubic cv = CoordinateCubic<D>(e, length, grid.v_axis());
+  auto height = [&](double xi) { return s * w(xi) + grid.At(cu(xi), cv(xi)).depth; };
+  constexpr int kSub = 16, kMaxLines = 8;
+  // The open contact piece [start, ...), if any; pieces are closed at grid
+  // lines and where g turns positive.
+  double start = 0;
+  bool open = false;
+  double xa = 0, ga = height(0);
+  if (ga < 0) open = true;
+  // Moves from xa to xb (no grid line or sign change strictly between
+  // unless found here); `line`: a grid line lies at xb.
+  auto advance = [&](double xb, int line) {
+    const double gb = height(xb);
+    if ((ga < 0) != (gb < 0)) {
+      const double r = BisectSign(height, xa, xb);
+      if (ga < 0) {
+        if (r > start) f(start, r);
+        open = false;
+      } else {
+        start = r;
+        open = true;
+      }
+    }
+    if (line >= 0 && open) {
+      if (xb > start) f(start, xb);
+      start = xb;
+      line_crossed(xb, line);
+    }
+    xa = xb;
+    ga = gb;
+  };
+  double cut[2 * kMaxLines];
+  int cut_axis[2 * kMaxLines];
+  for (int j = 0; j < kSub; ++j) {
+    const double a = static_cast<double>(j) / kSub, b = static_cast<double>(j + 1) / kSub;
+    int nc = 0;
+    // The grid lines between the cells of the sub-interval's ends, each
+    // crossed once (the cubic taken monotone over 1/16 of the element).
+    auto lines = [&](const Cubic& c, int ca, int cb, int axis, auto line_at) {
+      const int lo = std::min(ca, cb), hi = std::max(ca, cb);
+      for (int i = lo + 1; i <= hi && i - lo <= kMaxLines; ++i) {
+        const double at = line_at(i);
+        const auto d = [&](double x) { return c(x) - at; };
+        cut_axis[nc] = axis;
+        cut[nc++] = BisectSign(d, a, b);
+      }
+    };
+    if (grid.u_axis() < D)
+      lines(cu, grid.CellU(cu(a)), grid.CellU(cu(b)), 0, [&](int i) { return grid.LineU(i); });
+    if (grid.v_axis() < D)
+      lines(cv, grid.CellV(cv(a)), grid.CellV(cv(b)), 1, [&](int i) { return grid.LineV(i); });
+    // Insertion sort by position (a few entries).
+    for (int i = 1; i < nc; ++i)
+      for (int k = i; k > 0 && cut[k] < cut[k - 1]; --k) {
+        std::swap(cut[k], cut[k - 1]);
+        std::swap(cut_axis[k], cut_axis[k - 1]);
+      }
+    // Each line is found in one sub-interval only (the cell at a shared end
+    // is the same for both), and may round to either end of it.
+    for (int i = 0; i < nc; ++i) advance(std::clamp(cut[i], xa, b), cut_axis[i]);
+    advance(b, -1);
+  }
+  if (open && start < 1) f(start, 1.0);
+}
+
+template <int D>
+double Seabed::GridPotential(const Eigen::Matrix<double, 4 * D, 1>& e, double length,
+                             Eigen::Matrix<double, 4 * D, 1>* gradient,
+                             Eigen::Matrix<double, 4 * D, 4 * D>* hessian,
+                             Eigen::Matrix<double, 4 * D, 1>* roundoff) const {
+  using Point = Eigen::Matrix<double, D, 1>;
+  using Block = Eigen::Matrix<double, D, D>;
+  constexpr double kEps = std::numeric_limits<double>::epsilon();
+  // 7 points: exact to degree 13, the integrands are of degree <= 12.
+  static const GaussRule rule = MakeGaussRule(7);
+  double energy = 0;
+  // Where the element crosses a grid line in the bed, the slope across the
+  // line jumps by J, and so does the integrand of the gradient; as the
+  // crossing point xi* moves (dxi*/de = -s e_a^T / a', a the coordinate
+  // across the line, a' = da/dxi), the gradient changes by
+  // l k g J / a' s s^T e_a e_a^T (J taken in the direction of xi).
+  const BathymetryGrid& grid = *grid_;
+  auto crossing = [&](double xi, int which) {
+    if (!hessian) return;
+    const int axis = which == 0 ? grid.u_axis() : grid.v_axis();
+    double s[4], ds[4];
+    HermiteShape(xi, length, s);
+    HermiteShapeD1(xi, length, ds);
+    Point r = Point::Zero();
+    double rate = 0;  // da/dxi
+    for (int k = 0; k < 4; ++k) {
+      r += s[k] * e.template segment<D>(k * D);
+      rate += ds[k] * length * e(k * D + axis);
+    }
+    Point grad;
+    const double g = GridAt<D>(r, &grad, nullptr);
+    if (!(g < 0) || rate == 0) return;
+    const double spacing = which == 0 ? grid.LineU(1) - grid.LineU(0)
+                                      : grid.LineV(1) - grid.LineV(0);
+    const double delta = std::copysign(1e-6 * spacing, rate);
+    Point after = r, before = r;
+    after(axis) += delta;
+    before(axis) -= delta;
+    Point ga, gb;
+    GridAt<D>(after, &ga, nullptr);
+    GridAt<D>(before, &gb, nullptr);
+    const double jump = ga(axis) - gb(axis);
+    Eigen::Matrix<double, D, D> block = Eigen::Matrix<double, D, D>::Zero();
+    block(axis, axis) = length * k_ * g * jump / rate;
+    AddShapeBlocks<D>(1.0, s, block, hessian);
+  };
+  ForEachGridPiece<D>(e, length, [&](double a, double b) {
+    for (int gp = 0; gp < rule.n; ++gp) {
+      double s[4];
+      HermiteShape(a + (b - a) * rule.xi[gp], length, s);
+      const double wl = rule.weight[gp] * (b - a) * length;
+      Point r = Point::Zero();
+      double size = 0;
+      for (int k = 0; k < 4; ++k) {
+        r += s[k] * e.template segment<D>(k * D);
+        size += std::abs(s[k]) * e.template segment<D>(k * D).template lpNorm<1>();
+      }
+      Point grad;
+      Block hess;
+      const double pen = std::max(0.0, -GridAt<D>(r, &grad, hessian ? &hess : nullptr));
+      energy += wl * 0.5 * k_ * pen * pen;
+      if (gradient)
+        for (int k = 0; k < 4; ++k)
+          gradient->template segment<D>(k * D) -= (wl * k_ * pen * s[k]) * grad;
+      if (roundoff) {
+        size += std::abs(GridHeight(Eigen::Vector3d::Zero()));
+        for (int k = 0; k < 4; ++k)
+          roundoff->template segment<D>(k * D) +=
+              (wl * k_ * kEps * size * std::abs(s[k])) * grad.cwiseAbs();
+      }
+      if (hessian)
+        AddShapeBlocks<D>(wl, s, (k_ * (grad * grad.transpose() - pen * hess)).eval(), hessian);
+    }
+  }, crossing);
+  return energy;
+}
+
+template <int D>
+double Seabed::GridDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
+                               const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
+                               Eigen::Matrix<double, 4 * D, 1>* force,
+                               Eigen::Matrix<double, 4 * D, 4 * D>* c) const {
+  using Point = Eigen::Matrix<double, D, 1>;
+  using Block = Eigen::Matrix<double, D, D>;
+  static const GaussRule rule = MakeGaussRule(7);
+  double power = 0;
+  ForEachGridPiece<D>(e, length, [&](double a, double b) {
+    for (int gp = 0; gp < rule.n; ++gp) {
+      double s[4], ds[4];
+      const double xi = a + (b - a) * rule.xi[gp];
+      HermiteShape(xi, length, s);
+      HermiteShapeD1(xi, length, ds);
+      const double wl = rule.weight[gp] * (b - a) * length;
+      Point r = Point::Zero(), v = Point::Zero(), u = Point::Zero();
+      for (int k = 0; k < 4; ++k) {
+        r += s[k] * e.template segment<D>(k * D);
+        u += ds[k] * e.template segment<D>(k * D);
+        v += s[k] * edot.template segment<D>(k * D);
+      }
+      Point grad;
+      const double pen = std::max(0.0, -GridAt<D>(r, &grad, nullptr));
+      const double gn = grad.norm();
+      const Point n = grad / gn;
+      const Block proj = Block::Identity() - n * n.transpose();
+      Point q;
+      Block h;
+      power += wl * PointDissipation<D>(n, proj, k_ * pen * gn, v, u, c_, mu_a_, mu_t_, v_s_,
+                                        &q, &h);
+      if (force)
+        for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s[k]) * q;
+      if (c) AddShapeBlocks<D>(wl, s, h, c);
+    }
+  }, [](double, int) {});
+  return power;
+}
 
 template <int D>
 int Seabed::ContactPieces(const Eigen::Matrix<double, 4 * D, 1>& e, double length,
@@ -109,7 +374,7 @@ int Seabed::ContactPieces(const Eigen::Matrix<double, 4 * D, 1>& e, double lengt
   for (int i = 0; i < nbr; ++i) {
     const double a = br[i], b = i + 1 < nbr ? br[i + 1] : 1.0;
     if ((h(a) < 0) != (h(b) < 0)) {
-      const double r = Bisect(h, a, b);
+      const double r = BisectSign(h, a, b);
       if (r > prev && r < 1) {
         cuts[ncuts++] = r;
         prev = r;
@@ -137,6 +402,7 @@ double Seabed::AddPotential(const Eigen::Matrix<double, 4 * D, 1>& e, double len
                             Eigen::Matrix<double, 4 * D, 1>* gradient,
                             Eigen::Matrix<double, 4 * D, 4 * D>* hessian,
                             Eigen::Matrix<double, 4 * D, 1>* roundoff) const {
+  if (grid_) return GridPotential<D>(e, length, gradient, hessian, roundoff);
   using Point = Eigen::Matrix<double, D, 1>;
   constexpr double kEps = std::numeric_limits<double>::epsilon();
   double pieces[2][2];
@@ -177,6 +443,7 @@ double Seabed::AddDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
                               const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
                               Eigen::Matrix<double, 4 * D, 1>* force,
                               Eigen::Matrix<double, 4 * D, 4 * D>* c) const {
+  if (grid_) return GridDissipation<D>(e, edot, length, force, c);
   using Point = Eigen::Matrix<double, D, 1>;
   using Block = Eigen::Matrix<double, D, D>;
   double pieces[2][2];
@@ -193,26 +460,9 @@ double Seabed::AddDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
       v += s[k] * edot.template segment<D>(k * D);
     }
     const double pen = std::max(0.0, -(depth_ + n.dot(r)));
-    const double vn = n.dot(v);
-    Point q = (-c_ * vn) * n;
-    Block h = c_ * n * n.transpose();
-    power += c_ * vn * vn * wl;
-    const double normal_force = k_ * pen;
-    if ((mu_a_ != 0 || mu_t_ != 0) && normal_force > 0) {
-      const Point vb = v - vn * n;
-      Point t = proj * u;
-      const double tn = t.norm();
-      Block amat = mu_t_ * proj;  // the friction's A: q_f = -N A v_b / s
-      if (tn > 0) {
-        t /= tn;
-        amat += (mu_a_ - mu_t_) * t * t.transpose();
-      }
-      const double sq = std::sqrt(vb.squaredNorm() + v_s_ * v_s_);
-      const Point qf = (-normal_force / sq) * (amat * vb);
-      q += qf;
-      h += (normal_force / sq) * amat;
-      power -= wl * qf.dot(vb);
-    }
+    Point q;
+    Block h;
+    power += wl * PointDissipation<D>(n, proj, k_ * pen, v, u, c_, mu_a_, mu_t_, v_s_, &q, &h);
     if (force)
       for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s[k]) * q;
     if (c) AddShapeBlocks<D>(wl, s, h, c);

@@ -56,10 +56,56 @@
 // with the same Gauss points as the damping (exact only for the
 // polynomial terms). STATIC analyses see no friction (no velocities).
 //
-// Units SI. Used by MultibodyModel only when the scene has a seabed.
+// Bathymetry (engine/forces/bathymetry_grid.h). When the scene gives a
+// grid, the height above the bed is measured along the grid's up axis,
+//
+//   g(r) = s r_up + d(u, v),   penetration p = max(0, -g) [m],
+//
+// and the bed stores U = int k p^2 / 2 dx and pushes with
+// q = k p grad g (grad g = s e_up + d_u e_u + d_v e_v): along the bed's
+// local normal n = grad g / |grad g|, of size k p |grad g|. On a plane of
+// slope theta, p = p_n / cos(theta) (p_n the penetration along the normal)
+// and |grad g| = 1 / cos(theta): the bed is stiffer along its normal by
+// 1 / cos^2(theta) than a plane of the same k (3% at 10 degrees), and a
+// uniformly sloped grid is exactly the tilted plane of stiffness
+// k / cos^2(theta) (tests/seabed_bathymetry_test.cc). The vertical gap is
+// chosen because it is continuous across the grid lines, where the
+// gradient (and the normal) jumps: U's integrand stays continuous there,
+// the force stays the exact gradient of U and energy is conserved, and
+// only the tangent jumps where a cable node crosses a grid line (a
+// kink in U's gradient along the line).
+// Dividing by |grad g| (the true normal gap) would make U's integrand jump
+// at the grid lines, and the force would miss an impulse there.
+// Damping and friction use the local normal n and N = k p |grad g|, as on
+// a plane. The tangent adds the curvature term: k (grad g grad g^T -
+// p d_uv (e_u e_v^T + e_v e_u^T)) per unit length, and, where the element
+// crosses a grid line a = a_i in the bed, the term of the moving crossing
+// l k g J / a' S^T e_a e_a^T S there (J the jump of the slope dd/da across
+// the line in the direction of xi, a' = da/dxi): the force's integrand
+// jumps at the line, so its integral moves with the crossing point.
+//
+// Cutting. Inside one grid cell g along an element is a polynomial of
+// degree 6 in xi (the bilinear d of cubics u, v); the force, energy and
+// tangent integrands are of degree <= 12, which 7-point Gauss integrates
+// exactly. So the element is cut at every grid line it crosses and where
+// g changes sign, and each piece in the bed is integrated by 7-point
+// Gauss: exact, and the cut points do not move U's derivative (the
+// integrand vanishes at the zero crossings and is continuous at the grid
+// lines). The crossings are found on 16 equal sub-intervals of the
+// element (bisection to the last bit on each: the grid line crossings of
+// the cubics u, v, then the sign changes of g between them); an excursion
+// in or out of the bed, or a double crossing of one grid line, shorter
+// than 1/16 of the element is missed (the cable's mesh, not the grid,
+// then limits the resolution).
+//
+// Units SI. Used by MultibodyModel only when the scene has a seabed; the
+// plane's loops only test whether a grid is present.
+
+#include <optional>
 
 #include <Eigen/Core>
 
+#include "engine/forces/bathymetry_grid.h"
 #include "engine/scene.h"
 
 namespace cablesim {
@@ -99,19 +145,48 @@ class Seabed {
                         Eigen::Matrix<double, 4 * D, 1>* force,
                         Eigen::Matrix<double, 4 * D, 4 * D>* c) const;
 
-  // The pieces [xi0, xi1] of [0, 1] where the element is in the bed
+  // The pieces [xi0, xi1] of [0, 1] where the element is in a plane bed
   // (h < 0), at most 2; returns their number. Public for tests.
   template <int D>
   int ContactPieces(const Eigen::Matrix<double, 4 * D, 1>& e, double length,
                     double pieces[2][2]) const;
 
-  // Height above the bed [m] of a point.
-  double Height(const Eigen::Vector3d& r) const { return depth_ + normal_.dot(r); }
+  // Height above the bed [m] of a point (along the grid's up axis with a
+  // bathymetry grid).
+  double Height(const Eigen::Vector3d& r) const {
+    return grid_ ? GridHeight(r) : depth_ + normal_.dot(r);
+  }
+
+  // The bathymetry grid, or null for a plane bed.
+  const BathymetryGrid* grid() const { return grid_ ? &*grid_ : nullptr; }
 
  private:
+  double GridHeight(const Eigen::Vector3d& r) const;
+  // Calls f(xi0, xi1) for every piece of the element in a grid bed (within
+  // one cell and in the bed), and line_crossed(xi, axis) (axis 0: a u
+  // line, 1: a v line) where a piece in the bed crosses a grid line.
+  template <int D, typename F, typename L>
+  void ForEachGridPiece(const Eigen::Matrix<double, 4 * D, 1>& e, double length, F&& f,
+                        L&& line_crossed) const;
+  // The grid bed at a point r: the height g, its gradient and Hessian.
+  template <int D>
+  double GridAt(const Eigen::Matrix<double, D, 1>& r, Eigen::Matrix<double, D, 1>* grad,
+                Eigen::Matrix<double, D, D>* hess) const;
+  template <int D>
+  double GridPotential(const Eigen::Matrix<double, 4 * D, 1>& e, double length,
+                       Eigen::Matrix<double, 4 * D, 1>* gradient,
+                       Eigen::Matrix<double, 4 * D, 4 * D>* hessian,
+                       Eigen::Matrix<double, 4 * D, 1>* roundoff) const;
+  template <int D>
+  double GridDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
+                         const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
+                         Eigen::Matrix<double, 4 * D, 1>* force,
+                         Eigen::Matrix<double, 4 * D, 4 * D>* c) const;
+
   double depth_ = 0;
   Eigen::Vector3d normal_ = Eigen::Vector3d::UnitY();
   double k_ = 0, c_ = 0, mu_a_ = 0, mu_t_ = 0, v_s_ = 1e-3;
+  std::optional<BathymetryGrid> grid_;  // only with a bathymetry grid
 };
 
 }  // namespace cablesim
