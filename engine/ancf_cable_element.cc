@@ -297,13 +297,18 @@ void AncfCableElement<D>::AddFlowLoadAt(int g, const Coords& e, const Coords& ed
       v -= s0[k] * edot.template segment<D>(k * D);
     }
     const double un = u.norm();
-    if (!(un > 0)) return;
+    const double wl = rule_.weight[g] * length_;
+    if (!(un > 0)) {
+      // No tangent (a collapsed point): no drag, but the flow's inertia acts.
+      if (accel)
+        for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s0[k] * mi) * *accel;
+      return;
+    }
     const Point t = u / un;
     const Point vt = t.dot(v) * t, vn = v - vt;
     const double an = vn.norm(), at = vt.norm();
     Point q = kn * an * vn + kt * at * vt;
     if (accel) q += mi * *accel;
-    const double wl = rule_.weight[g] * length_;
     for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s0[k]) * q;
     if (!c) return;
     Block h = (2 * kt * at) * t * t.transpose();

@@ -41,6 +41,7 @@ void EnergyMomentumStepper::LoadMass() {
 }
 
 bool EnergyMomentumStepper::Initialize(std::string* reason) {
+  kept_.have = false;  // the solver's matrices now hold M and Phi_z
   model_->SetTime(t_);
   model_->ToFull(z_, &qm_);
   model_->NetForce(qm_, 1.0, &f_);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -83,21 +84,27 @@ class FrameRecorder {
     damped_power_ = model_->DampingPower(q_, qd_);
   }
 
-  // Records the evaluated frame in the summary and delivers it.
-  absl::Status Deliver() {
+  // Records the evaluated frame in the summary and delivers it. `reached`:
+  // the frame is a state the stepper reached (a step's end, or the start),
+  // not one interpolated between steps; only such states enter
+  // energy_max_increase and the energy scale (an interpolated state's
+  // energy carries the interpolant's error, not the stepper's).
+  absl::Status Deliver(bool reached = true) {
     if (summary_->frames == 0) summary_->energy_initial = frame_.energy.total;
     summary_->energy_final = frame_.energy.total;
     summary_->energy_damped = frame_.energy.damped;
-    summary_->energy_max_increase =
-        std::max(summary_->energy_max_increase,
-                 frame_.energy.total + frame_.energy.damped - summary_->energy_initial);
     summary_->max_constraint_violation =
         std::max(summary_->max_constraint_violation, frame_.constraint_violation);
     ++summary_->frames;
-    const EnergySample& e = frame_.energy;
+    if (reached) NoteReachedState(frame_.energy);
+    return sink_->OnFrame(frame_);
+  }
+  // A state the stepper reached, with energy e: its rise and its terms.
+  void NoteReachedState(const EnergySample& e) {
+    summary_->energy_max_increase = std::max(summary_->energy_max_increase,
+                                             e.total + e.damped - summary_->energy_initial);
     energy_scale_ = std::max({energy_scale_, std::abs(e.kinetic), std::abs(e.potential),
                               std::abs(e.axial) + std::abs(e.bending)});
-    return sink_->OnFrame(frame_);
   }
 
   absl::Status Emit(double t, double load_factor, const Eigen::VectorXd& z,
@@ -223,6 +230,16 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   double t = 0;
   double h = h_nominal;
   int successes = 0;
+  // Fixed steps: the time reached counted in ticks of h_min (every step is
+  // h_nominal / 2^k, a whole number of ticks), so that whether t is on a
+  // step's grid is decided exactly, however many steps rounding had to
+  // accumulate over.
+  // t itself is the time of the last anchor (the start, a frame it was
+  // snapped to, or a step that was not a whole number of ticks) plus the
+  // ticks since, so it carries one rounding, not the sum of every step's.
+  int64_t tick = 0, tick_anchor = 0;
+  double t_anchor = 0;
+  auto ticks_of = [h_min](double step) { return std::llround(step / h_min); };
   // Rises of the total energy below this are rounding (a scene at rest).
   const double energy_floor = model->energy_roundoff();
   // Backward Euler never raises the energy; the second-order steppers may.
@@ -277,7 +294,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   // is not the stepper's; the step's end state that follows it is guarded.
   auto CheckAndDeliver = [&](double tf, bool guard = true) {
     if (guard && !EnergyHolds(rec->frame().energy, tf)) return false;
-    if (absl::Status st = rec->Deliver(); !st.ok()) {
+    if (absl::Status st = rec->Deliver(/*reached=*/guard); !st.ok()) {
       summary->status = "cancelled";
       summary->error = std::string(st.message());
       return false;
@@ -296,9 +313,14 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     }
     if (!MayStep(control, t, summary)) return;
     const double remaining = duration - t;
-    // The last steps: one or two equal ones that end on the duration.
+    // The last steps: one or two equal ones that end on the duration; when
+    // what is left is a whole number of steps to rounding, whole steps (the
+    // frame at the end snaps t onto the duration).
+    const double left = remaining / h;
+    const bool whole =
+        left >= 0.5 && std::abs(left - std::round(left)) <= 1e-9 * std::max(1.0, left);
     const double h_try =
-        remaining < 2 * h ? remaining / std::ceil(remaining / h - 1e-9) : h;
+        remaining < 2 * h && !whole ? remaining / std::ceil(left - 1e-9) : h;
     z_0 = stepper.z();
     v_0 = stepper.v();
     a_0 = stepper.a();
@@ -361,7 +383,14 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     }
     if (st.converged) {
       const double t0 = t;
-      t += h_try;
+      if (!settings.adaptive && h_try == h) {
+        tick += ticks_of(h_try);
+        t = t_anchor + static_cast<double>(tick - tick_anchor) * h_min;
+      } else {
+        t += h_try;  // adaptive, or the last steps shortened to end on the duration
+        t_anchor = t;
+        tick_anchor = tick;
+      }
       external_work.After(stepper.z(), t, stepper.lambda(), 1);
       ++summary->steps;
       summary->min_step_s = std::min(summary->min_step_s, h_try);
@@ -373,12 +402,10 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       // a time on the doubled step's grid (a multiple of 2 h), so that steps
       // return to the nominal grid and the frames on it are step ends again
       // rather than interpolated.
-      if (!settings.adaptive && h < h_nominal && ++successes >= 4) {
-        const double cells = t / (2 * h);
-        if (std::abs(cells - std::round(cells)) <= 1e-6) {
-          h = std::min(h_nominal, 2 * h);
-          successes = 0;
-        }
+      if (!settings.adaptive && h < h_nominal && ++successes >= 4 &&
+          h_try == h && tick % (2 * ticks_of(h)) == 0) {
+        h = std::min(h_nominal, 2 * h);
+        successes = 0;
       }
       // Every frame this step reached: the step's end state where the
       // frame is its end (within 1e-6 of the step, which also keeps t on
@@ -390,13 +417,17 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
         if (!at_end && tf > t) break;
         if (at_end) {
           t = tf;
+          t_anchor = tf;
+          tick_anchor = tick;
           model->SetTime(tf);
           rec->Evaluate(tf, 1, stepper.z(), &stepper.v(), &stepper.a(), &stepper.lambda());
         } else {
           // The step's end is guarded before any frame inside it goes out.
           if (!end_checked) {
             model->SetTime(t);
-            if (!EnergyHolds(rec->StateEnergy(t, stepper.z(), stepper.v()), t)) return;
+            const EnergySample end = rec->StateEnergy(t, stepper.z(), stepper.v());
+            if (!EnergyHolds(end, t)) return;
+            rec->NoteReachedState(end);
             end_checked = true;
           }
           Interpolate((tf - t0) / h_try, h_try, stepper);

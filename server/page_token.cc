@@ -5,6 +5,8 @@
 #include <openssl/hmac.h>
 #include <openssl/rand.h>
 
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 
 #include "absl/status/status.h"
@@ -20,12 +22,22 @@ constexpr size_t kKeyBytes = 8;
 constexpr size_t kTagBytes = 16;
 constexpr size_t kTokenBytes = 1 + kNonceBytes + kKeyBytes + kTagBytes;
 
-// HMAC-SHA256(key, data), 32 bytes.
+// HMAC-SHA256(key, data), 32 bytes. Should OpenSSL fail (out of memory),
+// 32 random bytes instead: tokens made or checked with them are refused as
+// altered (fail closed), and nothing reads past a short result.
 std::string HmacSha256(const std::string& key, const std::string& data) {
   unsigned char out[EVP_MAX_MD_SIZE];
   unsigned int length = 0;
-  HMAC(EVP_sha256(), key.data(), static_cast<int>(key.size()),
-       reinterpret_cast<const unsigned char*>(data.data()), data.size(), out, &length);
+  if (HMAC(EVP_sha256(), key.data(), static_cast<int>(key.size()),
+           reinterpret_cast<const unsigned char*>(data.data()), data.size(), out,
+           &length) == nullptr ||
+      length != 32) {
+    length = 32;
+    if (RAND_bytes(out, 32) != 1) {
+      std::fputs("cablesim-server: OpenSSL's HMAC and RAND_bytes both failed\n", stderr);
+      std::abort();  // no token can be made or checked safely
+    }
+  }
   return std::string(reinterpret_cast<const char*>(out), length);
 }
 

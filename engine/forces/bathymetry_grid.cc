@@ -37,7 +37,7 @@ BathymetryGrid::Sample BathymetryGrid::At(double u, double v) const {
     *inside = false;
     if (n < 2) return;
     const double t = (x - x0) / dx;
-    if (t <= 0) return;
+    if (!(t > 0)) return;  // also a NaN coordinate: the first cell, never an index from it
     if (t >= n - 1) {
       *i = n - 2;
       *a = 1;
