@@ -140,16 +140,11 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
     rv += bt_mu_ - h * f_;
     if (m_ > 0) rhs_.tail(m_) = phi_ / h;
     NewtonIterate iterate;
-    iterate.last_increment = last_increment;
-    iterate.previous_increment = previous_increment;
-    iterate.zscale = 1 + z1_.lpNorm<Eigen::Infinity>();
-    iterate.residual = rv.lpNorm<Eigen::Infinity>() / scale;
-    iterate.violation = m_ > 0 ? phi_.lpNorm<Eigen::Infinity>() : 0.0;
-    if (!std::isfinite(iterate.residual) || !std::isfinite(iterate.violation)) {
-      st.reason = "the residual is not finite (the step diverged)";
+    if (!BeginIterate(rv, scale, phi_, z1_, last_increment, previous_increment,
+                      previous_at_floor, &iterate)) {
+      st.reason = kNotFiniteResidual;
       return st;
     }
-    iterate.previous_at_floor = previous_at_floor;
     previous_at_floor = false;
     const bool plain = iterate.residual <= tol && iterate.violation <= tol * iterate.zscale;
     if (judge && !(checking && plain)) {
@@ -167,9 +162,7 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
     }
     if (checking && NewtonConverged(iterate, tol)) {
       floor_expected_ = !plain;
-      st.converged = true;
-      st.residual = iterate.residual;
-      st.residual_floor = iterate.floor;
+      AcceptIterate(iterate, &st);
       break;
     }
     if (it == settings_.max_newton_iterations) {

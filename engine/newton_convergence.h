@@ -71,6 +71,24 @@ constexpr double kSumRounding = 4 * 2.220446049250313e-16;
 // few bits (16 machine epsilons).
 constexpr double kRoundingIncrement = 16 * 2.220446049250313e-16;
 
+// Starts a stepper's Newton iterate: the increments so far, zscale from
+// z1, the residual r relative to `scale` and the largest constraint value
+// of phi (0 without constraints). False when either is not finite (the
+// step diverged: kNotFiniteResidual says so).
+template <typename R>
+bool BeginIterate(const R& r, double scale, const Eigen::VectorXd& phi,
+                  const Eigen::VectorXd& z1, double last_increment, double previous_increment,
+                  bool previous_at_floor, NewtonIterate* it) {
+  it->last_increment = last_increment;
+  it->previous_increment = previous_increment;
+  it->zscale = 1 + z1.lpNorm<Eigen::Infinity>();
+  it->residual = r.template lpNorm<Eigen::Infinity>() / scale;
+  it->violation = phi.size() > 0 ? phi.lpNorm<Eigen::Infinity>() : 0.0;
+  it->previous_at_floor = previous_at_floor;
+  return std::isfinite(it->residual) && std::isfinite(it->violation);
+}
+inline constexpr char kNotFiniteResidual[] = "the residual is not finite (the step diverged)";
+
 inline bool NewtonConverged(const NewtonIterate& it, double tol) {
   const bool stalled = it.last_increment <= kRoundingIncrement * it.zscale ||
                        it.previous_at_floor ||

@@ -22,6 +22,7 @@
 
 #include <Eigen/Core>
 
+#include "engine/newton_convergence.h"
 #include "engine/saddle_point_solver.h"
 #include "engine/scene.h"
 
@@ -109,6 +110,13 @@ bool FactorNewtonMatrix(SaddlePointSolver* solver, const SparseRows& jac, double
 // `st`. False with st->reason when the linear solve is not good enough.
 bool SolveNewtonSystem(SaddlePointSolver* solver, const SolverSettings& settings,
                        Eigen::VectorXd* rhs, Eigen::VectorXd* dx, Stepper::StepStats* st);
+
+// Records a converged Newton iterate in the step's statistics.
+inline void AcceptIterate(const NewtonIterate& it, Stepper::StepStats* st) {
+  st->converged = true;
+  st->residual = it.residual;
+  st->residual_floor = it.floor;
+}
 
 // Adds the counts of a failed first attempt at a step to its retry's.
 void AddFailedAttempt(const Stepper::StepStats& first, Stepper::StepStats* retry);
