@@ -332,6 +332,9 @@ class SceneConverter {
     CABLESIM_RETURN_IF_ERROR(ConvertInitialVelocity());
     CABLESIM_RETURN_IF_ERROR(ConvertFluid());
     CABLESIM_RETURN_IF_ERROR(ConvertSeabed());
+    for (int i = 0; i < static_cast<int>(scene_.bodies.size()); ++i)
+      if (!scene_.bodies[i].contact_points_m.empty() && !scene_.seabed.enabled)
+        return Invalid(Sub(Indexed("", "bodies", i), "seabed_contact"), "needs a seabed");
     CABLESIM_RETURN_IF_ERROR(ConvertSolver());
     return std::move(scene_);
   }
@@ -550,6 +553,7 @@ class SceneConverter {
       return Invalid(Sub(path, "mass"), "required (give cylinder + density, or mass + inertia)");
     }
 
+    if (b.has_seabed_contact()) CABLESIM_RETURN_IF_ERROR(ConvertBodyContact(path, b, body));
     if (b.has_on()) return PlaceOnCable(i, b);
     CABLESIM_ASSIGN_OR_RETURN(body->position_m, VectorInRange(Sub(path, "position"), b.position(), plausible::kCoordinate));
     body->axis = Eigen::Vector3d::UnitX();
@@ -565,6 +569,27 @@ class SceneConverter {
       body->linear_damping_n_s_m = b.damping().linear();
       body->angular_damping_n_m_s = b.damping().angular();
     }
+    return absl::OkStatus();
+  }
+
+  // Body.seabed_contact: the points, their spring, damper and friction.
+  absl::Status ConvertBodyContact(const std::string& path, const v1::Body& b, BodySpec* body) {
+    const v1::BodySeabedContact& c = b.seabed_contact();
+    const std::string contact_path = Sub(path, "seabed_contact");
+    if (c.points_size() == 0)
+      return Invalid(Sub(contact_path, "points"), "at least one point is required");
+    for (int k = 0; k < c.points_size(); ++k) {
+      CABLESIM_ASSIGN_OR_RETURN(
+          const Eigen::Vector3d point,
+          VectorInRange(Indexed(contact_path, "points", k), c.points(k), plausible::kCoordinate));
+      body->contact_points_m.push_back(point);
+    }
+    CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(contact_path, "stiffness"), c.stiffness()));
+    body->contact_stiffness_n_m = c.stiffness();
+    CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(contact_path, "damping"), c.damping()));
+    body->contact_damping_n_s_m = c.damping();
+    CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(contact_path, "friction"), c.friction()));
+    body->contact_friction = c.friction();
     return absl::OkStatus();
   }
 
@@ -922,6 +947,10 @@ class SceneConverter {
     if (b.friction_speed() != 0) {
       CABLESIM_RETURN_IF_ERROR(CheckPositive("seabed.friction_speed", b.friction_speed()));
       spec.friction_speed_m_s = b.friction_speed();
+    }
+    if (b.friction_length() != 0) {
+      CABLESIM_RETURN_IF_ERROR(CheckPositive("seabed.friction_length", b.friction_length()));
+      spec.friction_length_m = b.friction_length();
     }
     if (b.has_bathymetry()) CABLESIM_RETURN_IF_ERROR(ConvertBathymetry(b));
     return absl::OkStatus();

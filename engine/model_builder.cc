@@ -660,6 +660,20 @@ void ModelBuilder::BuildElements() {
   if (scene_.seabed.enabled) {
     model_.seabed_.emplace(scene_.seabed);
     if (model_.seabed_->dissipates()) model_.has_damping_ = true;
+    // Bodies with contact points (SceneFromProto refuses them without a
+    // seabed).
+    for (int b = 0; b < static_cast<int>(scene_.bodies.size()); ++b) {
+      const BodySpec& body = scene_.bodies[b];
+      if (body.contact_points_m.empty()) continue;
+      MultibodyModel::BodyContact contact;
+      contact.coord = BodyCoord(b);
+      contact.points = body.contact_points_m;
+      contact.k = body.contact_stiffness_n_m;
+      contact.c = body.contact_damping_n_s_m;
+      contact.mu = body.contact_friction;
+      if (contact.c != 0 || contact.mu != 0) model_.has_damping_ = true;
+      model_.body_contacts_.push_back(std::move(contact));
+    }
   }
   if (model_.dim_ == 2) {
     BuildElementsOf<2>(&model_.elements2_);

@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
@@ -334,6 +335,17 @@ double MultibodyModel::NetForce(const VectorXd& q, double load_factor, VectorXd*
                                                      full_roundoff)
                                   : ElementForces<3>(q, &full, stiffness, stiffness_scale,
                                                      full_roundoff));
+  if (!body_contacts_.empty()) {
+    double contact_size = 0;
+    if (dim_ == 2) {
+      BodyContactTerms<2>(ContactTerm::kPotential, q, nullptr, &full, stiffness, stiffness_scale,
+                          full_roundoff, &contact_size);
+    } else {
+      BodyContactTerms<3>(ContactTerm::kPotential, q, nullptr, &full, stiffness, stiffness_scale,
+                          full_roundoff, &contact_size);
+    }
+    size = std::max(size, contact_size);
+  }
   for (const SlidingJoint& slider : sliders_) {
     SlidingJoint::Local local;
     slider.Penalty(q, &local, stiffness != nullptr);
@@ -460,6 +472,17 @@ double MultibodyModel::DampingForce(const VectorXd& q, const VectorXd& qdot, Vec
         tangent->values()[tangent->Slot(j_[i], j_[i])] += tangent_scale * s_(i) * s_(i) * c;
     }
   }
+  if (!body_contacts_.empty()) {
+    double contact_size = 0;
+    if (dim_ == 2) {
+      BodyContactTerms<2>(ContactTerm::kDissipation, q, &qdot, &full, tangent, tangent_scale,
+                          nullptr, &contact_size);
+    } else {
+      BodyContactTerms<3>(ContactTerm::kDissipation, q, &qdot, &full, tangent, tangent_scale,
+                          nullptr, &contact_size);
+    }
+    size = std::max(size, contact_size);
+  }
   for (const SlidingJoint& slider : sliders_) {
     if (!slider.has_friction()) continue;
     SlidingJoint::Local local;
@@ -490,7 +513,130 @@ double MultibodyModel::DampingPower(const VectorXd& q, const VectorXd& qdot) con
       power += BodyDampingCoefficient(b, k) * qdot(b.coord + k) * qdot(b.coord + k);
   for (const SlidingJoint& slider : sliders_)
     if (slider.has_friction()) power += slider.Friction(q, qdot, nullptr, false);
+  if (!body_contacts_.empty())
+    power += dim_ == 2 ? BodyContactTerms<2>(ContactTerm::kDissipation, q, &qdot, nullptr,
+                                             nullptr, 0, nullptr, nullptr)
+                       : BodyContactTerms<3>(ContactTerm::kDissipation, q, &qdot, nullptr,
+                                             nullptr, 0, nullptr, nullptr);
   return power;
+}
+
+template <int D>
+double MultibodyModel::BodyContactTerms(ContactTerm term, const VectorXd& q,
+                                        const VectorXd* other, VectorXd* full, SkylineLdlt* a,
+                                        double scale, VectorXd* roundoff, double* size) const {
+  constexpr int S = D == 2 ? 4 : 12;  // the body's natural coordinates
+  constexpr double kEps = std::numeric_limits<double>::epsilon();
+  using Point = Eigen::Matrix<double, D, 1>;
+  using Block = Eigen::Matrix<double, D, D>;
+  using Local = Eigen::Matrix<double, S, 1>;
+  const Seabed& bed = *seabed_;
+  const double bed_size = std::abs(bed.Height(Vector3d::Zero()));
+  double result = 0;
+  for (const BodyContact& c : body_contacts_) {
+    if (term == ContactTerm::kDissipation && c.c == 0 && c.mu == 0) continue;
+    if (term == ContactTerm::kStaticFriction && c.mu == 0) continue;
+    const Local qb = q.segment<S>(c.coord);
+    Local force = Local::Zero(), bound = Local::Zero();
+    Eigen::Matrix<double, S, S> matrix = Eigen::Matrix<double, S, S>::Zero();
+    for (const Vector3d& p : c.points) {
+      // r = B q_b: planar r_c + p_x u + p_y perp(u), spatial r_c + sum p_k e_k.
+      Eigen::Matrix<double, D, S> b = Eigen::Matrix<double, D, S>::Zero();
+      b.template leftCols<D>().setIdentity();
+      if constexpr (D == 2) {
+        b(0, 2) = b(1, 3) = p.x();
+        b(0, 3) = -p.y();
+        b(1, 2) = p.y();
+      } else {
+        for (int k = 0; k < 3; ++k) b.template block<3, 3>(0, 3 + 3 * k) = p(k) * Block::Identity();
+      }
+      const Point r = b * qb;
+      Point f = Point::Zero();
+      Block h = Block::Zero();
+      if (term == ContactTerm::kPotential) {
+        result += bed.PointPotential<D>(r, c.k, &f, a ? &h : nullptr);
+        f = -f;  // the force is minus the energy's gradient
+        if (roundoff && f.squaredNorm() > 0)
+          bound += (kEps * c.k * (bed_size + (b.cwiseAbs() * qb.cwiseAbs()).sum())) *
+                   (b.cwiseAbs().transpose() * Point::Ones());
+      } else if (term == ContactTerm::kDissipation) {
+        const Point v = b * other->segment<S>(c.coord);
+        result += bed.PointDissipation<D>(r, v, c.k, c.c, c.mu, &f, a ? &h : nullptr);
+      } else {
+        const Point r0 = b * other->segment<S>(c.coord);
+        bed.PointStaticFriction<D>(r, r0, c.k, c.mu, &f, a ? &h : nullptr);
+      }
+      force.noalias() += b.transpose() * f;
+      if (a) matrix.noalias() += b.transpose() * h * b;
+    }
+    if (size) *size = std::max(*size, force.template lpNorm<Eigen::Infinity>());
+    if (full) full->segment<S>(c.coord) += force;
+    if (roundoff) roundoff->segment<S>(c.coord) += bound + kEps * force.cwiseAbs();
+    if (!a) continue;
+    double* values = a->values();
+    // Lower triangle on z (as ScatterSlider).
+    for (int i = 0; i < S; ++i) {
+      const int ji = j_[c.coord + i];
+      if (ji < 0) continue;
+      for (int k = 0; k < S; ++k) {
+        const int jk = j_[c.coord + k];
+        if (jk < 0 || jk > ji) continue;
+        values[a->Slot(ji, jk)] += scale * s_(c.coord + i) * s_(c.coord + k) * matrix(i, k);
+      }
+    }
+  }
+  return result;
+}
+
+bool MultibodyModel::has_static_friction() const {
+  if (!seabed_) return false;
+  if (seabed_->has_friction() && (!elements2_.empty() || !elements3_.empty())) return true;
+  for (const BodyContact& c : body_contacts_)
+    if (c.mu != 0) return true;
+  return false;
+}
+
+void MultibodyModel::StaticFriction(const VectorXd& q, const VectorXd& q_start, VectorXd* f,
+                                    SkylineLdlt* matrix, double scale) {
+  if (!has_static_friction()) return;
+  VectorXd& full = scratch_static_;
+  full.setZero(c_.size());
+  auto cables = [&](const auto& elements, auto dim) {
+    constexpr int D = decltype(dim)::value, kN = 4 * D, kN2 = kN * kN;
+    if (!seabed_->has_friction()) return;
+    typename AncfCableElement<D>::Coords fe;
+    typename AncfCableElement<D>::Matrix me;
+    double* values = matrix ? matrix->values() : nullptr;
+    for (size_t k = 0; k < elements.size(); ++k) {
+      const ElementData<D>& e = elements[k];
+      fe.setZero();
+      if (matrix) me.setZero();
+      seabed_->AddStaticFriction<D>(q.segment<kN>(e.first_coord),
+                                              q_start.segment<kN>(e.first_coord),
+                                              e.element.length(), &fe, matrix ? &me : nullptr);
+      full.segment<kN>(e.first_coord) += fe;
+      if (!matrix) continue;
+      const int* slots = &element_slots_[kN2 * k];
+      const double* factors = &element_factors_[kN2 * k];
+      const double* mv = me.data();  // symmetric
+      for (int t = 0; t < kN2; ++t)
+        if (slots[t] >= 0) values[slots[t]] += scale * factors[t] * mv[t];
+    }
+  };
+  if (dim_ == 2) {
+    cables(elements2_, std::integral_constant<int, 2>());
+    BodyContactTerms<2>(ContactTerm::kStaticFriction, q, &q_start, &full, matrix, scale,
+                                  nullptr, nullptr);
+  } else {
+    cables(elements3_, std::integral_constant<int, 3>());
+    BodyContactTerms<3>(ContactTerm::kStaticFriction, q, &q_start, &full, matrix, scale,
+                                  nullptr, nullptr);
+  }
+  if (f) {
+    const int n = coordinates();
+    for (int i = 0; i < n; ++i)
+      if (j_[i] >= 0) (*f)(j_[i]) += s_(i) * full(i);
+  }
 }
 
 void MultibodyModel::Constraints(const VectorXd& q, VectorXd* phi, SparseRows* jac) const {
@@ -650,6 +796,11 @@ EnergySample MultibodyModel::Energy(const VectorXd& q, const VectorXd& qdot, dou
   double slider_energy = 0;
   for (const SlidingJoint& slider : sliders_) slider_energy += slider.Penalty(q, nullptr, false);
   en.potential += slider_energy;
+  if (!body_contacts_.empty())
+    en.contact += dim_ == 2 ? BodyContactTerms<2>(ContactTerm::kPotential, q, nullptr, nullptr,
+                                                  nullptr, 0, nullptr, nullptr)
+                            : BodyContactTerms<3>(ContactTerm::kPotential, q, nullptr, nullptr,
+                                                  nullptr, 0, nullptr, nullptr);
   en.total = en.kinetic + en.potential + en.axial + en.bending + en.contact;
   if (parts != nullptr) {
     // The element gravity above is at load factor 1 (statics scales it).

@@ -262,6 +262,21 @@ class MultibodyModel {
   // one holds no seabed object, and its force loops only test this.
   const Seabed* seabed() const { return seabed_ ? &*seabed_ : nullptr; }
 
+  // Bodies with seabed contact points (BodySpec::contact_points_m): their
+  // count. A scene without any holds none and its loops only test this.
+  int body_contacts() const { return static_cast<int>(body_contacts_.size()); }
+
+  // STATIC analyses only: the seabed's static friction (Seabed::
+  // AddStaticFriction, on cables and body contact points) at full q,
+  // opposing the displacement from q_start (where the analysis started).
+  // Adds its generalized force to the reduced `f` and scale times its
+  // matrix (symmetric, positive semi-definite; on z) to `matrix` when not
+  // null. has_static_friction(): whether there is any (else this does
+  // nothing and costs nothing).
+  bool has_static_friction() const;
+  void StaticFriction(const Eigen::VectorXd& q, const Eigen::VectorXd& q_start,
+                        Eigen::VectorXd* f, SkylineLdlt* matrix, double scale);
+
   // Whether frames carry the nodes' positions (the scene's output.shape).
   bool shape() const { return shape_; }
   // Every cable node's position [m] from full coordinates q (a split node
@@ -320,6 +335,26 @@ class MultibodyModel {
     double linear_damping = 0;   // [N s/m]
     double angular_damping = 0;  // [N m s/rad]
   };
+  // A body's seabed contact points (BodySpec): body frame [m], spring k
+  // [N/m], damper c [N s/m], friction mu [-] per point.
+  struct BodyContact {
+    int coord = 0;  // full index of the body's r_c
+    std::vector<Eigen::Vector3d> points;
+    double k = 0, c = 0, mu = 0;
+  };
+  enum class ContactTerm { kPotential, kDissipation, kStaticFriction };
+  // The body contact points' terms: kPotential (at q: returns U, adds the
+  // force -dU/dq to `full` and its Hessian to `a`), kDissipation (`other`
+  // the rate: returns the power, adds the force and its velocity tangent),
+  // kStaticFriction (`other` the start: returns 0). Each
+  // point r = B q_b is linear in its body's coordinates q_b, so the
+  // generalized force is B^T f and the matrix B^T H B, within the body's
+  // own block of the envelope. `size` (when not null) gets the largest
+  // force entry; `roundoff` a bound of the rounding (kPotential).
+  template <int D>
+  double BodyContactTerms(ContactTerm term, const Eigen::VectorXd& q,
+                          const Eigen::VectorXd* other, Eigen::VectorXd* full, SkylineLdlt* a,
+                          double scale, Eigen::VectorXd* roundoff, double* size) const;
   // A torque load on a body [N m]: torque = base + varying(t).
   struct TorqueLoad {
     int body = 0;
@@ -460,6 +495,9 @@ class MultibodyModel {
   bool has_damping_ = false;
   Eigen::Vector3d current_ = Eigen::Vector3d::Zero();  // the fluid's [m/s]
   std::optional<Seabed> seabed_;  // only in a scene with a seabed
+  std::vector<BodyContact> body_contacts_;  // only bodies with contact points
+  // Scratch (full size) for StaticFriction (sized on first use).
+  Eigen::VectorXd scratch_static_;
   // Only in a scene whose fluid has waves (then it carries the current too).
   std::optional<WaveLoad> wave_load_;
 

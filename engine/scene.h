@@ -89,6 +89,15 @@ struct BodySpec {
   // torque -angular c omega [N m s/rad].
   double linear_damping_n_s_m = 0;
   double angular_damping_n_m_s = 0;
+  // Points of the body that touch the seabed (Seabed::PointPotential), body
+  // frame [m]; empty: the body never touches it (and costs nothing).
+  // Each point has its own normal spring [N/m] and damper [N s/m], and
+  // isotropic Coulomb friction `contact_friction` [-] in the bed's plane
+  // (regularised as the cable's, by seabed.friction_speed).
+  std::vector<Eigen::Vector3d> contact_points_m;
+  double contact_stiffness_n_m = 0;
+  double contact_damping_n_s_m = 0;
+  double contact_friction = 0;
 };
 
 // A place on a cable (cable >= 0), on a body (body >= 0), or the ground
@@ -217,6 +226,10 @@ struct SeabedSpec {
   // Sliding speed [m/s] below which friction is regularised (the friction
   // force grows as v / sqrt(v^2 + friction_speed^2)).
   double friction_speed_m_s = 1e-3;
+  // STATIC analyses: displacement [m] from the configuration the analysis
+  // starts from (where the line was laid) below which friction is
+  // regularised (Seabed::AddStaticFriction).
+  double friction_length_m = 1e-5;
   // When enabled, the bed is this grid instead of the plane (depth_m is
   // then 0 and the normal a coordinate axis: the grid's "up").
   BathymetrySpec bathymetry;

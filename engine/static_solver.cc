@@ -18,6 +18,12 @@ StaticSolver::StaticSolver(MultibodyModel* model, const SolverSettings& settings
   m_ = model->multipliers();
   solver_.Resize(model->envelope(), model->jacobian_pattern());
   z_ = model->initial_z();
+  // Static friction opposes the displacement from here (where the scene
+  // laid its cables and bodies).
+  if (model->has_static_friction()) {
+    q_start_.setZero(model->coordinates());
+    model->ToFull(z_, &q_start_);
+  }
   lambda_.setZero(m_);
   z1_.setZero(n_);
   lambda1_.setZero(m_);
@@ -51,6 +57,15 @@ double StaticSolver::Merit(const Eigen::VectorXd& z, const Eigen::VectorXd& lamb
   model_->ToFull(z, &q_);
   const EnergySample e = model_->Energy(q_, qdot_zero_, alpha);
   double merit = e.total;
+  if (q_start_.size() > 0) {
+    // Friction is not a potential's force: its work from the iterate z1_
+    // by the trapezoidal rule, -(f(z1) + f(z)) / 2 . (z - z1), second
+    // order along the step (z = z1_ adds nothing).
+    work_.setZero();
+    model_->StaticFriction(q_, q_start_, &work_, nullptr, 0);
+    work_ += friction_;
+    merit -= 0.5 * work_.dot(z - z1_);
+  }
   if (m_ > 0) {
     model_->Constraints(q_, &phi_, nullptr);
     merit += lambda.dot(phi_) + 0.5 * gamma * phi_.squaredNorm();
@@ -81,6 +96,11 @@ StaticSolver::IncrementStats StaticSolver::Solve(double alpha, double tolerance)
     SkylineLdlt& a = solver_.a();
     a.SetZero();
     const double force_size = model_->NetForce(q_, alpha, &f_, &a, 1.0, &floor_);
+    if (q_start_.size() > 0) {
+      friction_.setZero(n_);
+      model_->StaticFriction(q_, q_start_, &friction_, &a, 1.0);
+      f_ += friction_;
+    }
     model_->Constraints(q_, &phi_, &solver_.b());
     bt_l_.setZero();
     solver_.b().AddTransposeMultiply(lambda1_.data(), bt_l_.data());

@@ -34,6 +34,11 @@
 // doubled while the merit keeps falling, since a slack cable's Newton steps
 // are short and alike.
 //
+// Seabed friction (MultibodyModel::StaticFriction) opposes the
+// displacement from the configuration the solver was built at (the scene's
+// layout): its force joins the residual, its symmetric matrix the Newton
+// matrix, and its work from the iterate (trapezoidal rule) the merit.
+//
 // Convergence is newton_convergence.h's test (per-entry rounding floor).
 // A scene with no equilibrium (a mechanism: a body or cable that the joints
 // do not hold against the loads) never converges: the solve stops after
@@ -112,6 +117,10 @@ class StaticSolver {
   int n_ = 0, m_ = 0;
   Eigen::VectorXd z_, lambda_, z1_, lambda1_, q_, f_, phi_, rhs_, dx_, bt_l_, floor_, work_;
   Eigen::VectorXd trial_z_, trial_lambda_, qdot_zero_;
+  // Full coordinates where the analysis started, for the seabed's static
+  // friction (MultibodyModel::StaticFriction); empty without it.
+  Eigen::VectorXd q_start_;
+  Eigen::VectorXd friction_;  // its force at the iterate z1_
   double merit_size_ = 0;
   std::function<bool()> should_stop_;
 };

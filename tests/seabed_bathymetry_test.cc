@@ -249,13 +249,7 @@ std::string Invalid(const std::string& bathymetry, const std::string& extra = ""
                 "area": 1e-4, "bending": "NONE", "points": [{"x": 0}, {"x": 1}]}],
     "seabed": {"stiffness": 1e5 %s, "bathymetry": %s}, "solver": {"analysis": "STATIC"}})",
                                            extra, bathymetry);
-  auto proto = ParseSceneJson(json);
-  EXPECT_TRUE(proto.ok()) << proto.status();
-  if (!proto.ok()) return "";
-  auto scene = SceneFromProto(*proto);
-  if (scene.ok()) return "ok";
-  EXPECT_EQ(scene.status().code(), absl::StatusCode::kInvalidArgument);
-  return std::string(scene.status().message());
+  return testing::SceneError(json);
 }
 
 TEST(SeabedBathymetryTest, BadGridsNameTheField) {

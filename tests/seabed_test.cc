@@ -40,11 +40,25 @@ constexpr double kXf = 85, kZf = 30;
 
 // The closed form: H and V from (x_F, z_F) by Newton on the two equations
 // (analytic Jacobian), to 1e-12 relative.
+// With seabed friction C_B (MAP's and MoorPy's CB; Masciola, Jonkman and
+// Robertson, "Implementation of a multisegmented, quasi-static cable
+// model", ISOPE 2013): the tension on the grounded line falls by C_B w per
+// metre from the touchdown point toward the anchor, T(s) = max(H - C_B w
+// (L_B - s), 0), so the grounded part stretches by int T / EA ds less than
+// H L_B / EA, and x_F gains
+//   (C_B w / (2 EA)) (-L_B^2 + (L_B - H / (C_B w)) max(L_B - H / (C_B w), 0)).
 struct SeabedCatenary {
   double h = 0, v = 0;
+  double cb = 0;
   double Lb() const { return kLength - v / kW; }
+  // The grounded line's tension at arc length s from the anchor.
+  double GroundTension(double s) const { return std::max(h - cb * kW * (Lb() - s), 0.0); }
   void Residual(double hh, double vv, double* fx, double* fz, double xf, double zf) const {
     *fx = kLength - vv / kW + hh / kW * std::asinh(vv / hh) + hh * kLength / kEa - xf;
+    if (cb > 0) {
+      const double lb = kLength - vv / kW, slack = lb - hh / (cb * kW);
+      *fx += cb * kW / (2 * kEa) * (-lb * lb + slack * std::max(slack, 0.0));
+    }
     *fz = hh / kW * (std::sqrt(1 + vv * vv / (hh * hh)) - 1) + vv * vv / (2 * kEa * kW) - zf;
   }
   bool Solve(double xf, double zf) {
@@ -106,15 +120,26 @@ std::string Bed(double damping = 0, double stiffness = kStiffness) {
 
 struct MooringStatics {
   double tension = 0, horizontal = 0, touchdown_x = 0, touchdown_s = 0, vertical_lb = 0;
+  double anchor_tension = 0;
+  std::vector<double> tension_at;  // at the arc lengths asked for
 };
+
+// The tension T = EA lam (lam^2 - 1) / 2 at arc length s.
+double TensionAt(const MultibodyModel& model, const Eigen::VectorXd& q, double s) {
+  Eigen::Vector3d slope;
+  model.CablePosition(q, 0, s, &slope);
+  const double lam = slope.norm();
+  return kEa * lam * (lam * lam - 1) / 2;
+}
 
 // Statics by StaticSolver on the model itself (the fairlead's tension is
 // read from the cable's stretch there: T = EA lam (lam^2 - 1) / 2, the
 // element's Green-Lagrange law), the touchdown point by bisection on the
 // height of the cable's cubic above the bed.
-MooringStatics SolveMooring(int elements) {
+MooringStatics SolveMooring(int elements, const std::string& bed = Bed(),
+                            const std::vector<double>& at = {}) {
   MooringStatics out;
-  const Scene scene = SceneFromJson(MooringScene(elements, "STATIC", Bed()));
+  const Scene scene = SceneFromJson(MooringScene(elements, "STATIC", bed));
   auto model = MultibodyModel::Build(scene);
   EXPECT_TRUE(model.ok()) << model.status();
   if (!model.ok()) return out;
@@ -133,6 +158,8 @@ MooringStatics SolveMooring(int elements) {
   out.tension = kEa * lam * (lam * lam - 1) / 2;
   out.horizontal = out.tension * slope.x() / lam;
   out.vertical_lb = kLength - out.tension * slope.y() / lam / kW;
+  out.anchor_tension = TensionAt(*model, q, 0);
+  for (double s : at) out.tension_at.push_back(TensionAt(*model, q, s));
   // Touchdown: the last point in the bed (height < 0) before the line
   // rises; the grounded part lies at -w/k, the suspended part above 0.
   const Seabed& bed = *model->seabed();
@@ -202,6 +229,59 @@ TEST(SeabedTest, TouchdownPointConvergesWithTheMesh) {
   for (size_t i = 1; i < meshes.size(); ++i) EXPECT_LE(lb_err[i], 0.5 * lb_err[i - 1]) << i;
   for (size_t i = 2; i < meshes.size(); ++i) EXPECT_LE(err[i], kLength / meshes[i]) << i;
   EXPECT_LT(err.back(), 0.02);
+}
+
+// Static friction (seabed.h, default friction_length 1e-5 m): the same
+// line, laid straight on the bed from the anchor to x = 62.5 m and then to
+// the fairlead, pulled into its catenary by the statics; every grounded
+// point moves toward the fairlead
+// (by the stretch), so friction is mobilised toward the anchor as the C_B
+// closed form assumes. Two coefficients: C_B = 0.1 (the tension falls by
+// C_B w L_B = 4.3 kN of 13.8 kN and reaches the anchor) and C_B = 0.5 (it
+// reaches zero 19.5 m from the anchor). The fairlead tension, H and the
+// tension along the grounded line (anchor, and 10 and 25 m before the
+// touchdown) against the closed form, at 160 elements.
+// Tolerance: 1e-4 of H (the mesh: 1e-5 measured without friction, above).
+// The regularisation mobilises friction only where the displacement from
+// the laid line u >> u_s (1e-5 m). Along the sliding line u is the stretch
+// (centimetres), so the tension's slope there is C_B w to 1e-6. Where the
+// tension reaches zero (C_B = 0.5) u grows as C_B w t^2 / (2 EA) with the
+// distance t, so friction is short over about sqrt(2 EA u_s / (C_B w)) =
+// 1.6 m, where the tension is about zero anyway: it moves the zero point,
+// not the profile. At a pinned anchor still under tension (C_B = 0.1) u
+// grows as T_a t / EA, so friction is short over EA u_s / T_a = 0.05 m:
+// the anchor's tension is higher by up to C_B w EA u_s / T_a (4 N), which
+// its tolerance adds twice. Measured (160 elements): H 0.05 and 0.12 N,
+// fairlead 0.43 and 0.65 N, anchor 3.0 and 0.0 N, along the line 0.5-0.75 N.
+TEST(SeabedTest, MooringStaticsWithFrictionMatchesTheCatenaryWithCB) {
+  for (double cb : {0.1, 0.5}) {
+    SeabedCatenary ref;
+    ref.cb = cb;
+    ASSERT_TRUE(ref.Solve(kXf, kZf + kW / kStiffness));
+    const std::vector<double> at = {ref.Lb() - 10, ref.Lb() - 25};
+    const MooringStatics fe = SolveMooring(
+        160,
+        absl::StrFormat(R"("seabed": {"depth": 0, "stiffness": %.17g, "friction_axial": %.17g,
+                           "friction_transverse": %.17g},)",
+                        kStiffness, cb, cb),
+        at);
+    const double t_ref = std::hypot(ref.h, ref.v);
+    std::printf("C_B %.1f closed form: H %.3f N, T %.3f N, anchor %.3f N, at L_B-10 %.3f N, "
+                "at L_B-25 %.3f N (L_B %.4f m)\n",
+                cb, ref.h, t_ref, ref.GroundTension(0), ref.GroundTension(at[0]),
+                ref.GroundTension(at[1]), ref.Lb());
+    std::printf("C_B %.1f statics:     H %.3f N, T %.3f N, anchor %.3f N, at L_B-10 %.3f N, "
+                "at L_B-25 %.3f N\n",
+                cb, fe.horizontal, fe.tension, fe.anchor_tension, fe.tension_at[0],
+                fe.tension_at[1]);
+    EXPECT_NEAR(fe.horizontal, ref.h, 1e-4 * ref.h);
+    EXPECT_NEAR(fe.tension, t_ref, 1e-4 * ref.h);
+    const double anchor = ref.GroundTension(0);
+    const double short_friction = anchor > 0 ? cb * kW * kEa * 1e-5 / anchor : 0;
+    EXPECT_NEAR(fe.anchor_tension, anchor, 1e-4 * ref.h + 2 * short_friction);
+    EXPECT_NEAR(fe.tension_at[0], ref.GroundTension(at[0]), 1e-4 * ref.h);
+    EXPECT_NEAR(fe.tension_at[1], ref.GroundTension(at[1]), 1e-4 * ref.h);
+  }
 }
 
 // A 10 m chain laid flat 0.1 m above the bed falls, bounces on the damped

@@ -602,5 +602,29 @@ TEST_F(StepperAllocationTest, WavesDoNotAllocate) {
   }
 }
 
+// Nor bodies on the seabed (contact points in fixed-size blocks): a block
+// laid at its resting depth slides on a damped, frictional bed, pulled at
+// the contact level by its friction force (so it keeps sliding: the
+// stick-slip transition at this step costs Newton failures, whose messages
+// allocate).
+TEST_F(StepperAllocationTest, BodyOnTheSeabedDoesNotAllocate) {
+  Scene scene = testing::SceneFromJson(R"({
+    "gravity": {"y": -9.81},
+    "bodies": [{"name": "block", "mass": 1000, "inertia": {"x": 100, "y": 120, "z": 110},
+                "position": {"y": 0.499509},
+                "seabed_contact": {"points": [{"x": -0.5, "y": -0.5}, {"x": 0.5, "y": -0.5}],
+                                   "stiffness": 1e7, "damping": 1e4, "friction": 0.5}}],
+    "loads": [{"at": {"body": "block", "point": {"y": -0.5}}, "force": {"x": 4905}}],
+    "initial_velocity": {"linear": {"x": 0.3}},
+    "seabed": {"stiffness": 1e6},
+    "solver": {"duration": 1}})");
+  for (Integrator integrator : {Integrator::kImplicitEuler, Integrator::kGeneralizedAlpha,
+                                Integrator::kHht, Integrator::kEnergyMomentum}) {
+    SCOPED_TRACE(::testing::Message() << "integrator " << static_cast<int>(integrator));
+    scene.solver.integrator = integrator;
+    ExpectStepsDoNotAllocate(scene, 0.01, 50);
+  }
+}
+
 }  // namespace
 }  // namespace cablesim

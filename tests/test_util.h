@@ -27,6 +27,18 @@ inline Scene SceneFromJson(const std::string& json) {
   return scene.ok() ? *scene : Scene{};
 }
 
+// The message of the scene's validation error ("ok" when it converts),
+// expecting INVALID_ARGUMENT.
+inline std::string SceneError(const std::string& json) {
+  auto proto = ParseSceneJson(json);
+  EXPECT_TRUE(proto.ok()) << proto.status();
+  if (!proto.ok()) return "";
+  auto scene = SceneFromProto(*proto);
+  if (scene.ok()) return "ok";
+  EXPECT_EQ(scene.status().code(), absl::StatusCode::kInvalidArgument);
+  return std::string(scene.status().message());
+}
+
 class CollectingSink : public FrameSink {
  public:
   absl::Status OnStart(const ModelInfo& info) override {

@@ -47,12 +47,11 @@ void AddShapeBlocks(double wl, const double* s, const Eigen::Matrix<double, D, D
 // [N/m], velocity v and tangent u: adds the force to *q and its velocity
 // tangent to *h; returns the power they dissipate per unit length [W/m].
 template <int D>
-double PointDissipation(const Eigen::Matrix<double, D, 1>& n,
-                        const Eigen::Matrix<double, D, D>& proj, double normal_force,
-                        const Eigen::Matrix<double, D, 1>& v,
-                        const Eigen::Matrix<double, D, 1>& u, double c, double mu_a, double mu_t,
-                        double v_s, Eigen::Matrix<double, D, 1>* q,
-                        Eigen::Matrix<double, D, D>* h) {
+double BedDissipation(const Eigen::Matrix<double, D, 1>& n,
+                      const Eigen::Matrix<double, D, D>& proj, double normal_force,
+                      const Eigen::Matrix<double, D, 1>& v, const Eigen::Matrix<double, D, 1>& u,
+                      double c, double mu_a, double mu_t, double v_s,
+                      Eigen::Matrix<double, D, 1>* q, Eigen::Matrix<double, D, D>* h) {
   using Point = Eigen::Matrix<double, D, 1>;
   using Block = Eigen::Matrix<double, D, D>;
   const double vn = n.dot(v);
@@ -113,7 +112,8 @@ Seabed::Seabed(const SeabedSpec& spec)
       c_(spec.damping_n_s_m2),
       mu_a_(spec.friction_axial),
       mu_t_(spec.friction_transverse),
-      v_s_(spec.friction_speed_m_s) {
+      v_s_(spec.friction_speed_m_s),
+      u_s_(spec.friction_length_m) {
   if (spec.bathymetry.enabled) {
     int axis = 0;
     normal_.cwiseAbs().maxCoeff(&axis);
@@ -299,7 +299,8 @@ template <int D>
 double Seabed::GridDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
                                const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
                                Eigen::Matrix<double, 4 * D, 1>* force,
-                               Eigen::Matrix<double, 4 * D, 4 * D>* c) const {
+                               Eigen::Matrix<double, 4 * D, 4 * D>* c, double damping,
+                               double speed) const {
   using Point = Eigen::Matrix<double, D, 1>;
   using Block = Eigen::Matrix<double, D, D>;
   static const GaussRule rule = MakeGaussRule(7);
@@ -324,8 +325,8 @@ double Seabed::GridDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
       const Block proj = Block::Identity() - n * n.transpose();
       Point q;
       Block h;
-      power += wl * PointDissipation<D>(n, proj, k_ * pen * gn, v, u, c_, mu_a_, mu_t_, v_s_,
-                                        &q, &h);
+      power += wl * BedDissipation<D>(n, proj, k_ * pen * gn, v, u, damping, mu_a_, mu_t_, speed,
+                                      &q, &h);
       if (force)
         for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s[k]) * q;
       if (c) AddShapeBlocks<D>(wl, s, h, c);
@@ -443,7 +444,97 @@ double Seabed::AddDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
                               const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
                               Eigen::Matrix<double, 4 * D, 1>* force,
                               Eigen::Matrix<double, 4 * D, 4 * D>* c) const {
-  if (grid_) return GridDissipation<D>(e, edot, length, force, c);
+  if (grid_) return GridDissipation<D>(e, edot, length, force, c, c_, v_s_);
+  return PlaneDissipation<D>(e, edot, length, force, c, c_, v_s_);
+}
+
+template <int D>
+void Seabed::AddStaticFriction(const Eigen::Matrix<double, 4 * D, 1>& e,
+                                 const Eigen::Matrix<double, 4 * D, 1>& e0, double length,
+                                 Eigen::Matrix<double, 4 * D, 1>* force,
+                                 Eigen::Matrix<double, 4 * D, 4 * D>* matrix) const {
+  if (!has_friction()) return;
+  // The displacement from the start takes the rate's place, u_s v_s's.
+  const Eigen::Matrix<double, 4 * D, 1> displacement = e - e0;
+  if (grid_) {
+    GridDissipation<D>(e, displacement, length, force, matrix, 0.0, u_s_);
+  } else {
+    PlaneDissipation<D>(e, displacement, length, force, matrix, 0.0, u_s_);
+  }
+}
+
+template <int D>
+double Seabed::GapAt(const Eigen::Matrix<double, D, 1>& r, Eigen::Matrix<double, D, 1>* grad,
+                     Eigen::Matrix<double, D, D>* hess) const {
+  if (grid_) return GridAt<D>(r, grad, hess);
+  *grad = normal_.head<D>();
+  if (hess) hess->setZero();
+  return depth_ + grad->dot(r);
+}
+
+template <int D>
+double Seabed::PointPotential(const Eigen::Matrix<double, D, 1>& r, double k,
+                              Eigen::Matrix<double, D, 1>* gradient,
+                              Eigen::Matrix<double, D, D>* hessian) const {
+  Eigen::Matrix<double, D, 1> grad;
+  Eigen::Matrix<double, D, D> hess;
+  const double g = GapAt<D>(r, &grad, hessian ? &hess : nullptr);
+  if (!(g < 0)) return 0;
+  const double pen = -g;
+  if (gradient) *gradient -= (k * pen) * grad;
+  if (hessian) *hessian += k * (grad * grad.transpose() - pen * hess);
+  return 0.5 * k * pen * pen;
+}
+
+template <int D>
+double Seabed::PointDissipation(const Eigen::Matrix<double, D, 1>& r,
+                                const Eigen::Matrix<double, D, 1>& v, double k, double c,
+                                double mu, Eigen::Matrix<double, D, 1>* force,
+                                Eigen::Matrix<double, D, D>* tangent) const {
+  using Point = Eigen::Matrix<double, D, 1>;
+  using Block = Eigen::Matrix<double, D, D>;
+  Point grad;
+  const double g = GapAt<D>(r, &grad, nullptr);
+  if (!(g < 0)) return 0;
+  const double gn = grad.norm();
+  const Point n = grad / gn;
+  Point q;
+  Block h;
+  // Isotropic: no cable direction (u = 0 gives A = mu P).
+  const double power = BedDissipation<D>(n, Block::Identity() - n * n.transpose(), -k * g * gn, v,
+                                         Point::Zero(), c, mu, mu, v_s_, &q, &h);
+  if (force) *force += q;
+  if (tangent) *tangent += h;
+  return power;
+}
+
+template <int D>
+void Seabed::PointStaticFriction(const Eigen::Matrix<double, D, 1>& r,
+                                   const Eigen::Matrix<double, D, 1>& r0, double k, double mu,
+                                   Eigen::Matrix<double, D, 1>* force,
+                                   Eigen::Matrix<double, D, D>* matrix) const {
+  using Point = Eigen::Matrix<double, D, 1>;
+  using Block = Eigen::Matrix<double, D, D>;
+  if (mu == 0) return;
+  Point grad;
+  const double g = GapAt<D>(r, &grad, nullptr);
+  if (!(g < 0)) return;
+  const double gn = grad.norm();
+  const Point n = grad / gn;
+  Point q;
+  Block h;
+  BedDissipation<D>(n, Block::Identity() - n * n.transpose(), -k * g * gn, (r - r0).eval(),
+                    Point::Zero(), 0.0, mu, mu, u_s_, &q, &h);
+  if (force) *force += q;
+  if (matrix) *matrix += h;
+}
+
+template <int D>
+double Seabed::PlaneDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
+                                const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
+                                Eigen::Matrix<double, 4 * D, 1>* force,
+                                Eigen::Matrix<double, 4 * D, 4 * D>* c, double damping,
+                                double speed) const {
   using Point = Eigen::Matrix<double, D, 1>;
   using Block = Eigen::Matrix<double, D, D>;
   double pieces[2][2];
@@ -462,7 +553,7 @@ double Seabed::AddDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
     const double pen = std::max(0.0, -(depth_ + n.dot(r)));
     Point q;
     Block h;
-    power += wl * PointDissipation<D>(n, proj, k_ * pen, v, u, c_, mu_a_, mu_t_, v_s_, &q, &h);
+    power += wl * BedDissipation<D>(n, proj, k_ * pen, v, u, damping, mu_a_, mu_t_, speed, &q, &h);
     if (force)
       for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s[k]) * q;
     if (c) AddShapeBlocks<D>(wl, s, h, c);
@@ -479,7 +570,19 @@ double Seabed::AddDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
   template double Seabed::Energy<D>(const Eigen::Matrix<double, 4 * D, 1>&, double) const; \
   template double Seabed::AddDissipation<D>(                                               \
       const Eigen::Matrix<double, 4 * D, 1>&, const Eigen::Matrix<double, 4 * D, 1>&,      \
-      double, Eigen::Matrix<double, 4 * D, 1>*, Eigen::Matrix<double, 4 * D, 4 * D>*) const;
+      double, Eigen::Matrix<double, 4 * D, 1>*, Eigen::Matrix<double, 4 * D, 4 * D>*) const; \
+  template void Seabed::AddStaticFriction<D>(                                            \
+      const Eigen::Matrix<double, 4 * D, 1>&, const Eigen::Matrix<double, 4 * D, 1>&,      \
+      double, Eigen::Matrix<double, 4 * D, 1>*, Eigen::Matrix<double, 4 * D, 4 * D>*) const; \
+  template double Seabed::PointPotential<D>(const Eigen::Matrix<double, D, 1>&, double,    \
+                                            Eigen::Matrix<double, D, 1>*,                  \
+                                            Eigen::Matrix<double, D, D>*) const;           \
+  template double Seabed::PointDissipation<D>(                                             \
+      const Eigen::Matrix<double, D, 1>&, const Eigen::Matrix<double, D, 1>&, double, double, \
+      double, Eigen::Matrix<double, D, 1>*, Eigen::Matrix<double, D, D>*) const;           \
+  template void Seabed::PointStaticFriction<D>(                                          \
+      const Eigen::Matrix<double, D, 1>&, const Eigen::Matrix<double, D, 1>&, double, double, \
+      Eigen::Matrix<double, D, 1>*, Eigen::Matrix<double, D, D>*) const;
 CABLESIM_SEABED_INSTANTIATE(2)
 CABLESIM_SEABED_INSTANTIATE(3)
 #undef CABLESIM_SEABED_INSTANTIATE

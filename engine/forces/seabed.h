@@ -54,7 +54,7 @@
 // semi-definite, that keeps Newton's matrix definite. The friction's q
 // derivative (through N and t_b) is left out too. Friction is integrated
 // with the same Gauss points as the damping (exact only for the
-// polynomial terms). STATIC analyses see no friction (no velocities).
+// polynomial terms). STATIC analyses see the static friction below.
 //
 // Bathymetry (engine/forces/bathymetry_grid.h). When the scene gives a
 // grid, the height above the bed is measured along the grid's up axis,
@@ -97,6 +97,36 @@
 // in or out of the bed, or a double crossing of one grid line, shorter
 // than 1/16 of the element is missed (the cable's mesh, not the grid,
 // then limits the resolution).
+//
+// Static friction (STATIC analyses: no velocities). Friction opposes the
+// displacement in the bed's plane of each material point from where the
+// analysis started (where the line was laid, e0), u_b = P (r(e) - r(e0)),
+// with the dynamic law's shape, the speed replaced by the displacement
+// and v_s by the regularisation length u_s (seabed.friction_length):
+//
+//   q_s = -N (mu_a u_a t_b + mu_t u_t) / sqrt(|u_b|^2 + u_s^2),
+//
+// a stiff spring (slope mu N / u_s) capped at Coulomb's mu N once |u_b|
+// >> u_s. It reproduces the grounded line of the elastic catenary with
+// seabed friction (MAP's and MoorPy's C_B: the tension falls by C_B w per
+// metre from the touchdown point toward the anchor) when the line was laid
+// nearer the anchor than it ends, so that every grounded point moved toward
+// the fairlead; within a length sqrt(2 EA u_s / (mu w)) of where the
+// tension reaches zero the friction is not fully mobilised
+// (tests/seabed_test.cc measures it against the closed form). The answer
+// depends on the start (path dependence: a line laid elsewhere carries other
+// friction), as real static friction does. The force is not a gradient (N
+// varies with the penetration); its matrix is the velocity tangent's form
+// N A / s (symmetric, positive semi-definite; the rank-one term and the
+// derivative through N left out), and the static solver's merit counts its
+// work along each step (StaticSolver).
+//
+// Bodies (PointPotential, PointDissipation): a body point r on the bed has its own
+// spring k [N/m] and damper c [N s/m] on the penetration along the bed's
+// up (the same gap g as the cable's, so a point on a grid bed sees the grid):
+// U = k p^2 / 2, force k p grad g, damping -c pdot n, isotropic Coulomb
+// friction mu N (N = k p |grad g|) regularised by v_s, and the same static
+// friction as the cable's with mu_a = mu_t = mu.
 //
 // Units SI. Used by MultibodyModel only when the scene has a seabed; the
 // plane's loops only test whether a grid is present.
@@ -145,6 +175,39 @@ class Seabed {
                         Eigen::Matrix<double, 4 * D, 1>* force,
                         Eigen::Matrix<double, 4 * D, 4 * D>* c) const;
 
+  // STATIC analyses: adds the static friction force q_s integrated with
+  // the shape functions (a generalized force, like AddDissipation's) to
+  // `force` and its matrix -dQ_s/de (the symmetric form above) to `matrix`
+  // when not null; e0 the element's coordinates where the analysis
+  // started.
+  template <int D>
+  void AddStaticFriction(const Eigen::Matrix<double, 4 * D, 1>& e,
+                           const Eigen::Matrix<double, 4 * D, 1>& e0, double length,
+                           Eigen::Matrix<double, 4 * D, 1>* force,
+                           Eigen::Matrix<double, 4 * D, 4 * D>* matrix) const;
+  bool has_static_friction() const { return has_friction(); }
+
+  // A body point at r with a spring k [N/m]: adds dU/dr to `gradient` and
+  // d^2U/dr^2 to `hessian` when not null; returns U [J].
+  template <int D>
+  double PointPotential(const Eigen::Matrix<double, D, 1>& r, double k,
+                        Eigen::Matrix<double, D, 1>* gradient,
+                        Eigen::Matrix<double, D, D>* hessian) const;
+  // Its damping c [N s/m] and friction mu at velocity v: adds the force to
+  // `force` and its velocity tangent to `tangent` when not null; returns
+  // the power dissipated [W].
+  template <int D>
+  double PointDissipation(const Eigen::Matrix<double, D, 1>& r,
+                          const Eigen::Matrix<double, D, 1>& v, double k, double c, double mu,
+                          Eigen::Matrix<double, D, 1>* force,
+                          Eigen::Matrix<double, D, D>* tangent) const;
+  // Its static friction (force and matrix), r0 where the analysis started.
+  template <int D>
+  void PointStaticFriction(const Eigen::Matrix<double, D, 1>& r,
+                             const Eigen::Matrix<double, D, 1>& r0, double k, double mu,
+                             Eigen::Matrix<double, D, 1>* force,
+                             Eigen::Matrix<double, D, D>* matrix) const;
+
   // The pieces [xi0, xi1] of [0, 1] where the element is in a plane bed
   // (h < 0), at most 2; returns their number. Public for tests.
   template <int D>
@@ -177,15 +240,30 @@ class Seabed {
                        Eigen::Matrix<double, 4 * D, 1>* gradient,
                        Eigen::Matrix<double, 4 * D, 4 * D>* hessian,
                        Eigen::Matrix<double, 4 * D, 1>* roundoff) const;
+  // Damping c and friction regularised at `speed` on the rate edot (the
+  // dynamic law), or friction alone on a displacement (statics). Returns
+  // the power.
   template <int D>
   double GridDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
                          const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
                          Eigen::Matrix<double, 4 * D, 1>* force,
-                         Eigen::Matrix<double, 4 * D, 4 * D>* c) const;
+                         Eigen::Matrix<double, 4 * D, 4 * D>* c, double damping,
+                         double speed) const;
+  template <int D>
+  double PlaneDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
+                          const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
+                          Eigen::Matrix<double, 4 * D, 1>* force,
+                          Eigen::Matrix<double, 4 * D, 4 * D>* c, double damping,
+                          double speed) const;
+  // The gap g at a point of D coordinates, its gradient (and, on a grid,
+  // Hessian when not null).
+  template <int D>
+  double GapAt(const Eigen::Matrix<double, D, 1>& r, Eigen::Matrix<double, D, 1>* grad,
+               Eigen::Matrix<double, D, D>* hess) const;
 
   double depth_ = 0;
   Eigen::Vector3d normal_ = Eigen::Vector3d::UnitY();
-  double k_ = 0, c_ = 0, mu_a_ = 0, mu_t_ = 0, v_s_ = 1e-3;
+  double k_ = 0, c_ = 0, mu_a_ = 0, mu_t_ = 0, v_s_ = 1e-3, u_s_ = 1e-5;
   std::optional<BathymetryGrid> grid_;  // only with a bathymetry grid
 };
 
