@@ -66,6 +66,14 @@ std::string PointsJson(const std::vector<Eigen::Vector2d>& p) {
   return absl::StrCat("[", absl::StrJoin(parts, ", "), "]");
 }
 
+// The rope of every case: 0.01 m, 1000 kg/m^3, E = 1e10 Pa, EI = 1e-3 N m^2,
+// 96 elements, axial damping 1e-3 s (which damps the axial waves).
+std::string RopeJson(const std::vector<Eigen::Vector2d>& points) {
+  return absl::StrCat(R"({"name": "rope", "points": )", PointsJson(points), R"(, "elements": 96,
+                "density": 1000, "youngs_modulus": 1e10, "diameter": 0.01,
+                "second_moment": 1e-13, "damping": {"axial_time": 1e-3}})");
+}
+
 // Atwood machine: masses m1 = 1 kg and m2 = 1.5 kg on a 0.01 m rope
 // (rho A = 0.0785 kg/m, EA = 7.85e5 N, EI = 1e-3 N m^2, 96 elements) hanging 1 m on
 // each side of a frictionless wheel of radius 0.1 m.
@@ -76,9 +84,7 @@ std::string Atwood(const std::string& model, double duration) {
   const auto points = Reeving(kRadius, kHang, kHang);
   const double length = PolylineLength(points);
   return absl::StrCat(R"({"gravity": {"y": -9.81}, "model": ")", model, R"(",
-    "cables": [{"name": "rope", "points": )", PointsJson(points), R"(, "elements": 96,
-                "density": 1000, "youngs_modulus": 1e10, "diameter": 0.01,
-                "second_moment": 1e-13, "damping": {"axial_time": 1e-3}}],
+    "cables": [)", RopeJson(points), R"(],
     "bodies": [{"name": "m1", "mass": )", kM1, R"(, "inertia": {"x": 1e-4, "y": 1e-4, "z": 1e-4},
                 "position": {"x": )", -kRadius, R"(, "y": )", -kHang, R"(}},
                {"name": "m2", "mass": )", kM2, R"(, "inertia": {"x": 1e-4, "y": 1e-4, "z": 1e-4},
@@ -156,9 +162,7 @@ std::string Capstan(const std::string& model) {
   const auto points = Reeving(kRadius, kHang, kHang);
   const double length = PolylineLength(points);
   return absl::StrCat(R"({"gravity": {"y": -9.81}, "model": ")", model, R"(",
-    "cables": [{"name": "rope", "points": )", PointsJson(points), R"(, "elements": 96,
-                "density": 1000, "youngs_modulus": 1e10, "diameter": 0.01,
-                "second_moment": 1e-13, "damping": {"axial_time": 1e-3}}],
+    "cables": [)", RopeJson(points), R"(],
     "bodies": [{"name": "m1", "mass": )", kM1, R"(, "inertia": {"x": 1e-4, "y": 1e-4, "z": 1e-4},
                 "position": {"x": )", -kRadius, R"(, "y": )", -kHang, R"(}}],
     "joints": [{"type": "PIN", "a": {"body": "m1"}, "b": {"cable": "rope", "s": 0}},
@@ -234,9 +238,7 @@ std::string HookBlock(const std::string& model) {
   const auto points = UnderWheel(kRadius, kHang);
   const double length = PolylineLength(points);
   return absl::StrCat(R"({"gravity": {"y": -9.81}, "model": ")", model, R"(",
-    "cables": [{"name": "rope", "points": )", PointsJson(points), R"(, "elements": 96,
-                "density": 1000, "youngs_modulus": 1e10, "diameter": 0.01,
-                "second_moment": 1e-13, "damping": {"axial_time": 1e-3}}],
+    "cables": [)", RopeJson(points), R"(],
     "bodies": [{"name": "block", "mass": )", kBlock, R"(, "inertia": {"x": 0.01, "y": 0.01, "z": 0.01},
                 "position": {"y": )", -kHang, R"(}}],
     "joints": [{"type": "PIN", "a": {"cable": "rope", "s": 0}},

@@ -90,6 +90,22 @@ int Sheave::ContactPieces(const Eigen::Matrix<double, 4 * D, 1>& e, double lengt
 
 namespace {
 
+// One Gauss point of a piece of an element inside the wheel: its weight
+// times the element length wl [m], the shape values (then -1 for a body's
+// centre: the offset r - c is linear in both) and their x-derivatives, the
+// point r, slope u, the projector P on the wheel's plane, the distance d
+// from the axis, the penetration pen > 0, the outward normal n, and a size
+// for the rounding bound.
+template <int D>
+struct InsidePoint {
+  double wl = 0;
+  double s[5] = {0, 0, 0, 0, -1};
+  double ds[4] = {0, 0, 0, 0};
+  Eigen::Matrix<double, D, 1> r, u, n;
+  Eigen::Matrix<double, D, D> proj;
+  double d = 0, pen = 0, size = 0;
+};
+
 // m += wl s_k s_m h on every block (k, m) of B blocks of size D.
 template <int D, int B>
 void AddBlocks(double wl, const double* s, const Eigen::Matrix<double, D, D>& h,
@@ -100,61 +116,70 @@ void AddBlocks(double wl, const double* s, const Eigen::Matrix<double, D, D>& h,
 
 }  // namespace
 
+template <int D, typename F>
+void Sheave::ForEachPointInside(const Eigen::Matrix<double, 4 * D, 1>& e, double length,
+                                const Eigen::Matrix<double, D, 1>& c, F&& f) const {
+  double pieces[kMaxPieces][2];
+  const int count = ContactPieces<D>(e, length, c, pieces);
+  if (count == 0) return;
+  InsidePoint<D> pt;
+  pt.proj.setIdentity();
+  if constexpr (D == 3) pt.proj -= axis_ * axis_.transpose();
+  const GaussRule& rule = PieceRule();
+  for (int p = 0; p < count; ++p) {
+    const double a = pieces[p][0], span = pieces[p][1] - a;
+    for (int g = 0; g < rule.n; ++g) {
+      const double xi = a + span * rule.xi[g];
+      HermiteShape(xi, length, pt.s);
+      HermiteShapeD1(xi, length, pt.ds);
+      pt.wl = rule.weight[g] * span * length;
+      pt.r.setZero();
+      pt.u.setZero();
+      pt.size = c.template lpNorm<1>() + radius_;
+      for (int k = 0; k < 4; ++k) {
+        pt.r += pt.s[k] * e.template segment<D>(k * D);
+        pt.u += pt.ds[k] * e.template segment<D>(k * D);
+        pt.size += std::abs(pt.s[k]) * e.template segment<D>(k * D).template lpNorm<1>();
+      }
+      const Eigen::Matrix<double, D, 1> rho = pt.proj * (pt.r - c);
+      pt.d = rho.norm();
+      pt.pen = radius_ - pt.d;
+      // At the axle the direction is undefined; a cable there is deep in
+      // the wheel and the outward push is taken as zero.
+      if (!(pt.pen > 0) || pt.d <= 1e-12 * radius_) continue;
+      pt.n = rho / pt.d;
+      f(pt);
+    }
+  }
+}
+
 template <int D, int B>
 double Sheave::Potential(const Eigen::Matrix<double, B * D, 1>& x, double length,
                          const Eigen::Matrix<double, D, 1>& c,
                          Eigen::Matrix<double, B * D, 1>* gradient,
                          Eigen::Matrix<double, B * D, B * D>* hessian,
                          Eigen::Matrix<double, B * D, 1>* roundoff) const {
-  using Point = Eigen::Matrix<double, D, 1>;
   using Block = Eigen::Matrix<double, D, D>;
   constexpr double kEps = std::numeric_limits<double>::epsilon();
-  const Eigen::Matrix<double, 4 * D, 1> e = x.template head<4 * D>();
-  double pieces[kMaxPieces][2];
-  const int count = ContactPieces<D>(e, length, c, pieces);
-  if (count == 0) return 0;
-  Block proj = Block::Identity();
-  if constexpr (D == 3) proj -= axis_ * axis_.transpose();
-  const GaussRule& rule = PieceRule();
   double energy = 0;
-  for (int p = 0; p < count; ++p) {
-    const double a = pieces[p][0], span = pieces[p][1] - a;
-    for (int g = 0; g < rule.n; ++g) {
-      // Shape values of the element's nodes, then -1 for a body's centre:
-      // the point's offset r - c is linear in both.
-      double s[5] = {0, 0, 0, 0, -1};
-      HermiteShape(a + span * rule.xi[g], length, s);
-      const double wl = rule.weight[g] * span * length;
-      Point r = Point::Zero();
-      double size = c.template lpNorm<1>() + radius_;
-      for (int k = 0; k < 4; ++k) {
-        r += s[k] * e.template segment<D>(k * D);
-        size += std::abs(s[k]) * e.template segment<D>(k * D).template lpNorm<1>();
-      }
-      const Point rho = proj * (r - c);
-      const double d = rho.norm();
-      const double pen = radius_ - d;
-      // At the axle the direction is undefined; a cable there is deep in
-      // the wheel and the outward push is taken as zero.
-      if (!(pen > 0) || d <= 1e-12 * radius_) continue;
-      const Point n = rho / d;
-      energy += wl * 0.5 * k_ * pen * pen;
-      if (gradient)
-        for (int k = 0; k < B; ++k)
-          gradient->template segment<D>(k * D) -= (wl * k_ * pen * s[k]) * n;
-      if (roundoff) {
-        const double bound = wl * k_ * kEps * size;
-        for (int k = 0; k < B; ++k)
-          roundoff->template segment<D>(k * D).array() += bound * std::abs(s[k]);
-      }
-      if (hessian) {
-        const Block nn = n * n.transpose();
-        const Block h = exact_tangent_ ? (k_ * (nn - (pen / d) * (proj - nn))).eval()
-                                       : (k_ * nn).eval();
-        AddBlocks<D, B>(wl, s, h, hessian);
-      }
+  ForEachPointInside<D>(x.template head<4 * D>(), length, c, [&](const InsidePoint<D>& pt) {
+    const double wl = pt.wl, pen = pt.pen;
+    energy += wl * 0.5 * k_ * pen * pen;
+    if (gradient)
+      for (int k = 0; k < B; ++k)
+        gradient->template segment<D>(k * D) -= (wl * k_ * pen * pt.s[k]) * pt.n;
+    if (roundoff) {
+      const double bound = wl * k_ * kEps * pt.size;
+      for (int k = 0; k < B; ++k)
+        roundoff->template segment<D>(k * D).array() += bound * std::abs(pt.s[k]);
     }
-  }
+    if (hessian) {
+      const Block nn = pt.n * pt.n.transpose();
+      const Block h = exact_tangent_ ? (k_ * (nn - (pen / pt.d) * (pt.proj - nn))).eval()
+                                     : (k_ * nn).eval();
+      AddBlocks<D, B>(wl, pt.s, h, hessian);
+    }
+  });
   return energy;
 }
 
@@ -166,44 +191,19 @@ double Sheave::Dissipation(const Eigen::Matrix<double, B * D, 1>& x,
                            Eigen::Matrix<double, B * D, B * D>* cmat) const {
   using Point = Eigen::Matrix<double, D, 1>;
   using Block = Eigen::Matrix<double, D, D>;
-  const Eigen::Matrix<double, 4 * D, 1> e = x.template head<4 * D>();
-  double pieces[kMaxPieces][2];
-  const int count = ContactPieces<D>(e, length, c, pieces);
-  if (count == 0) return 0;
-  Block proj = Block::Identity();
-  if constexpr (D == 3) proj -= axis_ * axis_.transpose();
-  const GaussRule& rule = PieceRule();
   double power = 0;
-  for (int p = 0; p < count; ++p) {
-    const double a = pieces[p][0], span = pieces[p][1] - a;
-    for (int g = 0; g < rule.n; ++g) {
-      double s[5] = {0, 0, 0, 0, -1}, ds[4];
-      const double xi = a + span * rule.xi[g];
-      HermiteShape(xi, length, s);
-      HermiteShapeD1(xi, length, ds);
-      const double wl = rule.weight[g] * span * length;
-      Point r = Point::Zero(), u = Point::Zero();
-      // The sliding velocity: the cable's minus the wheel centre's.
-      Point v = Point::Zero();
-      for (int k = 0; k < 4; ++k) {
-        r += s[k] * e.template segment<D>(k * D);
-        u += ds[k] * e.template segment<D>(k * D);
-      }
-      for (int k = 0; k < B; ++k) v += s[k] * xdot.template segment<D>(k * D);
-      const Point rho = proj * (r - c);
-      const double d = rho.norm();
-      const double pen = radius_ - d;
-      if (!(pen > 0) || d <= 1e-12 * radius_) continue;
-      const Point n = rho / d;
-      const Block surface = Block::Identity() - n * n.transpose();
-      Point q;
-      Block h;
-      power += wl * contact::PointDissipation<D>(n, surface, k_ * pen, v, u, c_, mu_, mu_, v_s_,
-                                                 &q, &h);
-      for (int k = 0; k < B; ++k) force->template segment<D>(k * D) += (wl * s[k]) * q;
-      if (cmat) AddBlocks<D, B>(wl, s, h, cmat);
-    }
-  }
+  ForEachPointInside<D>(x.template head<4 * D>(), length, c, [&](const InsidePoint<D>& pt) {
+    // The sliding velocity: the cable's minus the wheel centre's.
+    Point v = Point::Zero();
+    for (int k = 0; k < B; ++k) v += pt.s[k] * xdot.template segment<D>(k * D);
+    const Block surface = Block::Identity() - pt.n * pt.n.transpose();
+    Point q;
+    Block h;
+    power += pt.wl * contact::PointDissipation<D>(pt.n, surface, k_ * pt.pen, v, pt.u, c_, mu_,
+                                                  mu_, v_s_, &q, &h);
+    for (int k = 0; k < B; ++k) force->template segment<D>(k * D) += (pt.wl * pt.s[k]) * q;
+    if (cmat) AddBlocks<D, B>(pt.wl, pt.s, h, cmat);
+  });
   return power;
 }
 

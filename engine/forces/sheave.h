@@ -157,6 +157,11 @@ class Sheave {
                    Eigen::Matrix<double, B * D, 1>* gradient,
                    Eigen::Matrix<double, B * D, B * D>* hessian,
                    Eigen::Matrix<double, B * D, 1>* roundoff) const;
+  // Calls f(point) at every Gauss point of the element inside the wheel
+  // centred at c (InsidePoint in sheave.cc).
+  template <int D, typename F>
+  void ForEachPointInside(const Eigen::Matrix<double, 4 * D, 1>& e, double length,
+                          const Eigen::Matrix<double, D, 1>& c, F&& f) const;
   template <int D, int B>
   double Dissipation(const Eigen::Matrix<double, B * D, 1>& x,
                      const Eigen::Matrix<double, B * D, 1>& xdot, double length,
