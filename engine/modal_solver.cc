@@ -443,7 +443,7 @@ void RunModalAnalysis(MultibodyModel* model, const SolverSettings& settings, int
   frame.energy = model->Energy(q, zero, 1.0, &frame.energy_parts);
   // MODAL reports no support forces: their columns hold 0.
   frame.support_forces.assign(model->force_probe_count(), Eigen::Vector3d::Zero());
-  frame.has_contact = model->seabed() != nullptr;
+  frame.has_contact = model->has_contact();
   frame.constraint_violation = phi.size() ? phi.lpNorm<Eigen::Infinity>() : 0.0;
   summary->energy_initial = summary->energy_final = frame.energy.total;
   summary->max_constraint_violation = frame.constraint_violation;

@@ -680,6 +680,25 @@ void ModelBuilder::BuildElements() {
   } else {
     BuildElementsOf<3>(&model_.elements3_);
   }
+  BuildSheaves();
+}
+
+void ModelBuilder::BuildSheaves() {
+  MultibodyModel& m = model_;
+  if (scene_.sheaves.empty()) return;
+  m.sheave_mask_.assign(m.elements(), 0);
+  for (size_t i = 0; i < scene_.sheaves.size(); ++i) {
+    const SheaveSpec& spec = scene_.sheaves[i];
+    m.sheaves_.emplace_back(spec);
+    if (m.sheaves_.back().dissipates()) m.sheaves_dissipate_ = m.has_damping_ = true;
+    for (int cable = 0; cable < static_cast<int>(scene_.cables.size()); ++cable) {
+      if (!spec.cables.empty() &&
+          std::find(spec.cables.begin(), spec.cables.end(), cable) == spec.cables.end())
+        continue;
+      for (int k = m.cable_element_begin_[cable]; k < m.cable_element_begin_[cable + 1]; ++k)
+        m.sheave_mask_[k] |= uint64_t{1} << i;
+    }
+  }
 }
 
 absl::Status ModelBuilder::Sliders() {
@@ -868,19 +887,17 @@ void ModelBuilder::EnvelopeAndMass() {
     couple(&m.row_coord_[row.coord_begin], row.coord_end - row.coord_begin);
   }
 
-  // A slider couples its body with every element of its cable.
-  for (const JointSpec& joint : scene_.joints) {
-    if (joint.type != JointType::kSlide) continue;
-    const int cable = joint.a.cable >= 0 ? joint.a.cable : joint.b.cable;
-    const int body = joint.a.body >= 0 ? joint.a.body : joint.b.body;
+  // The first `count` coordinates of a body coupled with every element of
+  // a cable (a slider, a wheel the body carries).
+  auto couple_body_with_cable = [&](int body, int count, int cable) {
     int cable_lo = std::numeric_limits<int>::max(), body_lo = cable_lo;
     const int first = NodeCoord(mesh_.first_node[cable]);
     const int last = NodeCoord(mesh_.first_node[cable + 1]);
     for (int i = first; i < last; ++i)
       if (m.j_[i] >= 0) cable_lo = std::min(cable_lo, m.j_[i]);
-    for (int k = 0; k < bs; ++k)
+    for (int k = 0; k < count; ++k)
       if (m.j_[BodyCoord(body) + k] >= 0) body_lo = std::min(body_lo, m.j_[BodyCoord(body) + k]);
-    for (int k = 0; k < bs; ++k) {
+    for (int k = 0; k < count; ++k) {
       const int j = m.j_[BodyCoord(body) + k];
       if (j >= 0) m.envelope_[j] = std::min(m.envelope_[j], cable_lo);
     }
@@ -888,6 +905,21 @@ void ModelBuilder::EnvelopeAndMass() {
       const int j = m.j_[i];
       if (j >= 0 && j > body_lo) m.envelope_[j] = std::min(m.envelope_[j], body_lo);
     }
+  };
+  // A slider couples its body with every element of its cable.
+  for (const JointSpec& joint : scene_.joints) {
+    if (joint.type != JointType::kSlide) continue;
+    const int cable = joint.a.cable >= 0 ? joint.a.cable : joint.b.cable;
+    const int body = joint.a.body >= 0 ? joint.a.body : joint.b.body;
+    couple_body_with_cable(body, bs, cable);
+  }
+  // A wheel on a body couples the body's centre with the cables it touches.
+  for (const SheaveSpec& wheel : scene_.sheaves) {
+    if (wheel.body < 0) continue;
+    for (int cable = 0; cable < static_cast<int>(scene_.cables.size()); ++cable)
+      if (wheel.cables.empty() ||
+          std::find(wheel.cables.begin(), wheel.cables.end(), cable) != wheel.cables.end())
+        couple_body_with_cable(wheel.body, D, cable);
   }
 
   // The reduced mass matrix, with the element scatter tables.

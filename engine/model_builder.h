@@ -152,6 +152,9 @@ class ModelBuilder {
   // the model's energy_roundoff [J], and where each cable's elements begin
   // (for the energy per cable).
   void BuildElements();
+  // The scene's sheaves and which elements each may touch (after the
+  // elements: a sheave touches every element of the cables it lists).
+  void BuildSheaves();
 
   // The sliding joints (SlidingJoint, a penalty force; no rows), each
   // over its cable's elements, with its stiffness (default EA / l_e of

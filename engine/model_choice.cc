@@ -77,6 +77,13 @@ std::string OutOfPlaneField(const Scene& scene) {
   }
   if (scene.seabed.enabled)
     if (auto f = Z("seabed.normal", scene.seabed.normal); !f.empty()) return f;
+  for (size_t i = 0; i < scene.sheaves.size(); ++i) {
+    // A wheel's position off the plane does not matter to the planar
+    // model (its axis is z there); only a tilted axis needs the spatial one.
+    if (auto f = NotAboutZ(absl::StrCat("sheaves[", i, "].axis"), scene.sheaves[i].axis);
+        !f.empty())
+      return f;
+  }
   return "";
 }
 

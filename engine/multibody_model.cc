@@ -1,5 +1,7 @@
 #include "engine/multibody_model.h"
 
+#include <bit>
+
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -239,7 +241,7 @@ ModelInfo MultibodyModel::Info() const {
   info.cable_nodes = cable_nodes_;
   info.node_s = node_s_;
   info.shape = shape_;
-  info.contact = seabed_.has_value();
+  info.contact = has_contact();
   return info;
 }
 
@@ -251,6 +253,56 @@ void MultibodyModel::ToFull(const VectorXd& z, VectorXd* q) const {
 void MultibodyModel::RateToFull(const VectorXd& zdot, VectorXd* qdot) const {
   const int n = coordinates();
   for (int i = 0; i < n; ++i) (*qdot)(i) = j_[i] >= 0 ? s_(i) * zdot(j_[i]) : 0.0;
+}
+
+template <int D>
+void MultibodyModel::BodySheaveForce(const Sheave& wheel, int first_coord, double length,
+                                     const VectorXd& q, VectorXd* full, VectorXd* roundoff,
+                                     SkylineLdlt* stiffness, double scale) const {
+  constexpr int kN = 4 * D, kX = 5 * D;
+  const int centre = bodies_[wheel.body()].coord;
+  Eigen::Matrix<double, kX, 1> x, gradient = Eigen::Matrix<double, kX, 1>::Zero(),
+                                  rounding = Eigen::Matrix<double, kX, 1>::Zero();
+  x << q.segment<kN>(first_coord), q.segment<D>(centre);
+  Eigen::Matrix<double, kX, kX> hessian;
+  if (stiffness) hessian.setZero();
+  if (wheel.AddPotentialOnBody<D>(x, length, &gradient, stiffness ? &hessian : nullptr,
+                                  roundoff ? &rounding : nullptr) == 0)
+    return;
+  SlidingJoint::Local local;
+  local.n = kX;
+  for (int k = 0; k < kN; ++k) local.coord[k] = first_coord + k;
+  for (int k = 0; k < D; ++k) local.coord[kN + k] = centre + k;
+  local.force = -gradient;
+  if (stiffness) local.matrix = hessian;
+  local.rounding = rounding.maxCoeff();
+  ScatterSlider(local, full, roundoff, scale, stiffness);
+}
+
+template <int D>
+double MultibodyModel::BodySheaveDamping(const Sheave& wheel, int first_coord, double length,
+                                         const VectorXd& q, const VectorXd& qdot, VectorXd* full,
+                                         VectorXd* roundoff, SkylineLdlt* tangent,
+                                         double scale) const {
+  constexpr int kN = 4 * D, kX = 5 * D;
+  const int centre = bodies_[wheel.body()].coord;
+  Eigen::Matrix<double, kX, 1> x, xdot, force = Eigen::Matrix<double, kX, 1>::Zero();
+  x << q.segment<kN>(first_coord), q.segment<D>(centre);
+  xdot << qdot.segment<kN>(first_coord), qdot.segment<D>(centre);
+  Eigen::Matrix<double, kX, kX> c;
+  if (tangent) c.setZero();
+  const double power =
+      wheel.AddDissipationOnBody<D>(x, xdot, length, &force, tangent ? &c : nullptr);
+  if (full == nullptr || power == 0) return power;
+  SlidingJoint::Local local;
+  local.n = kX;
+  for (int k = 0; k < kN; ++k) local.coord[k] = first_coord + k;
+  for (int k = 0; k < D; ++k) local.coord[kN + k] = centre + k;
+  local.force = force;
+  if (tangent) local.matrix = c;
+  local.rounding = kSumRounding * force.cwiseAbs().maxCoeff();
+  ScatterSlider(local, full, roundoff, scale, tangent);
+  return power;
 }
 
 template <int D>
@@ -274,6 +326,18 @@ double MultibodyModel::ElementForces(const VectorXd& q, VectorXd* full, SkylineL
     if (seabed_)
       seabed_->AddPotential<D>(q.segment<kN>(e.first_coord), e.element.length(), &fe,
                                stiffness ? &ke : nullptr, roundoff ? &re : nullptr);
+    if (!sheaves_.empty()) {
+      for (uint64_t bits = sheave_mask_[k]; bits != 0; bits &= bits - 1) {
+        const Sheave& wheel = sheaves_[std::countr_zero(bits)];
+        if (wheel.body() >= 0) {
+          BodySheaveForce<D>(wheel, e.first_coord, e.element.length(), q, full, roundoff,
+                             stiffness, stiffness_scale);
+        } else {
+          wheel.AddPotential<D>(q.segment<kN>(e.first_coord), e.element.length(), &fe,
+                                stiffness ? &ke : nullptr, roundoff ? &re : nullptr);
+        }
+      }
+    }
     full->segment<kN>(e.first_coord) -= fe;
     // The element's own bound, and the rounding of adding it to the node.
     if (roundoff) roundoff->segment<kN>(e.first_coord) += re + kEps * fe.cwiseAbs();
@@ -403,7 +467,8 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
   const bool bed = seabed_ && seabed_->dissipates();
   for (size_t k = 0; k < elements.size(); ++k) {
     const ElementData<D>& e = elements[k];
-    if (!e.damped() && !bed && e.fluid_inertia == 0) continue;
+    const uint64_t wheels = sheaves_dissipate_ ? sheave_mask_[k] : 0;
+    if (!e.damped() && !bed && e.fluid_inertia == 0 && wheels == 0) continue;
     ce.setZero();
     if (e.axial_damping_s != 0 || e.bending_damping_s != 0)
       e.element.AddDampingMatrix(q.segment<kN>(e.first_coord), e.axial_damping_s,
@@ -423,6 +488,16 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
     }
     if (bed)
       seabed_->AddDissipation<D>(q.segment<kN>(e.first_coord), ve, e.element.length(), &fe, &ce);
+    for (uint64_t bits = wheels; bits != 0; bits &= bits - 1) {
+      const Sheave& wheel = sheaves_[std::countr_zero(bits)];
+      if (wheel.body() >= 0) {
+        const double p = BodySheaveDamping<D>(wheel, e.first_coord, e.element.length(), q, qdot,
+                                              full, roundoff, tangent, tangent_scale);
+        if (power) *power += p;
+      } else {
+        wheel.AddDissipation<D>(q.segment<kN>(e.first_coord), ve, e.element.length(), &fe, &ce);
+      }
+    }
     if (power) *power -= ve.dot(fe);
     if (full) full->segment<kN>(e.first_coord) += fe;
     size = std::max(size, fe.template lpNorm<Eigen::Infinity>());
@@ -745,6 +820,18 @@ void MultibodyModel::ElementEnergy(const VectorXd& q, const VectorXd& qdot, Ener
     en->axial += se.axial;
     en->bending += se.bending;
     if (seabed_) en->contact += seabed_->Energy<D>(qe, e.element.length());
+    if (!sheaves_.empty()) {
+      for (uint64_t bits = sheave_mask_[k]; bits != 0; bits &= bits - 1) {
+        const Sheave& wheel = sheaves_[std::countr_zero(bits)];
+        if (wheel.body() >= 0) {
+          Eigen::Matrix<double, 5 * D, 1> x;
+          x << qe, q.segment<D>(bodies_[wheel.body()].coord);
+          en->contact += wheel.AddPotentialOnBody<D>(x, e.element.length(), nullptr, nullptr);
+        } else {
+          en->contact += wheel.Energy<D>(qe, e.element.length());
+        }
+      }
+    }
     if (parts == nullptr) continue;
     while (static_cast<int>(k) >= cable_element_begin_[cable + 1]) ++cable;
     PartEnergy* part = &parts->cables[cable];

@@ -49,6 +49,7 @@
 #include "absl/status/statusor.h"
 #include "engine/ancf_cable_element.h"
 #include "engine/forces/seabed.h"
+#include "engine/forces/sheave.h"
 #include "engine/forces/wave_load.h"
 #include "engine/quadratic_form.h"
 #include "engine/scene.h"
@@ -276,6 +277,11 @@ class MultibodyModel {
   bool has_static_friction() const;
   void StaticFriction(const Eigen::VectorXd& q, const Eigen::VectorXd& q_start,
                         Eigen::VectorXd* f, SkylineLdlt* matrix, double scale);
+  // Whether frames carry energy.contact (a seabed or sheaves).
+  bool has_contact() const { return seabed_.has_value() || !sheaves_.empty(); }
+
+  // The scene's sheaves (engine/forces/sheave.h), none in most scenes.
+  const std::vector<Sheave>& sheaves() const { return sheaves_; }
 
   // Whether frames carry the nodes' positions (the scene's output.shape).
   bool shape() const { return shape_; }
@@ -441,6 +447,19 @@ class MultibodyModel {
   void AddRow(const QuadraticForm& f, Row::Kind kind, int joint, int body);
   // Adds a slider's local force to the full vector `full` (and its rounding
   // to `roundoff`) and scale times its matrix, mapped onto z, to `a`.
+  // A wheel carried by a body (Sheave::body() >= 0) on the element whose
+  // first full coordinate is first_coord: its force, tangent and rounding
+  // over the element and the body's centre, scattered like a slider's; and
+  // its damping and friction (returns their power).
+  template <int D>
+  void BodySheaveForce(const Sheave& wheel, int first_coord, double length,
+                       const Eigen::VectorXd& q, Eigen::VectorXd* full, Eigen::VectorXd* roundoff,
+                       SkylineLdlt* stiffness, double scale) const;
+  template <int D>
+  double BodySheaveDamping(const Sheave& wheel, int first_coord, double length,
+                           const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
+                           Eigen::VectorXd* full, Eigen::VectorXd* roundoff, SkylineLdlt* tangent,
+                           double scale) const;
   void ScatterSlider(const SlidingJoint::Local& local, Eigen::VectorXd* full, Eigen::VectorXd* roundoff,
                      double scale, SkylineLdlt* a) const;
   void ProjectInitialVelocity();
@@ -498,6 +517,11 @@ class MultibodyModel {
   std::vector<BodyContact> body_contacts_;  // only bodies with contact points
   // Scratch (full size) for StaticFriction (sized on first use).
   Eigen::VectorXd scratch_static_;
+  // Sheaves, and per element the bit set of those that touch its cable
+  // (empty without sheaves).
+  std::vector<Sheave> sheaves_;
+  std::vector<uint64_t> sheave_mask_;
+  bool sheaves_dissipate_ = false;
   // Only in a scene whose fluid has waves (then it carries the current too).
   std::optional<WaveLoad> wave_load_;
 

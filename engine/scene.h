@@ -235,6 +235,25 @@ struct SeabedSpec {
   BathymetrySpec bathymetry;
 };
 
+// A fixed wheel cables wrap around (engine/forces/sheave.h): a cylinder of
+// radius_m about the axis through position_m, pushing cables out with a
+// distributed spring and damper per unit undeformed length and rubbing on
+// them with Coulomb friction (a wheel that does not turn).
+struct SheaveSpec {
+  std::string name;
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  // unit
+  double radius_m = 0;
+  double stiffness_n_m2 = 0;  // [N/m per m of penetration per m of cable], > 0
+  double damping_n_s_m2 = 0;  // [N s/m per m of cable]
+  double friction = 0;        // Coulomb coefficient [-]
+  double friction_speed_m_s = 1e-3;  // regularisation, as SeabedSpec's
+  std::vector<int> cables;    // indices of the cables it touches; empty: all
+  // The body carrying it (index in Scene::bodies; the wheel's centre is the
+  // body's centre of mass and position_m is unused), or -1: fixed.
+  int body = -1;
+};
+
 struct InitialVelocitySpec {
   Eigen::Vector3d linear_m_s = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_rad_s = Eigen::Vector3d::Zero();
@@ -303,6 +322,7 @@ struct Scene {
   OutputSpec output;
   FluidSpec fluid;
   SeabedSpec seabed;
+  std::vector<SheaveSpec> sheaves;
 };
 
 }  // namespace cablesim

@@ -49,7 +49,7 @@ class FrameRecorder {
     if (model_->shape()) model_->NodePositions(q_, &frame_.nodes);
     frame_.energy = model_->Energy(q_, qd_, load_factor, &frame_.energy_parts);
     frame_.energy.damped = Damped(t);
-    frame_.has_contact = model_->seabed() != nullptr;
+    frame_.has_contact = model_->has_contact();
     frame_.angular_momentum = model_->AngularMomentum(q_, qd_);
     model_->Constraints(q_, &phi_, nullptr);
     frame_.constraint_violation = phi_.size() ? phi_.lpNorm<Eigen::Infinity>() : 0.0;

@@ -156,8 +156,8 @@ absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimi
       }
     }
   }
-  // A seabed adds energy.contact to every row.
-  const bool contact = checked.scene.seabed.enabled;
+  // A seabed or a sheave adds energy.contact to every row.
+  const bool contact = checked.scene.seabed.enabled || !checked.scene.sheaves.empty();
   const int64_t values =
       checked.frames * FrameRowSize(static_cast<int64_t>(checked.scene.probes.size()),
                                     static_cast<int64_t>(checked.scene.cables.size()),

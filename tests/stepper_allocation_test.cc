@@ -626,5 +626,27 @@ TEST_F(StepperAllocationTest, BodyOnTheSeabedDoesNotAllocate) {
   }
 }
 
+
+// A rope pinned at both ends sagging onto a wheel under its middle, with
+// friction and damping (the contact's pieces and Gauss points live on the
+// stack).
+TEST_F(StepperAllocationTest, SheaveContactDoesNotAllocate) {
+  Scene scene = testing::SceneFromJson(R"({
+    "gravity": {"y": -9.81},
+    "cables": [{"name": "rope", "points": [{"x": -1, "y": 0.1}, {"x": 1, "y": 0.1}],
+                "elements": 20, "density": 1000, "youngs_modulus": 1e9, "diameter": 0.01}],
+    "joints": [{"type": "PIN", "a": {"cable": "rope", "s": 0}},
+               {"type": "PIN", "a": {"cable": "rope", "s": 2}}],
+    "sheaves": [{"radius": 0.1, "friction": 0.3, "damping": 10}],
+    "solver": {"duration": 1}})");
+  ASSERT_EQ(scene.sheaves.size(), 1u);
+  for (Integrator integrator : {Integrator::kImplicitEuler, Integrator::kGeneralizedAlpha,
+                                Integrator::kHht, Integrator::kEnergyMomentum}) {
+    SCOPED_TRACE(::testing::Message() << "integrator " << static_cast<int>(integrator));
+    scene.solver.integrator = integrator;
+    ExpectStepsDoNotAllocate(scene, 0.001, 50);
+  }
+}
+
 }  // namespace
 }  // namespace cablesim

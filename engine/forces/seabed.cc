@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "engine/gauss_quadrature.h"
+#include "engine/forces/contact_point.h"
 #include "engine/hermite_shape.h"
 
 namespace cablesim {
@@ -34,48 +35,6 @@ void ForEachContactPoint(const double pieces[2][2], int count, double length, F&
   }
 }
 
-// m += wl s_k s_m h on every node block (k, m).
-template <int D>
-void AddShapeBlocks(double wl, const double* s, const Eigen::Matrix<double, D, D>& h,
-                    Eigen::Matrix<double, 4 * D, 4 * D>* m) {
-  for (int k = 0; k < 4; ++k)
-    for (int j = 0; j < 4; ++j) m->template block<D, D>(k * D, j * D) += (wl * s[k] * s[j]) * h;
-}
-
-// The damping and friction per unit length at one point of a bed with unit
-// normal n (proj = I - n n^T) under the elastic normal force `normal_force`
-// [N/m], velocity v and tangent u: adds the force to *q and its velocity
-// tangent to *h; returns the power they dissipate per unit length [W/m].
-template <int D>
-double BedDissipation(const Eigen::Matrix<double, D, 1>& n,
-                      const Eigen::Matrix<double, D, D>& proj, double normal_force,
-                      const Eigen::Matrix<double, D, 1>& v, const Eigen::Matrix<double, D, 1>& u,
-                      double c, double mu_a, double mu_t, double v_s,
-                      Eigen::Matrix<double, D, 1>* q, Eigen::Matrix<double, D, D>* h) {
-  using Point = Eigen::Matrix<double, D, 1>;
-  using Block = Eigen::Matrix<double, D, D>;
-  const double vn = n.dot(v);
-  *q = (-c * vn) * n;
-  *h = c * n * n.transpose();
-  double power = c * vn * vn;
-  if ((mu_a != 0 || mu_t != 0) && normal_force > 0) {
-    const Point vb = v - vn * n;
-    Point t = proj * u;
-    const double tn = t.norm();
-    Block amat = mu_t * proj;  // the friction's A: q_f = -N A v_b / s
-    if (tn > 0) {
-      t /= tn;
-      amat += (mu_a - mu_t) * t * t.transpose();
-    }
-    const double sq = std::sqrt(vb.squaredNorm() + v_s * v_s);
-    const Point qf = (-normal_force / sq) * (amat * vb);
-    *q += qf;
-    *h += (normal_force / sq) * amat;
-    power -= qf.dot(vb);
-  }
-  return power;
-}
-
 // The cubic of coordinate `axis` along an element (AncfCableElement<D>
 // layout), in xi in [0, 1]; zero for an axis the element does not have.
 template <int D>
@@ -86,24 +45,10 @@ Cubic CoordinateCubic(const Eigen::Matrix<double, 4 * D, 1>& e, double l, int ax
                 2 * a0 + l * b0 - 2 * a1 + l * b1}};
 }
 
-// The root of f on [a, b] (f(a) < 0 <= f(b) or the reverse, f continuous
-// and crossing once), by bisection to the last bit.
-template <typename F>
-double BisectSign(const F& f, double a, double b) {
-  const bool rising = f(a) < 0;
-  for (int i = 0; i < 200; ++i) {
-    const double m = 0.5 * (a + b);
-    if (m <= a || m >= b) break;
-    if ((f(m) < 0) == rising) {
-      a = m;
-    } else {
-      b = m;
-    }
-  }
-  return 0.5 * (a + b);
-}
-
 }  // namespace
+
+using contact::AddShapeBlocks;
+using contact::BisectSign;
 
 Seabed::Seabed(const SeabedSpec& spec)
     : depth_(spec.depth_m),
@@ -325,8 +270,8 @@ double Seabed::GridDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
       const Block proj = Block::Identity() - n * n.transpose();
       Point q;
       Block h;
-      power += wl * BedDissipation<D>(n, proj, k_ * pen * gn, v, u, damping, mu_a_, mu_t_, speed,
-                                      &q, &h);
+      power += wl * contact::PointDissipation<D>(n, proj, k_ * pen * gn, v, u, damping, mu_a_,
+                                                 mu_t_, speed, &q, &h);
       if (force)
         for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s[k]) * q;
       if (c) AddShapeBlocks<D>(wl, s, h, c);
@@ -501,8 +446,9 @@ double Seabed::PointDissipation(const Eigen::Matrix<double, D, 1>& r,
   Point q;
   Block h;
   // Isotropic: no cable direction (u = 0 gives A = mu P).
-  const double power = BedDissipation<D>(n, Block::Identity() - n * n.transpose(), -k * g * gn, v,
-                                         Point::Zero(), c, mu, mu, v_s_, &q, &h);
+  const double power =
+      contact::PointDissipation<D>(n, Block::Identity() - n * n.transpose(), -k * g * gn, v,
+                                   Point::Zero(), c, mu, mu, v_s_, &q, &h);
   if (force) *force += q;
   if (tangent) *tangent += h;
   return power;
@@ -523,8 +469,8 @@ void Seabed::PointStaticFriction(const Eigen::Matrix<double, D, 1>& r,
   const Point n = grad / gn;
   Point q;
   Block h;
-  BedDissipation<D>(n, Block::Identity() - n * n.transpose(), -k * g * gn, (r - r0).eval(),
-                    Point::Zero(), 0.0, mu, mu, u_s_, &q, &h);
+  contact::PointDissipation<D>(n, Block::Identity() - n * n.transpose(), -k * g * gn,
+                               (r - r0).eval(), Point::Zero(), 0.0, mu, mu, u_s_, &q, &h);
   if (force) *force += q;
   if (matrix) *matrix += h;
 }
@@ -553,7 +499,8 @@ double Seabed::PlaneDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
     const double pen = std::max(0.0, -(depth_ + n.dot(r)));
     Point q;
     Block h;
-    power += wl * BedDissipation<D>(n, proj, k_ * pen, v, u, damping, mu_a_, mu_t_, speed, &q, &h);
+    power += wl * contact::PointDissipation<D>(n, proj, k_ * pen, v, u, damping, mu_a_, mu_t_,
+                                               speed, &q, &h);
     if (force)
       for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s[k]) * q;
     if (c) AddShapeBlocks<D>(wl, s, h, c);
