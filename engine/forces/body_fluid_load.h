@@ -52,11 +52,12 @@
 // while the body is wet, s > 0). F_i is the Froude-Krylov force rho V du/dt
 // plus the added-mass force on the flow's acceleration; the added-mass
 // force on the body's own acceleration, -rho V_ref C_a rddot_c, is in the
-// mass matrix (added_mass(): the reduced mass matrix of the engine is
+// mass matrix (AddedMass: the reduced mass matrix of the engine is
 // constant, factored once per run, and the steppers' forces depend on q
 // and qdot only, so an acceleration-dependent force has no place), with
-// V_ref = V at the body's starting position: a floating body's draft
-// changes little, a submerged one's not at all.
+// V_ref = V at the body's `position` in the scene (before any initial
+// statics): a floating body's draft changes little, a submerged one's not
+// at all.
 //
 // Tangent of F_d + F_i + F_w in rdot_c: C = -dF/d(rdot_c) =
 // k_h (|v_h| P + v_h v_h^T / |v_h|) + 2 k_v |v_v| up up^T (P = I - up up^T,
