@@ -35,9 +35,14 @@
 //                             drag in a current, 200 s at h = 0.05, backward
 //                             Euler): the fluid-load path of a scene without
 //                             waves.
+//   CableWithEndCylinder:     scenes/cable-with-end-cylinder.json (a body,
+//                             no fluid).
+//   ThreeLineBuoy:            scenes/mooring-three-line-buoy.json (issue 17):
+//                             sim_s_per_wall_s is the issue's real-time ratio.
 
 #include <algorithm>
 #include <cmath>
+#include <ctime>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -165,10 +170,12 @@ double TipError(const Scene& scene) {
 void RunBenchmark(benchmark::State& state, const Scene& scene) {
   DiscardingSink sink;
   int64_t steps = 0, newton = 0, linear = 0;
-  double wall = 0;
+  double wall = 0, simulated = 0, cpu = 0;
   int dofs = 0, coordinates = 0;
   for (auto _ : state) {
+    const std::clock_t cpu_start = std::clock();
     absl::StatusOr<RunSummary> summary = RunScene(scene, &sink);
+    cpu += static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
     if (!summary.ok()) {
       state.SkipWithError(std::string(summary.status().message()).c_str());
       return;
@@ -181,6 +188,7 @@ void RunBenchmark(benchmark::State& state, const Scene& scene) {
     newton += summary->newton_iterations;
     linear += summary->linear_iterations;
     wall += summary->wall_seconds;
+    simulated += summary->end_time_s;
     dofs = summary->info.dofs;
     coordinates = summary->info.coordinates;
   }
@@ -191,6 +199,12 @@ void RunBenchmark(benchmark::State& state, const Scene& scene) {
   state.counters["linear_per_step"] =
       benchmark::Counter(static_cast<double>(linear) / static_cast<double>(steps));
   state.counters["dofs"] = benchmark::Counter(dofs);
+  // Simulated seconds per wall second (the summary's wall time: the run,
+  // model build and initial statics included).
+  state.counters["sim_s_per_wall_s"] = benchmark::Counter(simulated / wall);
+  // The same per second of this process's CPU time (a loaded machine
+  // stretches the wall time, not this).
+  state.counters["sim_s_per_cpu_s"] = benchmark::Counter(simulated / cpu);
   state.counters["coordinates"] = benchmark::Counter(coordinates);
   state.counters["us_per_step"] =
       benchmark::Counter(1e6 * wall / static_cast<double>(steps));
@@ -414,6 +428,18 @@ void BM_CableInCurrent(benchmark::State& state) {
   RunSample(state, "cable-in-current.json", ModelChoice::kAuto);
 }
 CABLESIM_RUN_BENCHMARK(BM_CableInCurrent);
+// A scene with a body and no fluid: what body hydrodynamics cost a scene
+// without them.
+void BM_CableWithEndCylinder(benchmark::State& state) {
+  RunSample(state, "cable-with-end-cylinder.json", ModelChoice::kAuto);
+}
+CABLESIM_RUN_BENCHMARK(BM_CableWithEndCylinder);
+// Issue 17: scenes/mooring-three-line-buoy.json as written (3 lines of 50
+// elements, a floating buoy in regular waves, from static equilibrium).
+void BM_ThreeLineBuoy(benchmark::State& state) {
+  RunSample(state, "mooring-three-line-buoy.json", ModelChoice::kAuto);
+}
+CABLESIM_RUN_BENCHMARK(BM_ThreeLineBuoy);
 BENCHMARK(BM_NewtonIteration_Direct)
     ->Unit(benchmark::kMicrosecond)
     ->UseRealTime()

@@ -555,6 +555,7 @@ class SceneConverter {
     }
 
     if (b.has_seabed_contact()) CABLESIM_RETURN_IF_ERROR(ConvertBodyContact(path, b, body));
+    CABLESIM_RETURN_IF_ERROR(ConvertBodyHydrodynamics(i, b, body));
     if (b.has_on()) return PlaceOnCable(i, b);
     CABLESIM_ASSIGN_OR_RETURN(body->position_m, VectorInRange(Sub(path, "position"), b.position(), plausible::kCoordinate));
     body->axis = Eigen::Vector3d::UnitX();
@@ -591,6 +592,40 @@ class SceneConverter {
     body->contact_damping_n_s_m = c.damping();
     CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(contact_path, "friction"), c.friction()));
     body->contact_friction = c.friction();
+    return absl::OkStatus();
+  }
+
+  // Body.hydrodynamics (BodyFluidLoad): the cylinder's size from the
+  // body's cylinder unless given; coefficients >= 0.
+  absl::Status ConvertBodyHydrodynamics(int i, const v1::Body& b, BodySpec* body) {
+    if (!b.has_hydrodynamics()) return absl::OkStatus();
+    const v1::BodyHydrodynamics& h = b.hydrodynamics();
+    const std::string path = Sub(Indexed("", "bodies", i), "hydrodynamics");
+    if (!(proto_.fluid().density() > 0))
+      return Invalid(path, "needs a fluid around the body (fluid.density > 0)");
+    if (!(scene_.gravity_m_s2.norm() > 0))
+      return Invalid(path, "needs gravity (it sets the vertical and the buoyancy)");
+    for (const auto& [name, given, value, from_cylinder, out] :
+         {std::tuple{"diameter", h.has_diameter(), h.diameter(), b.cylinder().diameter(),
+                     &body->hydro_diameter_m},
+          std::tuple{"height", h.has_height(), h.height(), b.cylinder().height(),
+                     &body->hydro_height_m}}) {
+      if (!given && !b.has_cylinder())
+        return Invalid(Sub(path, name), "required for a body given by mass (no cylinder)");
+      const double v = given ? value : from_cylinder;
+      CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange(Sub(path, name), v, plausible::kSize));
+      *out = v;
+    }
+    for (const auto& [name, value, out] :
+         {std::tuple{"drag_coefficient", h.drag_coefficient(), &body->hydro_drag},
+          std::tuple{"heave_drag_coefficient", h.heave_drag_coefficient(),
+                     &body->hydro_heave_drag},
+          std::tuple{"added_mass", h.added_mass(), &body->hydro_added_mass},
+          std::tuple{"heave_added_mass", h.heave_added_mass(), &body->hydro_heave_added_mass}}) {
+      CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(path, name), value));
+      *out = value;
+    }
+    body->has_hydrodynamics = true;
     return absl::OkStatus();
   }
 

@@ -657,6 +657,29 @@ void ModelBuilder::BuildElements() {
                        j.components, j.seed);
     model_.wave_load_.emplace(std::move(field), fluid.current_m_s);
   }
+  // The fluid's loads on bodies that ask for them (SceneFromProto requires
+  // a fluid and gravity with them).
+  for (int b = 0; b < static_cast<int>(scene_.bodies.size()); ++b) {
+    const BodySpec& body = scene_.bodies[b];
+    if (!body.has_hydrodynamics || !(fluid.density_kg_m3 > 0) || !(g > 0)) continue;
+    BodyFluidLoad::Params p;
+    p.density_kg_m3 = fluid.density_kg_m3;
+    p.g_m_s2 = g;
+    p.up = -scene_.gravity_m_s2 / g;
+    p.still_level_m = fluid.still_water_level_m;
+    p.diameter_m = body.hydro_diameter_m;
+    p.height_m = body.hydro_height_m;
+    p.drag = body.hydro_drag;
+    p.heave_drag = body.hydro_heave_drag;
+    p.added_mass = body.hydro_added_mass;
+    p.heave_added_mass = body.hydro_heave_added_mass;
+    p.current_m_s = fluid.current_m_s;
+    const BodyFluidLoad& load = model_.body_fluid_.emplace_back(p, BodyCoord(b), model_.dim_);
+    MultibodyModel::BodyData& data = model_.bodies_[b];
+    data.added_mass = load.AddedMass(q0_);
+    data.has_added_mass = !data.added_mass.isZero(0);
+    if (load.dynamic(model_.wave_load_.has_value())) model_.has_damping_ = true;
+  }
   if (scene_.seabed.enabled) {
     model_.seabed_.emplace(scene_.seabed);
     if (model_.seabed_->dissipates()) model_.has_damping_ = true;
@@ -936,6 +959,7 @@ void ModelBuilder::EnvelopeAndMass() {
       const double diag = k < D ? b.mass : b.jbar((k - D) / D);
       m.mass_.values()[m.mass_.Slot(j, j)] += m.s_(b.coord + k) * m.s_(b.coord + k) * diag;
     }
+    if (b.has_added_mass) m.ScatterBodyBlock(b.coord, b.added_mass, 1.0, &m.mass_);
   }
 }
 

@@ -117,6 +117,20 @@ void MultibodyModel::ScatterSlider(const SlidingJoint::Local& local, VectorXd* f
   }
 }
 
+void MultibodyModel::ScatterBodyBlock(int coord, const Eigen::Matrix3d& m, double scale,
+                                      SkylineLdlt* a) const {
+  double* values = a->values();
+  for (int i = 0; i < dim_; ++i) {
+    const int ji = j_[coord + i];
+    if (ji < 0) continue;
+    for (int k = 0; k < dim_; ++k) {
+      const int jk = j_[coord + k];
+      if (jk < 0 || jk > ji) continue;
+      values[a->Slot(ji, jk)] += scale * s_(coord + i) * s_(coord + k) * m(i, k);
+    }
+  }
+}
+
 absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene,
                                                     const std::function<bool()>& should_stop) {
   // The steps, what each computes and why, are in model_builder.h.
@@ -383,6 +397,12 @@ double MultibodyModel::NetForce(const VectorXd& q, double load_factor, VectorXd*
       }
     }
   }
+  // Bodies' hydrostatic buoyancy (BodyFluidLoad), scaled as gravity.
+  for (const BodyFluidLoad& b : body_fluid_) {
+    Eigen::Matrix3d k = Eigen::Matrix3d::Zero();
+    b.AddHydrostatic(q, load_factor, &full, stiffness ? &k : nullptr);
+    if (stiffness) ScatterBodyBlock(b.coord(), k, stiffness_scale, stiffness);
+  }
   // The size of the applied terms counts only coordinates that move: a
   // heavy body welded to ground must not loosen the tolerance elsewhere.
   double size = 0;
@@ -558,6 +578,19 @@ double MultibodyModel::DampingForce(const VectorXd& q, const VectorXd& qdot, Vec
     }
     size = std::max(size, contact_size);
   }
+  // The fluid's drag, inertia and wave buoyancy on bodies (BodyFluidLoad).
+  const WaveField* waves = wave_field();
+  for (const BodyFluidLoad& b : body_fluid_) {
+    if (!b.dynamic(waves != nullptr)) continue;
+    Eigen::Matrix3d c;
+    const Vector3d force = b.DynamicForce(q, qdot, time_, waves, tangent ? &c : nullptr);
+    for (int d = 0; d < dim_; ++d) {
+      full(b.coord() + d) += force(d);
+      if (full_roundoff) (*full_roundoff)(b.coord() + d) += kSumRounding * std::abs(force(d));
+    }
+    size = std::max(size, force.lpNorm<Eigen::Infinity>());
+    if (tangent) ScatterBodyBlock(b.coord(), c, tangent_scale, tangent);
+  }
   for (const SlidingJoint& slider : sliders_) {
     if (!slider.has_friction()) continue;
     SlidingJoint::Local local;
@@ -593,6 +626,12 @@ double MultibodyModel::DampingPower(const VectorXd& q, const VectorXd& qdot) con
                                              nullptr, 0, nullptr, nullptr)
                        : BodyContactTerms<3>(ContactTerm::kDissipation, q, &qdot, nullptr,
                                              nullptr, 0, nullptr, nullptr);
+  const WaveField* waves = wave_field();
+  for (const BodyFluidLoad& b : body_fluid_) {
+    if (!b.dynamic(waves != nullptr)) continue;
+    const Vector3d force = b.DynamicForce(q, qdot, time_, waves, nullptr);
+    for (int d = 0; d < dim_; ++d) power -= force(d) * qdot(b.coord() + d);
+  }
   return power;
 }
 
@@ -858,7 +897,12 @@ EnergySample MultibodyModel::Energy(const VectorXd& q, const VectorXd& qdot, dou
   const int D = dim_;
   for (size_t i = 0; i < bodies_.size(); ++i) {
     const BodyData& b = bodies_[i];
-    const double translation = 0.5 * b.mass * qdot.segment(b.coord, D).squaredNorm();
+    double translation = 0.5 * b.mass * qdot.segment(b.coord, D).squaredNorm();
+    if (b.has_added_mass) {
+      for (int i = 0; i < D; ++i)
+        for (int k = 0; k < D; ++k)
+          translation += 0.5 * b.added_mass(i, k) * qdot(b.coord + i) * qdot(b.coord + k);
+    }
     en.kinetic += translation;
     double kinetic = translation;
     const int axes = D == 2 ? 1 : 3;
@@ -888,11 +932,15 @@ EnergySample MultibodyModel::Energy(const VectorXd& q, const VectorXd& qdot, dou
                                                   nullptr, 0, nullptr, nullptr)
                             : BodyContactTerms<3>(ContactTerm::kPotential, q, nullptr, nullptr,
                                                   nullptr, 0, nullptr, nullptr);
+  // Bodies' hydrostatic buoyancy: its potential, with the loads.
+  double buoyancy_energy = 0;
+  for (const BodyFluidLoad& b : body_fluid_) buoyancy_energy += b.HydrostaticEnergy(q, load_factor);
+  en.potential += buoyancy_energy;
   en.total = en.kinetic + en.potential + en.axial + en.bending + en.contact;
   if (parts != nullptr) {
     // The element gravity above is at load factor 1 (statics scales it).
     for (PartEnergy& part : parts->cables) part.gravity *= load_factor;
-    parts->loads = slider_energy - external_work_;
+    parts->loads = slider_energy + buoyancy_energy - external_work_;
     if (load_force_.size() > 0) parts->loads -= load_factor * load_force_.dot(q);
   }
   return en;

@@ -48,6 +48,7 @@
 
 #include "absl/status/statusor.h"
 #include "engine/ancf_cable_element.h"
+#include "engine/forces/body_fluid_load.h"
 #include "engine/forces/seabed.h"
 #include "engine/forces/sheave.h"
 #include "engine/forces/wave_load.h"
@@ -259,6 +260,12 @@ class MultibodyModel {
   // without waves holds none and its elements take AddDrag's uniform current.
   const WaveLoad* wave_load() const { return wave_load_ ? &*wave_load_ : nullptr; }
 
+  // The fluid's loads on bodies (engine/forces/body_fluid_load.h): the
+  // hydrostatic part in NetForce (scaled with gravity by the load factor,
+  // its energy in the loads' part), the drag, inertia and wave buoyancy in
+  // DampingForce (their work in the damping power).
+  const std::vector<BodyFluidLoad>& body_fluid_loads() const { return body_fluid_; }
+
   // The scene's seabed (engine/forces/seabed.h), or null: a scene without
   // one holds no seabed object, and its force loops only test this.
   const Seabed* seabed() const { return seabed_ ? &*seabed_ : nullptr; }
@@ -340,6 +347,10 @@ class MultibodyModel {
     Eigen::Vector3d jbar = Eigen::Vector3d::Zero();  // per axis [kg m^2]
     double linear_damping = 0;   // [N s/m]
     double angular_damping = 0;  // [N m s/rad]
+    // The fluid's added mass on r_c (BodyFluidLoad::AddedMass) [kg], in the
+    // mass matrix and the kinetic energy; only with has_added_mass.
+    bool has_added_mass = false;
+    Eigen::Matrix3d added_mass = Eigen::Matrix3d::Zero();
   };
   // A body's seabed contact points (BodySpec): body frame [m], spring k
   // [N/m], damper c [N s/m], friction mu [-] per point.
@@ -462,6 +473,10 @@ class MultibodyModel {
                            double scale) const;
   void ScatterSlider(const SlidingJoint::Local& local, Eigen::VectorXd* full, Eigen::VectorXd* roundoff,
                      double scale, SkylineLdlt* a) const;
+  // Adds scale times the D x D block m on body coordinates from full index
+  // `coord` (its centre of mass), mapped onto z, to `a`.
+  void ScatterBodyBlock(int coord, const Eigen::Matrix3d& m, double scale, SkylineLdlt* a) const;
+  const WaveField* wave_field() const { return wave_load_ ? &wave_load_->field() : nullptr; }
   void ProjectInitialVelocity();
   // The scene's rigid initial velocity at full configuration q (all nodes
   // and bodies; fixed coordinates are dropped by Reduce).
@@ -524,6 +539,9 @@ class MultibodyModel {
   bool sheaves_dissipate_ = false;
   // Only in a scene whose fluid has waves (then it carries the current too).
   std::optional<WaveLoad> wave_load_;
+  // The fluid's loads on bodies that ask for them (empty in most scenes:
+  // then nothing is evaluated).
+  std::vector<BodyFluidLoad> body_fluid_;
 
   std::vector<Row> rows_;
   std::vector<int> row_coord_;

@@ -98,6 +98,16 @@ struct BodySpec {
   double contact_stiffness_n_m = 0;
   double contact_damping_n_s_m = 0;
   double contact_friction = 0;
+  // Fluid loads in the scene's fluid (engine/forces/body_fluid_load.h),
+  // only when has_hydrodynamics: a vertical cylinder of diameter and
+  // height [m] centred at the centre of mass displaces the fluid; Morison
+  // drag coefficients across the vertical (on d times the submerged length)
+  // and along it (on the end area) [-], added-mass coefficients across
+  // and along the vertical [-].
+  bool has_hydrodynamics = false;
+  double hydro_diameter_m = 0, hydro_height_m = 0;
+  double hydro_drag = 0, hydro_heave_drag = 0;
+  double hydro_added_mass = 0, hydro_heave_added_mass = 0;
 };
 
 // A place on a cable (cable >= 0), on a body (body >= 0), or the ground

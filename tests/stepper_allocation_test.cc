@@ -648,5 +648,30 @@ TEST_F(StepperAllocationTest, SheaveContactDoesNotAllocate) {
   }
 }
 
+
+// Nor the fluid's loads on a body (engine/forces/body_fluid_load.h): a
+// floating buoy with drag and added mass on a riser, in a regular wave.
+TEST_F(StepperAllocationTest, BodyHydrodynamicsDoNotAllocate) {
+  Scene scene = testing::SceneFromJson(R"({
+    "gravity": {"y": -9.81},
+    "fluid": {"density": 1025, "current": {"x": 0.2}, "water_depth": 20,
+              "waves": {"regular": [{"height": 2, "period": 8}]}},
+    "cables": [{"name": "riser", "points": [{"y": -20}, {"y": 0}], "elements": 10,
+                "density": 500, "youngs_modulus": 1e9, "diameter": 0.1}],
+    "bodies": [{"name": "buoy", "mass": 2000, "inertia": {"x": 100, "y": 100, "z": 100},
+                "hydrodynamics": {"diameter": 2, "height": 2, "drag_coefficient": 1,
+                                  "heave_drag_coefficient": 2, "added_mass": 1,
+                                  "heave_added_mass": 0.5}}],
+    "joints": [{"type": "PIN", "a": {"cable": "riser", "s": 0}},
+               {"type": "PIN", "a": {"cable": "riser", "s": 20}, "b": {"body": "buoy"}}],
+    "solver": {"duration": 1}})");
+  for (Integrator integrator : {Integrator::kImplicitEuler, Integrator::kGeneralizedAlpha,
+                                Integrator::kHht, Integrator::kEnergyMomentum}) {
+    SCOPED_TRACE(::testing::Message() << "integrator " << static_cast<int>(integrator));
+    scene.solver.integrator = integrator;
+    ExpectStepsDoNotAllocate(scene, 0.01, 50);
+  }
+}
+
 }  // namespace
 }  // namespace cablesim

@@ -39,6 +39,17 @@ inline std::string SceneError(const std::string& json) {
   return std::string(scene.status().message());
 }
 
+// A sample scene from scenes/ (e.g. "mooring-three-line-buoy.json"), that
+// must parse and convert.
+inline Scene SampleScene(const std::string& file) {
+  auto proto = ReadSceneFile(std::string(CABLESIM_SOURCE_DIR) + "/scenes/" + file);
+  EXPECT_TRUE(proto.ok()) << proto.status();
+  if (!proto.ok()) return Scene{};
+  auto scene = SceneFromProto(*proto);
+  EXPECT_TRUE(scene.ok()) << scene.status();
+  return scene.ok() ? *scene : Scene{};
+}
+
 class CollectingSink : public FrameSink {
  public:
   absl::Status OnStart(const ModelInfo& info) override {

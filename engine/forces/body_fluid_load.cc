@@ -1,0 +1,113 @@
+#include "engine/forces/body_fluid_load.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace cablesim {
+
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+using Eigen::VectorXd;
+
+BodyFluidLoad::BodyFluidLoad(const Params& p, int coord, int dim)
+    : p_(p), coord_(coord), dim_(dim) {
+  area_ = std::numbers::pi * p.diameter_m * p.diameter_m / 4;
+  up_.setZero();
+  up_.head(dim) = p.up.head(dim);
+  up_.normalize();
+}
+
+double BodyFluidLoad::Submerged(double z) const {
+  return std::clamp(p_.height_m / 2 - z, 0.0, p_.height_m);
+}
+
+double BodyFluidLoad::Height(const VectorXd& q) const {
+  double h = -p_.still_level_m;
+  for (int d = 0; d < dim_; ++d) h += up_(d) * q(coord_ + d);
+  return h;
+}
+
+Matrix3d BodyFluidLoad::AddedMass(const VectorXd& q0) const {
+  const double v = p_.density_kg_m3 * area_ * Submerged(Height(q0));
+  const Matrix3d vertical = up_ * up_.transpose();
+  Matrix3d m = v * (p_.added_mass * (Matrix3d::Identity() - vertical) +
+                    p_.heave_added_mass * vertical);
+  // Planar: only the plane's block is used; zero the rest for clarity.
+  if (dim_ == 2) {
+    m.row(2).setZero();
+    m.col(2).setZero();
+  }
+  return m;
+}
+
+double BodyFluidLoad::AddHydrostatic(const VectorXd& q, double scale, VectorXd* force,
+                                     Matrix3d* stiffness) const {
+  const double z = Height(q);
+  const double f = scale * p_.density_kg_m3 * p_.g_m_s2 * area_ * Submerged(z);
+  for (int d = 0; d < dim_; ++d) (*force)(coord_ + d) += f * up_(d);
+  if (stiffness != nullptr && z > -p_.height_m / 2 && z < p_.height_m / 2)
+    *stiffness += scale * p_.density_kg_m3 * p_.g_m_s2 * area_ * up_ * up_.transpose();
+  return std::abs(f);
+}
+
+double BodyFluidLoad::HydrostaticEnergy(const VectorXd& q, double scale) const {
+  const double z = Height(q), h = p_.height_m;
+  double p = 0;  // P(z), -P'(z) = s(z)
+  if (z >= h / 2) {
+    p = 0;
+  } else if (z > -h / 2) {
+    p = 0.5 * (z - h / 2) * (z - h / 2);
+  } else {
+    p = 0.5 * h * h - h * (z + h / 2);
+  }
+  return scale * p_.density_kg_m3 * p_.g_m_s2 * area_ * p;
+}
+
+bool BodyFluidLoad::dynamic(bool has_waves) const {
+  return p_.drag != 0 || p_.heave_drag != 0 || has_waves;
+}
+
+Vector3d BodyFluidLoad::DynamicForce(const VectorXd& q, const VectorXd& qdot, double t,
+                                     const WaveField* waves, Matrix3d* damping) const {
+  Vector3d r = Vector3d::Zero(), v = Vector3d::Zero();
+  r.head(dim_) = q.segment(coord_, dim_);
+  v.head(dim_) = qdot.segment(coord_, dim_);
+  const double rho = p_.density_kg_m3;
+  const double z = Height(q);
+  const double s = Submerged(z);
+  Vector3d u = p_.current_m_s, dudt = Vector3d::Zero();
+  Vector3d force = Vector3d::Zero();
+  if (waves != nullptr) {
+    const WaveField::Kinematics k = waves->At(r, t);
+    u += k.velocity_m_s;
+    dudt = k.acceleration_m_s2;
+    // The wave's change of the buoyancy: the level rises by eta.
+    force += rho * p_.g_m_s2 * area_ * (Submerged(z - k.elevation_m) - s) * up_;
+    // Froude-Krylov and added-mass inertia on the wetted volume.
+    const double a_up = up_.dot(dudt);
+    const Vector3d a_h = dudt - a_up * up_;
+    force += rho * area_ * s * ((1 + p_.added_mass) * a_h + (1 + p_.heave_added_mass) * a_up * up_);
+  }
+  if (damping != nullptr) damping->setZero();
+  if (s > 0 && (p_.drag != 0 || p_.heave_drag != 0)) {
+    const Vector3d vr = u - v;
+    const double vr_up = up_.dot(vr);
+    const Vector3d vh = vr - vr_up * up_;
+    const double kh = 0.5 * rho * p_.drag * p_.diameter_m * s;
+    const double kv = 0.5 * rho * p_.heave_drag * area_;
+    const double nh = vh.norm();
+    force += kh * nh * vh + kv * std::abs(vr_up) * vr_up * up_;
+    if (damping != nullptr) {
+      if (nh > 0) {
+        const Matrix3d horizontal = Matrix3d::Identity() - up_ * up_.transpose();
+        *damping += kh * (nh * horizontal + vh * vh.transpose() / nh);
+      }
+      *damping += 2 * kv * std::abs(vr_up) * up_ * up_.transpose();
+    }
+  }
+  if (dim_ == 2) force.z() = 0;
+  return force;
+}
+
+}  // namespace cablesim

@@ -1,0 +1,133 @@
+#ifndef CABLESIM_ENGINE_FORCES_BODY_FLUID_LOAD_H_
+#define CABLESIM_ENGINE_FORCES_BODY_FLUID_LOAD_H_
+
+// The fluid's load on a rigid body (a buoy, a clump weight, a float):
+// buoyancy of a vertical cylinder that may pierce the surface, and the
+// Morison drag and inertia of the flow (Morison, O'Brien, Johnson and
+// Schaaf, "The force exerted by surface waves on piles", J. Petroleum
+// Technology 2(5), 1950, eq. 1; the relative-velocity form with the
+// Froude-Krylov term as in DNV-RP-C205, 2010, section 6.2.2).
+//
+// Shape. The body displaces a vertical circular cylinder of diameter d
+// [m] and height H [m] centred at its centre of mass r_c, whatever the
+// body's orientation: a model for a buoy kept upright by its ballast and
+// moorings. It gives forces at the centre of mass only (no hydrostatic
+// roll/pitch restoring moment, no moment of the drag). With `up` the unit
+// vertical (the opposite of gravity), A = pi d^2 / 4 the waterplane area,
+// and z = up . r_c - level the centre's height above a water level, the
+// submerged length and volume are
+//
+//   s(z) = clamp(H / 2 - z, 0, H),   V(z) = A s(z).
+//
+// Buoyancy. Split into a conservative hydrostatic part about the still
+// water level (z_0 = up . r_c - still level) and, with waves, the change
+// that the wave elevation eta(x, t) at the centre's horizontal position
+// makes (the level then is still level + eta):
+//
+//   F_s = rho g A s(z_0) up                  (NetForce, scaled as gravity)
+//   F_w = rho g A (s(z_0 - eta) - s(z_0)) up (DynamicForce)
+//
+// F_s is minus the gradient of U_s = rho g A P(z_0) with P(z) = 0 above
+// the body (z >= H/2), (z - H/2)^2 / 2 while it pierces the level, and
+// H^2 / 2 - H (z + H/2) below it: U_s is the body's energy in the loads'
+// part. Its tangent -dF_s/dr_c = rho g A up up^T while the body pierces
+// the level (the hydrostatic heave stiffness rho g A_wp), 0 otherwise.
+// F_w makes the body heave with the surface (for a wave long against the
+// draft, rho g A eta is the linear Froude-Krylov heave force of the
+// dynamic pressure at the keel to first order in k s); its derivative in
+// r_c is left out of the Newton matrix (it is zero while the body pierces
+// both levels).
+//
+// Morison loads. The flow u = U + u_w(r_c, t) (current plus wave
+// kinematics, WaveField::At, at the centre of mass: not integrated over the
+// draft, so the load is exact for a body short against the wavelength;
+// above the still level the kinematics are those at z = 0). With the
+// relative velocity v_r = u - rdot_c split into its horizontal part v_h and
+// vertical part v_v = (v_r . up) up:
+//
+//   F_d = (1/2) rho C_d d s |v_h| v_h + (1/2) rho C_dv A |v_v| v_v
+//   F_i = rho V (I + C_a) du/dt,   C_a = C_ah (I - up up^T) + C_av up up^T
+//
+// (C_d on the projected area d s across the axis, C_dv on the end area A
+// while the body is wet, s > 0). F_i is the Froude-Krylov force rho V du/dt
+// plus the added-mass force on the flow's acceleration; the added-mass
+// force on the body's own acceleration, -rho V_ref C_a rddot_c, is in the
+// mass matrix (AddedMass: the reduced mass matrix of the engine is
+// constant, factored once per run, and the steppers' forces depend on q
+// and qdot only, so an acceleration-dependent force has no place), with
+// V_ref = V at the body's `position` in the scene (before any initial
+// statics): a floating body's draft changes little, a submerged one's not
+// at all.
+//
+// Tangent of F_d + F_i + F_w in rdot_c: C = -dF/d(rdot_c) =
+// k_h (|v_h| P + v_h v_h^T / |v_h|) + 2 k_v |v_v| up up^T (P = I - up up^T,
+// k_h = rho C_d d s / 2, k_v = rho C_dv A / 2), symmetric positive
+// semi-definite. The derivatives in r_c (through s, eta and the flow's
+// dependence on position) are left out, as for the cables' WaveLoad.
+//
+// Energy: F_d + F_i + F_w is not a potential's force; its power -F . rdot_c
+// joins the damping power (MultibodyModel::DampingPower), so energy.damped
+// counts the drag's dissipation and the waves' work, and energy.total +
+// energy.damped stays what the exact solution conserves.
+//
+// Units SI. Allocates nothing.
+
+#include <Eigen/Core>
+
+#include "engine/forces/waves.h"
+
+namespace cablesim {
+
+class BodyFluidLoad {
+ public:
+  struct Params {
+    double density_kg_m3 = 0;  // of the fluid
+    double g_m_s2 = 0;         // |gravity|
+    Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+    double still_level_m = 0;  // up . r of the still water level
+    double diameter_m = 0, height_m = 0;
+    double drag = 0, heave_drag = 0;              // C_d, C_dv [-]
+    double added_mass = 0, heave_added_mass = 0;  // C_ah, C_av [-]
+    Eigen::Vector3d current_m_s = Eigen::Vector3d::Zero();
+  };
+
+  // `coord` the full index of the body's centre of mass, `dim` 2 or 3.
+  BodyFluidLoad(const Params& p, int coord, int dim);
+
+  int coord() const { return coord_; }
+  double waterplane_area() const { return area_; }
+
+  // The submerged length s(z) [m] at the centre's height z above a level.
+  double Submerged(double z) const;
+  // The body's height above the still level [m] at full configuration q.
+  double Height(const Eigen::VectorXd& q) const;
+
+  // The added-mass matrix rho V_ref C_a on the centre's D coordinates
+  // [kg], for the body at full configuration q0.
+  Eigen::Matrix3d AddedMass(const Eigen::VectorXd& q0) const;
+
+  // F_s (times `scale`, the load factor) into `force` (full); its tangent
+  // scale * rho g A up up^T into `stiffness` (D x D, may be null). Returns
+  // |F_s|.
+  double AddHydrostatic(const Eigen::VectorXd& q, double scale, Eigen::VectorXd* force,
+                        Eigen::Matrix3d* stiffness) const;
+  // U_s [J], times `scale`.
+  double HydrostaticEnergy(const Eigen::VectorXd& q, double scale) const;
+
+  // F_d + F_i + F_w [N] at time t [s] under `waves` (null: none), and C
+  // [N s/m] into `damping` when not null.
+  Eigen::Vector3d DynamicForce(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, double t,
+                               const WaveField* waves, Eigen::Matrix3d* damping) const;
+  // Whether DynamicForce can be nonzero (drag, or a flow that accelerates).
+  bool dynamic(bool has_waves) const;
+
+ private:
+  Params p_;
+  int coord_ = 0, dim_ = 3;
+  double area_ = 0;
+  Eigen::Vector3d up_ = Eigen::Vector3d::UnitZ();  // zero beyond dim
+};
+
+}  // namespace cablesim
+
+#endif  // CABLESIM_ENGINE_FORCES_BODY_FLUID_LOAD_H_
