@@ -556,12 +556,8 @@ class SceneConverter {
 
     if (b.has_seabed_contact()) CABLESIM_RETURN_IF_ERROR(ConvertBodyContact(path, b, body));
     CABLESIM_RETURN_IF_ERROR(ConvertBodyHydrodynamics(i, b, body));
-    if (b.has_on()) return PlaceOnCable(i, b);
-    CABLESIM_ASSIGN_OR_RETURN(body->position_m, VectorInRange(Sub(path, "position"), b.position(), plausible::kCoordinate));
-    body->axis = Eigen::Vector3d::UnitX();
-    if (b.has_axis()) {
-      CABLESIM_ASSIGN_OR_RETURN(body->axis, Direction(Sub(path, "axis"), b.axis()));
-    }
+    // Damping before the placement: a body placed `on` a cable returns
+    // from there (its damping was silently dropped before).
     if (b.has_damping()) {
       const std::string damping_path = Sub(path, "damping");
       CABLESIM_RETURN_IF_ERROR(
@@ -570,6 +566,12 @@ class SceneConverter {
           CheckNonNegative(Sub(damping_path, "angular"), b.damping().angular()));
       body->linear_damping_n_s_m = b.damping().linear();
       body->angular_damping_n_m_s = b.damping().angular();
+    }
+    if (b.has_on()) return PlaceOnCable(i, b);
+    CABLESIM_ASSIGN_OR_RETURN(body->position_m, VectorInRange(Sub(path, "position"), b.position(), plausible::kCoordinate));
+    body->axis = Eigen::Vector3d::UnitX();
+    if (b.has_axis()) {
+      CABLESIM_ASSIGN_OR_RETURN(body->axis, Direction(Sub(path, "axis"), b.axis()));
     }
     return absl::OkStatus();
   }

@@ -42,6 +42,21 @@ std::string Rope(const std::string& body, const std::string& joints,
     "solver": {"duration": 0.2, "step": 0.002, "output_interval": 0.02}})");
 }
 
+// A body placed by the cable keeps its damping (it was dropped once: the
+// placement returned before the damping was read), and bad damping is
+// still named.
+TEST(BodyOnCableTest, PlacedBodyKeepsItsDamping) {
+  absl::StatusOr<Scene> scene = Convert(
+      Rope(R"("on": {"cable": "rope", "s": 0.5}, "damping": {"linear": 3, "angular": 0.5})", ""));
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  EXPECT_EQ(scene->bodies[0].linear_damping_n_s_m, 3);
+  EXPECT_EQ(scene->bodies[0].angular_damping_n_m_s, 0.5);
+  absl::StatusOr<Scene> bad =
+      Convert(Rope(R"("on": {"cable": "rope", "s": 0.5}, "damping": {"linear": -1})", ""));
+  ASSERT_FALSE(bad.ok());
+  EXPECT_THAT(std::string(bad.status().message()), HasSubstr("bodies[0].damping.linear"));
+}
+
 // Threaded at s = 0.5 is the hand-laid scene: centre (0.5, 0), axis +x,
 // PIN joints from the cable at 0.45 and 0.55 to the faces (-+0.05, 0, 0).
 // The two runs must be the same to rounding (1e-12 m): the same model.
