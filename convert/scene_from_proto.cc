@@ -486,6 +486,12 @@ class SceneConverter {
         cable->hydro_diameter_m = h.diameter();
       }
     }
+    if (c.has_winch()) {
+      cable->winch.enabled = true;
+      CABLESIM_ASSIGN_OR_RETURN(cable->winch.speed,
+                                ConvertTimeFunction(Sub(Sub(path, "winch"), "speed"),
+                                                    c.winch().speed()));
+    }
     if (c.has_damping()) {
       const v1::CableDamping& d = c.damping();
       const std::string damping_path = Sub(path, "damping");

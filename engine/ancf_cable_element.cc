@@ -14,6 +14,12 @@ AncfCableElement<D>::AncfCableElement(double length_m, double ea_n, double ei_n_
                                       BendingModel bending, int gauss_points)
     : length_(length_m), ea_(ea_n), ei_(ei_n_m2), bending_(bending),
       rule_(MakeGaussRule(gauss_points)) {
+  set_length(length_m);
+}
+
+template <int D>
+void AncfCableElement<D>::set_length(double length_m) {
+  length_ = length_m;
   for (int g = 0; g < rule_.n; ++g) {
     HermiteShape(rule_.xi[g], length_, s0_[g]);
     HermiteShapeD1(rule_.xi[g], length_, d1_[g]);

@@ -57,6 +57,10 @@ class AncfCableElement {
                    int gauss_points = kDefaultGaussPoints);
 
   double length() const { return length_; }
+  // A new undeformed length [m] (a winch cable's elements, whose length
+  // changes in time): the shape functions at the Gauss points are
+  // recomputed. Allocates nothing.
+  void set_length(double length_m);
 
   // Consistent mass matrix (eq. 8-10 of the paper, docs/model.md section 1) for mass per unit
   // length rho A [kg/m].

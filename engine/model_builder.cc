@@ -63,6 +63,101 @@ absl::Status ModelBuilder::ChooseDimension() {
   return absl::OkStatus();
 }
 
+absl::Status ModelBuilder::CheckWinches() const {
+  const int num_cables = static_cast<int>(scene_.cables.size());
+  for (int c = 0; c < num_cables; ++c) {
+    const CableSpec& cable = scene_.cables[c];
+    if (!cable.winch.enabled) continue;
+    const double len = cable.length_m, tol = kSnap * len;
+    if (scene_.solver.analysis == Analysis::kDynamic && scene_.solver.duration_s > 0) {
+      // L(t) = len + int_0^t speed on a grid no coarser than the step (at
+      // most 100,000 points), the first crossing of 0 refined by bisection.
+      const double duration = scene_.solver.duration_s;
+      const int n = static_cast<int>(std::min(
+          1e5, std::max(100.0, std::ceil(duration / std::max(scene_.solver.step_s, 1e-12)))));
+      auto length = [&](double t) { return len + cable.winch.speed.Integral(t); };
+      double t_prev = 0;
+      for (int i = 1; i <= n; ++i) {
+        const double t = duration * i / n;
+        if (length(t) > 0) {
+          t_prev = t;
+          continue;
+        }
+        double lo = t_prev, hi = t;
+        for (int k = 0; k < 60 && hi - lo > 1e-12 * (1 + hi); ++k) {
+          const double mid = 0.5 * (lo + hi);
+          (length(mid) > 0 ? lo : hi) = mid;
+        }
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "cables[%d].winch.speed: reels in the whole cable: its free length (length + "
+            "int speed dt) reaches 0 at t = %.6g s, within solver.duration (%.6g s)",
+            c, hi, duration));
+      }
+    }
+    bool held = false;
+    for (size_t j = 0; j < scene_.joints.size(); ++j) {
+      const JointSpec& joint = scene_.joints[j];
+      for (const Attachment* at : {&joint.a, &joint.b}) {
+        if (at->cable != c) continue;
+        if (joint.type == JointType::kSlide) {
+          return absl::InvalidArgumentError(absl::StrFormat(
+              "joints[%d]: a sliding joint cannot run on a winch cable (cables[%d].winch)", j, c));
+        }
+        const Attachment& other = at == &joint.a ? joint.b : joint.a;
+        if (std::abs(at->s_m - len) <= tol && other.IsGround()) held = true;
+        if (at->s_m > tol && at->s_m < len - tol) {
+          return absl::InvalidArgumentError(absl::StrFormat(
+              "joints[%d]: a winch cable (cables[%d].winch) takes joints only at its ends (s = 0 "
+              "or its length): its mesh moves through the material",
+              j, c));
+        }
+      }
+    }
+    if (!held) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "cables[%d].winch: the winch holds the cable's last point (s = length): join it to "
+          "the ground with a PIN or FIXED joint (with a motion for a moving winch)",
+          c));
+    }
+    for (size_t i = 0; i < scene_.loads.size(); ++i) {
+      const Attachment& at = scene_.loads[i].at;
+      if (at.cable == c && at.s_m > tol && at.s_m < len - tol) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "loads[%d].at: a winch cable (cables[%d].winch) takes loads only at its ends", i, c));
+      }
+    }
+    for (size_t i = 0; i < scene_.probes.size(); ++i) {
+      const Attachment& at = scene_.probes[i].at;
+      if (at.cable == c && at.s_m > tol && at.s_m < len - tol) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "probes[%d].at: a winch cable (cables[%d].winch) takes probes only at its ends", i,
+            c));
+      }
+    }
+    if (cable.bending_damping_s != 0 || cable.rayleigh_beta_s != 0) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "cables[%d].damping: a winch cable takes axial_time and rayleigh_alpha only (bending "
+          "damping on an axially moving mesh is not built)",
+          c));
+    }
+    if (scene_.fluid.density_kg_m3 > 0 || scene_.seabed.enabled) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "cables[%d].winch: a winch cable in a fluid or on a seabed is not modelled (their "
+          "loads on an axially moving mesh are not built)",
+          c));
+    }
+    if (scene_.solver.integrator == Integrator::kEnergyMomentum &&
+        scene_.solver.analysis == Analysis::kDynamic) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "solver.integrator: ENERGY_MOMENTUM does not take winches (cables[%d].winch): its "
+          "energy statement needs a constant mass; use HHT, GENERALIZED_ALPHA or "
+          "IMPLICIT_EULER",
+          c));
+    }
+  }
+  return absl::OkStatus();
+}
+
 void ModelBuilder::MeshCables() {
   const int num_cables = static_cast<int>(scene_.cables.size());
   std::vector<std::vector<double>>& node_s = mesh_.node_s;
@@ -761,6 +856,42 @@ absl::Status ModelBuilder::Sliders() {
   return absl::OkStatus();
 }
 
+void ModelBuilder::Winches() {
+  MultibodyModel& m = model_;
+  for (int c = 0; c < static_cast<int>(scene_.cables.size()); ++c) {
+    const CableSpec& cable = scene_.cables[c];
+    if (!cable.winch.enabled) continue;
+    MultibodyModel::WinchData w;
+    w.cable = c;
+    w.element_begin = m.cable_element_begin_[c];
+    w.element_end = m.cable_element_begin_[c + 1];
+    w.length0 = w.length = cable.length_m;
+    w.speed = cable.winch.speed;
+    w.mass_per_length = cable.density_kg_m3 * cable.area_m2;
+    w.ea = cable.youngs_modulus_pa * cable.area_m2;
+    w.axial_damping_s = cable.axial_damping_s;
+    w.alpha_1_s = cable.rayleigh_alpha_1_s;
+    m.winches_.push_back(std::move(w));
+  }
+  if (m.winches_.empty()) return;
+  m.winch_slot_.assign(m.elements(), -1);
+  int elements = 0;
+  for (const MultibodyModel::WinchData& w : m.winches_) {
+    for (int k = w.element_begin; k < w.element_end; ++k) {
+      m.winch_slot_[k] = elements++;
+      // The winch damps the material motion instead (WinchDamping).
+      if (m.dim_ == 2) {
+        m.elements2_[k].axial_damping_s = m.elements2_[k].alpha_1_s = 0;
+      } else {
+        m.elements3_[k].axial_damping_s = m.elements3_[k].alpha_1_s = 0;
+      }
+    }
+  }
+  for (auto* v : {&m.winch_cv_, &m.winch_ce_, &m.winch_mdot_, &m.winch_g_, &m.winch_h_})
+    v->assign(elements, Eigen::Matrix4d::Zero());
+  m.has_damping_ = true;  // the convective terms ride on DampingForce
+}
+
 void ModelBuilder::ConstantForces() {
   MultibodyModel& m = model_;
   const int D = m.dim_;
@@ -845,7 +976,36 @@ void ModelBuilder::Probes() {
       m.probe_force_rows_[p][row.axis] = row.row;
       found = true;
     }
+    // A probe at a winch's end reports the line tension.
+    for (int w = 0; w < static_cast<int>(m.winches_.size()); ++w) {
+      const CableSpec& cable = scene_.cables[m.winches_[w].cable];
+      if (at.cable != m.winches_[w].cable ||
+          std::abs(at.s_m - cable.length_m) > kSnap * cable.length_m)
+        continue;
+      if (m.probe_winch_.empty()) m.probe_winch_.assign(scene_.probes.size(), -1);
+      m.probe_winch_[p] = w;
+      found = true;
+    }
     if (found) m.force_probes_.push_back(static_cast<int>(p));
+  }
+}
+
+template <int D>
+void ModelBuilder::WinchBases(const std::vector<MultibodyModel::ElementData<D>>& elements) {
+  MultibodyModel& m = model_;
+  constexpr int kN = 4 * D, kN2 = kN * kN;
+  m.mass_base_.assign(m.mass_.values(), m.mass_.values() + m.mass_.stored());
+  m.constant_force_base_ = m.constant_force_;
+  for (const MultibodyModel::WinchData& w : m.winches_) {
+    for (int k = w.element_begin; k < w.element_end; ++k) {
+      const MultibodyModel::ElementData<D>& e = elements[k];
+      m.constant_force_base_.segment<kN>(e.first_coord) -= e.gravity;
+      const auto me = e.element.MassMatrix(e.mass_per_length);
+      for (int t = 0; t < kN2; ++t) {
+        const int slot = m.element_slots_[kN2 * k + t];
+        if (slot >= 0) m.mass_base_[slot] -= m.element_factors_[kN2 * k + t] * me(t / kN, t % kN);
+      }
+    }
   }
 }
 
@@ -1000,6 +1160,14 @@ MultibodyModel ModelBuilder::Finish() {
                           !model_.turning_rows_.empty();
   for (const MultibodyModel::TorqueLoad& t : model_.torques_)
     if (t.is_varying) model_.time_dependent_ = true;
+  if (!model_.winches_.empty()) {
+    model_.time_dependent_ = true;
+    if (model_.dim_ == 2) {
+      WinchBases(model_.elements2_);
+    } else {
+      WinchBases(model_.elements3_);
+    }
+  }
   model_.SetTime(0);
   if (model_.has_damping_) {
     model_.scratch_damping_ = VectorXd::Zero(q0_.size());

@@ -89,6 +89,17 @@ class ModelBuilder {
   // ChooseDimension does.
   absl::Status ChooseDimension();
 
+  // Fails, naming the field, when a winch (CableSpec::winch) cannot be
+  // modelled: its free length would reach 0 within solver.duration (at the
+  // time named), its cable's last point is not held by a PIN or FIXED
+  // joint to ground, something is attached inside the cable (joints,
+  // loads and probes only at its two ends: its mesh moves through the
+  // material), a sliding joint runs on it, the scene has a fluid or a
+  // seabed (their loads on an axially moving mesh are not built), or the
+  // integrator is ENERGY_MOMENTUM (its energy statement needs a constant
+  // mass).
+  absl::Status CheckWinches() const;
+
   // mesh(): per cable, `elements` uniform nodes plus a node at every joint
   // side, load and probe on it; arc lengths within Mesh::snap_m of one
   // another are one node, and of the cable's end, the end. A cable
@@ -162,6 +173,10 @@ class ModelBuilder {
   // is more than 1e-6 m from its cable at t = 0 (names the joint).
   absl::Status Sliders();
 
+  // The winches' data (MultibodyModel::WinchData): their cables' element
+  // ranges; the model then needs its damping pass (the convective terms).
+  void Winches();
+
   // The constant generalized force [N, or N m per unit slope]: element and
   // body gravity and each load's force at its point (the loads' also
   // apart, for the energy per part); the torques on bodies, kept apart
@@ -227,6 +242,10 @@ class ModelBuilder {
   void BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* elements);
   // The element scatter tables (per element, the (4D)^2 skyline slots
   // and factors s_a s_b) and the elements' share of the mass matrix.
+  // Finish's share for the winches: mass_base_ and constant_force_base_,
+  // the mass values and constant force without the winch elements.
+  template <int D>
+  void WinchBases(const std::vector<MultibodyModel::ElementData<D>>& elements);
   template <int D>
   void SetupElementSlots(const std::vector<MultibodyModel::ElementData<D>>& elements);
 

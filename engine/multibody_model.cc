@@ -12,6 +12,9 @@
 #include <Eigen/Geometry>
 
 #include "absl/status/status.h"
+#include "engine/forces/winch_inertia.h"
+#include "engine/gauss_quadrature.h"
+#include "engine/hermite_shape.h"
 #include "engine/model_builder.h"
 #include "engine/newton_convergence.h"
 
@@ -138,6 +141,7 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene,
   const absl::Status stopped =
       absl::CancelledError("stopped by the caller while building the model");
   if (absl::Status s = builder.ChooseDimension(); !s.ok()) return s;
+  if (absl::Status s = builder.CheckWinches(); !s.ok()) return s;
   builder.MeshCables();
   if (absl::Status s = builder.InitialCoordinates(); !s.ok()) return s;
   if (absl::Status s = builder.Joints(); !s.ok()) return s;
@@ -149,6 +153,7 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene,
   builder.BuildElements();
   if (builder.Stopped()) return stopped;
   if (absl::Status s = builder.Sliders(); !s.ok()) return s;
+  builder.Winches();
   builder.ConstantForces();
   builder.Probes();
   builder.EnvelopeAndMass();
@@ -598,6 +603,12 @@ double MultibodyModel::DampingForce(const VectorXd& q, const VectorXd& qdot, Vec
     ScatterSlider(local, &full, full_roundoff, tangent_scale, tangent);
     size = std::max(size, local.force.lpNorm<Eigen::Infinity>());
   }
+  if (!winches_.empty()) {
+    size = std::max(size, dim_ == 2 ? WinchForces<2>(q, qdot, &full, tangent, tangent_scale,
+                                                     full_roundoff)
+                                    : WinchForces<3>(q, qdot, &full, tangent, tangent_scale,
+                                                     full_roundoff));
+  }
   const int n = coordinates();
   for (int i = 0; i < n; ++i) {
     if (j_[i] < 0) continue;
@@ -631,6 +642,14 @@ double MultibodyModel::DampingPower(const VectorXd& q, const VectorXd& qdot) con
     if (!b.dynamic(waves != nullptr)) continue;
     const Vector3d force = b.DynamicForce(q, qdot, time_, waves, nullptr);
     for (int d = 0; d < dim_; ++d) power -= force(d) * qdot(b.coord() + d);
+  }
+  // A winch cable's damping (not its convective inertia, which dissipates
+  // nothing).
+  for (const WinchData& w : winches_) {
+    for (int index = w.element_begin; index < w.element_end; ++index) {
+      power += dim_ == 2 ? WinchDamping<2>(w, index, q, qdot, nullptr, nullptr)
+                         : WinchDamping<3>(w, index, q, qdot, nullptr, nullptr);
+    }
   }
   return power;
 }
@@ -832,6 +851,197 @@ void MultibodyModel::SetTime(double t) {
   for (VaryingForce& l : varying_forces_) l.value = Evaluate(l.force, t);
   for (TorqueLoad& tl : torques_)
     if (tl.is_varying) tl.torque = tl.base + Evaluate(tl.varying, t);
+  if (!winches_.empty()) {
+    if (dim_ == 2) {
+      UpdateWinches<2>();
+    } else {
+      UpdateWinches<3>();
+    }
+  }
+}
+
+template <int D>
+void MultibodyModel::UpdateWinches() {
+  constexpr int kN = 4 * D, kN2 = kN * kN;
+  std::vector<ElementData<D>>* elements_ptr;
+  if constexpr (D == 2) {
+    elements_ptr = &elements2_;
+  } else {
+    elements_ptr = &elements3_;
+  }
+  std::vector<ElementData<D>>& elements = *elements_ptr;
+  std::copy(mass_base_.begin(), mass_base_.end(), mass_.values());
+  constant_force_ = constant_force_base_;
+  const Eigen::Matrix<double, D, 1> g = gravity_.head<D>();
+  size_t slot = 0;
+  for (WinchData& w : winches_) {
+    const TimeFunction::Value v = w.speed.Evaluate(time_);
+    w.length = w.length0 + w.speed.Integral(time_);
+    w.rate = v.f;
+    w.accel = v.df;
+    const int n = w.element_end - w.element_begin;
+    const double l = w.length / n, ldot = w.rate / n, lddot = w.accel / n;
+    for (int k = 0; k < n; ++k, ++slot) {
+      const int index = w.element_begin + k;
+      ElementData<D>& e = elements[index];
+      e.element.set_length(l);
+      const auto me = e.element.MassMatrix(w.mass_per_length);
+      for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b) e.mbar(a, b) = me(D * a, D * b);
+      e.gravity = e.element.GravityForce(w.mass_per_length, g);
+      constant_force_.segment<kN>(e.first_coord) += e.gravity;
+      for (int t = 0; t < kN2; ++t) {
+        const int sl = element_slots_[kN2 * index + t];
+        if (sl >= 0) mass_.values()[sl] += element_factors_[kN2 * index + t] * me(t / kN, t % kN);
+      }
+      const WinchElementInertia in = ComputeWinchElementInertia(w.mass_per_length, l, k);
+      WinchConvectiveCoefficients(in, ldot, lddot, &winch_cv_[slot], &winch_ce_[slot]);
+      winch_mdot_[slot] = ldot * in.m_l;
+      winch_g_[slot] = in.g;
+      winch_h_[slot] = in.h;
+    }
+  }
+}
+
+template <int D>
+double MultibodyModel::WinchDamping(const WinchData& w, int index, const VectorXd& q,
+                                   const VectorXd& qdot,
+                                   typename AncfCableElement<D>::Coords* fe,
+                                   typename AncfCableElement<D>::Matrix* ce) const {
+  constexpr int kN = 4 * D;
+  if (w.alpha_1_s == 0 && w.axial_damping_s == 0) return 0;
+  const ElementData<D>& e = Elements<D>()[index];
+  const auto qe = q.segment<kN>(e.first_coord);
+  const auto ve = qdot.segment<kN>(e.first_coord);
+  const int n = w.element_end - w.element_begin, k = index - w.element_begin;
+  const double l = w.length / n, ldot = w.rate / n;
+  double power = 0;
+  if (w.alpha_1_s != 0) {
+    // -alpha int mu S^T v dx with the material velocity v = S edot + ldot W e.
+    const Eigen::Matrix4d& g = winch_g_[winch_slot_[index]];
+    for (int a = 0; a < 4; ++a) {
+      for (int d = 0; d < D; ++d) {
+        double p = 0;
+        for (int b = 0; b < 4; ++b) p += e.mbar(a, b) * ve(D * b + d) + ldot * g(a, b) * qe(D * b + d);
+        if (fe) (*fe)(D * a + d) -= w.alpha_1_s * p;
+        power += w.alpha_1_s * p * ve(D * a + d);
+        if (ce)
+          for (int b = 0; b < 4; ++b) (*ce)(D * a + d, D * b + d) += w.alpha_1_s * e.mbar(a, b);
+      }
+    }
+    // The power is alpha int mu |v|^2 = 2 alpha T: add ldot e^T G^T edot +
+    // ldot^2 e^T H e to the edot . (M edot + ldot G e) summed above.
+    const Eigen::Matrix4d& h = winch_h_[winch_slot_[index]];
+    for (int d = 0; d < D; ++d) {
+      for (int a = 0; a < 4; ++a) {
+        for (int b = 0; b < 4; ++b) {
+          power += w.alpha_1_s * ldot * qe(D * a + d) *
+                   (g(b, a) * ve(D * b + d) + ldot * h(a, b) * qe(D * b + d));
+        }
+      }
+    }
+  }
+  if (w.axial_damping_s != 0) {
+    // Kelvin-Voigt on the material strain rate u . d(r_s)/dt|_s.
+    static const GaussRule rule = MakeGaussRule(AncfCableElement<D>::kDefaultGaussPoints);
+    const double c = w.ea * w.axial_damping_s;
+    for (int gp = 0; gp < rule.n; ++gp) {
+      double d1[4], wd[4];
+      HermiteShapeD1(rule.xi[gp], l, d1);
+      WinchSlopeRateShape(rule.xi[gp], l, k, wd);
+      Eigen::Matrix<double, D, 1> u = Eigen::Matrix<double, D, 1>::Zero(), udot = u;
+      for (int a = 0; a < 4; ++a) {
+        u += d1[a] * qe.template segment<D>(D * a);
+        udot += d1[a] * ve.template segment<D>(D * a) + ldot * wd[a] * qe.template segment<D>(D * a);
+      }
+      const double wl = rule.weight[gp] * l, rate = u.dot(udot);
+      power += wl * c * rate * rate;
+      if (fe)
+        for (int a = 0; a < 4; ++a) fe->template segment<D>(D * a) -= (wl * c * rate * d1[a]) * u;
+      if (ce) {
+        const Eigen::Matrix<double, D, D> uu = u * u.transpose();
+        for (int a = 0; a < 4; ++a)
+          for (int b = 0; b < 4; ++b)
+            ce->template block<D, D>(D * a, D * b) += (wl * c * d1[a] * d1[b]) * uu;
+      }
+    }
+  }
+  return power;
+}
+
+template <int D>
+double MultibodyModel::WinchForces(const VectorXd& q, const VectorXd& qdot, VectorXd* full,
+                                   SkylineLdlt* tangent, double tangent_scale,
+                                   VectorXd* roundoff) const {
+  constexpr int kN = 4 * D, kN2 = kN * kN;
+  const auto& elements = Elements<D>();
+  typename AncfCableElement<D>::Coords fe;
+  typename AncfCableElement<D>::Matrix ce;
+  double size = 0;
+  for (const WinchData& w : winches_) {
+    for (int index = w.element_begin; index < w.element_end; ++index) {
+      const int slot = winch_slot_[index];
+      const ElementData<D>& e = elements[index];
+      const auto qe = q.segment<kN>(e.first_coord);
+      const auto ve = qdot.segment<kN>(e.first_coord);
+      const Eigen::Matrix4d& cv = winch_cv_[slot];
+      const Eigen::Matrix4d& cx = winch_ce_[slot];
+      // The convective force -cv edot - ce e; Newton takes Mdot (the
+      // symmetric part of cv).
+      fe.setZero();
+      ce.setZero();
+      for (int a = 0; a < 4; ++a) {
+        for (int d = 0; d < D; ++d) {
+          double f = 0, abs_sum = 0;
+          for (int b = 0; b < 4; ++b) {
+            const double tv = cv(a, b) * ve(D * b + d), te = cx(a, b) * qe(D * b + d);
+            f -= tv + te;
+            abs_sum += std::abs(tv) + std::abs(te);
+            ce(D * a + d, D * b + d) = winch_mdot_[slot](a, b);
+          }
+          fe(D * a + d) = f;
+          if (roundoff) (*roundoff)(e.first_coord + D * a + d) += kSumRounding * abs_sum;
+        }
+      }
+      WinchDamping<D>(w, index, q, qdot, &fe, tangent ? &ce : nullptr);
+      full->segment<kN>(e.first_coord) += fe;
+      size = std::max(size, fe.template lpNorm<Eigen::Infinity>());
+      if (roundoff)
+        roundoff->segment<kN>(e.first_coord).noalias() += kSumRounding * fe.cwiseAbs();
+      if (!tangent) continue;
+      const int* slots = &element_slots_[kN2 * index];
+      const double* factors = &element_factors_[kN2 * index];
+      for (int t = 0; t < kN2; ++t)
+        if (slots[t] >= 0) tangent->values()[slots[t]] += tangent_scale * factors[t] * ce(t / kN, t % kN);
+    }
+  }
+  return size;
+}
+
+double MultibodyModel::CableMass(int cable) const {
+  double mass = 0;
+  auto sum = [&](const auto& elements) {
+    for (int k = cable_element_begin_[cable]; k < cable_element_begin_[cable + 1]; ++k) {
+      const Eigen::Matrix4d& m = elements[k].mbar;
+      mass += m(0, 0) + m(0, 2) + m(2, 0) + m(2, 2);
+    }
+  };
+  if (dim_ == 2) {
+    sum(elements2_);
+  } else {
+    sum(elements3_);
+  }
+  return mass;
+}
+
+template <int D>
+Eigen::Vector3d MultibodyModel::WinchTension(const VectorXd& q, int w) const {
+  const ElementData<D>& e = Elements<D>()[winches_[w].element_end - 1];
+  const Eigen::Matrix<double, D, 1> u =
+      e.element.Slope(q.segment<4 * D>(e.first_coord), 1.0);
+  Eigen::Vector3d f = Eigen::Vector3d::Zero();
+  f.head<D>() = winches_[w].ea * 0.5 * (u.squaredNorm() - 1) * u;
+  return f;
 }
 
 template <int D>
@@ -1096,12 +1306,17 @@ void MultibodyModel::Probes(const VectorXd& q, const VectorXd& qdot, const Vecto
 
 namespace cablesim {
 
-void MultibodyModel::ProbeForces(const VectorXd& lambda,
+void MultibodyModel::ProbeForces(const VectorXd& q, const VectorXd& lambda,
                                  std::vector<Eigen::Vector3d>* out) const {
   out->resize(force_probes_.size());
   for (size_t k = 0; k < force_probes_.size(); ++k) {
     Eigen::Vector3d& force = (*out)[k];
     force.setZero();
+    if (!probe_winch_.empty() && probe_winch_[force_probes_[k]] >= 0) {
+      const int w = probe_winch_[force_probes_[k]];
+      force = dim_ == 2 ? WinchTension<2>(q, w) : WinchTension<3>(q, w);
+      continue;
+    }
     for (int d = 0; d < 3; ++d) {
       const int row = probe_force_rows_[force_probes_[k]][d];
       if (row >= 0) force(d) = -lambda(row);

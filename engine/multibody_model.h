@@ -303,8 +303,13 @@ class MultibodyModel {
   // The force [N] a moving support exerts on what it holds, -lambda of its
   // position rows, per probe placed on such a joint
   // (ModelInfo::force_probe_names).
-  void ProbeForces(const Eigen::VectorXd& lambda, std::vector<Eigen::Vector3d>* out) const;
-  // The number of probes on a moving support (ProbeForces' size).
+  // A probe at a winch's end (the cable's last point) reports the line
+  // tension instead: the force [N] the winch exerts on the cable, EA eps
+  // r_s at s = L(t) (eps the Green-Lagrange strain there, r_s the slope,
+  // pointing into the winch; |force| is the tension). `q`: full positions.
+  void ProbeForces(const Eigen::VectorXd& q, const Eigen::VectorXd& lambda,
+                   std::vector<Eigen::Vector3d>* out) const;
+  // The number of probes on a moving support or a winch's end (ProbeForces' size).
   int force_probe_count() const { return static_cast<int>(force_probes_.size()); }
 
   // Sliding joints (SlidingJoint, a penalty force): their number, and
@@ -312,6 +317,25 @@ class MultibodyModel {
   // last evaluation.
   int sliders() const { return static_cast<int>(sliders_.size()); }
   double SliderArcLength(int i) const { return sliders_[i].s(); }
+
+  // Winches (WinchSpec, docs/model.md "Winches"): an axially moving mesh
+  // on each winch cable, whose N elements all have the length L(t) / N, so
+  // the model's size is fixed while the free length L(t) changes. At
+  // SetTime the winch cables' elements, their mass matrices (in mass()),
+  // gravity and the convective inertia terms (forces/winch_inertia.h,
+  // added by DampingForce, which every stepper calls; not dissipation:
+  // DampingPower leaves them out) are evaluated at L(t). A scene without
+  // winches holds none and pays nothing. The total energy of a winch
+  // scene is not conserved (the winch does work that is not summed), so
+  // the dynamic run's energy guard is off there.
+  int winches() const { return static_cast<int>(winches_.size()); }
+  // Winch w's cable (scene order) and its free length L [m] at the time
+  // of SetTime.
+  int WinchCable(int w) const { return winches_[w].cable; }
+  double WinchLength(int w) const { return winches_[w].length; }
+  // A cable's mass [kg] from its elements' mass matrices at the time of
+  // SetTime (rho A L(t) on a winch cable).
+  double CableMass(int cable) const;
 
   // Which joint a constraint row belongs to (for messages), or -1 for a
   // body's own axis constraints.
@@ -418,6 +442,19 @@ class MultibodyModel {
     Eigen::Vector3d Normal(double t, Eigen::Vector3d* rate = nullptr,
                            Eigen::Vector3d* accel = nullptr) const;
   };
+  // A winch (WinchSpec) on a cable.
+  struct WinchData {
+    int cable = 0;
+    int element_begin = 0, element_end = 0;  // the cable's elements
+    double length0 = 0;                      // L(0) [m]
+    TimeFunction speed;                      // Ldot(t) [m/s]
+    double length = 0, rate = 0, accel = 0;  // L, Ldot, Lddot at time_
+    double mass_per_length = 0;              // rho A [kg/m]
+    double ea = 0;                           // [N]
+    // Damping on the material motion (WinchDamping); the elements' own
+    // damping is then 0.
+    double axial_damping_s = 0, alpha_1_s = 0;
+  };
   // Constraint rows as flat quadratic forms over local coordinate lists:
   // phi = c + sum lin_val * q[coord[lin_local]] + sum w q[coord[a]] q[coord[b]].
   struct Row {
@@ -478,6 +515,31 @@ class MultibodyModel {
   void ScatterBodyBlock(int coord, const Eigen::Matrix3d& m, double scale, SkylineLdlt* a) const;
   const WaveField* wave_field() const { return wave_load_ ? &wave_load_->field() : nullptr; }
   void ProjectInitialVelocity();
+  // SetTime's share for the winches: lengths, elements, mass, gravity and
+  // convective coefficients at time_.
+  template <int D>
+  void UpdateWinches();
+  // DampingForce's share for the winches: the convective force
+  // -cv edot - ce e per element into `full`, tangent_scale * Mdot (the
+  // symmetric part of cv; the skew ldot (G - G^T) and the small position
+  // term are left out of the Newton matrix) into `tangent`. Returns the
+  // largest force entry.
+  template <int D>
+  double WinchForces(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, Eigen::VectorXd* full,
+                     SkylineLdlt* tangent, double tangent_scale, Eigen::VectorXd* roundoff) const;
+  // A winch cable element's damping on the material motion: Rayleigh
+  // alpha as -alpha int mu S^T v dx (v the material velocity, so a rigid
+  // reel-in is damped as any motion through still air would be) and
+  // Kelvin-Voigt axial damping on the material strain rate (WinchSlopeRateShape);
+  // adds the force to `fe` and its edot-derivative to `ce` (either may be
+  // null) and returns the dissipated power [W], >= 0. Bending damping is
+  // refused on winch cables (CheckWinches).
+  template <int D>
+  double WinchDamping(const WinchData& w, int index, const Eigen::VectorXd& q,
+                      const Eigen::VectorXd& qdot, typename AncfCableElement<D>::Coords* fe,
+                      typename AncfCableElement<D>::Matrix* ce) const;
+  template <int D>
+  Eigen::Vector3d WinchTension(const Eigen::VectorXd& q, int w) const;
   // The scene's rigid initial velocity at full configuration q (all nodes
   // and bodies; fixed coordinates are dropped by Reduce).
   void RigidVelocity(const Eigen::VectorXd& q, Eigen::VectorXd* qdot) const;
@@ -582,6 +644,18 @@ class MultibodyModel {
   double external_work_ = 0;
   // Sliding joints (empty in most scenes: then nothing is evaluated).
   std::vector<SlidingJoint> sliders_;
+  // Winches (empty in most scenes: then nothing is evaluated).
+  std::vector<WinchData> winches_;
+  // Per winch element (winch by winch, along each cable): the convective
+  // coefficients cv, ce and Mdot = ldot dM/dl (4 x 4 per component) at time_.
+  std::vector<Eigen::Matrix4d> winch_cv_, winch_ce_, winch_mdot_, winch_g_, winch_h_;
+  // Per element: its index into those (-1: not on a winch cable).
+  std::vector<int> winch_slot_;
+  // mass_'s values and constant_force_ without the winch elements' shares.
+  std::vector<double> mass_base_;
+  Eigen::VectorXd constant_force_base_;
+  // Per probe: the winch at whose end it sits (ProbeForces), or -1.
+  std::vector<int> probe_winch_;
   // Scratch (full size) for DampingForce (sized only when has_damping_).
   Eigen::VectorXd scratch_damping_, scratch_damping_roundoff_;
 };

@@ -43,6 +43,17 @@ std::string_view AnalysisName(Analysis analysis);
 std::string_view IntegratorName(Integrator integrator);
 std::string_view LinearSolverName(LinearSolverKind solver);
 
+// A winch at a cable's end (MultibodyModel, docs/model.md "Winches"): the
+// cable's free (unstretched) length is L(t) = length_m + int_0^t speed, so
+// a positive speed [m/s] pays cable out and a negative one reels it in.
+// The winch holds the cable's last point (s = length_m), which a joint to
+// ground (PIN or FIXED, fixed or moving) must hold; the cable's material
+// is measured from its first point (s = 0), where the payload stays.
+struct WinchSpec {
+  bool enabled = false;
+  TimeFunction speed;
+};
+
 struct CableSpec {
   std::string name;
   // Polyline the undeformed-length cable is laid along at t = 0 (>= 2
@@ -73,6 +84,7 @@ struct CableSpec {
   double tangential_drag = 0;
   double added_mass = 0;
   double hydro_diameter_m = 0;
+  WinchSpec winch;  // disabled: the length is fixed
 };
 
 struct BodySpec {

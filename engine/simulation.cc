@@ -41,7 +41,7 @@ class FrameRecorder {
     frame_.t = t;
     model_->Probes(q_, qd_, qdd_, &frame_.probes);
     if (lambda) {
-      model_->ProbeForces(*lambda, &frame_.support_forces);
+      model_->ProbeForces(q_, *lambda, &frame_.support_forces);
     } else {
       // No multipliers at hand: the columns stay, with 0 (a row keeps its size).
       frame_.support_forces.assign(model_->force_probe_count(), Eigen::Vector3d::Zero());
@@ -272,7 +272,11 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   };
   // The energy guard on a state the stepper reached (a step's end): false
   // (with the summary failed) when its energy rose beyond the limit.
+  // A winch does work that is not summed (MultibodyModel::winches): no
+  // energy guard there.
+  const bool guard_energy = model->winches() == 0;
   auto EnergyHolds = [&](const EnergySample& e, double t_state) {
+    if (!guard_energy) return true;
     const double rise = e.total + e.damped - summary->energy_initial;
     const double scale = std::max({rec->energy_scale(), std::abs(e.kinetic),
                                    std::abs(e.potential), std::abs(e.axial) + std::abs(e.bending)});
@@ -334,7 +338,8 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     summary->linear_solves += st.linear_solves;
     summary->inexact_linear_solves += st.inexact_solves;
     summary->max_linear_residual = std::max(summary->max_linear_residual, st.max_linear_residual);
-    if (st.converged && check_steps && st.newton_iterations >= kEnergyCheckNewton) {
+    if (st.converged && check_steps && guard_energy &&
+        st.newton_iterations >= kEnergyCheckNewton) {
       // A step Newton found hard may have landed on a spurious root (an
       // element folded through itself: Green-Lagrange strain does not see
       // it); its energy says so. Take it back and halve the step.

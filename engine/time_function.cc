@@ -93,4 +93,53 @@ TimeFunction::Value TimeFunction::Evaluate(double t) const {
   return v;
 }
 
+namespace {
+
+// int_a^b of the table's function (values[0] before the first time, the
+// last value after the last), a <= b.
+double TableIntegral(const std::vector<double>& times, const std::vector<double>& values,
+                     double a, double b) {
+  const size_t n = times.size();
+  auto value_at = [&](double t) {
+    if (n == 1 || t <= times.front()) return values.front();
+    if (t >= times.back()) return values.back();
+    const size_t k = static_cast<size_t>(
+        std::upper_bound(times.begin(), times.end(), t) - times.begin()) - 1;
+    return values[k] + (values[k + 1] - values[k]) * (t - times[k]) / (times[k + 1] - times[k]);
+  };
+  // Breakpoints inside (a, b), then the trapezoidal rule between them.
+  double sum = 0, t0 = a, y0 = value_at(a);
+  for (size_t k = 0; k < n; ++k) {
+    if (times[k] <= a || times[k] >= b) continue;
+    sum += 0.5 * (y0 + values[k]) * (times[k] - t0);
+    t0 = times[k];
+    y0 = values[k];
+  }
+  return sum + 0.5 * (y0 + value_at(b)) * (b - t0);
+}
+
+}  // namespace
+
+double TimeFunction::Integral(double t) const {
+  double sum = constant_ * t;
+  if (!values_.empty()) {
+    sum += t >= 0 ? TableIntegral(times_, values_, 0, t) : -TableIntegral(times_, values_, t, 0);
+  }
+  constexpr double kTwoPi = 6.283185307179586;
+  for (const Harmonic& h : harmonics_) {
+    const double w = kTwoPi * h.frequency_hz;
+    if (w == 0) {
+      sum += h.amplitude * std::sin(h.phase_rad) * t;
+    } else {
+      sum += h.amplitude / w * (std::cos(h.phase_rad) - std::cos(w * t + h.phase_rad));
+    }
+  }
+  for (const Ramp& r : ramps_) {
+    const double a = std::max(0.0, t - r.start_s), b = std::max(0.0, -r.start_s);
+    sum += 0.5 * r.slope * (a * a - b * b);
+  }
+  for (const TimeFunction& f : terms_) sum += f.Integral(t);
+  return sum;
+}
+
 }  // namespace cablesim

@@ -62,6 +62,11 @@ class TimeFunction {
   bool IsZero() const;
 
   Value Evaluate(double t) const;
+  // The integral int_0^t f(tau) dtau, exact for every part (a table's
+  // segments by the trapezoidal rule, which is exact on them; a harmonic of
+  // frequency 0 is the constant A sin(phi)). A winch's free length is its
+  // initial length plus the integral of its pay-out speed (scene.h).
+  double Integral(double t) const;
   double operator()(double t) const { return Evaluate(t).f; }
 
  private:

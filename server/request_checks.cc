@@ -155,6 +155,21 @@ absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimi
         break;
       }
     }
+    // A probe at a winch's end (its cable's last point) reports the line
+    // tension, unless a moving support there already counted it.
+    if (probe.at.cable >= 0) {
+      const CableSpec& cable = checked.scene.cables[probe.at.cable];
+      bool counted = false;
+      for (const JointSpec& joint : checked.scene.joints) {
+        if (!joint.HasMotion()) continue;
+        const Attachment& held = joint.a.IsGround() ? joint.b : joint.a;
+        counted |= held.cable == probe.at.cable &&
+                   std::abs(held.s_m - probe.at.s_m) <= 1e-9 * cable.length_m;
+      }
+      if (!counted && cable.winch.enabled &&
+          std::abs(probe.at.s_m - cable.length_m) <= 1e-9 * cable.length_m)
+        force_values += 3;
+    }
   }
   // A seabed or a sheave adds energy.contact to every row.
   const bool contact = checked.scene.seabed.enabled || !checked.scene.sheaves.empty();

@@ -25,14 +25,9 @@ constexpr double kG = 9.81;
 constexpr double kPi = std::numbers::pi;
 
 using testing::CollectingSink;
+using testing::ProbeIndex;
 using testing::RunOk;
 using testing::SceneFromJson;
-
-int ProbeIndex(const ModelInfo& info, const std::string& name) {
-  for (size_t i = 0; i < info.probe_names.size(); ++i)
-    if (info.probe_names[i] == name) return static_cast<int>(i);
-  return -1;
-}
 
 // A cable laid from (-R, -h1) up to (-R, 0), over the top of a wheel of
 // radius R at the origin along a polygon whose chords touch the circle

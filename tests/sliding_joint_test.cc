@@ -24,15 +24,10 @@ constexpr double kG = 9.81;
 constexpr double kPi = std::numbers::pi;
 
 using testing::CollectingSink;
+using testing::ProbeIndex;
 using testing::RunOk;
 using testing::SceneFromJson;
 using ::testing::HasSubstr;
-
-int ProbeIndex(const ModelInfo& info, const std::string& name) {
-  for (size_t i = 0; i < info.probe_names.size(); ++i)
-    if (info.probe_names[i] == name) return static_cast<int>(i);
-  return -1;
-}
 
 // A straight steel bar (E = 2e11 Pa, d = 0.05 m: EI = 6.1e4 N m^2) of
 // length 2 m clamped at both ends, inclined at `angle` below +x, nearly

@@ -68,6 +68,13 @@ class CollectingSink : public FrameSink {
   std::vector<Frame> frames_;
 };
 
+// The index of the probe called `name` in `info`, or -1.
+inline int ProbeIndex(const ModelInfo& info, const std::string& name) {
+  for (size_t i = 0; i < info.probe_names.size(); ++i)
+    if (info.probe_names[i] == name) return static_cast<int>(i);
+  return -1;
+}
+
 // Runs a scene that must succeed; the frames land in `sink`.
 inline RunSummary RunOk(const Scene& scene, CollectingSink* sink) {
   auto summary = RunScene(scene, sink);
