@@ -7,6 +7,7 @@
 // spatial.
 
 #include <cmath>
+#include <ostream>
 #include <string>
 
 #include <gmock/gmock.h>
@@ -160,6 +161,12 @@ struct VerticalCase {
   const char* model;
   const char* integrator;
 };
+
+// Readable, stable test names (the default prints the struct's bytes,
+// pointers included, which change from run to run).
+void PrintTo(const VerticalCase& c, std::ostream* os) {
+  *os << (c.sign < 0 ? "reel_in_" : "pay_out_") << c.model << "_" << c.integrator;
+}
 
 class VerticalTest : public ::testing::TestWithParam<VerticalCase> {};
 
