@@ -1047,9 +1047,7 @@ class SceneConverter {
         // tension T = eps EA sinks p = T / (k R) = eps R into it.
         double ea = 0;
         for (int c = 0; c < static_cast<int>(scene_.cables.size()); ++c) {
-          if (!spec.cables.empty() &&
-              std::find(spec.cables.begin(), spec.cables.end(), c) == spec.cables.end())
-            continue;
+          if (!spec.Touches(c)) continue;
           ea = std::max(ea, scene_.cables[c].youngs_modulus_pa * scene_.cables[c].area_m2);
         }
         if (!(ea > 0)) return Invalid(Sub(path, "stiffness"), "must be given (no cable to touch)");

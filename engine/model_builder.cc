@@ -810,9 +810,7 @@ void ModelBuilder::BuildSheaves() {
     m.sheaves_.emplace_back(spec);
     if (m.sheaves_.back().dissipates()) m.sheaves_dissipate_ = m.has_damping_ = true;
     for (int cable = 0; cable < static_cast<int>(scene_.cables.size()); ++cable) {
-      if (!spec.cables.empty() &&
-          std::find(spec.cables.begin(), spec.cables.end(), cable) == spec.cables.end())
-        continue;
+      if (!spec.Touches(cable)) continue;
       for (int k = m.cable_element_begin_[cable]; k < m.cable_element_begin_[cable + 1]; ++k)
         m.sheave_mask_[k] |= uint64_t{1} << i;
     }
@@ -1100,9 +1098,7 @@ void ModelBuilder::EnvelopeAndMass() {
   for (const SheaveSpec& wheel : scene_.sheaves) {
     if (wheel.body < 0) continue;
     for (int cable = 0; cable < static_cast<int>(scene_.cables.size()); ++cable)
-      if (wheel.cables.empty() ||
-          std::find(wheel.cables.begin(), wheel.cables.end(), cable) != wheel.cables.end())
-        couple_body_with_cable(wheel.body, D, cable);
+      if (wheel.Touches(cable)) couple_body_with_cable(wheel.body, D, cable);
   }
 
   // The reduced mass matrix, with the element scatter tables.

@@ -8,6 +8,7 @@
 //
 // Units are SI: m, kg, s, N, Pa, rad.
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <string>
@@ -271,6 +272,9 @@ struct SheaveSpec {
   double friction = 0;        // Coulomb coefficient [-]
   double friction_speed_m_s = 1e-3;  // regularisation, as SeabedSpec's
   std::vector<int> cables;    // indices of the cables it touches; empty: all
+  bool Touches(int cable) const {
+    return cables.empty() || std::find(cables.begin(), cables.end(), cable) != cables.end();
+  }
   // The body carrying it (index in Scene::bodies; the wheel's centre is the
   // body's centre of mass and position_m is unused), or -1: fixed.
   int body = -1;
