@@ -334,6 +334,16 @@ void ExpectStepsDoNotAllocate(const Scene& scene, double h, int steps) {
   EXPECT_TRUE(std::isfinite(error_norms));
 }
 
+// The same with each of the four steppers.
+void ExpectEveryStepperDoesNotAllocate(Scene scene, double h, int steps) {
+  for (Integrator integrator : {Integrator::kImplicitEuler, Integrator::kGeneralizedAlpha,
+                                Integrator::kHht, Integrator::kEnergyMomentum}) {
+    SCOPED_TRACE(::testing::Message() << "integrator " << static_cast<int>(integrator));
+    scene.solver.integrator = integrator;
+    ExpectStepsDoNotAllocate(scene, h, steps);
+  }
+}
+
 // scenes/falling-pendulum.json, built in C++ (12 elements, no multipliers:
 // the pin removes the node's position).
 Scene FallingPendulum() {
@@ -594,12 +604,7 @@ TEST_F(StepperAllocationTest, WavesDoNotAllocate) {
     "joints": [{"type": "PIN", "a": {"cable": "riser", "s": 0}}],
     "solver": {"duration": 1}})");
   ASSERT_TRUE(scene.fluid.waves.any());
-  for (Integrator integrator : {Integrator::kImplicitEuler, Integrator::kGeneralizedAlpha,
-                                Integrator::kHht, Integrator::kEnergyMomentum}) {
-    SCOPED_TRACE(::testing::Message() << "integrator " << static_cast<int>(integrator));
-    scene.solver.integrator = integrator;
-    ExpectStepsDoNotAllocate(scene, 0.01, 50);
-  }
+  ExpectEveryStepperDoesNotAllocate(scene, 0.01, 50);
 }
 
 // Nor bodies on the seabed (contact points in fixed-size blocks): a block
@@ -618,14 +623,8 @@ TEST_F(StepperAllocationTest, BodyOnTheSeabedDoesNotAllocate) {
     "initial_velocity": {"linear": {"x": 0.3}},
     "seabed": {"stiffness": 1e6},
     "solver": {"duration": 1}})");
-  for (Integrator integrator : {Integrator::kImplicitEuler, Integrator::kGeneralizedAlpha,
-                                Integrator::kHht, Integrator::kEnergyMomentum}) {
-    SCOPED_TRACE(::testing::Message() << "integrator " << static_cast<int>(integrator));
-    scene.solver.integrator = integrator;
-    ExpectStepsDoNotAllocate(scene, 0.01, 50);
-  }
+  ExpectEveryStepperDoesNotAllocate(scene, 0.01, 50);
 }
-
 
 // A rope pinned at both ends sagging onto a wheel under its middle, with
 // friction and damping (the contact's pieces and Gauss points live on the
@@ -640,12 +639,7 @@ TEST_F(StepperAllocationTest, SheaveContactDoesNotAllocate) {
     "sheaves": [{"radius": 0.1, "friction": 0.3, "damping": 10}],
     "solver": {"duration": 1}})");
   ASSERT_EQ(scene.sheaves.size(), 1u);
-  for (Integrator integrator : {Integrator::kImplicitEuler, Integrator::kGeneralizedAlpha,
-                                Integrator::kHht, Integrator::kEnergyMomentum}) {
-    SCOPED_TRACE(::testing::Message() << "integrator " << static_cast<int>(integrator));
-    scene.solver.integrator = integrator;
-    ExpectStepsDoNotAllocate(scene, 0.001, 50);
-  }
+  ExpectEveryStepperDoesNotAllocate(scene, 0.001, 50);
 }
 
 
@@ -665,12 +659,7 @@ TEST_F(StepperAllocationTest, BodyHydrodynamicsDoNotAllocate) {
     "joints": [{"type": "PIN", "a": {"cable": "riser", "s": 0}},
                {"type": "PIN", "a": {"cable": "riser", "s": 20}, "b": {"body": "buoy"}}],
     "solver": {"duration": 1}})");
-  for (Integrator integrator : {Integrator::kImplicitEuler, Integrator::kGeneralizedAlpha,
-                                Integrator::kHht, Integrator::kEnergyMomentum}) {
-    SCOPED_TRACE(::testing::Message() << "integrator " << static_cast<int>(integrator));
-    scene.solver.integrator = integrator;
-    ExpectStepsDoNotAllocate(scene, 0.01, 50);
-  }
+  ExpectEveryStepperDoesNotAllocate(scene, 0.01, 50);
 }
 
 }  // namespace
