@@ -147,6 +147,23 @@ TEST(SheaveValidationTest, NamesTheField) {
   EXPECT_THAT(error(R"({"radius": 0.1, "cables": ["rop"]})"),
               HasSubstr("sheaves[0].cables[0]: no cable named \"rop\""));
   EXPECT_THAT(error(R"({"radius": 0.1}, {"radius": -2})"), HasSubstr("sheaves[1].radius"));
+  EXPECT_THAT(error(R"({"radius": 0.1, "body": "hook"})"),
+              HasSubstr("sheaves[0].body: no body named \"hook\""));
+}
+
+// A wheel on a body is centred on it: a position beside it is refused.
+TEST(SheaveValidationTest, WheelOnABodyTakesNoPosition) {
+  auto proto = ParseSceneJson(R"({"gravity": {"y": -9.81},
+    "cables": [{"name": "rope", "length": 1, "density": 1000, "youngs_modulus": 1e9,
+                "diameter": 0.01}],
+    "bodies": [{"name": "hook", "mass": 1, "inertia": {"x": 1, "y": 1, "z": 1}}],
+    "sheaves": [{"radius": 0.1, "body": "hook", "position": {"x": 1}}],
+    "solver": {"duration": 1}})");
+  ASSERT_TRUE(proto.ok()) << proto.status();
+  auto scene = SceneFromProto(*proto);
+  ASSERT_FALSE(scene.ok());
+  EXPECT_EQ(scene.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(scene.status().message()), HasSubstr("sheaves[0].position: not with body"));
 }
 
 // A tilted axis makes the scene spatial; the default stiffness is
