@@ -45,7 +45,11 @@ std::string SummaryToJson(const RunSummary& summary) {
         .Add("linear_solves", summary.linear_solves)
         .Add("inexact_linear_solves", summary.inexact_linear_solves)
         .Add("adaptive", summary.adaptive);
-    if (summary.integrator != "IMPLICIT_EULER") json.Add("rho_infinity", summary.rho_infinity);
+    // rho_infinity: the implicit second-order steppers' (the explicit ones
+    // have no such parameter).
+    if (summary.integrator != "IMPLICIT_EULER" && summary.integrator != "CENTRAL_DIFFERENCE" &&
+        summary.integrator != "DORMAND_PRINCE")
+      json.Add("rho_infinity", summary.rho_infinity);
     if (summary.has_error_estimate) {
       if (summary.error_estimate_m >= 0) json.Add("error_estimate_m", summary.error_estimate_m);
       json.Add("error_estimate_method", summary.error_estimate_method)

@@ -1246,6 +1246,22 @@ class SceneConverter {
                      "applies to GENERALIZED_ALPHA, HHT and ENERGY_MOMENTUM only (solver.integrator is " +
                          std::string(IntegratorName(out.integrator)) + ")");
     }
+    if (IsExplicit(out.integrator)) {
+      // Explicit: no Newton iteration and no Newton matrix; the only linear
+      // solve is with the constant mass matrix, factored once.
+      const std::string name(IntegratorName(out.integrator));
+      if (s.linear_solver() == v1::MINRES || s.linear_solver() == v1::GMRES) {
+        return Invalid("solver.linear_solver",
+                       "does not apply to " + name +
+                           " (explicit: it solves only with the constant mass matrix, factored "
+                           "once)");
+      }
+      for (const auto& [has, field] :
+           {std::pair{s.has_newton_tolerance(), "solver.newton_tolerance"},
+            std::pair{s.has_max_newton_iterations(), "solver.max_newton_iterations"}}) {
+        if (has) return Invalid(field, "does not apply to " + name + " (explicit: no Newton iteration)");
+      }
+    }
     for (const auto& [has, name] : {std::pair{s.has_tolerance(), "solver.tolerance"},
                                     std::pair{s.has_relative_tolerance(),
                                               "solver.relative_tolerance"}}) {
@@ -1364,9 +1380,14 @@ absl::StatusOr<Integrator> IntegratorFromProto(v1::Integrator integrator,
       return Integrator::kHht;
     case v1::ENERGY_MOMENTUM:
       return Integrator::kEnergyMomentum;
+    case v1::DORMAND_PRINCE:
+      return Integrator::kDormandPrince;
+    case v1::CENTRAL_DIFFERENCE:
+      return Integrator::kCentralDifference;
     default:
       return UnknownEnumValue(path, integrator,
-                              "IMPLICIT_EULER, GENERALIZED_ALPHA, HHT or ENERGY_MOMENTUM");
+                              "IMPLICIT_EULER, GENERALIZED_ALPHA, HHT, ENERGY_MOMENTUM, "
+                              "DORMAND_PRINCE or CENTRAL_DIFFERENCE");
   }
 }
 

@@ -667,6 +667,33 @@ void ModelBuilder::KeepMovableRows() {
   }
 }
 
+absl::Status ModelBuilder::CheckIntegratorFits() const {
+  if (!IsExplicit(scene_.solver.integrator) || scene_.solver.analysis != Analysis::kDynamic)
+    return absl::OkStatus();
+  const std::string name(IntegratorName(scene_.solver.integrator));
+  const MultibodyModel& m = model_;
+  if (!m.rows_.empty()) {
+    const MultibodyModel::Row& r = m.rows_.front();
+    const std::string what = r.joint >= 0
+                                 ? absl::StrFormat("joints[%d] is kept as constraint rows", r.joint)
+                                 : absl::StrFormat("bodies[%d] has its axes' constraint rows", r.body);
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "solver.integrator: %s is explicit and integrates unconstrained motion "
+        "only, and this scene has %d constraint rows (%s; only joints to ground are "
+        "eliminated): use HHT, GENERALIZED_ALPHA, ENERGY_MOMENTUM or IMPLICIT_EULER",
+        name, m.multipliers(), what));
+  }
+  for (int c = 0; c < static_cast<int>(scene_.cables.size()); ++c) {
+    if (scene_.cables[c].winch.enabled) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "solver.integrator: %s does not take winches (cables[%d].winch): it "
+          "factors the mass matrix once; use HHT, GENERALIZED_ALPHA or IMPLICIT_EULER",
+          name, c));
+    }
+  }
+  return absl::OkStatus();
+}
+
 absl::Status ModelBuilder::CheckMovingRows() const {
   std::vector<int> kept(scene_.joints.size(), 0), wanted(scene_.joints.size(), 0);
   for (const PendingRow& r : pending_)

@@ -149,6 +149,7 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene,
   builder.OrderUnknowns();
   builder.KeepMovableRows();
   if (absl::Status s = builder.CheckMovingRows(); !s.ok()) return s;
+  if (absl::Status s = builder.CheckIntegratorFits(); !s.ok()) return s;
   if (builder.Stopped()) return stopped;
   builder.BuildElements();
   if (builder.Stopped()) return stopped;

@@ -37,6 +37,10 @@ std::string_view IntegratorName(Integrator integrator) {
       return "HHT";
     case Integrator::kEnergyMomentum:
       return "ENERGY_MOMENTUM";
+    case Integrator::kDormandPrince:
+      return "DORMAND_PRINCE";
+    case Integrator::kCentralDifference:
+      return "CENTRAL_DIFFERENCE";
   }
   return "UNKNOWN";
 }

@@ -28,7 +28,8 @@ enum class BendingModel { kExact, kLinear, kNone };
 // (SlidingJoint; JointSpec::slide).
 enum class JointType { kPin, kFixed, kSlide };
 enum class Analysis { kDynamic, kStatic, kModal };
-enum class Integrator { kImplicitEuler, kGeneralizedAlpha, kHht, kEnergyMomentum };
+enum class Integrator { kImplicitEuler, kGeneralizedAlpha, kHht, kEnergyMomentum, kDormandPrince,
+                              kCentralDifference };
 // kDirect: exact block elimination (skyline LDL^T of the Newton block and a
 // dense Schur complement); kAuto: picked per scene (SaddlePointSolver).
 enum class LinearSolverKind { kMinres, kGmres, kDirect, kAuto };
@@ -42,6 +43,12 @@ enum class InitialState { kAsGiven, kStatic };
 // the summary reports).
 std::string_view AnalysisName(Analysis analysis);
 std::string_view IntegratorName(Integrator integrator);
+// DORMAND_PRINCE and CENTRAL_DIFFERENCE: no Newton iteration, constant mass
+// factored once, unconstrained scenes only (ModelBuilder::CheckIntegratorFits).
+inline bool IsExplicit(Integrator integrator) {
+  return integrator == Integrator::kDormandPrince ||
+         integrator == Integrator::kCentralDifference;
+}
 std::string_view LinearSolverName(LinearSolverKind solver);
 
 // A winch at a cable's end (MultibodyModel, docs/model.md "Winches"): the

@@ -516,7 +516,11 @@ void EstimateError(MultibodyModel* model, const SolverSettings& settings,
   summary->has_error_estimate = true;
   SolverSettings companion = settings;
   companion.error_estimate = false;
-  const int order = settings.integrator == Integrator::kImplicitEuler ? 1 : 2;
+  // DORMAND_PRINCE is fifth order at its steps, but frames between steps are
+  // cubic Hermite (fourth order): 4 covers both.
+  const int order = settings.integrator == Integrator::kImplicitEuler    ? 1
+                    : settings.integrator == Integrator::kDormandPrince ? 4
+                                                                         : 2;
   double factor = 1;
   if (settings.adaptive) {
     companion.tolerance_m /= 32;

@@ -3,6 +3,8 @@
 #include <algorithm>
 
 #include "absl/strings/str_format.h"
+#include "engine/central_difference_stepper.h"
+#include "engine/dormand_prince_stepper.h"
 #include "engine/energy_momentum_stepper.h"
 #include "engine/generalized_alpha_stepper.h"
 #include "engine/implicit_euler_stepper.h"
@@ -84,6 +86,10 @@ std::unique_ptr<Stepper> MakeStepper(MultibodyModel* model, const SolverSettings
                                                        GeneralizedAlphaStepper::Variant::kHht);
     case Integrator::kEnergyMomentum:
       return std::make_unique<EnergyMomentumStepper>(model, settings);
+    case Integrator::kDormandPrince:
+      return std::make_unique<DormandPrinceStepper>(model, settings);
+    case Integrator::kCentralDifference:
+      return std::make_unique<CentralDifferenceStepper>(model, settings);
     case Integrator::kImplicitEuler:
       break;
   }

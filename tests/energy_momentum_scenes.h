@@ -12,9 +12,9 @@
 
 namespace cablesim::testing {
 
-inline std::string EnergyMomentumFallingPendulum(double duration_s, double step_s,
-                                                 const std::string& extra,
-                                                 double output_interval_s = 0.01) {
+// The same scene with `solver` fields of the caller's (integrator, step...).
+inline std::string FallingPendulumWithSolver(double duration_s, double output_interval_s,
+                                             const std::string& solver) {
   return absl::StrFormat(R"({
     "gravity": {"y": -9.81},
     "cables": [{"name": "beam", "length": 1.2, "elements": 12, "direction": {"x": 1},
@@ -22,9 +22,16 @@ inline std::string EnergyMomentumFallingPendulum(double duration_s, double step_
                 "area": 0.0018, "second_moment": 1.215e-8, "bending": "EXACT"}],
     "joints": [{"type": "PIN", "a": {"cable": "beam", "s": 0}}],
     "probes": [{"name": "tip", "cable": "beam", "s": 1.2}],
-    "solver": {"duration": %g, "step": %g, "output_interval": %g,
-               "integrator": "ENERGY_MOMENTUM" %s}})",
-                         duration_s, step_s, output_interval_s, extra);
+    "solver": {"duration": %g, "output_interval": %g, %s}})",
+                         duration_s, output_interval_s, solver);
+}
+
+inline std::string EnergyMomentumFallingPendulum(double duration_s, double step_s,
+                                                 const std::string& extra,
+                                                 double output_interval_s = 0.01) {
+  return FallingPendulumWithSolver(
+      duration_s, output_interval_s,
+      absl::StrFormat(R"("step": %g, "integrator": "ENERGY_MOMENTUM" %s)", step_s, extra));
 }
 
 }  // namespace cablesim::testing

@@ -337,7 +337,9 @@ std::vector<InvalidCase> InvalidCases() {
        "solver.error_estimate: ", "DYNAMIC analysis only"},
       {"UnknownIntegrator",
        absl::StrCat(R"({"cables": [)", kCable, R"(], "solver": {"duration": 1, "integrator": 9}})"),
-       "solver.integrator: ", "IMPLICIT_EULER, GENERALIZED_ALPHA, HHT or ENERGY_MOMENTUM"},
+       "solver.integrator: ",
+       "IMPLICIT_EULER, GENERALIZED_ALPHA, HHT, ENERGY_MOMENTUM, DORMAND_PRINCE or "
+       "CENTRAL_DIFFERENCE"},
       {"UnknownLinearSolver",
        absl::StrCat(R"({"cables": [)", kCable,
                     R"(], "solver": {"duration": 1, "linear_solver": 9}})"),

@@ -1,0 +1,108 @@
+#include "engine/dormand_prince_stepper.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "absl/strings/str_format.h"
+
+namespace cablesim {
+namespace {
+
+// Dormand and Prince (1980), the 5(4) pair: nodes c, the lower triangle a
+// (row i holds a_i1 .. a_i,i-1), and e = b - bhat (b is the row a_7).
+constexpr double kC[DormandPrinceStepper::kStages] = {0, 1.0 / 5, 3.0 / 10, 4.0 / 5, 8.0 / 9, 1, 1};
+constexpr double kA[DormandPrinceStepper::kStages][DormandPrinceStepper::kStages - 1] = {
+    {},
+    {1.0 / 5},
+    {3.0 / 40, 9.0 / 40},
+    {44.0 / 45, -56.0 / 15, 32.0 / 9},
+    {19372.0 / 6561, -25360.0 / 2187, 64448.0 / 6561, -212.0 / 729},
+    {9017.0 / 3168, -355.0 / 33, 46732.0 / 5247, 49.0 / 176, -5103.0 / 18656},
+    {35.0 / 384, 0, 500.0 / 1113, 125.0 / 192, -2187.0 / 6784, 11.0 / 84}};
+constexpr double kE[DormandPrinceStepper::kStages] = {
+    71.0 / 57600, 0, -71.0 / 16695, 71.0 / 1920, -17253.0 / 339200, 22.0 / 525, -1.0 / 40};
+
+}  // namespace
+
+DormandPrinceStepper::DormandPrinceStepper(MultibodyModel* model,
+                                           const SolverSettings& /*settings*/)
+    : model_(model), acceleration_(model) {
+  n_ = model->dofs();
+  z_ = model->initial_z();
+  v_ = model->initial_v();
+  a_.setZero(n_);
+  lambda_.resize(0);
+  z_old_ = z_;
+  v_old_ = v_;
+  a_old_ = a_;
+  for (int i = 0; i < kStages; ++i) {
+    vs_[i].setZero(n_);
+    as_[i].setZero(n_);
+  }
+  zs_.setZero(n_);
+  err_z_.setZero(n_);
+}
+
+bool DormandPrinceStepper::Initialize(std::string* reason) {
+  if (!acceleration_.Prepare("DORMAND_PRINCE", reason)) return false;
+  if (!acceleration_.Evaluate(t_, z_, v_, &a_)) {
+    *reason = "the initial acceleration is not finite";
+    return false;
+  }
+  a_old_ = a_;
+  return true;
+}
+
+Stepper::StepStats DormandPrinceStepper::Step(double h) {
+  StepStats st;
+  vs_[0] = v_;
+  as_[0] = a_;  // first same as last
+  for (int i = 1; i < kStages; ++i) {
+    zs_ = z_;
+    vs_[i] = v_;
+    for (int j = 0; j < i; ++j) {
+      const double w = h * kA[i][j];
+      if (w == 0) continue;
+      zs_ += w * vs_[j];
+      vs_[i] += w * as_[j];
+    }
+    if (!acceleration_.Evaluate(t_ + kC[i] * h, zs_, vs_[i], &as_[i])) {
+      model_->SetTime(t_);
+      st.reason = absl::StrFormat(
+          "the acceleration at stage %d of the explicit step is not finite (h = %.3g s: likely "
+          "beyond DORMAND_PRINCE's stability limit, about 3.3 / omega_max)",
+          i + 1, h);
+      return st;
+    }
+  }
+  err_z_.setZero();
+  for (int i = 0; i < kStages; ++i)
+    if (kE[i] != 0) err_z_ += (h * kE[i]) * vs_[i];
+  z_old_.swap(z_);
+  v_old_.swap(v_);
+  a_old_.swap(a_);
+  z_ = zs_;  // Z_7: the row a_7 is b
+  v_ = vs_[kStages - 1];
+  a_ = as_[kStages - 1];
+  t_old_ = t_;
+  t_ += h;
+  st.converged = true;
+  return st;
+}
+
+void DormandPrinceStepper::Restore() {
+  z_.swap(z_old_);
+  v_.swap(v_old_);
+  a_.swap(a_old_);
+  t_ = t_old_;
+  model_->SetTime(t_);
+}
+
+double DormandPrinceStepper::LocalErrorNorm(double /*h*/, double atol, double rtol) const {
+  double worst = 0;
+  for (int i = 0; i < n_; ++i)
+    worst = std::max(worst, std::abs(err_z_(i)) / (atol + rtol * std::abs(z_(i))));
+  return worst;
+}
+
+}  // namespace cablesim

@@ -1,0 +1,83 @@
+#ifndef CABLESIM_ENGINE_DORMAND_PRINCE_STEPPER_H_
+#define CABLESIM_ENGINE_DORMAND_PRINCE_STEPPER_H_
+
+// DORMAND_PRINCE: the explicit Runge-Kutta pair 5(4) of Dormand and Prince
+// (J. Comput. Appl. Math. 6:19-26, 1980; coefficients as in Hairer, Norsett
+// and Wanner, Solving ODEs I, 2nd ed., table II.5.2), on the first-order
+// form of the unconstrained equations of motion on the unknowns z,
+//
+//   z' = v,   M v' = f(t, z, v) = Q_a(z, t) - Q_k(z) - C(z) v,
+//
+// with M the constant reduced mass matrix, factored once (SkylineLdlt).
+// A step of size h evaluates the accelerations a = M^-1 f at seven stages
+// (t + c_i h, Z_i, V_i), Z_i = z + h sum_j a_ij V_j, V_i = v + h sum_j a_ij
+// A_j; the seventh is the step's end (z1 = Z_7, v1 = V_7: the method's b
+// row is its a_7 row), and its acceleration is the next step's first stage
+// ("first same as last"): six force evaluations and six back-substitutions
+// with the mass per step, no Newton, no tangent. Fifth order in z and v.
+//
+// Local error (adaptive steps): the difference to the embedded fourth-order
+// solution, e_z = h sum_i (b_i - bhat_i) V_i, in positions (the power of h
+// in it is 5, local extrapolation as in DOPRI5).
+//
+// Where it applies. An explicit method is stable only while h omega_max
+// stays within its stability region (for DOPRI5 about 3.3 along the
+// imaginary axis, where the undamped modes sit); omega_max is the cable's
+// stiffest element mode, an axial one: omega_max = 9.6 sqrt(E / rho) / l
+// for elements of length l at rest (MODAL analysis of 12 and 24 soft and 12
+// steel elements: 9.57, 9.56, 9.55), higher under tension. It pays where that step is as
+// large as accuracy asks for anyway (soft cables, ropes, slack lines with
+// fine output); a steel cable of short elements needs micro-steps (an
+// implicit stepper then). Adaptive steps find the limit themselves; fixed
+// steps beyond it grow until the run's energy guard stops the run.
+// The model's constraint rows (joints other than to ground, bodies' axes)
+// and winches (a mass that changes) are refused when the model is built
+// (ModelBuilder::CheckIntegratorFits); lambda() is empty.
+//
+// Step() allocates nothing.
+
+#include <array>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "engine/explicit_acceleration.h"
+#include "engine/multibody_model.h"
+#include "engine/scene.h"
+#include "engine/stepper.h"
+
+namespace cablesim {
+
+class DormandPrinceStepper final : public Stepper {
+ public:
+  DormandPrinceStepper(MultibodyModel* model, const SolverSettings& settings);
+
+  bool Initialize(std::string* reason) override;
+  StepStats Step(double h) override;
+  void Restore() override;
+  double LocalErrorNorm(double h, double atol, double rtol) const override;
+  int local_error_order() const override { return 5; }
+  int order() const override { return 5; }
+
+  const Eigen::VectorXd& z() const override { return z_; }
+  const Eigen::VectorXd& v() const override { return v_; }
+  const Eigen::VectorXd& a() const override { return a_; }
+  const Eigen::VectorXd& lambda() const override { return lambda_; }
+
+  static constexpr int kStages = 7;
+
+ private:
+  MultibodyModel* model_;
+  ExplicitAcceleration acceleration_;
+  int n_ = 0;
+  Eigen::VectorXd z_, v_, a_, lambda_;
+  Eigen::VectorXd z_old_, v_old_, a_old_;
+  double t_ = 0, t_old_ = 0;
+  // Stage velocities V_i (= the stages' z') and accelerations A_i.
+  std::array<Eigen::VectorXd, kStages> vs_, as_;
+  Eigen::VectorXd zs_, err_z_;
+};
+
+}  // namespace cablesim
+
+#endif  // CABLESIM_ENGINE_DORMAND_PRINCE_STEPPER_H_
