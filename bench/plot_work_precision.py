@@ -15,6 +15,7 @@ Needs Debian's python3-matplotlib (deploy/install-deps.sh); no network.
 """
 
 import csv
+import textwrap
 import math
 import os
 import sys
@@ -91,7 +92,9 @@ def plot_scene(scene, rows, out_dir):
     failed = [r for r in rows if r["status"] == "failed"]
     footnote = []
     if skipped:
-        footnote.append("not run by this build: " + ", ".join(skipped))
+        # Refused by the scene's validation (a setting that does not apply to
+        # that stepper), wrapped so that it stays left of the legend.
+        footnote += textwrap.wrap("refused (setting does not apply): " + ", ".join(skipped), 120)
     if failed:
         footnote.append(f"{len(failed)} runs failed (see work_precision.csv)")
     if footnote:
