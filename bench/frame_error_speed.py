@@ -48,7 +48,7 @@ for tag, integrator, solver, step, extra in [
         ("ga5n6", "GENERALIZED_ALPHA", "DIRECT", 5e-4, dict(GA, newton_tolerance=1e-6)),
         ("ga5n5", "GENERALIZED_ALPHA", "DIRECT", 5e-4, dict(GA, newton_tolerance=1e-5)),
         ("ga4n5", "GENERALIZED_ALPHA", "DIRECT", 4e-4, dict(GA, newton_tolerance=1e-5)),
-        # Explicit steppers (no Newton; stable while h omega_max < 2 and about 3.3).
+        # Explicit steppers (no Newton; undamped modes stable while h omega_max < 2 and <= 1).
         ("cd8", "CENTRAL_DIFFERENCE", "AUTO", 8e-4, {}),
         ("cd7", "CENTRAL_DIFFERENCE", "AUTO", 7e-4, {}),
         ("cd5", "CENTRAL_DIFFERENCE", "AUTO", 5e-4, {}),

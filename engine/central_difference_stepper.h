@@ -20,8 +20,10 @@
 // predictor v_n + h a_n, an O(h^2) change of it, which keeps the order two.
 //
 // Stability: h omega_max < 2 for the undamped modes (omega_max the stiffest
-// element mode, see dormand_prince_stepper.h); beyond it the step grows
-// without bound and the run's energy guard stops it.
+// element mode, see dormand_prince_stepper.h). A fixed step beyond it at the
+// initial state is refused by Initialize (ExplicitAcceleration::Prepare);
+// one that tension makes unstable later grows until the run's energy guard
+// stops it.
 //
 // Local error (adaptive steps): Zienkiewicz and Xie's estimate for Newmark
 // methods (Earthquake Eng. Struct. Dyn. 20:871-887, 1991) at beta = 0,
@@ -61,6 +63,7 @@ class CentralDifferenceStepper final : public Stepper {
 
  private:
   MultibodyModel* model_;
+  SolverSettings settings_;
   ExplicitAcceleration acceleration_;
   int n_ = 0;
   Eigen::VectorXd z_, v_, a_, lambda_;

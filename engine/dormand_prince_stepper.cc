@@ -25,8 +25,8 @@ constexpr double kE[DormandPrinceStepper::kStages] = {
 }  // namespace
 
 DormandPrinceStepper::DormandPrinceStepper(MultibodyModel* model,
-                                           const SolverSettings& /*settings*/)
-    : model_(model), acceleration_(model) {
+                                           const SolverSettings& settings)
+    : model_(model), settings_(settings), acceleration_(model) {
   n_ = model->dofs();
   z_ = model->initial_z();
   v_ = model->initial_v();
@@ -44,7 +44,14 @@ DormandPrinceStepper::DormandPrinceStepper(MultibodyModel* model,
 }
 
 bool DormandPrinceStepper::Initialize(std::string* reason) {
-  if (!acceleration_.Prepare("DORMAND_PRINCE", reason)) return false;
+  // |R(i omega h)| = 1.01 at omega h = 1.725 (R the stability polynomial,
+  // dormand_prince_stepper.h): beyond, the stiffest undamped mode grows by
+  // more than 1 % a step.
+  if (!acceleration_.Prepare("DORMAND_PRINCE", settings_, z_, 1.725,
+                             "1.725 / omega_max, where its stiffest undamped mode grows by 1 % a "
+                             "step",
+                             reason))
+    return false;
   if (!acceleration_.Evaluate(t_, z_, v_, &a_)) {
     *reason = "the initial acceleration is not finite";
     return false;
@@ -70,7 +77,7 @@ Stepper::StepStats DormandPrinceStepper::Step(double h) {
       model_->SetTime(t_);
       st.reason = absl::StrFormat(
           "the acceleration at stage %d of the explicit step is not finite (h = %.3g s: likely "
-          "beyond DORMAND_PRINCE's stability limit, about 3.3 / omega_max)",
+          "beyond DORMAND_PRINCE's stability limit, about 1 / omega_max for undamped modes)",
           i + 1, h);
       return st;
     }

@@ -20,16 +20,23 @@
 // solution, e_z = h sum_i (b_i - bhat_i) V_i, in positions (the power of h
 // in it is 5, local extrapolation as in DOPRI5).
 //
-// Where it applies. An explicit method is stable only while h omega_max
-// stays within its stability region (for DOPRI5 about 3.3 along the
-// imaginary axis, where the undamped modes sit); omega_max is the cable's
+// Where it applies. An explicit method is stable only while h lambda stays
+// within its stability region, lambda = +-i omega for an undamped mode. The
+// DOPRI5 region reaches -3.3 on the real axis but meets the imaginary axis
+// only up to omega h = 1: beyond, an undamped mode grows by |R(i omega h)|
+// a step, 1.003 at omega h = 1.5, 1.03 at 2, 1.44 at 3 (R the method's
+// stability polynomial, sum_{k<=5} z^k / k! + z^6 / 600); damping moves
+// modes left, into the region. So without damping: h omega_max <= 1,
+// half central difference's limit, bought back by the order. omega_max is the cable's
 // stiffest element mode, an axial one: omega_max = 9.6 sqrt(E / rho) / l
 // for elements of length l at rest (MODAL analysis of 12 and 24 soft and 12
 // steel elements: 9.57, 9.56, 9.55), higher under tension. It pays where that step is as
 // large as accuracy asks for anyway (soft cables, ropes, slack lines with
 // fine output); a steel cable of short elements needs micro-steps (an
-// implicit stepper then). Adaptive steps find the limit themselves; fixed
-// steps beyond it grow until the run's energy guard stops the run.
+// implicit stepper then). Adaptive steps find the limit themselves; a fixed
+// step beyond 1.725 / omega_max at the initial state (growth 1 % a step) is
+// refused by Initialize, one that tension makes unstable later grows until
+// the run's energy guard stops the run.
 // The model's constraint rows (joints other than to ground, bodies' axes)
 // and winches (a mass that changes) are refused when the model is built
 // (ModelBuilder::CheckIntegratorFits); lambda() is empty.
@@ -68,6 +75,7 @@ class DormandPrinceStepper final : public Stepper {
 
  private:
   MultibodyModel* model_;
+  SolverSettings settings_;
   ExplicitAcceleration acceleration_;
   int n_ = 0;
   Eigen::VectorXd z_, v_, a_, lambda_;

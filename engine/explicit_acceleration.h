@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 
 #include "engine/multibody_model.h"
+#include "engine/scene.h"
 #include "engine/skyline_ldlt.h"
 
 namespace cablesim {
@@ -27,7 +28,20 @@ class ExplicitAcceleration {
   // Factors the mass; false with `reason` when the model has constraint
   // rows (ModelBuilder::CheckIntegratorFits refuses those first) or the
   // mass is not positive definite. `stepper` names the caller in messages.
-  bool Prepare(const char* stepper, std::string* reason);
+  // With a fixed step (settings not adaptive), also false when the step is
+  // beyond `limit` / omega_max at the initial state z0 (`limit`: the
+  // stepper's omega h where its stiffest undamped mode starts to grow by
+  // more than 1 % a step; `limit_text` explains it in the message).
+  bool Prepare(const char* stepper, const SolverSettings& settings, const Eigen::VectorXd& z0,
+               double limit, const char* limit_text, std::string* reason);
+
+  // The stiffest mode's angular frequency [rad/s] of the linearization at
+  // z (time as last set): sqrt of the largest |eigenvalue| of M^-1 K_T(z),
+  // by power iteration in the M inner product (at most 300 iterations, until
+  // the Rayleigh quotient settles to 1e-6). The quotient approaches the
+  // eigenvalue from below: a lower bound, so a step refused by it is surely
+  // beyond the limit at that state. Allocates (called once, at the start).
+  double StiffestFrequency(const Eigen::VectorXd& z);
 
   // acc = M^-1 f(t, z, v); false when it is not finite.
   bool Evaluate(double t, const Eigen::VectorXd& z, const Eigen::VectorXd& v,

@@ -231,7 +231,7 @@ TEST(BodyFluidLoadTest, BuoyancyIsTheGradientOfItsEnergy) {
 // it was (the damping power integrated by the trapezoidal rule: second
 // order, so halving the step quarters the drift).
 TEST(BodyFluidLoadTest, EnergyBalanceClosesWithDragAndWaves) {
-  for (const std::string waves :
+  for (const std::string& waves :
        {std::string(), std::string(R"(, "water_depth": 30,
             "waves": {"regular": [{"height": 1.5, "period": 6}], "ramp_time": 3})")}) {
     SCOPED_TRACE(waves.empty() ? "still water" : "waves");

@@ -228,7 +228,9 @@ TEST(ServerSharedStoreTest, ThreeServersShareOneQueueAndSurviveKillNine) {
     EXPECT_EQ(second_runs[job.id()], 1) << job.id() << " finished other than once";
     retaken += job.attempts() > 1;
     // The item server 1 held when it died ran again, as attempt 2.
-    if (job.id() == victim) EXPECT_EQ(job.attempts(), 2);
+    if (job.id() == victim) {
+      EXPECT_EQ(job.attempts(), 2);
+    }
   }
   std::cout << "60-item sweep with server 1 killed (SIGKILL) holding an item after at least "
             << kItems / 3
