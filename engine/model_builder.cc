@@ -679,8 +679,8 @@ absl::Status ModelBuilder::CheckIntegratorFits() const {
                                  : absl::StrFormat("bodies[%d] has its axes' constraint rows", r.body);
     return absl::InvalidArgumentError(absl::StrFormat(
         "solver.integrator: %s is explicit and integrates unconstrained motion "
-        "only, and this scene has %d constraint rows (%s; only joints to ground are "
-        "eliminated): use HHT, GENERALIZED_ALPHA, ENERGY_MOMENTUM or IMPLICIT_EULER",
+        "only, and this scene has %d constraint rows (%s; only joints to fixed ground "
+        "points are eliminated): use HHT, GENERALIZED_ALPHA, ENERGY_MOMENTUM or IMPLICIT_EULER",
         name, m.multipliers(), what));
   }
   for (int c = 0; c < static_cast<int>(scene_.cables.size()); ++c) {
