@@ -1246,20 +1246,28 @@ class SceneConverter {
                      "applies to GENERALIZED_ALPHA, HHT and ENERGY_MOMENTUM only (solver.integrator is " +
                          std::string(IntegratorName(out.integrator)) + ")");
     }
-    if (IsExplicit(out.integrator)) {
-      // Explicit: no Newton iteration and no Newton matrix; the only linear
-      // solve is with the constant mass matrix, factored once.
+    // Explicit steppers take no Newton iteration and solve only with the
+    // constant mass matrix, factored once: the Newton and linear-solver
+    // settings do not apply to them, unless a static solve runs first
+    // (analysis STATIC or MODAL, or initial_state STATIC), which uses them.
+    const bool static_solve = out.analysis != Analysis::kDynamic ||
+                              s.initial_state() == v1::Solver::STATIC;
+    if (IsExplicit(out.integrator) && !static_solve) {
       const std::string name(IntegratorName(out.integrator));
-      if (s.linear_solver() == v1::MINRES || s.linear_solver() == v1::GMRES) {
-        return Invalid("solver.linear_solver",
-                       "does not apply to " + name +
-                           " (explicit: it solves only with the constant mass matrix, factored "
-                           "once)");
-      }
+      const std::string why = "does not apply to " + name +
+                              " (explicit: no Newton iteration; it solves only with the constant "
+                              "mass matrix, factored once)";
+      if (s.linear_solver() == v1::MINRES || s.linear_solver() == v1::GMRES)
+        return Invalid("solver.linear_solver", why);
       for (const auto& [has, field] :
            {std::pair{s.has_newton_tolerance(), "solver.newton_tolerance"},
-            std::pair{s.has_max_newton_iterations(), "solver.max_newton_iterations"}}) {
-        if (has) return Invalid(field, "does not apply to " + name + " (explicit: no Newton iteration)");
+            std::pair{s.has_max_newton_iterations(), "solver.max_newton_iterations"},
+            std::pair{s.has_linear_tolerance(), "solver.linear_tolerance"},
+            std::pair{s.has_max_linear_iterations(), "solver.max_linear_iterations"},
+            std::pair{s.preconditioner() != v1::Solver::PRECONDITIONER_UNSPECIFIED,
+                      "solver.preconditioner"},
+            std::pair{s.accept_inexact_solves(), "solver.accept_inexact_solves"}}) {
+        if (has) return Invalid(field, why);
       }
     }
     for (const auto& [has, name] : {std::pair{s.has_tolerance(), "solver.tolerance"},

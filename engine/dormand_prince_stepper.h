@@ -17,23 +17,27 @@
 // with the mass per step, no Newton, no tangent. Fifth order in z and v.
 //
 // Local error (adaptive steps): the difference to the embedded fourth-order
-// solution, e_z = h sum_i (b_i - bhat_i) V_i, in positions (the power of h
-// in it is 5, local extrapolation as in DOPRI5).
+// solution in positions, e_z = h sum_i (b_i - bhat_i) V_i, and in
+// velocities times h, h e_v = h^2 sum_i (b_i - bhat_i) A_i (metres too: a
+// stiff mode's error shows in the velocities omega h times larger); the
+// power of h in it is 5 (local extrapolation as in DOPRI5).
 //
 // Where it applies. An explicit method is stable only while h lambda stays
 // within its stability region, lambda = +-i omega for an undamped mode. The
 // DOPRI5 region reaches -3.3 on the real axis but meets the imaginary axis
 // only up to omega h = 1: beyond, an undamped mode grows by |R(i omega h)|
 // a step, 1.003 at omega h = 1.5, 1.03 at 2, 1.44 at 3 (R the method's
-// stability polynomial, sum_{k<=5} z^k / k! + z^6 / 600); damping moves
-// modes left, into the region. So without damping: h omega_max <= 1,
-// half central difference's limit, bought back by the order. omega_max is the cable's
+// stability polynomial, sum_{k<=5} z^k / k! + z^6 / 600); moderate
+// damping moves modes left, into the region, heavy damping (2 xi omega h
+// beyond 3.3) out of it again. So without damping: h omega_max <= 1, half
+// central difference's limit, bought back by the order. omega_max is the cable's
 // stiffest element mode, an axial one: omega_max = 9.6 sqrt(E / rho) / l
 // for elements of length l at rest (MODAL analysis of 12 and 24 soft and 12
 // steel elements: 9.57, 9.56, 9.55), higher under tension. It pays where that step is as
 // large as accuracy asks for anyway (soft cables, ropes, slack lines with
 // fine output); a steel cable of short elements needs micro-steps (an
-// implicit stepper then). Adaptive steps find the limit themselves; a fixed
+// implicit stepper then). Adaptive steps stay below stable_step() (the
+// stiffness estimate of the last step); a fixed
 // step beyond 1.725 / omega_max at the initial state (growth 1 % a step) is
 // refused by Initialize, one that tension makes unstable later grows until
 // the run's energy guard stops the run.
@@ -44,6 +48,7 @@
 // Step() allocates nothing.
 
 #include <array>
+#include <limits>
 #include <string>
 
 #include <Eigen/Core>
@@ -70,6 +75,16 @@ class DormandPrinceStepper final : public Stepper {
   const Eigen::VectorXd& v() const override { return v_; }
   const Eigen::VectorXd& a() const override { return a_; }
   const Eigen::VectorXd& lambda() const override { return lambda_; }
+  // 0.99 / max(rho, omega_max): within the stability region's reach along
+  // the imaginary axis (0.997), where no undamped mode grows. (A cap at
+  // 1.5 let the 30 s falling pendulum's energy rise by 0.5 J of 81 J at a
+  // whip; at 0.99 it does not rise.) rho = |f(y7) - f(y6)| / |y7 - y6| from the last
+  // step's two stages at t + h (Hairer and Wanner's stiffness estimate for
+  // DOPRI5, Solving ODEs II, section IV.2: the dominant |eigenvalue| of the
+  // Jacobian along the difference, omega for an oscillating mode) sees a
+  // stiff mode once it is excited; omega_max (power iteration on M^-1 K_T,
+  // at the start and every 50 steps, 20 warm iterations) sees it before.
+  double stable_step() const override { return stable_step_; }
 
   static constexpr int kStages = 7;
 
@@ -81,9 +96,12 @@ class DormandPrinceStepper final : public Stepper {
   Eigen::VectorXd z_, v_, a_, lambda_;
   Eigen::VectorXd z_old_, v_old_, a_old_;
   double t_ = 0, t_old_ = 0;
+  double stable_step_ = std::numeric_limits<double>::infinity();
+  double omega_max_ = 0;  // last power-iteration estimate [rad/s]
+  int steps_ = 0;
   // Stage velocities V_i (= the stages' z') and accelerations A_i.
   std::array<Eigen::VectorXd, kStages> vs_, as_;
-  Eigen::VectorXd zs_, err_z_;
+  Eigen::VectorXd zs_, err_z_, err_v_;
 };
 
 }  // namespace cablesim

@@ -1,6 +1,7 @@
 #include "engine/explicit_acceleration.h"
 
 #include <cmath>
+#include <cstdint>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -12,6 +13,11 @@ ExplicitAcceleration::ExplicitAcceleration(MultibodyModel* model)
   q_.setZero(model->coordinates());
   qd_.setZero(model->coordinates());
   f_.setZero(model->dofs());
+  stiffness_.SetPattern(model->envelope());
+  x_.setZero(model->dofs());
+  kx_.setZero(model->dofs());
+  mx_.setZero(model->dofs());
+  StartVector();
 }
 
 bool ExplicitAcceleration::Prepare(const char* stepper, const SolverSettings& settings,
@@ -26,7 +32,7 @@ bool ExplicitAcceleration::Prepare(const char* stepper, const SolverSettings& se
     return false;
   }
   if (!settings.adaptive) {
-    const double omega = StiffestFrequency(z0);
+    const double omega = StiffestFrequency(z0, 300);
     if (settings.step_s * omega > limit) {
       *reason = absl::StrFormat(
           "solver.step: %.4g s is beyond %s's stability limit for this scene, about %.3g s "
@@ -40,35 +46,42 @@ bool ExplicitAcceleration::Prepare(const char* stepper, const SolverSettings& se
   return true;
 }
 
-double ExplicitAcceleration::StiffestFrequency(const Eigen::VectorXd& z) {
-  const int n = model_->dofs();
-  if (n == 0) return 0;
-  SkylineLdlt stiffness;
-  stiffness.SetPattern(model_->envelope());
-  stiffness.SetZero();
+double ExplicitAcceleration::StiffestFrequency(const Eigen::VectorXd& z, int iterations) {
+  if (model_->dofs() == 0) return 0;
+  stiffness_.SetZero();
   model_->ToFull(z, &q_);
-  model_->NetForce(q_, 1.0, &f_, &stiffness, 1.0);
-  // A start rich in the highest modes: neighbouring unknowns of opposite
-  // sign, perturbed so that no mode is missed by symmetry.
-  Eigen::VectorXd x(n), kx(n), mx(n);
-  for (int i = 0; i < n; ++i) x(i) = (i % 2 ? -1.0 : 1.0) * (1 + 0.1 * std::sin(1.7 * i + 0.3));
+  model_->NetForce(q_, 1.0, &f_, &stiffness_, 1.0);
   double lambda = 0;
-  for (int it = 0; it < 300; ++it) {
-    stiffness.Multiply(x.data(), kx.data());
-    model_->mass().Multiply(x.data(), mx.data());
-    const double xmx = x.dot(mx);
+  for (int it = 0; it < iterations; ++it) {
+    stiffness_.Multiply(x_.data(), kx_.data());
+    model_->mass().Multiply(x_.data(), mx_.data());
+    const double xmx = x_.dot(mx_);
     if (!(xmx > 0)) break;
-    const double next = x.dot(kx) / xmx;
+    const double next = x_.dot(kx_) / xmx;
     const bool settled = it > 0 && std::abs(next - lambda) <= 1e-6 * std::abs(next);
     lambda = next;
     if (settled) break;
-    x = kx;
-    mass_.Solve(x.data());
-    const double norm = x.lpNorm<Eigen::Infinity>();
-    if (!(norm > 0) || !std::isfinite(norm)) break;
-    x /= norm;
+    x_ = kx_;
+    mass_.Solve(x_.data());
+    const double norm = x_.lpNorm<Eigen::Infinity>();
+    if (!(norm > 0) || !std::isfinite(norm)) {
+      StartVector();
+      break;
+    }
+    x_ /= norm;
   }
   return std::sqrt(std::abs(lambda));
+}
+
+void ExplicitAcceleration::StartVector() {
+  // Every mode in it: a fixed pseudo-random vector (an alternating pattern
+  // would repeat node by node, 4 or 6 unknowns a node, and be smooth along
+  // the cable).
+  uint64_t state = 0x9e3779b97f4a7c15ULL;
+  for (int i = 0; i < x_.size(); ++i) {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    x_(i) = static_cast<double>(state >> 11) * 0x1.0p-53 - 0.5;
+  }
 }
 
 bool ExplicitAcceleration::Evaluate(double t, const Eigen::VectorXd& z,

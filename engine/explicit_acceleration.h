@@ -37,20 +37,25 @@ class ExplicitAcceleration {
 
   // The stiffest mode's angular frequency [rad/s] of the linearization at
   // z (time as last set): sqrt of the largest |eigenvalue| of M^-1 K_T(z),
-  // by power iteration in the M inner product (at most 300 iterations, until
-  // the Rayleigh quotient settles to 1e-6). The quotient approaches the
-  // eigenvalue from below: a lower bound, so a step refused by it is surely
-  // beyond the limit at that state. Allocates (called once, at the start).
-  double StiffestFrequency(const Eigen::VectorXd& z);
+  // by power iteration in the M inner product (at most `iterations`, until
+  // the Rayleigh quotient settles to 1e-6), warm-started from the last
+  // call's vector (so a few iterations follow a slowly changing mode). The
+  // quotient approaches the eigenvalue from below: a lower bound, so a step
+  // refused by it is surely beyond the limit at that state. Allocates
+  // nothing.
+  double StiffestFrequency(const Eigen::VectorXd& z, int iterations);
 
   // acc = M^-1 f(t, z, v); false when it is not finite.
   bool Evaluate(double t, const Eigen::VectorXd& z, const Eigen::VectorXd& v,
                 Eigen::VectorXd* acc);
 
  private:
+  void StartVector();
+
   MultibodyModel* model_;
   SkylineLdlt mass_;
-  Eigen::VectorXd q_, qd_, f_;
+  SkylineLdlt stiffness_;  // K_T for StiffestFrequency
+  Eigen::VectorXd q_, qd_, f_, x_, kx_, mx_;
 };
 
 }  // namespace cablesim

@@ -384,7 +384,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
         }
         continue;
       }
-      h = h_try * factor;
+      h = std::min(h_try * factor, stepper.stable_step());
     }
     if (st.converged) {
       const double t0 = t;

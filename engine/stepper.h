@@ -17,6 +17,7 @@
 // nothing.
 
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -68,6 +69,13 @@ class Stepper {
   virtual int local_error_order() const = 0;
   // Global order of accuracy in positions (Richardson extrapolation).
   virtual int order() const = 0;
+
+  // The largest next step [s] the stepper can take stably, from what its
+  // last step saw (infinity: no limit, the implicit steppers). Adaptive
+  // steps never grow beyond it: an explicit stepper's local error estimate
+  // is small for a mode that grows just beyond its stability limit, so the
+  // error controller alone lets such a mode grow to many tolerances first.
+  virtual double stable_step() const { return std::numeric_limits<double>::infinity(); }
 
   virtual const Eigen::VectorXd& z() const = 0;
   virtual const Eigen::VectorXd& v() const = 0;
