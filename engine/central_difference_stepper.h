@@ -42,38 +42,24 @@
 
 #include <Eigen/Core>
 
-#include "engine/explicit_acceleration.h"
+#include "engine/explicit_stepper.h"
 #include "engine/multibody_model.h"
 #include "engine/scene.h"
-#include "engine/stepper.h"
 
 namespace cablesim {
 
-class CentralDifferenceStepper final : public Stepper {
+class CentralDifferenceStepper final : public ExplicitStepper {
  public:
   CentralDifferenceStepper(MultibodyModel* model, const SolverSettings& settings);
 
   bool Initialize(std::string* reason) override;
   StepStats Step(double h) override;
-  void Restore() override;
   double LocalErrorNorm(double h, double atol, double rtol) const override;
   int local_error_order() const override { return 3; }
   int order() const override { return 2; }
 
-  const Eigen::VectorXd& z() const override { return z_; }
-  const Eigen::VectorXd& v() const override { return v_; }
-  const Eigen::VectorXd& a() const override { return a_; }
-  const Eigen::VectorXd& lambda() const override { return lambda_; }
-
  private:
-  MultibodyModel* model_;
-  SolverSettings settings_;
-  ExplicitAcceleration acceleration_;
-  int n_ = 0;
-  Eigen::VectorXd z_, v_, a_, lambda_;
-  Eigen::VectorXd z_old_, v_old_, a_old_;
-  double t_ = 0, t_old_ = 0;
-  Eigen::VectorXd v_pred_;
+  Eigen::VectorXd z1_, v1_, a1_, v_pred_;  // the step's end and the damping's predictor
 };
 
 }  // namespace cablesim

@@ -26,15 +26,7 @@ constexpr double kE[DormandPrinceStepper::kStages] = {
 
 DormandPrinceStepper::DormandPrinceStepper(MultibodyModel* model,
                                            const SolverSettings& settings)
-    : model_(model), settings_(settings), acceleration_(model) {
-  n_ = model->dofs();
-  z_ = model->initial_z();
-  v_ = model->initial_v();
-  a_.setZero(n_);
-  lambda_.resize(0);
-  z_old_ = z_;
-  v_old_ = v_;
-  a_old_ = a_;
+    : ExplicitStepper(model, settings) {
   for (int i = 0; i < kStages; ++i) {
     vs_[i].setZero(n_);
     as_[i].setZero(n_);
@@ -48,18 +40,11 @@ bool DormandPrinceStepper::Initialize(std::string* reason) {
   // |R(i omega h)| = 1.01 at omega h = 1.725 (R the stability polynomial,
   // dormand_prince_stepper.h): beyond, the stiffest undamped mode grows by
   // more than 1 % a step.
-  if (!acceleration_.Prepare("DORMAND_PRINCE", settings_, z_, 1.725,
-                             "1.725 / omega_max, where its stiffest undamped mode grows by 1 % a "
-                             "step",
-                             reason))
+  if (!Start("DORMAND_PRINCE", 1.725,
+             "1.725 / omega_max, where its stiffest undamped mode grows by 1 % a step",
+             &omega_max_, reason))
     return false;
-  omega_max_ = acceleration_.StiffestFrequency(z_, 300);
   stable_step_ = omega_max_ > 0 ? 0.99 / omega_max_ : stable_step_;
-  if (!acceleration_.Evaluate(t_, z_, v_, &a_)) {
-    *reason = "the initial acceleration is not finite";
-    return false;
-  }
-  a_old_ = a_;
   return true;
 }
 
@@ -112,24 +97,11 @@ Stepper::StepStats DormandPrinceStepper::Step(double h) {
     const double stiffest = std::max(rho, omega_max_);
     stable_step_ = stiffest > 0 ? 0.99 / stiffest : std::numeric_limits<double>::infinity();
   }
-  z_old_.swap(z_);
-  v_old_.swap(v_);
-  a_old_.swap(a_);
-  z_ = zs_;  // Z_7: the row a_7 is b
-  v_ = vs_[kStages - 1];
-  a_ = as_[kStages - 1];
-  t_old_ = t_;
-  t_ += h;
+  // The end is the last stage (Z_7: the row a_7 is b); its acceleration is
+  // the next step's first stage.
+  Accept(h, &zs_, &vs_[kStages - 1], &as_[kStages - 1]);
   st.converged = true;
   return st;
-}
-
-void DormandPrinceStepper::Restore() {
-  z_.swap(z_old_);
-  v_.swap(v_old_);
-  a_.swap(a_old_);
-  t_ = t_old_;
-  model_->SetTime(t_);
 }
 
 double DormandPrinceStepper::LocalErrorNorm(double /*h*/, double atol, double rtol) const {

@@ -53,28 +53,22 @@
 
 #include <Eigen/Core>
 
-#include "engine/explicit_acceleration.h"
+#include "engine/explicit_stepper.h"
 #include "engine/multibody_model.h"
 #include "engine/scene.h"
-#include "engine/stepper.h"
 
 namespace cablesim {
 
-class DormandPrinceStepper final : public Stepper {
+class DormandPrinceStepper final : public ExplicitStepper {
  public:
   DormandPrinceStepper(MultibodyModel* model, const SolverSettings& settings);
 
   bool Initialize(std::string* reason) override;
   StepStats Step(double h) override;
-  void Restore() override;
   double LocalErrorNorm(double h, double atol, double rtol) const override;
   int local_error_order() const override { return 5; }
   int order() const override { return 5; }
 
-  const Eigen::VectorXd& z() const override { return z_; }
-  const Eigen::VectorXd& v() const override { return v_; }
-  const Eigen::VectorXd& a() const override { return a_; }
-  const Eigen::VectorXd& lambda() const override { return lambda_; }
   // 0.99 / max(rho, omega_max): within the stability region's reach along
   // the imaginary axis (0.997), where no undamped mode grows. (A cap at
   // 1.5 let the 30 s falling pendulum's energy rise by 0.5 J of 81 J at a
@@ -89,13 +83,6 @@ class DormandPrinceStepper final : public Stepper {
   static constexpr int kStages = 7;
 
  private:
-  MultibodyModel* model_;
-  SolverSettings settings_;
-  ExplicitAcceleration acceleration_;
-  int n_ = 0;
-  Eigen::VectorXd z_, v_, a_, lambda_;
-  Eigen::VectorXd z_old_, v_old_, a_old_;
-  double t_ = 0, t_old_ = 0;
   double stable_step_ = std::numeric_limits<double>::infinity();
   double omega_max_ = 0;  // last power-iteration estimate [rad/s]
   int steps_ = 0;

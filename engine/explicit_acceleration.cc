@@ -22,7 +22,8 @@ ExplicitAcceleration::ExplicitAcceleration(MultibodyModel* model)
 
 bool ExplicitAcceleration::Prepare(const char* stepper, const SolverSettings& settings,
                                    const Eigen::VectorXd& z0, double limit,
-                                   const char* limit_text, std::string* reason) {
+                                   const char* limit_text, double* omega_max,
+                                   std::string* reason) {
   if (model_->multipliers() > 0) {
     *reason = absl::StrCat(stepper, " integrates unconstrained motion only");
     return false;
@@ -31,8 +32,9 @@ bool ExplicitAcceleration::Prepare(const char* stepper, const SolverSettings& se
     *reason = "the mass matrix could not be factorized (not positive definite)";
     return false;
   }
+  const double omega = StiffestFrequency(z0, 300);
+  *omega_max = omega;
   if (!settings.adaptive) {
-    const double omega = StiffestFrequency(z0, 300);
     if (settings.step_s * omega > limit) {
       *reason = absl::StrFormat(
           "solver.step: %.4g s is beyond %s's stability limit for this scene, about %.3g s "

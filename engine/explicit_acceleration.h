@@ -28,12 +28,13 @@ class ExplicitAcceleration {
   // Factors the mass; false with `reason` when the model has constraint
   // rows (ModelBuilder::CheckIntegratorFits refuses those first) or the
   // mass is not positive definite. `stepper` names the caller in messages.
-  // With a fixed step (settings not adaptive), also false when the step is
-  // beyond `limit` / omega_max at the initial state z0 (`limit`: the
-  // stepper's omega h where its stiffest undamped mode starts to grow by
-  // more than 1 % a step; `limit_text` explains it in the message).
+  // Puts omega_max at the initial state z0 (StiffestFrequency) into
+  // *omega_max. With a fixed step (settings not adaptive), also false when
+  // the step is beyond `limit` / omega_max (`limit`: the stepper's omega h
+  // where its stiffest undamped mode starts to grow by more than 1 % a
+  // step; `limit_text` explains it in the message).
   bool Prepare(const char* stepper, const SolverSettings& settings, const Eigen::VectorXd& z0,
-               double limit, const char* limit_text, std::string* reason);
+               double limit, const char* limit_text, double* omega_max, std::string* reason);
 
   // The stiffest mode's angular frequency [rad/s] of the linearization at
   // z (time as last set): sqrt of the largest |eigenvalue| of M^-1 K_T(z),
