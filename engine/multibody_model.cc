@@ -363,12 +363,7 @@ double MultibodyModel::ElementForces(const VectorXd& q, VectorXd* full, SkylineL
     if (roundoff) roundoff->segment<kN>(e.first_coord) += re + kEps * fe.cwiseAbs();
     size = std::max(size, fe.template lpNorm<Eigen::Infinity>());
     if (!stiffness) continue;
-    const int* slots = &element_slots_[kN2 * k];
-    const double* factors = &element_factors_[kN2 * k];
-    const double* kv = ke.data();  // symmetric, so layout order does not matter
-    for (int t = 0; t < kN2; ++t) {
-      if (slots[t] >= 0) values[slots[t]] += stiffness_scale * factors[t] * kv[t];
-    }
+    ScatterElementMatrix<kN2>(k, ke.data(), stiffness_scale, values);
   }
   return size;
 }
@@ -531,11 +526,7 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
       roundoff->segment<kN>(e.first_coord).noalias() +=
           kSumRounding * (ce.cwiseAbs() * ve.cwiseAbs() + fe.cwiseAbs());
     if (!tangent) continue;
-    const int* slots = &element_slots_[kN2 * k];
-    const double* factors = &element_factors_[kN2 * k];
-    const double* cv = ce.data();  // symmetric
-    for (int t = 0; t < kN2; ++t)
-      if (slots[t] >= 0) values[slots[t]] += tangent_scale * factors[t] * cv[t];
+    ScatterElementMatrix<kN2>(k, ce.data(), tangent_scale, values);
   }
   return size;
 }
@@ -750,11 +741,7 @@ void MultibodyModel::StaticFriction(const VectorXd& q, const VectorXd& q_start, 
                                               e.element.length(), &fe, matrix ? &me : nullptr);
       full.segment<kN>(e.first_coord) += fe;
       if (!matrix) continue;
-      const int* slots = &element_slots_[kN2 * k];
-      const double* factors = &element_factors_[kN2 * k];
-      const double* mv = me.data();  // symmetric
-      for (int t = 0; t < kN2; ++t)
-        if (slots[t] >= 0) values[slots[t]] += scale * factors[t] * mv[t];
+      ScatterElementMatrix<kN2>(k, me.data(), scale, values);
     }
   };
   if (dim_ == 2) {
@@ -891,10 +878,7 @@ void MultibodyModel::UpdateWinches() {
         for (int b = 0; b < 4; ++b) e.mbar(a, b) = me(D * a, D * b);
       e.gravity = e.element.GravityForce(w.mass_per_length, g);
       constant_force_.segment<kN>(e.first_coord) += e.gravity;
-      for (int t = 0; t < kN2; ++t) {
-        const int sl = element_slots_[kN2 * index + t];
-        if (sl >= 0) mass_.values()[sl] += element_factors_[kN2 * index + t] * me(t / kN, t % kN);
-      }
+      ScatterElementMatrix<kN2>(index, me.data(), 1.0, mass_.values());
       const WinchElementInertia in = ComputeWinchElementInertia(w.mass_per_length, l, k);
       WinchConvectiveCoefficients(in, ldot, lddot, &winch_cv_[slot], &winch_ce_[slot]);
       winch_mdot_[slot] = ldot * in.m_l;

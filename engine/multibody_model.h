@@ -628,6 +628,15 @@ class MultibodyModel {
   // Per element, the (4D)^2 skyline slots (or -1) and factors s_a s_b.
   std::vector<int> element_slots_;
   std::vector<double> element_factors_;
+  // Adds scale times element k's symmetric (4D)^2 matrix m (either storage
+  // order) to the skyline `values` through those slots; kN2 = (4D)^2.
+  template <int kN2>
+  void ScatterElementMatrix(int k, const double* m, double scale, double* values) const {
+    const int* slots = &element_slots_[kN2 * k];
+    const double* factors = &element_factors_[kN2 * k];
+    for (int t = 0; t < kN2; ++t)
+      if (slots[t] >= 0) values[slots[t]] += scale * factors[t] * m[t];
+  }
   SparseRows jac_pattern_;
   // Scratch (full size) for NetForce.
   Eigen::VectorXd scratch_full_, scratch_roundoff_;
