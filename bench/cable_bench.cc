@@ -51,10 +51,10 @@
 
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
-#include "engine/multibody_model.h"
-#include "engine/saddle_point_solver.h"
-#include "engine/scene.h"
-#include "engine/simulation.h"
+#include "engine/model/multibody_model.h"
+#include "engine/linear/saddle_point_solver.h"
+#include "engine/scene/scene.h"
+#include "engine/run/simulation.h"
 
 namespace cablesim {
 namespace {

@@ -18,7 +18,7 @@
 #include "convert/run_proto.h"
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
-#include "engine/simulation.h"
+#include "engine/run/simulation.h"
 #include "server/result_codec.h"
 
 namespace cablesim {

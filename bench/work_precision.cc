@@ -20,7 +20,7 @@
 //
 // Error [m]: the largest distance between a probe of the run and the same
 // probe of the reference run at every common output frame
-// (engine/probe_trajectory.h). Wall time [s]: RunScene, model build
+// (engine/output/probe_trajectory.h). Wall time [s]: RunScene, model build
 // included, frames kept in memory; median of `repeats` runs. The reference
 // is the first of the scene's `reference` patches that runs; its own error
 // is estimated by rerunning it at twice its step (reference_self_error_m:
@@ -50,8 +50,8 @@
 #include "convert/json_merge.h"
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
-#include "engine/probe_trajectory.h"
-#include "engine/simulation.h"
+#include "engine/output/probe_trajectory.h"
+#include "engine/run/simulation.h"
 
 namespace cablesim {
 namespace {

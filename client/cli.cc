@@ -26,7 +26,8 @@
 #include "convert/run_proto.h"
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
-#include "engine/simulation.h"
+#include "engine/run/simulation.h"
+#include "engine/scene/integrator_traits.h"
 
 // The arguments are parsed here rather than with absl flags: absl's parser
 // exits the process (with status 1) on an unknown flag or --help and keeps

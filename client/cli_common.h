@@ -19,7 +19,7 @@
 #include "client/csv_writer.h"
 #include "client/shape_csv_writer.h"
 #include "client/service_client.h"
-#include "engine/simulation.h"
+#include "engine/run/simulation.h"
 
 namespace cablesim::cli_internal {
 

@@ -8,7 +8,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
-#include "engine/frame_columns.h"
+#include "engine/output/frame_columns.h"
 
 namespace cablesim {
 namespace {

@@ -2,7 +2,7 @@
 #define CABLESIM_CLIENT_CSV_WRITER_H_
 
 // Writes a run's trajectory as CSV, one row per frame, in the columns of
-// FrameColumns (engine/frame_columns.h):
+// FrameColumns (engine/output/frame_columns.h):
 //
 //   t, then for each probe NAME.x NAME.y NAME.z NAME.vx NAME.vy NAME.vz
 //   NAME.ax NAME.ay NAME.az, then energy.kinetic energy.potential
@@ -23,7 +23,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
-#include "engine/simulation.h"
+#include "engine/run/simulation.h"
 
 namespace cablesim {
 

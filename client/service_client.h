@@ -15,7 +15,7 @@
 
 #include "absl/status/statusor.h"
 #include "cablesim/v1/service.grpc.pb.h"
-#include "engine/simulation.h"
+#include "engine/run/simulation.h"
 #include "server/cablesim_server.h"
 
 namespace cablesim {

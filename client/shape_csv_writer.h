@@ -20,7 +20,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
-#include "engine/simulation.h"
+#include "engine/run/simulation.h"
 
 namespace cablesim {
 

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "engine/simulation.h"
+#include "engine/run/simulation.h"
 
 namespace cablesim {
 

@@ -2,12 +2,12 @@
 #define CABLESIM_CONVERT_RUN_PROTO_H_
 
 // The one place where the engine's run results (ModelInfo, Frame,
-// RunSummary; engine/simulation.h) meet their cablesim.v1 messages
+// RunSummary; engine/run/simulation.h) meet their cablesim.v1 messages
 // (proto/cablesim/v1/service.proto), in both directions. A field added to
 // an engine struct is one line in each direction here.
 //
 // A frame travels as a row of doubles in the order of FrameColumns
-// (engine/frame_columns.h), the CSV columns of `cablesim run --out`.
+// (engine/output/frame_columns.h), the CSV columns of `cablesim run --out`.
 // Doubles are copied exactly, so a frame read back with FrameReader is
 // bit-identical to the engine's.
 
@@ -17,8 +17,8 @@
 #include "absl/status/statusor.h"
 #include "absl/types/span.h"
 #include "cablesim/v1/service.pb.h"
-#include "engine/frame_columns.h"
-#include "engine/simulation.h"
+#include "engine/output/frame_columns.h"
+#include "engine/run/simulation.h"
 
 namespace cablesim {
 

@@ -15,7 +15,8 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/string_view.h"
 #include "convert/plausible_ranges.h"
-#include "engine/polyline.h"
+#include "engine/scene/polyline.h"
+#include "engine/scene/integrator_traits.h"
 
 // Local helpers for early return on error.
 #define CABLESIM_RETURN_IF_ERROR(expr)   \
@@ -1214,15 +1215,14 @@ class SceneConverter {
       out.modes = s.modes();
     }
 
-    const bool alpha_family =
-        out.integrator == Integrator::kGeneralizedAlpha || out.integrator == Integrator::kHht;
+    const IntegratorTraits& traits = TraitsOf(out.integrator);
     if (s.has_rho_infinity()) {
-      if (!alpha_family) {
+      if (!traits.has_rho_infinity) {
         return Invalid("solver.rho_infinity",
                        "applies to GENERALIZED_ALPHA and HHT only (solver.integrator is " +
                            std::string(IntegratorName(out.integrator)) + ")");
       }
-      const double lo = out.integrator == Integrator::kHht ? 0.5 : 0.0;
+      const double lo = traits.min_rho_infinity;
       if (!(s.rho_infinity() >= lo && s.rho_infinity() <= 1)) {
         return Invalid("solver.rho_infinity",
                        absl::StrCat("must be in [", Num(lo), ", 1] for ",
@@ -1233,14 +1233,15 @@ class SceneConverter {
     }
     out.adaptive = s.adaptive();
     out.error_estimate = s.error_estimate();
-    // Steppers whose Newton matrix can be kept across iterations and steps.
-    const bool keeps_matrix = alpha_family || out.integrator == Integrator::kEnergyMomentum;
+    // Steppers whose Newton matrix can be kept across iterations and steps
+    // (IntegratorTraits::keeps_newton_matrix).
+    const bool keeps_matrix = traits.keeps_newton_matrix;
     // Default on for the alpha family; off for ENERGY_MOMENTUM, whose point
     // is conservation: with a kept matrix Newton converges linearly and
     // stops just under its tolerance, and those residuals add up (the 100 s
     // falling pendulum drifted by 2e-5 of its energy with it, 5e-7 without).
     out.reuse_factorization =
-        s.has_reuse_factorization() ? s.reuse_factorization() : alpha_family;
+        s.has_reuse_factorization() ? s.reuse_factorization() : traits.reuses_matrix_by_default;
     if (s.has_reuse_factorization() && s.reuse_factorization() && !keeps_matrix) {
       return Invalid("solver.reuse_factorization",
                      "applies to GENERALIZED_ALPHA, HHT and ENERGY_MOMENTUM only (solver.integrator is " +
@@ -1252,7 +1253,7 @@ class SceneConverter {
     // (analysis STATIC or MODAL, or initial_state STATIC), which uses them.
     const bool static_solve = out.analysis != Analysis::kDynamic ||
                               s.initial_state() == v1::Solver::STATIC;
-    if (IsExplicit(out.integrator) && !static_solve) {
+    if (traits.is_explicit && !static_solve) {
       const std::string name(IntegratorName(out.integrator));
       const std::string why = "does not apply to " + name +
                               " (explicit: no Newton iteration; it solves only with the constant "

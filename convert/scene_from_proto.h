@@ -8,7 +8,7 @@
 
 #include "absl/status/statusor.h"
 #include "cablesim/v1/scene.pb.h"
-#include "engine/scene.h"
+#include "engine/scene/scene.h"
 
 namespace cablesim {
 
@@ -33,7 +33,7 @@ absl::StatusOr<LinearSolverKind> LinearSolverFromProto(v1::LinearSolver solver,
                                                        std::string_view path);
 
 // The scene-file spelling of an engine enum value (AnalysisName, ...) is
-// declared with the enums in engine/scene.h.
+// declared with the enums in engine/scene/scene.h.
 
 }  // namespace cablesim
 

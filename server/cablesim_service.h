@@ -4,7 +4,7 @@
 // cablesim.v1.CablesimService (proto/cablesim/v1/service.proto): a thin
 // layer that converts requests, validates them (convert/), checks the
 // server's limits (server/request_checks.h), runs the engine
-// (engine/simulation.h) or hands work to the JobManager, and converts the
+// (engine/run/simulation.h) or hands work to the JobManager, and converts the
 // results back (convert/run_proto.h).
 //
 // Streams honour flow control: the engine runs in the RPC's thread and

@@ -6,7 +6,7 @@
 //   E = kinetic + potential + axial + bending,
 //   relative_drift = (E_final - E_initial) / scale,
 //   scale = max over frames of (kinetic + axial + bending),
-// and the series of each cable and body (EnergyParts, engine/simulation.h).
+// and the series of each cable and body (EnergyParts, engine/run/simulation.h).
 
 #include <vector>
 
@@ -14,7 +14,7 @@
 
 namespace cablesim {
 
-// `values` are rows in the header's columns (engine/frame_columns.h),
+// `values` are rows in the header's columns (engine/output/frame_columns.h),
 // found by name: a trajectory stored before the energy per part was
 // recorded has no part series.
 v1::EnergyResponse EnergyFromTrajectory(const v1::RunHeader& header,

@@ -16,7 +16,7 @@
 #include "absl/strings/string_view.h"
 #include "absl/time/time.h"
 #include "cablesim/v1/service.pb.h"
-#include "engine/simulation.h"
+#include "engine/run/simulation.h"
 
 namespace cablesim {
 

@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "absl/strings/str_format.h"
-#include "engine/generalized_alpha_stepper.h"
+#include "engine/steppers/generalized_alpha_stepper.h"
 #include "tests/test_util.h"
 
 namespace cablesim {

@@ -3,7 +3,7 @@
 // central differences of the strain energy; tangents against central
 // differences of the force; rigid motions and rotations.
 
-#include "engine/ancf_cable_element.h"
+#include "engine/elements/ancf_cable_element.h"
 
 #include <cmath>
 #include <random>

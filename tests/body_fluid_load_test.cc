@@ -19,8 +19,8 @@
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
 #include "engine/forces/waves.h"
-#include "engine/multibody_model.h"
-#include "engine/simulation.h"
+#include "engine/model/multibody_model.h"
+#include "engine/run/simulation.h"
 #include "tests/test_util.h"
 
 namespace cablesim {

@@ -16,10 +16,10 @@
 #include "absl/strings/str_replace.h"
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
-#include "engine/ancf_cable_element.h"
-#include "engine/multibody_model.h"
-#include "engine/simulation.h"
-#include "engine/skyline_ldlt.h"
+#include "engine/elements/ancf_cable_element.h"
+#include "engine/model/multibody_model.h"
+#include "engine/run/simulation.h"
+#include "engine/linear/skyline_ldlt.h"
 #include "tests/test_util.h"
 
 namespace cablesim {

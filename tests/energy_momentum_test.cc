@@ -1,4 +1,4 @@
-// The ENERGY_MOMENTUM stepper (engine/energy_momentum_stepper.h): the
+// The ENERGY_MOMENTUM stepper (engine/steppers/energy_momentum_stepper.h): the
 // element's discrete gradient is one (its work over a step is the exact
 // change of the strain energy, and it exerts no net force or moment), the
 // stepper keeps the angular momentum of a free spinning body and of the
@@ -14,7 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "absl/strings/str_format.h"
-#include "engine/ancf_cable_element.h"
+#include "engine/elements/ancf_cable_element.h"
 #include "tests/energy_momentum_scenes.h"
 #include "tests/test_util.h"
 

@@ -1,4 +1,4 @@
-// The energy per part (EnergyParts, engine/simulation.h): the parts sum to
+// The energy per part (EnergyParts, engine/run/simulation.h): the parts sum to
 // the totals, and single parts against closed forms (free fall, a cable at
 // rest, a point load's potential).
 
@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "engine/frame_columns.h"
+#include "engine/output/frame_columns.h"
 #include "tests/test_util.h"
 
 namespace cablesim {

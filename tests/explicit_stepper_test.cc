@@ -1,5 +1,5 @@
-// The explicit steppers DORMAND_PRINCE (engine/dormand_prince_stepper.h) and
-// CENTRAL_DIFFERENCE (engine/central_difference_stepper.h): exact where the
+// The explicit steppers DORMAND_PRINCE (engine/steppers/dormand_prince_stepper.h) and
+// CENTRAL_DIFFERENCE (engine/steppers/central_difference_stepper.h): exact where the
 // motion is a polynomial they integrate exactly, close to an implicit
 // reference on the falling pendulum, at their orders (5 and 2), within
 // their tolerance when adaptive, and a step beyond the stability limit is
@@ -14,7 +14,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "engine/multibody_model.h"
+#include "engine/model/multibody_model.h"
+#include "engine/scene/integrator_traits.h"
 #include "tests/energy_momentum_scenes.h"
 #include "tests/test_util.h"
 

@@ -8,9 +8,9 @@
 #include <gtest/gtest.h>
 #include <unsupported/Eigen/IterativeSolvers>
 
-#include "engine/krylov.h"
-#include "engine/saddle_point_solver.h"
-#include "engine/skyline_ldlt.h"
+#include "engine/linear/krylov.h"
+#include "engine/linear/saddle_point_solver.h"
+#include "engine/linear/skyline_ldlt.h"
 
 namespace cablesim {
 namespace {

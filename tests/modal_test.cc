@@ -17,10 +17,10 @@
 #include "absl/strings/str_cat.h"
 #include "client/json_line.h"
 #include "client/summary_json.h"
-#include "engine/modal_solver.h"
-#include "engine/multibody_model.h"
-#include "engine/simulation.h"
-#include "engine/static_solver.h"
+#include "engine/analysis/modal_solver.h"
+#include "engine/model/multibody_model.h"
+#include "engine/run/simulation.h"
+#include "engine/analysis/static_solver.h"
 #include "test_util.h"
 
 namespace cablesim {

@@ -3,7 +3,7 @@
 // order of the unknowns, and the joints refused at the start. Each test runs
 // the steps up to the one it is about and reads that step's result.
 
-#include "engine/model_builder.h"
+#include "engine/model/model_builder.h"
 
 #include <string>
 

@@ -11,7 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "absl/strings/str_format.h"
-#include "engine/saddle_point_solver.h"
+#include "engine/linear/saddle_point_solver.h"
 #include "tests/test_util.h"
 
 namespace cablesim {

@@ -13,7 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "absl/strings/str_cat.h"
-#include "engine/simulation.h"
+#include "engine/run/simulation.h"
 #include "test_util.h"
 
 namespace cablesim {

@@ -1,6 +1,6 @@
-// The probe-position error between two runs (engine/probe_trajectory.h).
+// The probe-position error between two runs (engine/output/probe_trajectory.h).
 
-#include "engine/probe_trajectory.h"
+#include "engine/output/probe_trajectory.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

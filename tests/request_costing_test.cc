@@ -11,7 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "convert/scene_file.h"
-#include "engine/frame_columns.h"
+#include "engine/output/frame_columns.h"
 #include "server/request_checks.h"
 
 namespace cablesim {

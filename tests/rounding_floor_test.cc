@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "absl/strings/str_format.h"
-#include "engine/ancf_cable_element.h"
+#include "engine/elements/ancf_cable_element.h"
 #include "tests/test_util.h"
 
 namespace cablesim {

@@ -8,7 +8,7 @@
 
 #include "client/summary_json.h"
 #include "convert/run_proto.h"
-#include "engine/simulation.h"
+#include "engine/run/simulation.h"
 
 namespace cablesim {
 namespace {

@@ -18,8 +18,9 @@
 #include "absl/strings/str_cat.h"
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
-#include "engine/scene.h"
-#include "engine/simulation.h"
+#include "engine/scene/scene.h"
+#include "engine/scene/integrator_traits.h"
+#include "engine/run/simulation.h"
 
 namespace cablesim {
 namespace {

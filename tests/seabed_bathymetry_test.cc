@@ -20,8 +20,8 @@
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
 #include "engine/forces/seabed.h"
-#include "engine/multibody_model.h"
-#include "engine/static_solver.h"
+#include "engine/model/multibody_model.h"
+#include "engine/analysis/static_solver.h"
 #include "tests/test_util.h"
 
 namespace cablesim {

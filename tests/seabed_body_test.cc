@@ -19,8 +19,8 @@
 #include <gtest/gtest.h>
 
 #include "absl/strings/str_format.h"
-#include "engine/multibody_model.h"
-#include "engine/static_solver.h"
+#include "engine/model/multibody_model.h"
+#include "engine/analysis/static_solver.h"
 #include "tests/test_util.h"
 
 namespace cablesim {

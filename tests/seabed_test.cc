@@ -19,9 +19,9 @@
 
 #include "absl/strings/str_format.h"
 #include "engine/forces/seabed.h"
-#include "engine/frame_columns.h"
-#include "engine/multibody_model.h"
-#include "engine/static_solver.h"
+#include "engine/output/frame_columns.h"
+#include "engine/model/multibody_model.h"
+#include "engine/analysis/static_solver.h"
 #include "tests/test_util.h"
 
 namespace cablesim {

@@ -13,7 +13,7 @@
 #include "client/csv_writer.h"
 #include "convert/run_proto.h"
 #include "convert/scene_from_proto.h"
-#include "engine/frame_columns.h"
+#include "engine/output/frame_columns.h"
 #include "server_test_util.h"
 #include "test_util.h"
 

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "engine/frame_columns.h"
+#include "engine/output/frame_columns.h"
 #include "tests/test_util.h"
 
 namespace cablesim {

@@ -17,7 +17,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
-#include "engine/simulation.h"
+#include "engine/run/simulation.h"
 #include "test_util.h"
 
 namespace cablesim {

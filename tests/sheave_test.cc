@@ -15,7 +15,7 @@
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
 #include "engine/forces/sheave.h"
-#include "engine/model_choice.h"
+#include "engine/model/model_choice.h"
 #include "test_util.h"
 
 namespace cablesim {

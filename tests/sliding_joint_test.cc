@@ -12,9 +12,9 @@
 #include "absl/strings/str_cat.h"
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
-#include "engine/multibody_model.h"
-#include "engine/simulation.h"
-#include "engine/sliding_joint.h"
+#include "engine/model/multibody_model.h"
+#include "engine/run/simulation.h"
+#include "engine/forces/sliding_joint.h"
 #include "test_util.h"
 
 namespace cablesim {

@@ -12,7 +12,7 @@
 
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_replace.h"
-#include "engine/model_choice.h"
+#include "engine/model/model_choice.h"
 #include "tests/test_util.h"
 
 namespace cablesim {

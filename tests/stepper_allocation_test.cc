@@ -34,10 +34,12 @@
 #include <Eigen/Core>
 #include <gtest/gtest.h>
 
-#include "engine/implicit_euler_stepper.h"
-#include "engine/stepper.h"
-#include "engine/multibody_model.h"
-#include "engine/scene.h"
+#include "engine/steppers/implicit_euler_stepper.h"
+#include "engine/scene/integrator_traits.h"
+#include "engine/steppers/make_stepper.h"
+#include "engine/steppers/stepper.h"
+#include "engine/model/multibody_model.h"
+#include "engine/scene/scene.h"
 #include "tests/test_util.h"
 
 namespace {
@@ -325,7 +327,7 @@ void ExpectStepsDoNotAllocate(const Scene& scene, double h, int steps) {
   const Counts counts = window.Stop();
 
   EXPECT_EQ(not_converged, 0) << "first failure at counted step " << first_failure;
-  if (!IsExplicit(scene.solver.integrator)) {
+  if (!TraitsOf(scene.solver.integrator).is_explicit) {
     EXPECT_GT(newton, 0);  // explicit steppers have no Newton iteration
   }
   EXPECT_EQ(counts.news, 0) << "operator new calls in " << steps << " steps "

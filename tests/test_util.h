@@ -13,9 +13,9 @@
 
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
-#include "engine/multibody_model.h"
-#include "engine/simulation.h"
-#include "engine/skyline_ldlt.h"
+#include "engine/model/multibody_model.h"
+#include "engine/run/simulation.h"
+#include "engine/linear/skyline_ldlt.h"
 
 namespace cablesim::testing {
 

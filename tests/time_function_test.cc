@@ -1,4 +1,4 @@
-// Time functions (engine/time_function.h) against their closed forms, and
+// Time functions (engine/scene/time_function.h) against their closed forms, and
 // the scene validation of prescribed motions and time-varying loads.
 
 #include <cmath>
@@ -10,7 +10,7 @@
 
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
-#include "engine/time_function.h"
+#include "engine/scene/time_function.h"
 
 namespace cablesim {
 namespace {

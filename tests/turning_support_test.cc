@@ -16,7 +16,7 @@
 #include "absl/strings/str_format.h"
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
-#include "engine/simulation.h"
+#include "engine/run/simulation.h"
 #include "test_util.h"
 
 namespace cablesim {

@@ -19,10 +19,10 @@
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
 #include "engine/forces/waves.h"
-#include "engine/model_choice.h"
-#include "engine/multibody_model.h"
-#include "engine/simulation.h"
-#include "engine/skyline_ldlt.h"
+#include "engine/model/model_choice.h"
+#include "engine/model/multibody_model.h"
+#include "engine/run/simulation.h"
+#include "engine/linear/skyline_ldlt.h"
 #include "tests/test_util.h"
 
 namespace cablesim {

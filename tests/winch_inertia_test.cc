@@ -11,7 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "engine/forces/winch_inertia.h"
-#include "engine/hermite_shape.h"
+#include "engine/elements/hermite_shape.h"
 
 namespace cablesim {
 namespace {

@@ -16,9 +16,9 @@
 #include "absl/strings/str_cat.h"
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
-#include "engine/multibody_model.h"
-#include "engine/simulation.h"
-#include "engine/time_function.h"
+#include "engine/model/multibody_model.h"
+#include "engine/run/simulation.h"
+#include "engine/scene/time_function.h"
 #include "test_util.h"
 
 namespace cablesim {

@@ -24,7 +24,7 @@
 
 #include <vector>
 
-#include "engine/scene.h"
+#include "engine/scene/scene.h"
 
 namespace cablesim {
 

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <limits>
 
-#include "engine/gauss_quadrature.h"
+#include "engine/elements/gauss_quadrature.h"
 #include "engine/forces/contact_point.h"
-#include "engine/hermite_shape.h"
+#include "engine/elements/hermite_shape.h"
 
 namespace cablesim {
 namespace {

@@ -136,7 +136,7 @@
 #include <Eigen/Core>
 
 #include "engine/forces/bathymetry_grid.h"
-#include "engine/scene.h"
+#include "engine/scene/scene.h"
 
 namespace cablesim {
 

@@ -5,8 +5,8 @@
 #include <limits>
 
 #include "engine/forces/contact_point.h"
-#include "engine/gauss_quadrature.h"
-#include "engine/hermite_shape.h"
+#include "engine/elements/gauss_quadrature.h"
+#include "engine/elements/hermite_shape.h"
 
 namespace cablesim {
 namespace {

@@ -67,7 +67,7 @@
 
 #include <Eigen/Core>
 
-#include "engine/scene.h"
+#include "engine/scene/scene.h"
 
 namespace cablesim {
 

@@ -2,7 +2,7 @@
 
 #include <utility>
 
-#include "engine/gauss_quadrature.h"
+#include "engine/elements/gauss_quadrature.h"
 
 namespace cablesim {
 

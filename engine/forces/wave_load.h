@@ -54,7 +54,7 @@
 
 #include <Eigen/Core>
 
-#include "engine/ancf_cable_element.h"
+#include "engine/elements/ancf_cable_element.h"
 #include "engine/forces/waves.h"
 
 namespace cablesim {

@@ -1,7 +1,7 @@
 #include "engine/forces/winch_inertia.h"
 
-#include "engine/gauss_quadrature.h"
-#include "engine/hermite_shape.h"
+#include "engine/elements/gauss_quadrature.h"
+#include "engine/elements/hermite_shape.h"
 
 namespace cablesim {
 

@@ -13,7 +13,7 @@
 #include "absl/status/statusor.h"
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
-#include "engine/simulation.h"
+#include "engine/run/simulation.h"
 
 namespace {
 

@@ -1,0 +1,410 @@
+#include "engine/elements/ancf_cable_element.h"
+
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Geometry>
+
+#include "engine/elements/hermite_shape.h"
+
+namespace cablesim {
+
+template <int D>
+AncfCableElement<D>::AncfCableElement(double length_m, double ea_n, double ei_n_m2,
+                                      BendingModel bending, int gauss_points)
+    : length_(length_m), ea_(ea_n), ei_(ei_n_m2), bending_(bending),
+      rule_(MakeGaussRule(gauss_points)) {
+  set_length(length_m);
+}
+
+template <int D>
+void AncfCableElement<D>::set_length(double length_m) {
+  length_ = length_m;
+  for (int g = 0; g < rule_.n; ++g) {
+    HermiteShape(rule_.xi[g], length_, s0_[g]);
+    HermiteShapeD1(rule_.xi[g], length_, d1_[g]);
+    HermiteShapeD2(rule_.xi[g], length_, d2_[g]);
+  }
+}
+
+template <int D>
+typename AncfCableElement<D>::Matrix AncfCableElement<D>::MassMatrix(
+    double mass_per_length_kg_m) const {
+  const double l = length_;
+  const double m = mass_per_length_kg_m * l;
+  Eigen::Matrix4d c;
+  c << 156, 22 * l, 54, -13 * l,
+       22 * l, 4 * l * l, 13 * l, -3 * l * l,
+       54, 13 * l, 156, -22 * l,
+       -13 * l, -3 * l * l, -22 * l, 4 * l * l;
+  c *= m / 420;
+  Matrix mass = Matrix::Zero();
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j)
+      for (int d = 0; d < D; ++d) mass(i * D + d, j * D + d) = c(i, j);
+  return mass;
+}
+
+template <int D>
+typename AncfCableElement<D>::Coords AncfCableElement<D>::GravityForce(
+    double mass_per_length_kg_m, const Point& g) const {
+  const double l = length_;
+  const double m = mass_per_length_kg_m * l;
+  Coords q;
+  q.template segment<D>(0) = m * g / 2;
+  q.template segment<D>(D) = m * l * g / 12;
+  q.template segment<D>(2 * D) = m * g / 2;
+  q.template segment<D>(3 * D) = -m * l * g / 12;
+  return q;
+}
+
+template <int D>
+typename AncfCableElement<D>::Point AncfCableElement<D>::Position(const Coords& e,
+                                                                  double xi) const {
+  double s[4];
+  HermiteShape(xi, length_, s);
+  Point r = Point::Zero();
+  for (int k = 0; k < 4; ++k) r += s[k] * e.template segment<D>(k * D);
+  return r;
+}
+
+template <int D>
+typename AncfCableElement<D>::Point AncfCableElement<D>::Slope(const Coords& e,
+                                                               double xi) const {
+  double s[4];
+  HermiteShapeD1(xi, length_, s);
+  Point r = Point::Zero();
+  for (int k = 0; k < 4; ++k) r += s[k] * e.template segment<D>(k * D);
+  return r;
+}
+
+template <int D>
+typename AncfCableElement<D>::BMatrix AncfCableElement<D>::B(int g) const {
+  BMatrix b = BMatrix::Zero();
+  for (int k = 0; k < 4; ++k)
+    for (int d = 0; d < D; ++d) {
+      b(d, k * D + d) = d1_[g][k];
+      b(D + d, k * D + d) = d2_[g][k];
+    }
+  return b;
+}
+
+template <int D>
+typename AncfCableElement<D>::Energy AncfCableElement<D>::StrainEnergy(const Coords& e) const {
+  Energy energy;
+  for (int g = 0; g < rule_.n; ++g) {
+    Point u = Point::Zero(), w = Point::Zero();
+    for (int k = 0; k < 4; ++k) {
+      u += d1_[g][k] * e.template segment<D>(k * D);
+      w += d2_[g][k] * e.template segment<D>(k * D);
+    }
+    const double a = u.squaredNorm(), b = u.dot(w), c = w.squaredNorm();
+    const double eps = (a - 1) / 2;
+    const double wl = rule_.weight[g] * length_;
+    energy.axial += wl * 0.5 * ea_ * eps * eps;
+    double kappa2 = 0;
+    if (bending_ == BendingModel::kExact) {
+      kappa2 = (a * c - b * b) / (a * a * a);
+    } else if (bending_ == BendingModel::kLinear) {
+      kappa2 = c;
+    }
+    energy.bending += wl * 0.5 * ei_ * kappa2;
+  }
+  return energy;
+}
+
+template <int D>
+void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* tangent,
+                                       Coords* roundoff) const {
+  using Id = Eigen::Matrix<double, D, D>;
+  constexpr double kEps = std::numeric_limits<double>::epsilon();
+  // For `roundoff`: |e_k| per node (once per element), and per node the
+  // bound summed over the Gauss points (the same for each of its D entries).
+  double node_size[4] = {0, 0, 0, 0}, node_bound[4] = {0, 0, 0, 0};
+  if (roundoff)
+    for (int k = 0; k < 4; ++k) node_size[k] = e.template segment<D>(k * D).norm();
+  for (int g = 0; g < rule_.n; ++g) {
+    const double* s1 = d1_[g];
+    const double* s2 = d2_[g];
+    Point u = Point::Zero(), w = Point::Zero();
+    for (int k = 0; k < 4; ++k) {
+      u += s1[k] * e.template segment<D>(k * D);
+      w += s2[k] * e.template segment<D>(k * D);
+    }
+    const double a = u.squaredNorm(), b = u.dot(w), c = w.squaredNorm();
+    const double wl = rule_.weight[g] * length_;
+    // Spectral-norm bounds of the Hessian blocks of psi (for `roundoff`).
+    double nuu = 0, nuw = 0, nww = 0;
+
+    // Gradient (gu, gw) and Hessian blocks of psi with respect to (u, w).
+    const double eps = (a - 1) / 2;
+    Point gu = ea_ * eps * u, gw = Point::Zero();
+    Block huu = Block::Zero(), huw = Block::Zero(), hww = Block::Zero();
+    if (tangent) huu = ea_ * (eps * Id::Identity() + u * u.transpose());
+    if (roundoff) nuu = ea_ * (std::abs(eps) + a);
+    if (bending_ == BendingModel::kLinear) {
+      gw += ei_ * w;
+      if (tangent) hww += ei_ * Id::Identity();
+      nww = ei_;
+    } else if (bending_ == BendingModel::kExact) {
+      // psi_b = EI/2 f(a, b, c), f = c / a^2 - b^2 / a^3, with
+      // da/du = 2u, db/du = w, db/dw = u, dc/dw = 2w.
+      const double ia = 1 / a, ia2 = ia * ia, ia3 = ia2 * ia, ia4 = ia2 * ia2;
+      const double k = 0.5 * ei_;
+      const double fa = k * (-2 * c * ia3 + 3 * b * b * ia4);
+      const double fb = k * (-2 * b * ia3);
+      const double fc = k * ia2;
+      gu += 2 * fa * u + fb * w;
+      gw += fb * u + 2 * fc * w;
+      const double faa = k * (6 * c * ia4 - 12 * b * b * ia4 * ia);
+      const double fab = k * (6 * b * ia4);
+      const double fac = k * (-2 * ia3);
+      const double fbb = k * (-2 * ia3);
+      if (roundoff) {
+        const double nunw = std::sqrt(a * c);  // |u| |w|
+        nuu += 4 * std::abs(faa) * a + 4 * std::abs(fab) * nunw + std::abs(fbb) * c +
+               2 * std::abs(fa);
+        nuw = 2 * std::abs(fab) * a + (4 * std::abs(fac) + std::abs(fbb)) * nunw + std::abs(fb);
+        nww = std::abs(fbb) * a + 2 * std::abs(fc);
+      }
+      if (tangent) {
+        // Second derivatives of f through a, b, c, plus f_a, f_b, f_c times
+        // the Hessians of a, b, c.
+        huu += 4 * faa * u * u.transpose() + 2 * fab * (u * w.transpose() + w * u.transpose()) +
+               fbb * w * w.transpose() + 2 * fa * Id::Identity();
+        huw += 2 * fab * u * u.transpose() + 4 * fac * u * w.transpose() +
+               fbb * w * u.transpose() + fb * Id::Identity();
+        hww += fbb * u * u.transpose() + 2 * fc * Id::Identity();
+      }
+    }
+    for (int k = 0; k < 4; ++k)
+      force->template segment<D>(k * D) += wl * (s1[k] * gu + s2[k] * gw);
+    if (roundoff) {
+      double du = 0, dw = 0;
+      for (int k = 0; k < 4; ++k) {
+        du += std::abs(s1[k]) * node_size[k];
+        dw += std::abs(s2[k]) * node_size[k];
+      }
+      du *= kEps;
+      dw *= kEps;
+      // |g|_1 >= |g|_2: a bound without a square root.
+      const double dgu = wl * (nuu * du + nuw * dw + kEps * gu.template lpNorm<1>());
+      const double dgw = wl * (nuw * du + nww * dw + kEps * gw.template lpNorm<1>());
+      for (int k = 0; k < 4; ++k) node_bound[k] += std::abs(s1[k]) * dgu + std::abs(s2[k]) * dgw;
+    }
+    if (tangent) AddUpperBlocks(g, wl, huu, huw, hww, tangent);
+  }
+  if (roundoff)
+    for (int k = 0; k < 4; ++k) roundoff->template segment<D>(k * D).array() += node_bound[k];
+  if (tangent) MirrorUpperBlocks(tangent);
+}
+
+template <int D>
+void AncfCableElement<D>::AddUpperBlocks(int g, double wl, const Block& huu, const Block& huw,
+                                         const Block& hww, Matrix* tangent) const {
+  // B's node block k is [s_k' I; s_k'' I], so block (k, m) of B^T H B is
+  // s_k' s_m' H_uu + s_k' s_m'' H_uw + s_k'' s_m' H_wu + s_k'' s_m'' H_ww.
+  const double* s1 = d1_[g];
+  const double* s2 = d2_[g];
+  for (int k = 0; k < 4; ++k) {
+    const double p1 = wl * s1[k], p2 = wl * s2[k];
+    for (int m = k; m < 4; ++m) {
+      const double q1 = s1[m], q2 = s2[m];
+      tangent->template block<D, D>(k * D, m * D) +=
+          (p1 * q1) * huu + (p1 * q2) * huw + (p2 * q1) * huw.transpose() + (p2 * q2) * hww;
+    }
+  }
+}
+
+template <int D>
+void AncfCableElement<D>::MirrorUpperBlocks(Matrix* tangent) {
+  for (int k = 0; k < 4; ++k)
+    for (int m = k + 1; m < 4; ++m)
+      tangent->template block<D, D>(m * D, k * D) =
+          tangent->template block<D, D>(k * D, m * D).transpose();
+}
+
+template <int D>
+void AncfCableElement<D>::AddDampingMatrix(const Coords& e, double axial_s, double bending_s,
+                                           Matrix* c) const {
+  // Rows of the curvature vector: 1 in the plane, 3 in space.
+  constexpr int kRows = D == 2 ? 1 : 3;
+  using GBlock = Eigen::Matrix<double, kRows, D>;
+  const double ca = ea_ * axial_s, cb = bending_ == BendingModel::kNone ? 0.0 : ei_ * bending_s;
+  Matrix upper = Matrix::Zero();
+  for (int g = 0; g < rule_.n; ++g) {
+    Point u = Point::Zero(), w = Point::Zero();
+    for (int k = 0; k < 4; ++k) {
+      u += d1_[g][k] * e.template segment<D>(k * D);
+      w += d2_[g][k] * e.template segment<D>(k * D);
+    }
+    const double wl = rule_.weight[g] * length_;
+    Block huu = ca * u * u.transpose(), huw = Block::Zero(), hww = Block::Zero();
+    if (cb != 0) {
+      // k = u x w / a^(3/2), a = u.u: dk/dw = [u]x / a^(3/2),
+      // dk/du = -[w]x / a^(3/2) - 3 k u^T / a.
+      const double a = u.squaredNorm(), ia15 = 1 / (a * std::sqrt(a));
+      GBlock gu, gw;
+      if constexpr (D == 2) {
+        const double k = (u.x() * w.y() - u.y() * w.x()) * ia15;
+        gu << w.y() * ia15, -w.x() * ia15;
+        gu -= (3 * k / a) * u.transpose();
+        gw << -u.y() * ia15, u.x() * ia15;
+      } else {
+        const Point k = u.cross(w) * ia15;
+        Block wx, ux;
+        wx << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
+        ux << 0, -u.z(), u.y(), u.z(), 0, -u.x(), -u.y(), u.x(), 0;
+        gu = -ia15 * wx - (3 / a) * k * u.transpose();
+        gw = ia15 * ux;
+      }
+      huu += cb * gu.transpose() * gu;
+      huw = cb * gu.transpose() * gw;
+      hww = cb * gw.transpose() * gw;
+    }
+    AddUpperBlocks(g, wl, huu, huw, hww, &upper);
+  }
+  MirrorUpperBlocks(&upper);
+  *c += upper;
+}
+
+template <int D>
+void AncfCableElement<D>::AddDrag(const Coords& e, const Coords& edot, const Point& current,
+                                  double kn, double kt, Coords* force, Matrix* c) const {
+  for (int g = 0; g < rule_.n; ++g) AddFlowLoadAt(g, e, edot, current, nullptr, kn, kt, 0, force, c);
+}
+
+template <int D>
+typename AncfCableElement<D>::Point AncfCableElement<D>::GaussPosition(const Coords& e,
+                                                                       int g) const {
+  Point r = Point::Zero();
+  for (int k = 0; k < 4; ++k) r += s0_[g][k] * e.template segment<D>(k * D);
+  return r;
+}
+
+template <int D>
+void AncfCableElement<D>::AddMorison(const Coords& e, const Coords& edot,
+                                     const Point* flow_velocity, const Point* flow_acceleration,
+                                     double kn, double kt, double mi, Coords* force,
+                                     Matrix* c) const {
+  for (int g = 0; g < rule_.n; ++g)
+    AddFlowLoadAt(g, e, edot, flow_velocity[g], &flow_acceleration[g], kn, kt, mi, force, c);
+}
+
+template <int D>
+void AncfCableElement<D>::AddFlowLoadAt(int g, const Coords& e, const Coords& edot,
+                                        const Point& flow, const Point* accel, double kn,
+                                        double kt, double mi, Coords* force, Matrix* c) const {
+  {
+    const double* s0 = s0_[g];
+    Point u = Point::Zero(), v = flow;
+    for (int k = 0; k < 4; ++k) {
+      u += d1_[g][k] * e.template segment<D>(k * D);
+      v -= s0[k] * edot.template segment<D>(k * D);
+    }
+    const double un = u.norm();
+    const double wl = rule_.weight[g] * length_;
+    if (!(un > 0)) {
+      // No tangent (a collapsed point): no drag, but the flow's inertia acts.
+      if (accel)
+        for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s0[k] * mi) * *accel;
+      return;
+    }
+    const Point t = u / un;
+    const Point vt = t.dot(v) * t, vn = v - vt;
+    const double an = vn.norm(), at = vt.norm();
+    Point q = kn * an * vn + kt * at * vt;
+    if (accel) q += mi * *accel;
+    for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s0[k]) * q;
+    if (!c) return;
+    Block h = (2 * kt * at) * t * t.transpose();
+    if (an > 0) {
+      h += (kn * an) * (Block::Identity() - t * t.transpose()) + (kn / an) * vn * vn.transpose();
+    }
+    for (int k = 0; k < 4; ++k)
+      for (int m = 0; m < 4; ++m)
+        c->template block<D, D>(k * D, m * D) += (wl * s0[k] * s0[m]) * h;
+  }
+}
+
+namespace {
+
+// The element's Gram matrix G = E^T E (module doc of
+// AddDiscreteGradientCorrection) and E.
+template <int D>
+void GramOf(const Eigen::Matrix<double, 4 * D, 1>& e, double l, Eigen::Matrix<double, D, 3>* ev,
+            Eigen::Matrix3d* g) {
+  ev->col(0) = (e.template segment<D>(2 * D) - e.template segment<D>(0)) / l;
+  ev->col(1) = e.template segment<D>(D);
+  ev->col(2) = e.template segment<D>(3 * D);
+  *g = ev->transpose() * *ev;
+}
+
+}  // namespace
+
+template <int D>
+void AncfCableElement<D>::AddDiscreteGradientCorrection(const Coords& e0, const Coords& e1,
+                                                        Coords* correction) const {
+  using EMatrix = Eigen::Matrix<double, D, 3>;
+  const double l = length_;
+  EMatrix ev0, ev1, evm;
+  Eigen::Matrix3d g0, g1, gm;
+  GramOf<D>(e0, l, &ev0, &g0);
+  GramOf<D>(e1, l, &ev1, &g1);
+  const Coords em = 0.5 * (e0 + e1);
+  GramOf<D>(em, l, &evm, &gm);  // the Gram matrix of the midpoint
+  // p_dg: the discrete gradient in G; p_mid: dUt/dG at G(em).
+  Eigen::Matrix3d p_dg = Eigen::Matrix3d::Zero(), p_mid = Eigen::Matrix3d::Zero();
+  const bool exact = bending_ == BendingModel::kExact;
+  const double k = 0.5 * ei_;
+  for (int gp = 0; gp < rule_.n; ++gp) {
+    const Eigen::Vector3d al(l * d1_[gp][2], d1_[gp][1], d1_[gp][3]);
+    const Eigen::Vector3d be(l * d2_[gp][2], d2_[gp][1], d2_[gp][3]);
+    const Eigen::Matrix3d aa = al * al.transpose(), bb = be * be.transpose();
+    const Eigen::Matrix3d ab = 0.5 * (al * be.transpose() + be * al.transpose());
+    const double wl = rule_.weight[gp] * l;
+    auto abc = [&](const Eigen::Matrix3d& g, double* a, double* b, double* c) {
+      *a = al.dot(g * al);
+      *b = al.dot(g * be);
+      *c = be.dot(g * be);
+    };
+    double a0, b0, c0, a1, b1, c1, am, bm, cm;
+    abc(g0, &a0, &b0, &c0);
+    abc(g1, &a1, &b1, &c1);
+    abc(gm, &am, &bm, &cm);
+    // Axial psi_a = EA (a - 1) / 4 (linear in a: exact at the mean) and
+    // LINEAR bending psi_c = EI / 2 (constant).
+    double fa = 0.25 * ea_ * (0.5 * (a0 + a1) - 1), fb = 0, fc = 0;
+    double ga = 0.25 * ea_ * (am - 1), gb = 0, gc = 0;
+    if (bending_ == BendingModel::kLinear) fc = gc = k;
+    if (exact) {
+      // psi = k (c A(a) - b^2 B(a)), A = a^-2, B = a^-3: the discrete
+      // product rule with the exact difference quotients of A and B.
+      const double i0 = 1 / a0, i1 = 1 / a1;
+      const double abar = 0.5 * (i0 * i0 + i1 * i1), bbar = 0.5 * (i0 * i0 * i0 + i1 * i1 * i1);
+      const double da = -(a0 + a1) * (i0 * i0) * (i1 * i1);
+      const double db = -(a0 * a0 + a0 * a1 + a1 * a1) * (i0 * i0 * i0) * (i1 * i1 * i1);
+      fa += k * (0.5 * (c0 + c1) * da - 0.5 * (b0 * b0 + b1 * b1) * db);
+      fb += k * (-(b0 + b1) * bbar);
+      fc += k * abar;
+      const double ia = 1 / am, ia2 = ia * ia, ia3 = ia2 * ia, ia4 = ia2 * ia2;
+      ga += k * (-2 * cm * ia3 + 3 * bm * bm * ia4);
+      gb += k * (-2 * bm * ia3);
+      gc += k * ia2;
+    }
+    p_dg += wl * (fa * aa + fb * ab + fc * bb);
+    p_mid += wl * (ga * aa + gb * ab + gc * bb);
+  }
+  // Force on the three vectors 2 E P; on the coordinates through
+  // d / l = (r_A - r_O) / l.
+  const EMatrix fv = 2 * evm * (p_dg - p_mid);
+  correction->template segment<D>(0) -= fv.col(0) / l;
+  correction->template segment<D>(D) += fv.col(1);
+  correction->template segment<D>(2 * D) += fv.col(0) / l;
+  correction->template segment<D>(3 * D) += fv.col(2);
+}
+
+template class AncfCableElement<2>;
+template class AncfCableElement<3>;
+
+}  // namespace cablesim

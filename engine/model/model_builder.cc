@@ -1,0 +1,1236 @@
+#include "engine/model/model_builder.h"
+#include "engine/scene/integrator_traits.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <utility>
+
+#include <Eigen/Dense>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "engine/model/model_choice.h"
+#include "engine/scene/polyline.h"
+
+namespace cablesim {
+namespace {
+
+using Eigen::Vector3d;
+using Eigen::VectorXd;
+
+// Relative tolerance for matching arc lengths to nodes.
+constexpr double kSnap = 1e-9;
+constexpr double kPi = std::numbers::pi;
+
+// The body frame at t = 0 from its x axis (scene.h): columns x, y, z.
+Eigen::Matrix3d BodyFrame(const Vector3d& axis) {
+  const Vector3d x = axis.normalized();
+  Vector3d y = Vector3d::UnitZ().cross(x);
+  if (y.norm() < 1e-12) y = Vector3d::UnitX().cross(x);
+  y.normalize();
+  Eigen::Matrix3d r;
+  r.col(0) = x;
+  r.col(1) = y;
+  r.col(2) = x.cross(y);
+  return r;
+}
+
+LinearVector Constant(const Vector3d& v) {
+  return {LinearForm::Constant(v.x()), LinearForm::Constant(v.y()), LinearForm::Constant(v.z())};
+}
+
+LinearVector Combination(const std::vector<std::pair<double, LinearVector>>& terms) {
+  LinearVector r;
+  for (const auto& [s, v] : terms) r = Add(r, v, s);
+  return r;
+}
+
+}  // namespace
+
+int ModelBuilder::Mesh::Node(const Attachment& at) const {
+  const auto& s = node_s[at.cable];
+  auto it = std::lower_bound(s.begin(), s.end(), at.s_m - snap_m[at.cable]);
+  return first_node[at.cable] + static_cast<int>(it - s.begin());
+}
+
+absl::Status ModelBuilder::ChooseDimension() {
+  absl::StatusOr<int> dim = cablesim::ChooseDimension(scene_);
+  if (!dim.ok()) return dim.status();
+  model_.dim_ = *dim;
+  model_.node_stride_ = 2 * *dim;
+  model_.body_stride_ = *dim == 2 ? 4 : 12;
+  return absl::OkStatus();
+}
+
+absl::Status ModelBuilder::CheckWinches() const {
+  const int num_cables = static_cast<int>(scene_.cables.size());
+  for (int c = 0; c < num_cables; ++c) {
+    const CableSpec& cable = scene_.cables[c];
+    if (!cable.winch.enabled) continue;
+    const double len = cable.length_m, tol = kSnap * len;
+    if (scene_.solver.analysis == Analysis::kDynamic && scene_.solver.duration_s > 0) {
+      // L(t) = len + int_0^t speed on a grid no coarser than the step (at
+      // most 100,000 points), the first crossing of 0 refined by bisection.
+      const double duration = scene_.solver.duration_s;
+      const int n = static_cast<int>(std::min(
+          1e5, std::max(100.0, std::ceil(duration / std::max(scene_.solver.step_s, 1e-12)))));
+      auto length = [&](double t) { return len + cable.winch.speed.Integral(t); };
+      double t_prev = 0;
+      for (int i = 1; i <= n; ++i) {
+        const double t = duration * i / n;
+        if (length(t) > 0) {
+          t_prev = t;
+          continue;
+        }
+        double lo = t_prev, hi = t;
+        for (int k = 0; k < 60 && hi - lo > 1e-12 * (1 + hi); ++k) {
+          const double mid = 0.5 * (lo + hi);
+          (length(mid) > 0 ? lo : hi) = mid;
+        }
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "cables[%d].winch.speed: reels in the whole cable: its free length (length + "
+            "int speed dt) reaches 0 at t = %.6g s, within solver.duration (%.6g s)",
+            c, hi, duration));
+      }
+    }
+    bool held = false;
+    for (size_t j = 0; j < scene_.joints.size(); ++j) {
+      const JointSpec& joint = scene_.joints[j];
+      for (const Attachment* at : {&joint.a, &joint.b}) {
+        if (at->cable != c) continue;
+        if (joint.type == JointType::kSlide) {
+          return absl::InvalidArgumentError(absl::StrFormat(
+              "joints[%d]: a sliding joint cannot run on a winch cable (cables[%d].winch)", j, c));
+        }
+        const Attachment& other = at == &joint.a ? joint.b : joint.a;
+        if (std::abs(at->s_m - len) <= tol && other.IsGround()) held = true;
+        if (at->s_m > tol && at->s_m < len - tol) {
+          return absl::InvalidArgumentError(absl::StrFormat(
+              "joints[%d]: a winch cable (cables[%d].winch) takes joints only at its ends (s = 0 "
+              "or its length): its mesh moves through the material",
+              j, c));
+        }
+      }
+    }
+    if (!held) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "cables[%d].winch: the winch holds the cable's last point (s = length): join it to "
+          "the ground with a PIN or FIXED joint (with a motion for a moving winch)",
+          c));
+    }
+    for (size_t i = 0; i < scene_.loads.size(); ++i) {
+      const Attachment& at = scene_.loads[i].at;
+      if (at.cable == c && at.s_m > tol && at.s_m < len - tol) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "loads[%d].at: a winch cable (cables[%d].winch) takes loads only at its ends", i, c));
+      }
+    }
+    for (size_t i = 0; i < scene_.probes.size(); ++i) {
+      const Attachment& at = scene_.probes[i].at;
+      if (at.cable == c && at.s_m > tol && at.s_m < len - tol) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "probes[%d].at: a winch cable (cables[%d].winch) takes probes only at its ends", i,
+            c));
+      }
+    }
+    if (cable.bending_damping_s != 0 || cable.rayleigh_beta_s != 0) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "cables[%d].damping: a winch cable takes axial_time and rayleigh_alpha only (bending "
+          "damping on an axially moving mesh is not built)",
+          c));
+    }
+    if (scene_.fluid.density_kg_m3 > 0 || scene_.seabed.enabled) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "cables[%d].winch: a winch cable in a fluid or on a seabed is not modelled (their "
+          "loads on an axially moving mesh are not built)",
+          c));
+    }
+    if (scene_.solver.integrator == Integrator::kEnergyMomentum &&
+        scene_.solver.analysis == Analysis::kDynamic) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "solver.integrator: ENERGY_MOMENTUM does not take winches (cables[%d].winch): its "
+          "energy statement needs a constant mass; use HHT, GENERALIZED_ALPHA or "
+          "IMPLICIT_EULER",
+          c));
+    }
+  }
+  return absl::OkStatus();
+}
+
+void ModelBuilder::MeshCables() {
+  const int num_cables = static_cast<int>(scene_.cables.size());
+  std::vector<std::vector<double>>& node_s = mesh_.node_s;
+  node_s.assign(num_cables, {});
+  mesh_.snap_m.resize(num_cables);
+  for (int c = 0; c < num_cables; ++c) {
+    const CableSpec& cable = scene_.cables[c];
+    mesh_.snap_m[c] = kSnap * cable.length_m;
+    for (int k = 0; k <= cable.elements; ++k)
+      node_s[c].push_back(cable.length_m * k / cable.elements);
+  }
+  auto require = [&](const Attachment& at) {
+    if (at.cable >= 0) node_s[at.cable].push_back(at.s_m);
+  };
+  // A sliding joint needs no node: it moves along the cable.
+  for (const JointSpec& j : scene_.joints)
+    if (j.type != JointType::kSlide) require(j.a), require(j.b);
+  for (const LoadSpec& l : scene_.loads) require(l.at);
+  for (const ProbeSpec& p : scene_.probes) require(p.at);
+  // Where a bending-free cable kinks (a PIN or a load inside it) and where
+  // it must not (a FIXED joint there).
+  std::vector<std::vector<double>> kink_s(num_cables), smooth_s(num_cables);
+  auto interior = [&](const Attachment& at) {
+    if (at.cable < 0 || scene_.cables[at.cable].bending != BendingModel::kNone) return false;
+    const double len = scene_.cables[at.cable].length_m, tol = mesh_.snap_m[at.cable];
+    return at.s_m > tol && at.s_m < len - tol;
+  };
+  for (const JointSpec& j : scene_.joints) {
+    if (j.type == JointType::kSlide) continue;
+    for (const Attachment* at : {&j.a, &j.b}) {
+      if (!interior(*at)) continue;
+      (j.type == JointType::kPin ? kink_s : smooth_s)[at->cable].push_back(at->s_m);
+    }
+  }
+  for (const LoadSpec& l : scene_.loads)
+    if (interior(l.at)) kink_s[l.at.cable].push_back(l.at.s_m);
+  mesh_.first_node.assign(num_cables + 1, 0);
+  mesh_.twin_of.clear();
+  std::vector<int>& twin_of = mesh_.twin_of;
+  for (int c = 0; c < num_cables; ++c) {
+    auto& s = node_s[c];
+    std::sort(s.begin(), s.end());
+    const double tol = mesh_.snap_m[c];
+    std::vector<double> unique;
+    for (double v : s)
+      if (unique.empty() || v - unique.back() > tol) unique.push_back(v);
+    // A point within tol of the end snaps to it.
+    unique.back() = scene_.cables[c].length_m;
+    auto near = [&](const std::vector<double>& list, double v) {
+      for (double x : list)
+        if (std::abs(x - v) <= tol) return true;
+      return false;
+    };
+    s.clear();
+    for (double v : unique) {
+      s.push_back(v);
+      twin_of.push_back(-1);
+      if (near(kink_s[c], v) && !near(smooth_s[c], v)) {
+        s.push_back(v);
+        twin_of.push_back(static_cast<int>(twin_of.size()) - 1);
+        ++model_.split_nodes_;
+      }
+    }
+    mesh_.first_node[c + 1] = mesh_.first_node[c] + static_cast<int>(s.size());
+  }
+  model_.num_nodes_ = mesh_.nodes();
+}
+
+int ModelBuilder::BodyCoord(int body) const {
+  return model_.node_stride_ * model_.num_nodes_ + model_.body_stride_ * body;
+}
+
+absl::Status ModelBuilder::InitialCoordinates() {
+  const int D = model_.dim_, num_nodes = model_.num_nodes_;
+  const int num_bodies = static_cast<int>(scene_.bodies.size());
+  q0_ = VectorXd::Zero(BodyCoord(num_bodies));
+  model_.initial_velocity_ = scene_.initial_velocity;
+  for (int c = 0; c < static_cast<int>(scene_.cables.size()); ++c) {
+    const CableSpec& cable = scene_.cables[c];
+    const double stretch = PolylineLength(cable.points) / cable.length_m;
+    for (size_t k = 0; k < mesh_.node_s[c].size(); ++k) {
+      const int node = mesh_.first_node[c] + static_cast<int>(k);
+      // The two halves of a split node take the tangents of their sides.
+      const std::vector<int>& twin_of = mesh_.twin_of;
+      const int side = twin_of[node] >= 0                                 ? 1
+                       : node + 1 < num_nodes && twin_of[node + 1] == node ? -1
+                                                                          : 0;
+      Vector3d p, t;
+      PolylineAt(cable.points, mesh_.node_s[c][k] / cable.length_m, &p, &t, side);
+      const int i = NodeCoord(node);
+      const Vector3d slope = stretch * t;
+      q0_.segment(i, D) = p.head(D);
+      q0_.segment(i + D, D) = slope.head(D);
+    }
+  }
+  frame0_.resize(num_bodies);
+  for (int b = 0; b < num_bodies; ++b) {
+    const BodySpec& body = scene_.bodies[b];
+    const int i = BodyCoord(b);
+    frame0_[b] = BodyFrame(body.axis);
+    q0_.segment(i, D) = body.position_m.head(D);
+    MultibodyModel::BodyData data;
+    data.coord = i;
+    data.mass = body.mass_kg;
+    data.linear_damping = body.linear_damping_n_s_m;
+    data.angular_damping = body.angular_damping_n_m_s;
+    if (data.linear_damping != 0 || data.angular_damping != 0) model_.has_damping_ = true;
+    const Vector3d& inertia = body.inertia_kg_m2;
+    if (D == 2) {
+      q0_.segment<2>(i + 2) = frame0_[b].col(0).head<2>();
+      data.jbar = Vector3d(inertia.z(), 0, 0);
+    } else {
+      for (int k = 0; k < 3; ++k) {
+        q0_.segment<3>(i + 3 + 3 * k) = frame0_[b].col(k);
+      }
+      data.jbar = Vector3d::Constant(inertia.sum() / 2) - inertia;
+      // Relative: a plate's (0.1, 0.2, 0.3) leaves 6e-17 by rounding, a
+      // mass matrix singular in all but name.
+      if (!(data.jbar.minCoeff() > 1e-12 * inertia.maxCoeff())) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "bodies[%d].inertia: the spatial model needs each principal moment to be less than "
+            "the sum of the other two (a real body's mass lies off every axis); got "
+            "(%.6g, %.6g, %.6g) kg m^2",
+            b, inertia.x(), inertia.y(), inertia.z()));
+      }
+    }
+    model_.bodies_.push_back(data);
+  }
+  return absl::OkStatus();
+}
+
+LinearVector ModelBuilder::NodePosition(int node) const {
+  LinearVector v;
+  for (int d = 0; d < model_.dim_; ++d) v[d] = LinearForm::Coordinate(NodeCoord(node) + d);
+  return v;
+}
+
+LinearVector ModelBuilder::NodeSlope(int node) const {
+  const int D = model_.dim_;
+  LinearVector v;
+  for (int d = 0; d < D; ++d) v[d] = LinearForm::Coordinate(NodeCoord(node) + D + d);
+  return v;
+}
+
+LinearVector ModelBuilder::BodyAxis(int body, int k) const {
+  const int i = BodyCoord(body);
+  LinearVector v;
+  if (model_.dim_ == 3) {
+    for (int d = 0; d < 3; ++d) v[d] = LinearForm::Coordinate(i + 3 + 3 * k + d);
+  } else if (k == 0) {
+    v[0] = LinearForm::Coordinate(i + 2);
+    v[1] = LinearForm::Coordinate(i + 3);
+  } else if (k == 1) {  // perp(u) = (-u_y, u_x)
+    v[0] = LinearForm::Coordinate(i + 3, -1);
+    v[1] = LinearForm::Coordinate(i + 2);
+  } else {
+    v = Constant(Vector3d::UnitZ());
+  }
+  return v;
+}
+
+std::array<LinearVector, 3> ModelBuilder::BodyAxes(int body) const {
+  return {BodyAxis(body, 0), BodyAxis(body, 1), BodyAxis(body, 2)};
+}
+
+LinearVector ModelBuilder::BodyPoint(int body, const Vector3d& p) const {
+  const int D = model_.dim_, i = BodyCoord(body);
+  LinearVector v;
+  for (int d = 0; d < D; ++d) v[d] = LinearForm::Coordinate(i + d);
+  for (int k = 0; k < D; ++k)
+    if (p(k) != 0) v = Add(v, BodyAxis(body, k), p(k));
+  return v;
+}
+
+LinearVector ModelBuilder::PointOf(const Attachment& at) const {
+  if (at.cable >= 0) return NodePosition(mesh_.Node(at));
+  return BodyPoint(at.body, at.point_body_m);
+}
+
+Vector3d ModelBuilder::AtStart(const LinearVector& v) const {
+  return Vector3d(v[0].Evaluate(q0_), v[1].Evaluate(q0_), v[2].Evaluate(q0_));
+}
+
+absl::Status ModelBuilder::Joints() {
+  const int D = model_.dim_, bs = model_.body_stride_;
+  const int num_nodes = model_.num_nodes_;
+  elimination_.grounded.assign(q0_.size(), false);
+  elimination_.clamp_dir.assign(num_nodes, Vector3d::Zero());
+  elimination_.clamped.assign(num_nodes, false);
+  std::vector<bool>& grounded = elimination_.grounded;
+  pending_.clear();
+  for (int ji = 0; ji < static_cast<int>(scene_.joints.size()); ++ji) {
+    const JointSpec& joint = scene_.joints[ji];
+    if (joint.type == JointType::kSlide) {
+      // A force (Sliders), not rows: one side a body, the other a cable.
+      if (!((joint.a.body >= 0 && joint.b.cable >= 0) ||
+            (joint.b.body >= 0 && joint.a.cable >= 0))) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "joints[", ji, "].type: SLIDE joins a body (one side) to a cable (the other)"));
+      }
+      continue;
+    }
+    Attachment a = joint.a, b = joint.b;
+    if (a.IsGround()) std::swap(a, b);
+    if (a.IsGround()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("joints[", ji, "].a: a joint needs a cable or a body on one side"));
+    }
+    const bool fixed = joint.type == JointType::kFixed;
+    if (b.IsGround() && (joint.HasMotion() || joint.HasRotation())) {
+      // A moving support: its point stays as rows (below); FIXED keeps the
+      // orientation by elimination, as a fixed support does, or, when the
+      // support turns, by rows whose normals turn with it.
+      if (joint.HasRotation()) {
+        AddTurningRows(ji, a);
+      } else if (fixed && a.cable >= 0) {
+        const int node = mesh_.Node(a);
+        elimination_.clamped[node] = true;
+        elimination_.clamp_dir[node] = AtStart(NodeSlope(node)).normalized();
+      } else if (fixed) {
+        const int i = BodyCoord(a.body);
+        for (int k = D; k < bs; ++k) grounded[i + k] = true;
+      }
+      const LinearVector pa = PointOf(a);
+      const Vector3d p0 = AtStart(pa);
+      for (int d = 0; d < D; ++d) {
+        LinearForm diff = pa[d];
+        diff.c -= p0(d);
+        PendingRow row{QuadraticForm::FromLinear(diff), Row::kPosition, ji, -1};
+        row.motion_axis = d;
+        pending_.push_back(row);
+      }
+      continue;
+    }
+    if (b.IsGround()) {
+      if (a.cable >= 0) {
+        const int node = mesh_.Node(a);
+        for (int d = 0; d < D; ++d) grounded[NodeCoord(node) + d] = true;
+        if (fixed) {
+          elimination_.clamped[node] = true;
+          elimination_.clamp_dir[node] = AtStart(NodeSlope(node)).normalized();
+        }
+        continue;
+      }
+      const int i = BodyCoord(a.body);
+      if (fixed) {
+        for (int k = 0; k < bs; ++k) grounded[i + k] = true;
+        continue;
+      }
+      if (a.point_body_m.norm() == 0) {
+        for (int d = 0; d < D; ++d) grounded[i + d] = true;
+        continue;
+      }
+    }
+    // Points coincide: D rows.
+    const LinearVector pa = PointOf(a);
+    const LinearVector pb = b.IsGround() ? Constant(AtStart(pa)) : PointOf(b);
+    for (int d = 0; d < D; ++d) {
+      LinearForm diff = pa[d];
+      diff += pb[d].Scaled(-1);
+      pending_.push_back({QuadraticForm::FromLinear(diff), Row::kPosition, ji, -1});
+    }
+    if (!fixed || b.IsGround()) continue;
+    if (absl::Status s = AddOrientationRows(ji, a, b); !s.ok()) return s;
+  }
+  // Each body's axes stay unit and orthogonal.
+  for (int b = 0; b < static_cast<int>(scene_.bodies.size()); ++b) {
+    const auto e = BodyAxes(b);
+    const int axes = D == 2 ? 1 : 3;
+    for (int k = 0; k < axes; ++k) {
+      QuadraticForm f = Dot(e[k], e[k], D);
+      f.c -= 1;
+      pending_.push_back({f, Row::kAxes, -1, b});
+    }
+    for (int k = 0; k < axes; ++k)
+      for (int l = k + 1; l < axes; ++l)
+        pending_.push_back({Dot(e[k], e[l], D), Row::kAxes, -1, b});
+  }
+  return absl::OkStatus();
+}
+
+void ModelBuilder::AddTurningRows(int ji, Attachment a) {
+  const int D = model_.dim_;
+  // One row n . x = 0 per pair (x, n) of a held direction x and a normal
+  // n of its initial direction: a clamped slope r_x keeps n . r_x = 0 for
+  // the D - 1 normals of d0 (its length, the stretch, stays free); a body
+  // keeps u . v0 = 0 (planar) or u . v0 = u . w0 = v . w0 = 0 (spatial),
+  // which with its unit and orthogonality rows fix its axes to R(t) e0.
+  auto add = [&](int coord, const Vector3d& n0) {
+    LinearForm f;
+    for (int d = 0; d < D; ++d) f.terms[coord + d] = 1;  // placeholders
+    PendingRow row{QuadraticForm::FromLinear(f), Row::kDirection, ji, -1};
+    row.turn_coord = coord;
+    row.turn_n0 = n0;
+    pending_.push_back(row);
+  };
+  auto at_start = [&](int coord) {
+    Vector3d x = Vector3d::Zero();
+    x.head(D) = q0_.segment(coord, D);
+    return x;
+  };
+  if (a.cable >= 0) {
+    const int slope = NodeCoord(mesh_.Node(a)) + D;
+    const Vector3d d0 = at_start(slope).normalized();
+    if (D == 2) {
+      add(slope, Vector3d(-d0.y(), d0.x(), 0));
+    } else {
+      const Vector3d n1 = d0.unitOrthogonal();
+      add(slope, n1);
+      add(slope, d0.cross(n1));
+    }
+    return;
+  }
+  const int c = BodyCoord(a.body);
+  if (D == 2) {
+    add(c + 2, Vector3d(-q0_(c + 3), q0_(c + 2), 0));
+  } else {
+    add(c + 3, at_start(c + 6));
+    add(c + 3, at_start(c + 9));
+    add(c + 6, at_start(c + 9));
+  }
+}
+
+absl::Status ModelBuilder::AddOrientationRows(int ji, Attachment a, Attachment b) {
+  const int D = model_.dim_;
+  if (a.cable < 0 && b.cable >= 0) std::swap(a, b);  // a node first
+  if (a.cable >= 0 && b.cable >= 0) {
+    // Two cables welded end to end: the slopes stay equal, r_x,b = c r_x,a
+    // with c = |r_x,b| / |r_x,a| at t = 0 (1 for a cable split at the
+    // joint): D linear rows, of full rank in every configuration. (Rows
+    // (r_x,a x r_x,b) . m with fixed m lose rank once the tangent turns
+    // onto m.) The stretch on both sides is thereby tied; that is exact for
+    // a uniform cable without a point load at the joint.
+    const LinearVector ta = NodeSlope(mesh_.Node(a)), tb = NodeSlope(mesh_.Node(b));
+    const Vector3d t0a = AtStart(ta), t0b = AtStart(tb);
+    const double sine = t0a.cross(t0b).norm() / (t0a.norm() * t0b.norm());
+    if (!(sine <= 1e-6) || t0a.dot(t0b) <= 0) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "joints[%d]: FIXED between two cables needs their tangents parallel and in the same "
+          "sense at t = 0 (sine of the angle between them: %.6g)",
+          ji, sine));
+    }
+    const double ratio = t0b.norm() / t0a.norm();
+    for (int d = 0; d < D; ++d) {
+      LinearForm diff = tb[d];
+      diff += ta[d].Scaled(-ratio);
+      pending_.push_back({QuadraticForm::FromLinear(diff), Row::kSlope, ji, -1});
+    }
+  } else if (a.cable >= 0) {
+    // A cable tangent along the body's x axis: t . e2 = 0 (and t . e3 = 0).
+    const LinearVector t = NodeSlope(mesh_.Node(a));
+    pending_.push_back({Dot(t, BodyAxis(b.body, 1), D), Row::kDirection, ji, -1});
+    if (D == 3) pending_.push_back({Dot(t, BodyAxis(b.body, 2), D), Row::kDirection, ji, -1});
+  } else {
+    // Two bodies welded: with B0 = A0 R0 at t = 0, b's axes must stay
+    // A R0: e2_b . u_hat = 0, e3_b . u_hat = 0, e3_b . v_hat = 0 where
+    // u_hat, v_hat are A R0 e_x, A R0 e_y (planar: the first only).
+    const Eigen::Matrix3d r0 = frame0_[a.body].transpose() * frame0_[b.body];
+    const auto ea = BodyAxes(a.body);
+    const LinearVector u_hat =
+        Combination({{r0(0, 0), ea[0]}, {r0(1, 0), ea[1]}, {r0(2, 0), ea[2]}});
+    const LinearVector v_hat =
+        Combination({{r0(0, 1), ea[0]}, {r0(1, 1), ea[1]}, {r0(2, 1), ea[2]}});
+    pending_.push_back({Dot(BodyAxis(b.body, 1), u_hat, D), Row::kDirection, ji, -1});
+    if (D == 3) {
+      pending_.push_back({Dot(BodyAxis(b.body, 2), u_hat, D), Row::kDirection, ji, -1});
+      pending_.push_back({Dot(BodyAxis(b.body, 2), v_hat, D), Row::kDirection, ji, -1});
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::Status ModelBuilder::CheckJointsAtStart() const {
+  std::vector<double> gap2(scene_.joints.size(), 0.0);
+  for (const PendingRow& r : pending_) {
+    const double v = r.f.Evaluate(q0_);
+    if (r.kind == Row::kPosition) gap2[r.joint] += v * v;
+    // (A turning support's rows hold at t = 0 by construction; f holds
+    // placeholders until SetTime writes n(0).)
+    if (r.kind == Row::kDirection && r.turn_coord < 0 && std::abs(v) > 1e-6) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "joints[%d]: FIXED needs the cable tangent parallel to the other side's axis at "
+          "t = 0 (sine of the angle between them: %.6g)",
+          r.joint, v));
+    }
+  }
+  for (size_t j = 0; j < gap2.size(); ++j) {
+    if (std::sqrt(gap2[j]) > 1e-6) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "joints[%d]: its two points are %.6g m apart at t = 0 (they must coincide)",
+          static_cast<int>(j), std::sqrt(gap2[j])));
+    }
+  }
+  return absl::OkStatus();
+}
+
+void ModelBuilder::OrderUnknowns() {
+  MultibodyModel& m = model_;
+  const int D = m.dim_, bs = m.body_stride_, ncoord = static_cast<int>(q0_.size());
+  const int num_bodies = static_cast<int>(scene_.bodies.size());
+  const std::vector<bool>& grounded = elimination_.grounded;
+  m.c_ = VectorXd::Zero(ncoord);
+  m.s_ = VectorXd::Zero(ncoord);
+  m.j_.assign(ncoord, -1);
+  int next = 0;
+  std::vector<bool> body_placed(num_bodies, false);
+  auto place_body = [&](int b) {
+    if (body_placed[b]) return;
+    body_placed[b] = true;
+    const int i = BodyCoord(b);
+    for (int k = 0; k < bs; ++k) {
+      if (grounded[i + k]) {
+        m.c_(i + k) = q0_(i + k);
+      } else {
+        m.j_[i + k] = next++;
+        m.s_(i + k) = 1;
+      }
+    }
+  };
+  std::vector<std::vector<int>> bodies_at_node(m.num_nodes_);
+  for (const JointSpec& joint : scene_.joints) {
+    // A slider's body goes last (SlidingJoint: a bordered band).
+    if (joint.type == JointType::kSlide) continue;
+    if (joint.a.cable >= 0 && joint.b.body >= 0)
+      bodies_at_node[mesh_.Node(joint.a)].push_back(joint.b.body);
+    if (joint.b.cable >= 0 && joint.a.body >= 0)
+      bodies_at_node[mesh_.Node(joint.b)].push_back(joint.a.body);
+  }
+  for (int node = 0; node < m.num_nodes_; ++node) {
+    const int i = NodeCoord(node);
+    const int twin = mesh_.twin_of[node];
+    for (int k = 0; k < D; ++k) {
+      if (twin >= 0) {
+        const int t = NodeCoord(twin) + k;
+        m.j_[i + k] = m.j_[t];
+        m.s_(i + k) = m.s_(t);
+        m.c_(i + k) = m.c_(t);
+      } else if (grounded[i + k]) {
+        m.c_(i + k) = q0_(i + k);
+      } else {
+        m.j_[i + k] = next++;
+        m.s_(i + k) = 1;
+      }
+    }
+    if (elimination_.clamped[node]) {
+      const int alpha = next++;
+      for (int k = 0; k < D; ++k) {
+        m.j_[i + D + k] = alpha;
+        m.s_(i + D + k) = elimination_.clamp_dir[node](k);
+      }
+    } else {
+      for (int k = D; k < 2 * D; ++k) {
+        m.j_[i + k] = next++;
+        m.s_(i + k) = 1;
+      }
+    }
+    for (int b : bodies_at_node[node]) place_body(b);
+  }
+  for (int b = 0; b < num_bodies; ++b) place_body(b);
+  m.dofs_ = next;
+
+  // z0 and v0 by least squares through the map (exact for consistent data).
+  m.z0_ = m.Reduce(q0_);
+  VectorXd qd0 = VectorXd::Zero(ncoord);
+  m.RigidVelocity(q0_, &qd0);
+  m.v0_ = m.Reduce(qd0);
+}
+
+void ModelBuilder::KeepMovableRows() {
+  MultibodyModel& m = model_;
+  // A row that no unknown can change (both sides held by ground, say a
+  // pinned node and a body pinned at its centre of mass, or the axes of a
+  // welded body) is satisfied by construction, as far as
+  // CheckJointsAtStart allows, and could never be corrected.
+  // The test is the row's gradient on z at t = 0 (the rows are linear or
+  // bilinear, so a row with a zero reduced gradient there is one that the
+  // elimination has made constant, e.g. a clamped node welded to a body
+  // welded to ground).
+  for (const PendingRow& r : pending_) {
+    VectorXd grad = VectorXd::Zero(m.dofs_);
+    for (const auto& [i, v] : r.f.linear)
+      if (m.j_[i] >= 0) grad(m.j_[i]) += v * m.s_(i);
+    for (const auto& [ij, v] : r.f.quadratic) {
+      if (m.j_[ij.first] >= 0) grad(m.j_[ij.first]) += v * m.s_(ij.first) * q0_(ij.second);
+      if (m.j_[ij.second] >= 0) grad(m.j_[ij.second]) += v * m.s_(ij.second) * q0_(ij.first);
+    }
+    if (grad.lpNorm<Eigen::Infinity>() <= 1e-12) continue;
+    m.AddRow(r.f, r.kind, r.joint, r.body);
+    if (r.motion_axis >= 0) {
+      MultibodyModel::MovingRow moving;
+      moving.row = static_cast<int>(m.rows_.size()) - 1;
+      moving.joint = r.joint;
+      moving.axis = r.motion_axis;
+      moving.c0 = r.f.c;
+      moving.motion = scene_.joints[r.joint].motion[r.motion_axis];
+      m.moving_rows_.push_back(moving);
+    }
+    if (r.turn_coord >= 0) {
+      MultibodyModel::TurningRow turning;
+      turning.row = static_cast<int>(m.rows_.size()) - 1;
+      turning.coord = r.turn_coord;
+      turning.n0 = r.turn_n0;
+      turning.axis = scene_.joints[r.joint].rotation_axis;
+      turning.angle = scene_.joints[r.joint].rotation;
+      m.turning_rows_.push_back(turning);
+    }
+  }
+}
+
+absl::Status ModelBuilder::CheckIntegratorFits() const {
+  if (!TraitsOf(scene_.solver.integrator).is_explicit || scene_.solver.analysis != Analysis::kDynamic)
+    return absl::OkStatus();
+  const std::string name(IntegratorName(scene_.solver.integrator));
+  const MultibodyModel& m = model_;
+  if (!m.rows_.empty()) {
+    const MultibodyModel::Row& r = m.rows_.front();
+    const std::string what = r.joint >= 0
+                                 ? absl::StrFormat("joints[%d] is kept as constraint rows", r.joint)
+                                 : absl::StrFormat("bodies[%d] has its axes' constraint rows", r.body);
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "solver.integrator: %s is explicit and integrates unconstrained motion "
+        "only, and this scene has %d constraint rows (%s; only joints to fixed ground "
+        "points are eliminated): use HHT, GENERALIZED_ALPHA, ENERGY_MOMENTUM or IMPLICIT_EULER",
+        name, m.multipliers(), what));
+  }
+  for (int c = 0; c < static_cast<int>(scene_.cables.size()); ++c) {
+    if (scene_.cables[c].winch.enabled) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "solver.integrator: %s does not take winches (cables[%d].winch): it "
+          "factors the mass matrix once; use HHT, GENERALIZED_ALPHA or IMPLICIT_EULER",
+          name, c));
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::Status ModelBuilder::CheckMovingRows() const {
+  std::vector<int> kept(scene_.joints.size(), 0), wanted(scene_.joints.size(), 0);
+  for (const PendingRow& r : pending_)
+    if (r.motion_axis >= 0) ++wanted[r.joint];
+  for (const MultibodyModel::MovingRow& m : model_.moving_rows_) ++kept[m.joint];
+  for (size_t j = 0; j < kept.size(); ++j) {
+    if (kept[j] != wanted[j]) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "joints[%d].motion: the point it moves is also held by a fixed joint to ground",
+          static_cast<int>(j)));
+    }
+  }
+  return absl::OkStatus();
+}
+
+template <int D>
+void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* elements) {
+  const double extent = q0_.lpNorm<Eigen::Infinity>();  // scene size [m]
+  const Eigen::Matrix<double, D, 1> g = scene_.gravity_m_s2.head<D>();
+  const std::vector<int>& first_node = mesh_.first_node;
+  model_.cable_element_begin_.assign(1, 0);
+  for (int c = 0; c < static_cast<int>(scene_.cables.size()); ++c) {
+    if (Stopped()) return;
+    const CableSpec& cable = scene_.cables[c];
+    model_.cable_names_.push_back(cable.name);
+    const double ea = cable.youngs_modulus_pa * cable.area_m2;
+    const double ei = cable.youngs_modulus_pa * cable.second_moment_m4;
+    const double mpl = cable.density_kg_m3 * cable.area_m2;
+    // In a fluid: buoyancy (the displaced fluid's weight off gravity),
+    // isotropic added mass, and the drag factors of AddDrag.
+    const double rho_f = scene_.fluid.density_kg_m3;
+    const double dh = cable.hydro_diameter_m > 0 ? cable.hydro_diameter_m
+                                                 : std::sqrt(4 * cable.area_m2 / kPi);
+    const double displaced = rho_f > 0 ? rho_f * kPi * dh * dh / 4 : 0.0;  // [kg/m]
+    const double drag_n = 0.5 * rho_f * cable.normal_drag * dh;
+    const double drag_t = 0.5 * rho_f * cable.tangential_drag * kPi * dh;
+    for (int k = first_node[c]; k + 1 < first_node[c + 1]; ++k) {
+      if (mesh_.twin_of[k + 1] == k) continue;  // the two halves of a split node
+      const int local = k - first_node[c];
+      const double l = mesh_.node_s[c][local + 1] - mesh_.node_s[c][local];
+      MultibodyModel::ElementData<D> e;
+      e.element = AncfCableElement<D>(l, ea, ei, cable.bending);
+      // Energy the element can hold from coordinates known to 16 eps
+      // (1 + |q0|_inf): a strain of that over l, a curvature of it over l^2.
+      const double strain = 16 * std::numeric_limits<double>::epsilon() * (1 + extent) / l;
+      model_.energy_roundoff_ += (ea + ei / (l * l)) * l * strain * strain;
+      e.first_coord = NodeCoord(k);
+      e.mass_per_length = mpl + cable.added_mass * displaced;
+      e.gravity = e.element.GravityForce(mpl - displaced, g);
+      e.drag_n = drag_n;
+      e.drag_t = drag_t;
+      if (model_.wave_load_) {
+        // The flow's inertia: Froude-Krylov plus added mass (WaveLoad).
+        e.fluid_inertia = (1 + cable.added_mass) * displaced;
+        if (e.fluid_inertia != 0) model_.has_damping_ = true;
+      }
+      e.axial_damping_s = cable.axial_damping_s + cable.rayleigh_beta_s;
+      e.bending_damping_s = cable.bending_damping_s + cable.rayleigh_beta_s;
+      e.alpha_1_s = cable.rayleigh_alpha_1_s;
+      if (e.damped()) model_.has_damping_ = true;
+      const auto me = e.element.MassMatrix(e.mass_per_length);
+      for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b) e.mbar(a, b) = me(D * a, D * b);
+      elements->push_back(e);
+    }
+    model_.cable_element_begin_.push_back(static_cast<int>(elements->size()));
+  }
+}
+
+void ModelBuilder::BuildElements() {
+  model_.current_ = scene_.fluid.current_m_s;
+  // Waves need a fluid, gravity (the vertical and the dispersion) and a
+  // depth; SceneFromProto refuses waves without them, naming the field.
+  const FluidSpec& fluid = scene_.fluid;
+  const double g = scene_.gravity_m_s2.norm();
+  if (fluid.waves.any() && fluid.density_kg_m3 > 0 && g > 0 && fluid.water_depth_m > 0) {
+    WaveField field(-scene_.gravity_m_s2 / g, fluid.still_water_level_m, fluid.water_depth_m, g,
+                    fluid.waves.ramp_s);
+    for (const RegularWaveSpec& r : fluid.waves.regular)
+      field.AddRegular(r.height_m, r.period_s, r.direction, r.phase_rad);
+    for (const JonswapSpec& j : fluid.waves.jonswap)
+      field.AddJonswap(j.significant_height_m, j.peak_period_s, j.peak_factor, j.direction,
+                       j.components, j.seed);
+    model_.wave_load_.emplace(std::move(field), fluid.current_m_s);
+  }
+  // The fluid's loads on bodies that ask for them (SceneFromProto requires
+  // a fluid and gravity with them).
+  for (int b = 0; b < static_cast<int>(scene_.bodies.size()); ++b) {
+    const BodySpec& body = scene_.bodies[b];
+    if (!body.has_hydrodynamics || !(fluid.density_kg_m3 > 0) || !(g > 0)) continue;
+    BodyFluidLoad::Params p;
+    p.density_kg_m3 = fluid.density_kg_m3;
+    p.g_m_s2 = g;
+    p.up = -scene_.gravity_m_s2 / g;
+    p.still_level_m = fluid.still_water_level_m;
+    p.diameter_m = body.hydro_diameter_m;
+    p.height_m = body.hydro_height_m;
+    p.drag = body.hydro_drag;
+    p.heave_drag = body.hydro_heave_drag;
+    p.added_mass = body.hydro_added_mass;
+    p.heave_added_mass = body.hydro_heave_added_mass;
+    p.current_m_s = fluid.current_m_s;
+    const BodyFluidLoad& load = model_.body_fluid_.emplace_back(p, BodyCoord(b), model_.dim_);
+    MultibodyModel::BodyData& data = model_.bodies_[b];
+    data.added_mass = load.AddedMass(q0_);
+    data.has_added_mass = !data.added_mass.isZero(0);
+    if (load.dynamic(model_.wave_load_.has_value())) model_.has_damping_ = true;
+  }
+  if (scene_.seabed.enabled) {
+    model_.seabed_.emplace(scene_.seabed);
+    if (model_.seabed_->dissipates()) model_.has_damping_ = true;
+    // Bodies with contact points (SceneFromProto refuses them without a
+    // seabed).
+    for (int b = 0; b < static_cast<int>(scene_.bodies.size()); ++b) {
+      const BodySpec& body = scene_.bodies[b];
+      if (body.contact_points_m.empty()) continue;
+      MultibodyModel::BodyContact contact;
+      contact.coord = BodyCoord(b);
+      contact.points = body.contact_points_m;
+      contact.k = body.contact_stiffness_n_m;
+      contact.c = body.contact_damping_n_s_m;
+      contact.mu = body.contact_friction;
+      if (contact.c != 0 || contact.mu != 0) model_.has_damping_ = true;
+      model_.body_contacts_.push_back(std::move(contact));
+    }
+  }
+  if (model_.dim_ == 2) {
+    BuildElementsOf<2>(&model_.elements2_);
+  } else {
+    BuildElementsOf<3>(&model_.elements3_);
+  }
+  BuildSheaves();
+}
+
+void ModelBuilder::BuildSheaves() {
+  MultibodyModel& m = model_;
+  if (scene_.sheaves.empty()) return;
+  m.sheave_mask_.assign(m.elements(), 0);
+  for (size_t i = 0; i < scene_.sheaves.size(); ++i) {
+    const SheaveSpec& spec = scene_.sheaves[i];
+    m.sheaves_.emplace_back(spec);
+    if (m.sheaves_.back().dissipates()) m.sheaves_dissipate_ = m.has_damping_ = true;
+    for (int cable = 0; cable < static_cast<int>(scene_.cables.size()); ++cable) {
+      if (!spec.Touches(cable)) continue;
+      for (int k = m.cable_element_begin_[cable]; k < m.cable_element_begin_[cable + 1]; ++k)
+        m.sheave_mask_[k] |= uint64_t{1} << i;
+    }
+  }
+}
+
+absl::Status ModelBuilder::Sliders() {
+  MultibodyModel& m = model_;
+  for (int ji = 0; ji < static_cast<int>(scene_.joints.size()); ++ji) {
+    const JointSpec& joint = scene_.joints[ji];
+    if (joint.type != JointType::kSlide) continue;
+    const Attachment& on_cable = joint.a.cable >= 0 ? joint.a : joint.b;
+    const Attachment& on_body = joint.a.body >= 0 ? joint.a : joint.b;
+    const int cable = on_cable.cable;
+    const CableSpec& spec = scene_.cables[cable];
+    std::vector<SlidingJoint::Segment> segments;
+    double s0 = 0;
+    for (int k = m.cable_element_begin_[cable]; k < m.cable_element_begin_[cable + 1]; ++k) {
+      const int first = m.dim_ == 2 ? m.elements2_[k].first_coord : m.elements3_[k].first_coord;
+      const double l =
+          m.dim_ == 2 ? m.elements2_[k].element.length() : m.elements3_[k].element.length();
+      segments.push_back({first, s0, l});
+      s0 += l;
+    }
+    // Default stiffness: the axial stiffness EA / l_e of one element.
+    double k = joint.slide.stiffness_n_m;
+    if (k == 0) k = spec.youngs_modulus_pa * spec.area_m2 * spec.elements / spec.length_m;
+    SlidingJoint slider(m.dim_, std::move(segments), BodyCoord(on_body.body), m.body_stride_,
+                        on_body.point_body_m, k, joint.slide.friction,
+                        joint.slide.stick_velocity_m_s, on_cable.s_m);
+    const double gap = slider.Gap(q0_);
+    if (gap > 1e-6) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "joints[%d]: the body point is %.6g m from the cable at t = 0 (a sliding joint starts "
+          "on its cable)",
+          ji, gap));
+    }
+    if (slider.has_friction()) m.has_damping_ = true;
+    m.sliders_.push_back(std::move(slider));
+  }
+  return absl::OkStatus();
+}
+
+void ModelBuilder::Winches() {
+  MultibodyModel& m = model_;
+  for (int c = 0; c < static_cast<int>(scene_.cables.size()); ++c) {
+    const CableSpec& cable = scene_.cables[c];
+    if (!cable.winch.enabled) continue;
+    MultibodyModel::WinchData w;
+    w.cable = c;
+    w.element_begin = m.cable_element_begin_[c];
+    w.element_end = m.cable_element_begin_[c + 1];
+    w.length0 = w.length = cable.length_m;
+    w.speed = cable.winch.speed;
+    w.mass_per_length = cable.density_kg_m3 * cable.area_m2;
+    w.ea = cable.youngs_modulus_pa * cable.area_m2;
+    w.axial_damping_s = cable.axial_damping_s;
+    w.alpha_1_s = cable.rayleigh_alpha_1_s;
+    m.winches_.push_back(std::move(w));
+  }
+  if (m.winches_.empty()) return;
+  m.winch_slot_.assign(m.elements(), -1);
+  int elements = 0;
+  for (const MultibodyModel::WinchData& w : m.winches_) {
+    for (int k = w.element_begin; k < w.element_end; ++k) {
+      m.winch_slot_[k] = elements++;
+      // The winch damps the material motion instead (WinchDamping).
+      if (m.dim_ == 2) {
+        m.elements2_[k].axial_damping_s = m.elements2_[k].alpha_1_s = 0;
+      } else {
+        m.elements3_[k].axial_damping_s = m.elements3_[k].alpha_1_s = 0;
+      }
+    }
+  }
+  for (auto* v : {&m.winch_cv_, &m.winch_ce_, &m.winch_mdot_, &m.winch_g_, &m.winch_h_})
+    v->assign(elements, Eigen::Matrix4d::Zero());
+  m.has_damping_ = true;  // the convective terms ride on DampingForce
+}
+
+void ModelBuilder::ConstantForces() {
+  MultibodyModel& m = model_;
+  const int D = m.dim_;
+  m.gravity_ = scene_.gravity_m_s2;
+  for (const BodySpec& body : scene_.bodies) m.body_names_.push_back(body.name);
+  m.constant_force_ = VectorXd::Zero(q0_.size());
+  for (const auto& e : m.elements2_) m.constant_force_.segment<8>(e.first_coord) += e.gravity;
+  for (const auto& e : m.elements3_) m.constant_force_.segment<12>(e.first_coord) += e.gravity;
+  for (const MultibodyModel::BodyData& b : m.bodies_)
+    m.constant_force_.segment(b.coord, D) += b.mass * scene_.gravity_m_s2.head(D);
+  // A force F at a point r = sum_i a_i q_i + c does the work F . dr, so its
+  // generalized force is sum_d F_d a_{d,i} on q_i (constant: the point is
+  // linear in q).
+  if (!scene_.loads.empty()) m.load_force_ = VectorXd::Zero(q0_.size());
+  auto add_point_force = [&](const LinearVector& point, const Vector3d& force) {
+    for (int d = 0; d < D; ++d) {
+      for (const auto& [i, v] : point[d].terms) {
+        m.constant_force_(i) += v * force(d);
+        m.load_force_(i) += v * force(d);
+      }
+    }
+  };
+  for (const LoadSpec& load : scene_.loads) {
+    const LinearVector point = PointOf(load.at);
+    add_point_force(point, load.force_n);
+    if (!IsZero(load.varying_force_n)) {
+      MultibodyModel::VaryingForce v;
+      for (int d = 0; d < D; ++d)
+        for (const auto& [i, c] : point[d].terms) v.point[d].push_back({i, c});
+      v.force = load.varying_force_n;
+      m.varying_forces_.push_back(std::move(v));
+    }
+    const bool varying_torque = !IsZero(load.varying_torque_nm);
+    if (load.at.body >= 0 && (load.torque_nm.norm() > 0 || varying_torque)) {
+      MultibodyModel::TorqueLoad t;
+      t.body = load.at.body;
+      t.torque = t.base = load.torque_nm;
+      t.varying = load.varying_torque_nm;
+      t.is_varying = varying_torque;
+      m.torques_.push_back(std::move(t));
+    }
+  }
+}
+
+void ModelBuilder::Probes() {
+  MultibodyModel& m = model_;
+  // The cable nodes (output.shape), a split node's second half left out.
+  m.shape_ = scene_.output.shape;
+  for (size_t c = 0; c + 1 < mesh_.first_node.size(); ++c) {
+    int count = 0;
+    for (int k = mesh_.first_node[c]; k < mesh_.first_node[c + 1]; ++k) {
+      if (mesh_.twin_of[k] >= 0) continue;
+      m.shape_coord_.push_back(NodeCoord(k));
+      m.node_s_.push_back(mesh_.node_s[c][k - mesh_.first_node[c]]);
+      ++count;
+    }
+    m.cable_nodes_.push_back(count);
+  }
+  m.probe_term_begin_.push_back(0);
+  for (const ProbeSpec& p : scene_.probes) {
+    const LinearVector point = PointOf(p.at);
+    for (int d = 0; d < 3; ++d) {
+      for (const auto& [i, v] : point[d].terms) m.probe_terms_.push_back({i, v});
+      m.probe_term_begin_.push_back(static_cast<int>(m.probe_terms_.size()));
+      m.probe_const_.push_back(point[d].c);
+    }
+    m.probe_names_.push_back(p.name);
+  }
+  // Probes placed where a moving support holds its cable or body report
+  // the support's force (its rows' multipliers).
+  m.probe_force_rows_.assign(scene_.probes.size(), {-1, -1, -1});
+  for (size_t p = 0; p < scene_.probes.size(); ++p) {
+    const Attachment& at = scene_.probes[p].at;
+    bool found = false;
+    for (const MultibodyModel::MovingRow& row : m.moving_rows_) {
+      const JointSpec& joint = scene_.joints[row.joint];
+      const Attachment& held = joint.a.IsGround() ? joint.b : joint.a;
+      const bool same = at.cable >= 0 ? held.cable == at.cable && mesh_.Node(held) == mesh_.Node(at)
+                                      : held.body == at.body && held.body >= 0 &&
+                                            (held.point_body_m - at.point_body_m).norm() <= 1e-12;
+      if (!same) continue;
+      m.probe_force_rows_[p][row.axis] = row.row;
+      found = true;
+    }
+    // A probe at a winch's end reports the line tension.
+    for (int w = 0; w < static_cast<int>(m.winches_.size()); ++w) {
+      const CableSpec& cable = scene_.cables[m.winches_[w].cable];
+      if (at.cable != m.winches_[w].cable ||
+          std::abs(at.s_m - cable.length_m) > kSnap * cable.length_m)
+        continue;
+      if (m.probe_winch_.empty()) m.probe_winch_.assign(scene_.probes.size(), -1);
+      m.probe_winch_[p] = w;
+      found = true;
+    }
+    if (found) m.force_probes_.push_back(static_cast<int>(p));
+  }
+}
+
+template <int D>
+void ModelBuilder::WinchBases(const std::vector<MultibodyModel::ElementData<D>>& elements) {
+  MultibodyModel& m = model_;
+  constexpr int kN = 4 * D, kN2 = kN * kN;
+  m.mass_base_.assign(m.mass_.values(), m.mass_.values() + m.mass_.stored());
+  m.constant_force_base_ = m.constant_force_;
+  for (const MultibodyModel::WinchData& w : m.winches_) {
+    for (int k = w.element_begin; k < w.element_end; ++k) {
+      const MultibodyModel::ElementData<D>& e = elements[k];
+      m.constant_force_base_.segment<kN>(e.first_coord) -= e.gravity;
+      const auto me = e.element.MassMatrix(e.mass_per_length);
+      for (int t = 0; t < kN2; ++t) {
+        const int slot = m.element_slots_[kN2 * k + t];
+        if (slot >= 0) m.mass_base_[slot] -= m.element_factors_[kN2 * k + t] * me(t / kN, t % kN);
+      }
+    }
+  }
+}
+
+template <int D>
+void ModelBuilder::SetupElementSlots(const std::vector<MultibodyModel::ElementData<D>>& elements) {
+  MultibodyModel& m = model_;
+  constexpr int kN = 4 * D, kN2 = kN * kN;
+  m.element_slots_.resize(kN2 * elements.size());
+  m.element_factors_.resize(kN2 * elements.size());
+  for (size_t k = 0; k < elements.size(); ++k) {
+    if (k % 65536 == 0 && Stopped()) return;
+    const MultibodyModel::ElementData<D>& e = elements[k];
+    for (int a = 0; a < kN; ++a) {
+      for (int b = 0; b < kN; ++b) {
+        const int ia = e.first_coord + a, ib = e.first_coord + b;
+        const int ja = m.j_[ia], jb = m.j_[ib];
+        // A(ja, jb) with ja > jb is stored once; the diagonal takes every
+        // (a, b) with ja == jb (both orders of a != b), as the sum requires.
+        const int slot = (ja >= 0 && jb >= 0 && ja >= jb) ? m.mass_.Slot(ja, jb) : -1;
+        m.element_slots_[kN2 * k + kN * a + b] = slot;
+        m.element_factors_[kN2 * k + kN * a + b] = slot < 0 ? 0 : m.s_(ia) * m.s_(ib);
+      }
+    }
+    const auto me = e.element.MassMatrix(e.mass_per_length);
+    for (int t = 0; t < kN2; ++t) {
+      const int slot = m.element_slots_[kN2 * k + t];
+      if (slot >= 0)
+        m.mass_.values()[slot] += m.element_factors_[kN2 * k + t] * me(t / kN, t % kN);
+    }
+  }
+}
+
+void ModelBuilder::EnvelopeAndMass() {
+  MultibodyModel& m = model_;
+  const int D = m.dim_, bs = m.body_stride_;
+  m.envelope_.resize(m.dofs_);
+  for (int j = 0; j < m.dofs_; ++j) m.envelope_[j] = j;
+  auto couple = [&](const int* idx, int n) {
+    int lo = std::numeric_limits<int>::max();
+    for (int k = 0; k < n; ++k)
+      if (m.j_[idx[k]] >= 0) lo = std::min(lo, m.j_[idx[k]]);
+    for (int k = 0; k < n; ++k)
+      if (m.j_[idx[k]] >= 0) m.envelope_[m.j_[idx[k]]] = std::min(m.envelope_[m.j_[idx[k]]], lo);
+  };
+  {
+    std::vector<int> idx(4 * D);
+    for (const auto& e : m.elements2_) {
+      for (int k = 0; k < 8; ++k) idx[k] = e.first_coord + k;
+      couple(idx.data(), 8);
+    }
+    for (const auto& e : m.elements3_) {
+      for (int k = 0; k < 12; ++k) idx[k] = e.first_coord + k;
+      couple(idx.data(), 12);
+    }
+  }
+  for (const MultibodyModel::BodyData& b : m.bodies_) {
+    std::vector<int> idx(bs);
+    for (int k = 0; k < bs; ++k) idx[k] = b.coord + k;
+    couple(idx.data(), bs);
+  }
+  for (const Row& row : m.rows_) {
+    couple(&m.row_coord_[row.coord_begin], row.coord_end - row.coord_begin);
+  }
+
+  // The first `count` coordinates of a body coupled with every element of
+  // a cable (a slider, a wheel the body carries).
+  auto couple_body_with_cable = [&](int body, int count, int cable) {
+    int cable_lo = std::numeric_limits<int>::max(), body_lo = cable_lo;
+    const int first = NodeCoord(mesh_.first_node[cable]);
+    const int last = NodeCoord(mesh_.first_node[cable + 1]);
+    for (int i = first; i < last; ++i)
+      if (m.j_[i] >= 0) cable_lo = std::min(cable_lo, m.j_[i]);
+    for (int k = 0; k < count; ++k)
+      if (m.j_[BodyCoord(body) + k] >= 0) body_lo = std::min(body_lo, m.j_[BodyCoord(body) + k]);
+    for (int k = 0; k < count; ++k) {
+      const int j = m.j_[BodyCoord(body) + k];
+      if (j >= 0) m.envelope_[j] = std::min(m.envelope_[j], cable_lo);
+    }
+    for (int i = first; i < last; ++i) {
+      const int j = m.j_[i];
+      if (j >= 0 && j > body_lo) m.envelope_[j] = std::min(m.envelope_[j], body_lo);
+    }
+  };
+  // A slider couples its body with every element of its cable.
+  for (const JointSpec& joint : scene_.joints) {
+    if (joint.type != JointType::kSlide) continue;
+    const int cable = joint.a.cable >= 0 ? joint.a.cable : joint.b.cable;
+    const int body = joint.a.body >= 0 ? joint.a.body : joint.b.body;
+    couple_body_with_cable(body, bs, cable);
+  }
+  // A wheel on a body couples the body's centre with the cables it touches.
+  for (const SheaveSpec& wheel : scene_.sheaves) {
+    if (wheel.body < 0) continue;
+    for (int cable = 0; cable < static_cast<int>(scene_.cables.size()); ++cable)
+      if (wheel.Touches(cable)) couple_body_with_cable(wheel.body, D, cable);
+  }
+
+  // The reduced mass matrix, with the element scatter tables.
+  m.mass_.SetPattern(m.envelope_);
+  if (D == 2) {
+    SetupElementSlots(m.elements2_);
+  } else {
+    SetupElementSlots(m.elements3_);
+  }
+  for (const MultibodyModel::BodyData& b : m.bodies_) {
+    for (int k = 0; k < bs; ++k) {
+      const int j = m.j_[b.coord + k];
+      if (j < 0) continue;
+      const double diag = k < D ? b.mass : b.jbar((k - D) / D);
+      m.mass_.values()[m.mass_.Slot(j, j)] += m.s_(b.coord + k) * m.s_(b.coord + k) * diag;
+    }
+    if (b.has_added_mass) m.ScatterBodyBlock(b.coord, b.added_mass, 1.0, &m.mass_);
+  }
+}
+
+void ModelBuilder::ConstraintPattern() {
+  MultibodyModel& m = model_;
+  m.jac_pattern_.cols = m.dofs_;
+  for (const Row& row : m.rows_) {
+    for (int k = row.coord_begin; k < row.coord_end; ++k) {
+      if (m.j_[m.row_coord_[k]] < 0) continue;
+      m.jac_pattern_.col.push_back(m.j_[m.row_coord_[k]]);
+      m.jac_pattern_.value.push_back(0);
+    }
+    m.jac_pattern_.row_start.push_back(static_cast<int>(m.jac_pattern_.col.size()));
+  }
+  m.mono_row_.assign(m.mono_a_.size(), -1);
+  m.mono_col_.assign(m.mono_a_.size(), -1);
+  m.mono_factor_.assign(m.mono_a_.size(), 0.0);
+  for (const Row& row : m.rows_) {
+    const int* coord = &m.row_coord_[row.coord_begin];
+    for (int k = row.mono_begin; k < row.mono_end; ++k) {
+      const int a = coord[m.mono_a_[k]], b = coord[m.mono_b_[k]];
+      const int ja = m.j_[a], jb = m.j_[b];
+      if (ja < 0 || jb < 0) continue;
+      // w q_a q_b has Hessian entries (a, b) and (b, a) equal to w; on z
+      // they land on (ja, jb) and (jb, ja): stored once off the diagonal,
+      // twice (2 w) on it.
+      m.mono_row_[k] = std::max(ja, jb);
+      m.mono_col_[k] = std::min(ja, jb);
+      m.mono_factor_[k] = m.mono_w_[k] * m.s_(a) * m.s_(b) * (ja == jb ? 2 : 1);
+    }
+  }
+}
+
+MultibodyModel ModelBuilder::Finish() {
+  model_.scratch_full_ = VectorXd::Zero(q0_.size());
+  model_.scratch_roundoff_ = VectorXd::Zero(q0_.size());
+  model_.time_dependent_ = !model_.moving_rows_.empty() || !model_.varying_forces_.empty() ||
+                          !model_.turning_rows_.empty();
+  for (const MultibodyModel::TorqueLoad& t : model_.torques_)
+    if (t.is_varying) model_.time_dependent_ = true;
+  if (!model_.winches_.empty()) {
+    model_.time_dependent_ = true;
+    if (model_.dim_ == 2) {
+      WinchBases(model_.elements2_);
+    } else {
+      WinchBases(model_.elements3_);
+    }
+  }
+  model_.SetTime(0);
+  if (model_.has_damping_) {
+    model_.scratch_damping_ = VectorXd::Zero(q0_.size());
+    model_.scratch_damping_roundoff_ = VectorXd::Zero(q0_.size());
+  }
+  model_.ProjectInitialVelocity();
+  return std::move(model_);
+}
+
+// MultibodyModel::Build is defined here, beside the steps it runs, so that
+// the model's own file does not need the builder (the builder needs the
+// model; not the other way round).
+absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene,
+                                                    const std::function<bool()>& should_stop) {
+  // The steps, what each computes and why, are in model_builder.h.
+  ModelBuilder builder(scene, should_stop);
+  const absl::Status stopped =
+      absl::CancelledError("stopped by the caller while building the model");
+  if (absl::Status s = builder.ChooseDimension(); !s.ok()) return s;
+  if (absl::Status s = builder.CheckWinches(); !s.ok()) return s;
+  builder.MeshCables();
+  if (absl::Status s = builder.InitialCoordinates(); !s.ok()) return s;
+  if (absl::Status s = builder.Joints(); !s.ok()) return s;
+  if (absl::Status s = builder.CheckJointsAtStart(); !s.ok()) return s;
+  builder.OrderUnknowns();
+  builder.KeepMovableRows();
+  if (absl::Status s = builder.CheckMovingRows(); !s.ok()) return s;
+  if (absl::Status s = builder.CheckIntegratorFits(); !s.ok()) return s;
+  if (builder.Stopped()) return stopped;
+  builder.BuildElements();
+  if (builder.Stopped()) return stopped;
+  if (absl::Status s = builder.Sliders(); !s.ok()) return s;
+  builder.Winches();
+  builder.ConstantForces();
+  builder.Probes();
+  builder.EnvelopeAndMass();
+  if (builder.Stopped()) return stopped;
+  builder.ConstraintPattern();
+  return builder.Finish();
+}
+
+}  // namespace cablesim

@@ -1,0 +1,674 @@
+#ifndef CABLESIM_ENGINE_MODEL_MULTIBODY_MODEL_H_
+#define CABLESIM_ENGINE_MODEL_MULTIBODY_MODEL_H_
+
+// The multibody model of a scene, planar (D = 2) or spatial (D = 3): ANCF
+// cable elements (4 D coordinates each, MODEL.md sections 1-3), rigid bodies
+// (section 6), joints, gravity and constant loads (section 4).
+//
+// Coordinates. The full coordinate vector q holds, cable by cable and node
+// by node, [r, r_x] (position [m] and slope [-], D each), then per body its
+// natural coordinates [m], [-]:
+//   planar:  [r_c, u]           (4)   body axes e1 = u, e2 = perp(u)
+//   spatial: [r_c, u, v, w]     (12)  body axes e1 = u, e2 = v, e3 = w
+// where r_c is the centre of mass and u, v, w the body's x, y, z axes in the
+// world. A body point p (body frame) is at r_c + p_x e1 + p_y e2 (+ p_z e3):
+// linear in q. The kinetic energy is then (1/2) qdot^T M qdot with a constant
+// mass matrix diag(m I, Jb_x I, Jb_y I, Jb_z I), Jb_k = int rho p_k^2 dV =
+// (I_1 + I_2 + I_3) / 2 - I_k from the principal moments (planar: only u,
+// with Jb = I_z), so the body has no velocity-dependent (gyroscopic) forces
+// in these coordinates: rotation is carried by the axes and the unit and
+// orthogonality constraints of the axes (1 row planar, 6 spatial). Why
+// natural coordinates: the mass matrix stays constant as for the cable, so
+// every stepper treats bodies and cables alike, and every joint row is at
+// most quadratic in q (QuadraticForm). A planar scene run in the spatial
+// model follows the same discrete trajectory (w stays e_z, v = perp(u)).
+//
+// Coordinates that a joint to ground fixes are removed: q = c + S z, where
+// z are the unknowns (dofs) and each full coordinate is either a constant or
+// a multiple of one unknown. A pinned node loses its position; a clamped
+// (FIXED to ground) node also keeps its slope along its initial direction
+// d0, r_x = alpha d0 with alpha unknown (the cable may still stretch there);
+// a body welded to ground loses all its coordinates, a body pinned to ground
+// at its centre of mass loses r_c. Every other joint is a constraint
+// Phi(q) = 0 with a Lagrange multiplier.
+//
+// The unknowns are ordered along each cable, and a body's right after the
+// first cable node it is joined to, so the Newton matrix on z is banded
+// (see SkylineLdlt).
+//
+// All vectors of size dofs() are "reduced"; of size coordinates() "full".
+
+#include <array>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "absl/status/statusor.h"
+#include "engine/elements/ancf_cable_element.h"
+#include "engine/forces/body_fluid_load.h"
+#include "engine/forces/seabed.h"
+#include "engine/forces/sheave.h"
+#include "engine/forces/wave_load.h"
+#include "engine/constraints/quadratic_form.h"
+#include "engine/scene/scene.h"
+#include "engine/output/results.h"
+#include "engine/linear/skyline_ldlt.h"
+#include "engine/forces/sliding_joint.h"
+#include "engine/linear/sparse_rows.h"
+
+namespace cablesim {
+
+class ModelBuilder;
+
+class MultibodyModel {
+ public:
+  // Builds the mesh (a node wherever a joint, load or probe sits), the
+  // coordinate map, and the constraint pattern, by the steps of
+  // ModelBuilder (model_builder.h), in order. InvalidArgument names the
+  // scene field when the scene cannot be assembled (for example joint sides
+  // that do not coincide at t = 0). `should_stop` (empty: never) is asked
+  // between the steps and within the long ones (ModelBuilder): Cancelled
+  // when it said stop.
+  static absl::StatusOr<MultibodyModel> Build(const Scene& scene,
+                                              const std::function<bool()>& should_stop = {});
+
+  // 2 (planar) or 3 (spatial), chosen by ChooseDimension (model_choice.h).
+  int dimension() const { return dim_; }
+  int coordinates() const { return static_cast<int>(c_.size()); }
+  int dofs() const { return dofs_; }
+  int multipliers() const { return static_cast<int>(rows_.size()); }
+  int elements() const { return static_cast<int>(elements2_.size() + elements3_.size()); }
+  // Nodes of the mesh; a node split where a cable without bending
+  // stiffness kinks (ModelBuilder::MeshCables) counts once.
+  int nodes() const { return num_nodes_ - split_nodes_; }
+  ModelInfo Info() const;
+
+  // Initial unknowns and their rates: the scene's rigid initial motion,
+  // projected onto the joints (ProjectInitialVelocity in the .cc); the
+  // largest change the projection made [m/s or 1/s].
+  double initial_velocity_correction() const { return initial_velocity_correction_; }
+  const Eigen::VectorXd& initial_z() const { return z0_; }
+  const Eigen::VectorXd& initial_v() const { return v0_; }
+
+  // Starts the motion from unknowns z instead of the scene's layout (its
+  // static equilibrium, say): the scene's rigid initial velocity is taken
+  // at that configuration and projected onto the joints as in Build.
+  void SetInitialState(const Eigen::VectorXd& z);
+
+  // q = c + S z, and qdot = S zdot.
+  void ToFull(const Eigen::VectorXd& z, Eigen::VectorXd* q) const;
+  void RateToFull(const Eigen::VectorXd& zdot, Eigen::VectorXd* qdot) const;
+
+  // The skyline envelope of the Newton matrix on z (mass, stiffness and
+  // constraint Hessians all fit in it).
+  const std::vector<int>& envelope() const { return envelope_; }
+
+  // The constant reduced mass matrix S^T M S, in the layout of envelope().
+  const SkylineLdlt& mass() const { return mass_; }
+
+  // f = load_factor * Q_a(q) - Q_k(q) on the unknowns: gravity and applied
+  // loads (scaled) minus elastic forces. `q` is the full configuration.
+  // When `stiffness` is not null, also adds stiffness_scale * d(-f)/dz (the
+  // elastic tangent stiffness K_T; the skew-symmetric derivative of torque
+  // loads is left out, see NetForce in the .cc) to it; its pattern is
+  // envelope(). One pass over the elements does both.
+  // Returns the size of the terms that were added, max(|Q_a|_inf, |Q_k|_inf)
+  // over the coordinates that move: the scale against which Newton residuals
+  // are small (the two nearly cancel at equilibrium).
+  // When `roundoff` is not null, it receives per unknown a bound on the
+  // rounding error of f: the elements' bounds (AncfCableElement::
+  // ElasticForce: coordinates known to eps |q| only, amplified by the
+  // stiffness) plus eps times every term summed into the entry. This is the
+  // floor below which no Newton iteration can push the residual.
+  double NetForce(const Eigen::VectorXd& q, double load_factor, Eigen::VectorXd* f,
+                  SkylineLdlt* stiffness = nullptr, double stiffness_scale = 0,
+                  Eigen::VectorXd* roundoff = nullptr);
+
+  // The energy-momentum stepper's elastic force (energy_momentum_stepper.h):
+  // with f = NetForce(qm) at qm = (q0 + q1) / 2, subtracting the cable
+  // elements' AncfCableElement::AddDiscreteGradientCorrection(q0, q1) from
+  // the reduced f turns its elastic part into the discrete gradient of the
+  // strain energy. Allocates nothing.
+  void SubtractDiscreteGradientCorrection(const Eigen::VectorXd& q0, const Eigen::VectorXd& q1,
+                                          Eigen::VectorXd* f);
+
+  // Damping (velocity-dependent forces), only in a scene that asks for it:
+  // per cable Kelvin-Voigt and Rayleigh damping (AncfCableElement::
+  // AddDampingMatrix, with times axial_s + beta and bending_s + beta, plus
+  // alpha times the element mass matrix), per body -c v on the centre of
+  // mass and a torque -c omega, which in natural coordinates is the force
+  // -c udot on the planar axis u, and -(c / 2) edot_k on each spatial axis
+  // (for orthonormal axes |omega|^2 = (1/2) sum_k |edot_k|^2). All are
+  // Q_d = -C(q) qdot with C symmetric positive semi-definite. Morison drag
+  // on cables in a fluid (AncfCableElement::AddDrag) is quadratic in the
+  // velocity relative to the current; C is then its velocity derivative,
+  // also symmetric positive semi-definite. With waves (WaveLoad) the drag
+  // is on the velocity relative to current plus waves, and the flow's
+  // inertia joins the force (not C: it does not depend on qdot); both are
+  // evaluated at the time of SetTime.
+  bool has_damping() const { return has_damping_; }
+
+  // Adds the damping force -C(q) qdot to the reduced force `f` (as
+  // NetForce left it); when `tangent` is not null, adds tangent_scale * C
+  // (on z) to it: d(-f)/d(zdot). The derivative of C(q) qdot in q is not
+  // symmetric and is left out of the Newton matrix (Newton then contracts
+  // at a rate of order h |C'(q) qdot| / |M / h + C|, small unless the
+  // damping is strong and the motion fast). When `roundoff` is not null,
+  // adds a bound of the rounding of these terms (eps times the sums of
+  // absolute values). Returns the largest damping force entry [N].
+  double DampingForce(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, Eigen::VectorXd* f,
+                      SkylineLdlt* tangent = nullptr, double tangent_scale = 0,
+                      Eigen::VectorXd* roundoff = nullptr);
+
+  // The power the damping dissipates, -Q_d . qdot [W]: qdot^T C(q) qdot >= 0
+  // without drag; a current or waves may make the fluid's share negative
+  // (the flow then does work on the cable). At the time of SetTime.
+  double DampingPower(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot) const;
+
+  // The energy [J] below which a change of the total energy is rounding:
+  // sum over elements of (EA + EI / l^2) l d^2, d = 16 eps (1 + |q0|_inf) / l,
+  // the strain energy of the strain (and curvature) that coordinates known
+  // only to their last bits can hold. The energy checks of a dynamic run
+  // ignore rises below it (a cable at rest stays at rest silently).
+  double energy_roundoff() const { return energy_roundoff_; }
+
+  // Constraint values Phi(q) [multipliers()] and Jacobian dPhi/dz.
+  void Constraints(const Eigen::VectorXd& q, Eigen::VectorXd* phi, SparseRows* jac) const;
+  // An empty Jacobian with the constraint pattern (values to be filled).
+  const SparseRows& jacobian_pattern() const { return jac_pattern_; }
+
+  // Adds scale * sum_i lambda_i d^2 Phi_i / dz^2 to `a`.
+  void AddConstraintHessian(const Eigen::VectorXd& q, const Eigen::VectorXd& lambda,
+                            double scale, SkylineLdlt* a) const;
+
+  // gamma_i = -qdot^T (d^2 Phi_i / dq^2) qdot - 2 Phi_i,qt qdot -
+  // d^2 Phi_i / dt^2, the right-hand side of the acceleration-level
+  // constraints Phi_z zdd = gamma (eq. 30), at the time of SetTime. Only
+  // the rows of moving supports depend on time: Phi_i = r_i - p_i - d_i(t),
+  // so their -Phi_tt = d_i''(t); and those of turning supports, Phi_i =
+  // n(t) . x, so theirs is -2 n' . xdot - n'' . x.
+  void ConstraintGamma(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
+                       Eigen::VectorXd* gamma) const;
+
+  // Time. Prescribed motions (rows Phi_i(q, t) = r_i(q) - p_i - d_i(t) of a
+  // joint to ground whose ground point moves by d(t)) and time-varying
+  // loads are evaluated at the time set here; Constraints, NetForce and
+  // ConstraintGamma use it. A scene without either has nothing to
+  // evaluate (is_time_dependent() false) and SetTime only stores t.
+  void SetTime(double t);
+  double time() const { return time_; }
+  bool is_time_dependent() const { return time_dependent_; }
+
+  // Energy of a full state; potential includes the constant loads, and
+  // minus the work the external agents have done so far
+  // (AccumulateExternalWork): torques, time-varying loads and moving
+  // supports. `total` is then what the exact solution conserves.
+  // When `parts` is not null it also receives the energy per cable and per
+  // body (EnergyParts, output/results.h), each part summed over its own
+  // elements, gravity and loads apart from the total's single dot product,
+  // so that the parts' sums check the totals to rounding; `parts->loads` is
+  // the constant loads' potential minus the external work. Its vectors are
+  // resized (no allocation once they have the size).
+  EnergySample Energy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, double load_factor,
+                      EnergyParts* parts = nullptr) const;
+
+  // Work that is not a potential's is summed step by step: call this after
+  // every accepted step (or load increment) with the full configurations,
+  // times and multipliers before and after it.
+  //  - a torque on a body (not a constant force in these coordinates): its
+  //    mean over the step times the rotation vector of the step; exact in
+  //    the plane for a constant torque, in space when the rotation axis is
+  //    fixed, second order otherwise;
+  //  - a time-varying force F(t) at a point x: (F(t0) + F(t1)) / 2 . (x1 -
+  //    x0), the trapezoidal rule (second order);
+  //  - a moving support: the force it exerts on the system is -lambda_i
+  //    along row i, and the support point moves by d_i(t1) - d_i(t0), so
+  //    W = -(lambda_i0 + lambda_i1) / 2 (d_i(t1) - d_i(t0)) (second order);
+  //  - a turning support: generally the work of a rheonomic row is
+  //    int lambda_i Phi_i,t dt (since Phi_q qdot = -Phi_t), here
+  //    W = (lambda_i0 + lambda_i1) / 2 (n(t1) - n(t0)) . (x0 + x1) / 2
+  //    (second order; the moving support's formula is its case Phi_t =
+  //    -d').
+  bool has_external_work() const {
+    return !torques_.empty() || !varying_forces_.empty() || !moving_rows_.empty() ||
+           !turning_rows_.empty();
+  }
+  void AccumulateExternalWork(const Eigen::VectorXd& q_before, const Eigen::VectorXd& q_after,
+                              double t_before, double t_after,
+                              const Eigen::VectorXd& lambda_before,
+                              const Eigen::VectorXd& lambda_after, double load_factor);
+  // Starts the sum over (a new run of the same model).
+  void ResetExternalWork() { external_work_ = 0; }
+  double external_work() const { return external_work_; }
+
+  // Angular momentum about the world origin [kg m^2/s], exact for the
+  // discretised mass: sum over elements of mbar_ab r_a x rdot_b (r_a the
+  // element's nodal vectors, mbar its scalar mass matrix), plus per body
+  // m r_c x rdot_c + sum_k Jb_k e_k x edot_k. Planar models return (0, 0, L_z).
+  Eigen::Vector3d AngularMomentum(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot) const;
+
+  // The position [m] at undeformed arc length s [m] along cable `cable`
+  // (scene order), from full coordinates q: the element's cubic there;
+  // its slope dr/ds [-] into `slope` when not null.
+  Eigen::Vector3d CablePosition(const Eigen::VectorXd& q, int cable, double s,
+                                Eigen::Vector3d* slope = nullptr) const;
+
+  // The scene's wave load (engine/forces/wave_load.h), or null: a scene
+  // without waves holds none and its elements take AddDrag's uniform current.
+  const WaveLoad* wave_load() const { return wave_load_ ? &*wave_load_ : nullptr; }
+
+  // The fluid's loads on bodies (engine/forces/body_fluid_load.h): the
+  // hydrostatic part in NetForce (scaled with gravity by the load factor,
+  // its energy in the loads' part), the drag, inertia and wave buoyancy in
+  // DampingForce (their work in the damping power).
+  const std::vector<BodyFluidLoad>& body_fluid_loads() const { return body_fluid_; }
+
+  // The scene's seabed (engine/forces/seabed.h), or null: a scene without
+  // one holds no seabed object, and its force loops only test this.
+  const Seabed* seabed() const { return seabed_ ? &*seabed_ : nullptr; }
+
+  // Bodies with seabed contact points (BodySpec::contact_points_m): their
+  // count. A scene without any holds none and its loops only test this.
+  int body_contacts() const { return static_cast<int>(body_contacts_.size()); }
+
+  // STATIC analyses only: the seabed's static friction (Seabed::
+  // AddStaticFriction, on cables and body contact points) at full q,
+  // opposing the displacement from q_start (where the analysis started).
+  // Adds its generalized force to the reduced `f` and scale times its
+  // matrix (symmetric, positive semi-definite; on z) to `matrix` when not
+  // null. has_static_friction(): whether there is any (else this does
+  // nothing and costs nothing).
+  bool has_static_friction() const;
+  void StaticFriction(const Eigen::VectorXd& q, const Eigen::VectorXd& q_start,
+                        Eigen::VectorXd* f, SkylineLdlt* matrix, double scale);
+  // Whether frames carry energy.contact (a seabed or sheaves).
+  bool has_contact() const { return seabed_.has_value() || !sheaves_.empty(); }
+
+  // The scene's sheaves (engine/forces/sheave.h), none in most scenes.
+  const std::vector<Sheave>& sheaves() const { return sheaves_; }
+
+  // Whether frames carry the nodes' positions (the scene's output.shape).
+  bool shape() const { return shape_; }
+  // Every cable node's position [m] from full coordinates q (a split node
+  // once), in the order of ModelInfo::node_s; from a rate, the nodes'
+  // velocities. `out` is resized (no allocation once it has the size).
+  void NodePositions(const Eigen::VectorXd& q, std::vector<Eigen::Vector3d>* out) const;
+
+  // Probes from full position, velocity and acceleration.
+  void Probes(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
+              const Eigen::VectorXd& qddot, std::vector<ProbeSample>* out) const;
+  // The force [N] a moving support exerts on what it holds, -lambda of its
+  // position rows, per probe placed on such a joint
+  // (ModelInfo::force_probe_names).
+  // A probe at a winch's end (the cable's last point) reports the line
+  // tension instead: the force [N] the winch exerts on the cable, EA eps
+  // r_s at s = L(t) (eps the Green-Lagrange strain there, r_s the slope,
+  // pointing into the winch; |force| is the tension). `q`: full positions.
+  void ProbeForces(const Eigen::VectorXd& q, const Eigen::VectorXd& lambda,
+                   std::vector<Eigen::Vector3d>* out) const;
+  // The number of probes on a moving support or a winch's end (ProbeForces' size).
+  int force_probe_count() const { return static_cast<int>(force_probes_.size()); }
+
+  // Sliding joints (SlidingJoint, a penalty force): their number, and
+  // where each slider is now, its arc length on its cable [m] as of the
+  // last evaluation.
+  int sliders() const { return static_cast<int>(sliders_.size()); }
+  double SliderArcLength(int i) const { return sliders_[i].s(); }
+
+  // Winches (WinchSpec, docs/model.md "Winches"): an axially moving mesh
+  // on each winch cable, whose N elements all have the length L(t) / N, so
+  // the model's size is fixed while the free length L(t) changes. At
+  // SetTime the winch cables' elements, their mass matrices (in mass()),
+  // gravity and the convective inertia terms (forces/winch_inertia.h,
+  // added by DampingForce, which every stepper calls; not dissipation:
+  // DampingPower leaves them out) are evaluated at L(t). A scene without
+  // winches holds none and pays nothing. The total energy of a winch
+  // scene is not conserved (the winch does work that is not summed), so
+  // the dynamic run's energy guard is off there.
+  int winches() const { return static_cast<int>(winches_.size()); }
+  // Winch w's cable (scene order) and its free length L [m] at the time
+  // of SetTime.
+  int WinchCable(int w) const { return winches_[w].cable; }
+  double WinchLength(int w) const { return winches_[w].length; }
+  // A cable's mass [kg] from its elements' mass matrices at the time of
+  // SetTime (rho A L(t) on a winch cable).
+  double CableMass(int cable) const;
+
+  // Which joint a constraint row belongs to (for messages), or -1 for a
+  // body's own axis constraints.
+  int RowJoint(int row) const { return rows_[row].joint; }
+
+ private:
+  // Build's steps fill in the members below.
+  friend class ModelBuilder;
+
+  template <int D>
+  struct ElementData {
+    AncfCableElement<D> element;
+    int first_coord = 0;  // full index of its first node's position
+    double mass_per_length = 0;
+    Eigen::Matrix<double, 4 * D, 1> gravity;
+    Eigen::Matrix4d mbar;  // scalar mass matrix: M = mbar (x) I_D
+    // Damping: Kelvin-Voigt times [s] (Rayleigh beta included) and
+    // Rayleigh alpha [1/s].
+    double axial_damping_s = 0, bending_damping_s = 0, alpha_1_s = 0;
+    // Morison drag factors kn, kt [kg/m^2] (AncfCableElement::AddDrag).
+    double drag_n = 0, drag_t = 0;
+    // With waves: the flow's inertia factor (1 + C_a) rho A [kg/m]
+    // (WaveLoad); 0 without waves.
+    double fluid_inertia = 0;
+    bool damped() const {
+      return axial_damping_s != 0 || bending_damping_s != 0 || alpha_1_s != 0 ||
+             drag_n != 0 || drag_t != 0;
+    }
+  };
+  struct BodyData {
+    int coord = 0;  // full index of r_c
+    double mass = 0;
+    Eigen::Vector3d jbar = Eigen::Vector3d::Zero();  // per axis [kg m^2]
+    double linear_damping = 0;   // [N s/m]
+    double angular_damping = 0;  // [N m s/rad]
+    // The fluid's added mass on r_c (BodyFluidLoad::AddedMass) [kg], in the
+    // mass matrix and the kinetic energy; only with has_added_mass.
+    bool has_added_mass = false;
+    Eigen::Matrix3d added_mass = Eigen::Matrix3d::Zero();
+  };
+  // A body's seabed contact points (BodySpec): body frame [m], spring k
+  // [N/m], damper c [N s/m], friction mu [-] per point.
+  struct BodyContact {
+    int coord = 0;  // full index of the body's r_c
+    std::vector<Eigen::Vector3d> points;
+    double k = 0, c = 0, mu = 0;
+  };
+  enum class ContactTerm { kPotential, kDissipation, kStaticFriction };
+  // The body contact points' terms: kPotential (at q: returns U, adds the
+  // force -dU/dq to `full` and its Hessian to `a`), kDissipation (`other`
+  // the rate: returns the power, adds the force and its velocity tangent),
+  // kStaticFriction (`other` the start: returns 0). Each
+  // point r = B q_b is linear in its body's coordinates q_b, so the
+  // generalized force is B^T f and the matrix B^T H B, within the body's
+  // own block of the envelope. `size` (when not null) gets the largest
+  // force entry; `roundoff` a bound of the rounding (kPotential).
+  template <int D>
+  double BodyContactTerms(ContactTerm term, const Eigen::VectorXd& q,
+                          const Eigen::VectorXd* other, Eigen::VectorXd* full, SkylineLdlt* a,
+                          double scale, Eigen::VectorXd* roundoff, double* size) const;
+  // A torque load on a body [N m]: torque = base + varying(t).
+  struct TorqueLoad {
+    int body = 0;
+    Eigen::Vector3d torque = Eigen::Vector3d::Zero();
+    Eigen::Vector3d base = Eigen::Vector3d::Zero();
+    TimeVector varying;
+    bool is_varying = false;
+  };
+  // A flat linear form sum coeff * q[coord].
+  struct ProbeTerm {
+    int coord = 0;
+    double coeff = 0;
+  };
+  // A time-varying force at a point: per component d, the point's linear
+  // form (the generalized force is F_d coeff on q[coord]).
+  struct VaryingForce {
+    std::array<std::vector<ProbeTerm>, 3> point;
+    TimeVector force;
+    Eigen::Vector3d value = Eigen::Vector3d::Zero();  // force(time_)
+  };
+  // A constraint row of a moving support: c = c0 - motion(t).
+  struct MovingRow {
+    int row = 0;
+    int joint = 0, axis = 0;  // scene joint and component of its motion
+    double c0 = 0;
+    TimeFunction motion;
+    double rate = 0, accel = 0;  // motion' and motion'' at time_
+  };
+  // A direction row of a turning support: n(t) . x = 0, x the D
+  // coordinates from full index `coord` (a clamped slope or a body axis),
+  // n(t) = R(angle(t)) n0 with R the rotation about the unit `axis`.
+  // SetTime writes n(t) into the row's linear coefficients, so Constraints
+  // and the Jacobian need nothing else; Phi_t = n' . x and Phi_tt = n'' . x
+  // enter the initial velocity and ConstraintGamma.
+  struct TurningRow {
+    int row = 0;
+    int coord = 0;
+    Eigen::Vector3d n0 = Eigen::Vector3d::Zero(), axis = Eigen::Vector3d::UnitZ();
+    TimeFunction angle;
+    Eigen::Vector3d n = Eigen::Vector3d::Zero(), rate = Eigen::Vector3d::Zero(),
+                    accel = Eigen::Vector3d::Zero();  // n, n', n'' at time_
+    // n at time t (Rodrigues' formula); with `rate` and `accel` not null,
+    // also n' = angle' a x n and n'' = angle'' a x n + angle'^2 a x (a x n).
+    Eigen::Vector3d Normal(double t, Eigen::Vector3d* rate = nullptr,
+                           Eigen::Vector3d* accel = nullptr) const;
+  };
+  // A winch (WinchSpec) on a cable.
+  struct WinchData {
+    int cable = 0;
+    int element_begin = 0, element_end = 0;  // the cable's elements
+    double length0 = 0;                      // L(0) [m]
+    TimeFunction speed;                      // Ldot(t) [m/s]
+    double length = 0, rate = 0, accel = 0;  // L, Ldot, Lddot at time_
+    double mass_per_length = 0;              // rho A [kg/m]
+    double ea = 0;                           // [N]
+    // Damping on the material motion (WinchDamping); the elements' own
+    // damping is then 0.
+    double axial_damping_s = 0, alpha_1_s = 0;
+  };
+  // Constraint rows as flat quadratic forms over local coordinate lists:
+  // phi = c + sum lin_val * q[coord[lin_local]] + sum w q[coord[a]] q[coord[b]].
+  struct Row {
+    int joint = -1;  // scene joint, or -1 for a body's own axis constraint
+    int body = -1;   // the body of an axis constraint
+    enum Kind { kPosition, kDirection, kSlope, kAxes } kind = kPosition;
+    double c = 0;
+    int coord_begin = 0, coord_end = 0;  // into row_coord_
+    int lin_begin = 0, lin_end = 0;      // into lin_local_, lin_value_
+    int mono_begin = 0, mono_end = 0;    // into mono_a_, mono_b_, mono_w_
+  };
+  static constexpr int kMaxRowCoords = 48;
+
+  template <int D>
+  double ElementForces(const Eigen::VectorXd& q, Eigen::VectorXd* full, SkylineLdlt* stiffness,
+                       double stiffness_scale, Eigen::VectorXd* roundoff) const;
+  template <int D>
+  void ElementDiscreteGradientCorrection(const Eigen::VectorXd& q0, const Eigen::VectorXd& q1,
+                                         Eigen::VectorXd* full) const;
+  template <int D>
+  double ElementDamping(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
+                        Eigen::VectorXd* full, SkylineLdlt* tangent, double tangent_scale,
+                        Eigen::VectorXd* roundoff, double* power) const;
+  // Per body coordinate the damping coefficient c_i of its force -c_i qdot_i.
+  double BodyDampingCoefficient(const BodyData& b, int k) const;
+  template <int D>
+  void ElementEnergy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, EnergySample* en,
+                     EnergyParts* parts) const;
+  template <int D>
+  Eigen::Vector3d CablePositionOf(const Eigen::VectorXd& q, int cable, double s,
+                                  Eigen::Vector3d* slope) const;
+  template <int D>
+  Eigen::Vector3d ElementAngularMomentum(const Eigen::VectorXd& q,
+                                         const Eigen::VectorXd& qdot) const;
+  double RowValue(const Row& row, const Eigen::VectorXd& q) const;
+  // Local gradient of a row: grad[k] for coordinate row_coord_[begin + k].
+  void RowGradient(const Row& row, const Eigen::VectorXd& q, double* grad) const;
+  void AddRow(const QuadraticForm& f, Row::Kind kind, int joint, int body);
+  // Adds a slider's local force to the full vector `full` (and its rounding
+  // to `roundoff`) and scale times its matrix, mapped onto z, to `a`.
+  // A wheel carried by a body (Sheave::body() >= 0) on the element whose
+  // first full coordinate is first_coord: its force, tangent and rounding
+  // over the element and the body's centre, scattered like a slider's; and
+  // its damping and friction (returns their power).
+  template <int D>
+  void BodySheaveForce(const Sheave& wheel, int first_coord, double length,
+                       const Eigen::VectorXd& q, Eigen::VectorXd* full, Eigen::VectorXd* roundoff,
+                       SkylineLdlt* stiffness, double scale) const;
+  template <int D>
+  double BodySheaveDamping(const Sheave& wheel, int first_coord, double length,
+                           const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
+                           Eigen::VectorXd* full, Eigen::VectorXd* roundoff, SkylineLdlt* tangent,
+                           double scale) const;
+  void ScatterSlider(const SlidingJoint::Local& local, Eigen::VectorXd* full, Eigen::VectorXd* roundoff,
+                     double scale, SkylineLdlt* a) const;
+  // Adds scale times the D x D block m on body coordinates from full index
+  // `coord` (its centre of mass), mapped onto z, to `a`.
+  void ScatterBodyBlock(int coord, const Eigen::Matrix3d& m, double scale, SkylineLdlt* a) const;
+  const WaveField* wave_field() const { return wave_load_ ? &wave_load_->field() : nullptr; }
+  void ProjectInitialVelocity();
+  // SetTime's share for the winches: lengths, elements, mass, gravity and
+  // convective coefficients at time_.
+  template <int D>
+  void UpdateWinches();
+  // DampingForce's share for the winches: the convective force
+  // -cv edot - ce e per element into `full`, tangent_scale * Mdot (the
+  // symmetric part of cv; the skew ldot (G - G^T) and the small position
+  // term are left out of the Newton matrix) into `tangent`. Returns the
+  // largest force entry.
+  template <int D>
+  double WinchForces(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, Eigen::VectorXd* full,
+                     SkylineLdlt* tangent, double tangent_scale, Eigen::VectorXd* roundoff) const;
+  // A winch cable element's damping on the material motion: Rayleigh
+  // alpha as -alpha int mu S^T v dx (v the material velocity, so a rigid
+  // reel-in is damped as any motion through still air would be) and
+  // Kelvin-Voigt axial damping on the material strain rate (WinchSlopeRateShape);
+  // adds the force to `fe` and its edot-derivative to `ce` (either may be
+  // null) and returns the dissipated power [W], >= 0. Bending damping is
+  // refused on winch cables (CheckWinches).
+  template <int D>
+  double WinchDamping(const WinchData& w, int index, const Eigen::VectorXd& q,
+                      const Eigen::VectorXd& qdot, typename AncfCableElement<D>::Coords* fe,
+                      typename AncfCableElement<D>::Matrix* ce) const;
+  template <int D>
+  Eigen::Vector3d WinchTension(const Eigen::VectorXd& q, int w) const;
+  // The scene's rigid initial velocity at full configuration q (all nodes
+  // and bodies; fixed coordinates are dropped by Reduce).
+  void RigidVelocity(const Eigen::VectorXd& q, Eigen::VectorXd* qdot) const;
+  // Unknowns from a full vector, by least squares through q = c + S z
+  // (exact for a full vector the map can produce; c is ignored, so this is
+  // for rates and for positions whose fixed coordinates are c).
+  Eigen::VectorXd Reduce(const Eigen::VectorXd& full) const;
+  template <int D>
+  const std::vector<ElementData<D>>& Elements() const {
+    if constexpr (D == 2) {
+      return elements2_;
+    } else {
+      return elements3_;
+    }
+  }
+
+  int dim_ = 2;
+  int node_stride_ = 4;  // 2 D
+  int body_stride_ = 4;  // 4 planar, 12 spatial
+
+  // Coordinate map: q_i = c_i + s_i z_{j_i} (j_i = -1: constant).
+  Eigen::VectorXd c_, s_;
+  std::vector<int> j_;
+  int dofs_ = 0;
+  int num_nodes_ = 0;    // including the second half of each split node
+  int split_nodes_ = 0;
+  Eigen::VectorXd z0_, v0_;
+  double initial_velocity_correction_ = 0;
+  InitialVelocitySpec initial_velocity_;
+
+  std::vector<ElementData<2>> elements2_;
+  std::vector<ElementData<3>> elements3_;
+  std::vector<BodyData> bodies_;
+  std::vector<TorqueLoad> torques_;
+  Eigen::VectorXd constant_force_;  // full: gravity and point loads
+  // Full: the point loads alone (empty without any), for EnergyParts::loads.
+  Eigen::VectorXd load_force_;
+  // Per cable, its first element; one more entry, the element count.
+  std::vector<int> cable_element_begin_;
+  Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();  // [m/s^2]
+  std::vector<std::string> cable_names_, body_names_;
+  // The cable nodes of ModelInfo: per distinct node its position's first
+  // full coordinate; per cable the count; per node its arc length [m].
+  bool shape_ = false;
+  std::vector<int> shape_coord_;
+  std::vector<int> cable_nodes_;
+  std::vector<double> node_s_;
+  double energy_roundoff_ = 0;
+  bool has_damping_ = false;
+  Eigen::Vector3d current_ = Eigen::Vector3d::Zero();  // the fluid's [m/s]
+  std::optional<Seabed> seabed_;  // only in a scene with a seabed
+  std::vector<BodyContact> body_contacts_;  // only bodies with contact points
+  // Scratch (full size) for StaticFriction (sized on first use).
+  Eigen::VectorXd scratch_static_;
+  // Sheaves, and per element the bit set of those that touch its cable
+  // (empty without sheaves).
+  std::vector<Sheave> sheaves_;
+  std::vector<uint64_t> sheave_mask_;
+  bool sheaves_dissipate_ = false;
+  // Only in a scene whose fluid has waves (then it carries the current too).
+  std::optional<WaveLoad> wave_load_;
+  // The fluid's loads on bodies that ask for them (empty in most scenes:
+  // then nothing is evaluated).
+  std::vector<BodyFluidLoad> body_fluid_;
+
+  std::vector<Row> rows_;
+  std::vector<int> row_coord_;
+  std::vector<int> lin_local_;
+  std::vector<double> lin_value_;
+  std::vector<int> mono_a_, mono_b_;
+  std::vector<double> mono_w_;
+  // Per monomial: the (row >= col) entry of its Hessian on z (or -1) and
+  // its factor.
+  std::vector<int> mono_row_, mono_col_;
+  std::vector<double> mono_factor_;
+
+  // Probes: per probe and component d < 3, a linear form over q (as flat
+  // term lists); velocity and acceleration use the same coefficients.
+  std::vector<int> probe_term_begin_;  // size 3 * probes + 1
+  std::vector<ProbeTerm> probe_terms_;
+  std::vector<double> probe_const_;    // 3 per probe
+  std::vector<std::string> probe_names_;
+
+  std::vector<int> envelope_;
+  SkylineLdlt mass_;
+  // Per element, the (4D)^2 skyline slots (or -1) and factors s_a s_b.
+  std::vector<int> element_slots_;
+  std::vector<double> element_factors_;
+  // Adds scale times element k's symmetric (4D)^2 matrix m (either storage
+  // order) to the skyline `values` through those slots; kN2 = (4D)^2.
+  template <int kN2>
+  void ScatterElementMatrix(int k, const double* m, double scale, double* values) const {
+    const int* slots = &element_slots_[kN2 * k];
+    const double* factors = &element_factors_[kN2 * k];
+    for (int t = 0; t < kN2; ++t)
+      if (slots[t] >= 0) values[slots[t]] += scale * factors[t] * m[t];
+  }
+  SparseRows jac_pattern_;
+  // Scratch (full size) for NetForce.
+  Eigen::VectorXd scratch_full_, scratch_roundoff_;
+  // Per probe on a moving support, its row per component (-1: none).
+  std::vector<std::array<int, 3>> probe_force_rows_;
+  std::vector<int> force_probes_;  // which probes (ascending)
+  // Time dependence.
+  double time_ = 0;
+  bool time_dependent_ = false;
+  std::vector<MovingRow> moving_rows_;
+  std::vector<TurningRow> turning_rows_;
+  std::vector<VaryingForce> varying_forces_;
+  // Work done by torques, time-varying loads and moving supports so far [J].
+  double external_work_ = 0;
+  // Sliding joints (empty in most scenes: then nothing is evaluated).
+  std::vector<SlidingJoint> sliders_;
+  // Winches (empty in most scenes: then nothing is evaluated).
+  std::vector<WinchData> winches_;
+  // Per winch element (winch by winch, along each cable): the convective
+  // coefficients cv, ce and Mdot = ldot dM/dl (4 x 4 per component) at time_.
+  std::vector<Eigen::Matrix4d> winch_cv_, winch_ce_, winch_mdot_, winch_g_, winch_h_;
+  // Per element: its index into those (-1: not on a winch cable).
+  std::vector<int> winch_slot_;
+  // mass_'s values and constant_force_ without the winch elements' shares.
+  std::vector<double> mass_base_;
+  Eigen::VectorXd constant_force_base_;
+  // Per probe: the winch at whose end it sits (ProbeForces), or -1.
+  std::vector<int> probe_winch_;
+  // Scratch (full size) for DampingForce (sized only when has_damping_).
+  Eigen::VectorXd scratch_damping_, scratch_damping_roundoff_;
+};
+
+}  // namespace cablesim
+
+#endif  // CABLESIM_ENGINE_MODEL_MULTIBODY_MODEL_H_

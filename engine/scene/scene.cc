@@ -1,0 +1,44 @@
+#include "engine/scene/scene.h"
+
+namespace cablesim {
+
+bool IsZero(const TimeVector& v) {
+  return v[0].IsZero() && v[1].IsZero() && v[2].IsZero();
+}
+
+Eigen::Vector3d Evaluate(const TimeVector& v, double t, int order) {
+  Eigen::Vector3d r;
+  for (int d = 0; d < 3; ++d) {
+    const TimeFunction::Value x = v[d].Evaluate(t);
+    r(d) = order == 0 ? x.f : order == 1 ? x.df : x.ddf;
+  }
+  return r;
+}
+
+std::string_view AnalysisName(Analysis analysis) {
+  switch (analysis) {
+    case Analysis::kDynamic:
+      return "DYNAMIC";
+    case Analysis::kStatic:
+      return "STATIC";
+    case Analysis::kModal:
+      return "MODAL";
+  }
+  return "UNKNOWN";
+}
+
+std::string_view LinearSolverName(LinearSolverKind solver) {
+  switch (solver) {
+    case LinearSolverKind::kMinres:
+      return "MINRES";
+    case LinearSolverKind::kGmres:
+      return "GMRES";
+    case LinearSolverKind::kDirect:
+      return "DIRECT";
+    case LinearSolverKind::kAuto:
+      return "AUTO";
+  }
+  return "UNKNOWN";
+}
+
+}  // namespace cablesim

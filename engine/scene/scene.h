@@ -1,0 +1,357 @@
+#ifndef CABLESIM_ENGINE_SCENE_SCENE_H_
+#define CABLESIM_ENGINE_SCENE_SCENE_H_
+
+// The engine's description of a scene: plain structs, free of protobuf.
+// convert/ builds one from a cablesim.v1.Scene after validating it; the
+// vectors here keep the indices of the scene file, so the engine can name a
+// field (`joints[1]`) in its own errors.
+//
+// Units are SI: m, kg, s, N, Pa, rad.
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "engine/scene/time_function.h"
+
+namespace cablesim {
+
+// AUTO: planar when the whole scene lies in the x-y plane (model_choice.h).
+enum class ModelChoice { kAuto, kPlanar, kSpatial };
+enum class BendingModel { kExact, kLinear, kNone };
+// kSlide: a body point kept on a cable, free to slide along it
+// (SlidingJoint; JointSpec::slide).
+enum class JointType { kPin, kFixed, kSlide };
+enum class Analysis { kDynamic, kStatic, kModal };
+enum class Integrator { kImplicitEuler, kGeneralizedAlpha, kHht, kEnergyMomentum, kDormandPrince,
+                              kCentralDifference };
+// kDirect: exact block elimination (skyline LDL^T of the Newton block and a
+// dense Schur complement); kAuto: picked per scene (SaddlePointSolver).
+enum class LinearSolverKind { kMinres, kGmres, kDirect, kAuto };
+// What preconditions MINRES and GMRES (engine/linear/saddle_point_solver.h).
+enum class PreconditionerKind { kBlock, kJacobi, kNone };
+// Where a DYNAMIC run starts: the scene as laid out, or its static
+// equilibrium under gravity and loads (StaticSolver).
+enum class InitialState { kAsGiven, kStatic };
+
+// The scene-file spelling of an enum value, e.g. "DYNAMIC", "MINRES" (what
+// the summary reports).
+std::string_view AnalysisName(Analysis analysis);
+// IntegratorName and every other fact of an integrator: integrator_traits.h.
+std::string_view LinearSolverName(LinearSolverKind solver);
+
+// A winch at a cable's end (MultibodyModel, docs/model.md "Winches"): the
+// cable's free (unstretched) length is L(t) = length_m + int_0^t speed, so
+// a positive speed [m/s] pays cable out and a negative one reels it in.
+// The winch holds the cable's last point (s = length_m), which a joint to
+// ground (PIN or FIXED, fixed or moving) must hold; the cable's material
+// is measured from its first point (s = 0), where the payload stays.
+struct WinchSpec {
+  bool enabled = false;
+  TimeFunction speed;
+};
+
+struct CableSpec {
+  std::string name;
+  // Polyline the undeformed-length cable is laid along at t = 0 (>= 2
+  // points). A straight cable has two.
+  std::vector<Eigen::Vector3d> points;
+  double length_m = 0;  // undeformed length
+  int elements = 10;    // before extra nodes are inserted
+  double density_kg_m3 = 0;
+  double youngs_modulus_pa = 0;
+  double area_m2 = 0;
+  double second_moment_m4 = 0;
+  BendingModel bending = BendingModel::kExact;
+  // Damping (MultibodyModel::DampingForce; 0: none). Kelvin-Voigt
+  // retardation times [s]: axial stress E (eps + axial_damping_s deps/dt),
+  // bending moment EI (kappa + bending_damping_s dkappa/dt). Rayleigh:
+  // mass-proportional alpha [1/s] (force -alpha M qdot) and
+  // stiffness-proportional beta [s], applied to the material stiffness,
+  // that is added to both retardation times.
+  double axial_damping_s = 0;
+  double bending_damping_s = 0;
+  double rayleigh_alpha_1_s = 0;
+  double rayleigh_beta_s = 0;
+  // Hydrodynamics in the scene's fluid (MultibodyModel::DampingForce,
+  // ModelBuilder::BuildElements): Morison drag coefficients normal and
+  // tangential [-], added-mass coefficient [-] and outer diameter [m]
+  // (0: that of a solid circle of the cable's area).
+  double normal_drag = 0;
+  double tangential_drag = 0;
+  double added_mass = 0;
+  double hydro_diameter_m = 0;
+  WinchSpec winch;  // disabled: the length is fixed
+};
+
+struct BodySpec {
+  std::string name;
+  double mass_kg = 0;
+  // Principal moments of inertia about the centre of mass, body axes.
+  Eigen::Vector3d inertia_kg_m2 = Eigen::Vector3d::Zero();
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();  // centre of mass
+  // Local x axis in the world at t = 0, unit. The local y axis is
+  // normalize(e_z x axis) (normalize(e_x x axis) when the axis is along z),
+  // and z = x x y; the principal moments refer to these axes.
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitX();
+  // Damping (0: none): force -linear c v on the centre of mass [N s/m],
+  // torque -angular c omega [N m s/rad].
+  double linear_damping_n_s_m = 0;
+  double angular_damping_n_m_s = 0;
+  // Points of the body that touch the seabed (Seabed::PointPotential), body
+  // frame [m]; empty: the body never touches it (and costs nothing).
+  // Each point has its own normal spring [N/m] and damper [N s/m], and
+  // isotropic Coulomb friction `contact_friction` [-] in the bed's plane
+  // (regularised as the cable's, by seabed.friction_speed).
+  std::vector<Eigen::Vector3d> contact_points_m;
+  double contact_stiffness_n_m = 0;
+  double contact_damping_n_s_m = 0;
+  double contact_friction = 0;
+  // Fluid loads in the scene's fluid (engine/forces/body_fluid_load.h),
+  // only when has_hydrodynamics: a vertical cylinder of diameter and
+  // height [m] centred at the centre of mass displaces the fluid; Morison
+  // drag coefficients across the vertical (on d times the submerged length)
+  // and along it (on the end area) [-], added-mass coefficients across
+  // and along the vertical [-].
+  bool has_hydrodynamics = false;
+  double hydro_diameter_m = 0, hydro_height_m = 0;
+  double hydro_drag = 0, hydro_heave_drag = 0;
+  double hydro_added_mass = 0, hydro_heave_added_mass = 0;
+};
+
+// A place on a cable (cable >= 0), on a body (body >= 0), or the ground
+// (both -1).
+struct Attachment {
+  int cable = -1;
+  double s_m = 0;  // arc length in the undeformed cable
+  int body = -1;
+  Eigen::Vector3d point_body_m = Eigen::Vector3d::Zero();
+  bool IsGround() const { return cable < 0 && body < 0; }
+};
+
+// Three time functions: a vector (x, y, z) that varies in time.
+using TimeVector = std::array<TimeFunction, 3>;
+bool IsZero(const TimeVector& v);
+// Its value, first or second derivative (order 0, 1, 2) at t.
+Eigen::Vector3d Evaluate(const TimeVector& v, double t, int order = 0);
+
+// A sliding joint's parameters (SlidingJoint).
+struct SlideSpec {
+  double friction = 0;        // Coulomb coefficient mu [-]
+  double stiffness_n_m = 0;   // penalty stiffness [N/m]; 0: EA / l_e of the cable
+  double stick_velocity_m_s = 1e-3;  // friction regularization v_s [m/s]
+};
+
+struct JointSpec {
+  JointType type = JointType::kPin;
+  Attachment a;  // never ground
+  Attachment b;
+  // Joints to ground only: the ground point moves by motion(t) [m] from
+  // its place at t = 0 (motion(0) = 0); a FIXED joint keeps its initial
+  // direction (the support translates). Zero: a fixed support.
+  TimeVector motion;
+  SlideSpec slide;  // SLIDE only
+  bool HasMotion() const { return !IsZero(motion); }
+  // FIXED joints to ground only: the support also turns by the angle
+  // rotation(t) [rad] (rotation(0) = 0) about the unit `rotation_axis`
+  // (world axes), and the held slope or body axes turn with it.
+  TimeFunction rotation;
+  Eigen::Vector3d rotation_axis = Eigen::Vector3d::UnitZ();
+  bool HasRotation() const { return !rotation.IsZero(); }
+};
+
+struct LoadSpec {
+  Attachment at;
+  Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
+  Eigen::Vector3d torque_nm = Eigen::Vector3d::Zero();  // bodies only
+  // Added to force_n and torque_nm at time t (statics: at t = 0).
+  TimeVector varying_force_n;
+  TimeVector varying_torque_nm;
+  bool IsVarying() const { return !IsZero(varying_force_n) || !IsZero(varying_torque_nm); }
+};
+
+struct ProbeSpec {
+  std::string name;
+  Attachment at;
+};
+
+// A regular linear (Airy) wave (WaveField::AddRegular): height H = 2 a
+// [m], period [s], horizontal unit direction of travel, phase [rad].
+struct RegularWaveSpec {
+  double height_m = 0;
+  double period_s = 0;
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
+  double phase_rad = 0;
+};
+
+// An irregular JONSWAP sea (WaveField::AddJonswap).
+struct JonswapSpec {
+  double significant_height_m = 0;
+  double peak_period_s = 0;
+  double peak_factor = 3.3;  // gamma [-]
+  uint64_t seed = 0;
+  int components = 100;
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitX();  // horizontal, unit
+};
+
+// Waves on the fluid's surface (engine/forces/waves.h, their load
+// engine/forces/wave_load.h): the sum of every component, ramped in over
+// ramp_s [s] (0: none).
+struct WavesSpec {
+  std::vector<RegularWaveSpec> regular;
+  std::vector<JonswapSpec> jonswap;
+  double ramp_s = 0;
+  bool any() const { return !regular.empty() || !jonswap.empty(); }
+};
+
+// A fluid filling the scene: density [kg/m^3] (0: none) and a uniform,
+// steady current [m/s]. Cables in it are buoyed (their displaced weight is
+// taken off their gravity) and feel their hydrodynamics. Waves, when there
+// are any, are measured from the still water level (its height above the
+// origin along the vertical, the opposite of gravity [m]) in water of
+// water_depth_m [m] below it.
+struct FluidSpec {
+  double density_kg_m3 = 0;
+  Eigen::Vector3d current_m_s = Eigen::Vector3d::Zero();
+  double still_water_level_m = 0;
+  double water_depth_m = 0;
+  WavesSpec waves;
+};
+
+// A bathymetry grid (engine/forces/bathymetry_grid.h): depths [m] below
+// the origin along the seabed's normal at nx x ny nodes u = origin_x + i dx,
+// v = origin_y + j dy on the two axes across the normal, row-major
+// (depths_m[j nx + i]), bilinear between them.
+struct BathymetrySpec {
+  bool enabled = false;  // false: the bed is the plane of SeabedSpec
+  double origin_x_m = 0, origin_y_m = 0;
+  double dx_m = 1, dy_m = 1;
+  int nx = 1, ny = 1;
+  std::vector<double> depths_m;
+};
+
+// A seabed the cables lie on (MultibodyModel, engine/forces/seabed.h): the
+// plane of points r with normal . r = -depth_m, the normal pointing out of
+// the bed into the water. Contact is a distributed spring and damper per
+// unit undeformed cable length; Coulomb friction acts in the bed's plane.
+struct SeabedSpec {
+  bool enabled = false;  // false: no seabed (and no seabed object)
+  double depth_m = 0;
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitY();  // unit
+  double stiffness_n_m2 = 0;   // [N/m per m of penetration per m of cable]
+  double damping_n_s_m2 = 0;   // [N s/m per m of cable]
+  double friction_axial = 0;       // Coulomb coefficient along the cable [-]
+  double friction_transverse = 0;  // across the cable, in the bed's plane [-]
+  // Sliding speed [m/s] below which friction is regularised (the friction
+  // force grows as v / sqrt(v^2 + friction_speed^2)).
+  double friction_speed_m_s = 1e-3;
+  // STATIC analyses: displacement [m] from the configuration the analysis
+  // starts from (where the line was laid) below which friction is
+  // regularised (Seabed::AddStaticFriction).
+  double friction_length_m = 1e-5;
+  // When enabled, the bed is this grid instead of the plane (depth_m is
+  // then 0 and the normal a coordinate axis: the grid's "up").
+  BathymetrySpec bathymetry;
+};
+
+// A fixed wheel cables wrap around (engine/forces/sheave.h): a cylinder of
+// radius_m about the axis through position_m, pushing cables out with a
+// distributed spring and damper per unit undeformed length and rubbing on
+// them with Coulomb friction (a wheel that does not turn).
+struct SheaveSpec {
+  std::string name;
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  // unit
+  double radius_m = 0;
+  double stiffness_n_m2 = 0;  // [N/m per m of penetration per m of cable], > 0
+  double damping_n_s_m2 = 0;  // [N s/m per m of cable]
+  double friction = 0;        // Coulomb coefficient [-]
+  double friction_speed_m_s = 1e-3;  // regularisation, as SeabedSpec's
+  std::vector<int> cables;    // indices of the cables it touches; empty: all
+  bool Touches(int cable) const {
+    return cables.empty() || std::find(cables.begin(), cables.end(), cable) != cables.end();
+  }
+  // The body carrying it (index in Scene::bodies; the wheel's centre is the
+  // body's centre of mass and position_m is unused), or -1: fixed.
+  int body = -1;
+};
+
+struct InitialVelocitySpec {
+  Eigen::Vector3d linear_m_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_rad_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d origin_m = Eigen::Vector3d::Zero();
+};
+
+struct SolverSettings {
+  Analysis analysis = Analysis::kDynamic;
+  double duration_s = 0;
+  double step_s = 1e-3;
+  double output_interval_s = 0;  // 0: every step
+  Integrator integrator = Integrator::kHht;
+  LinearSolverKind linear_solver = LinearSolverKind::kAuto;
+  int load_steps = 10;
+  double newton_tolerance = 1e-8;
+  int max_newton_iterations = 25;
+  int max_step_halvings = 12;
+  double linear_tolerance = 1e-10;
+  int max_linear_iterations = 200;
+  // MINRES and GMRES: the preconditioner, and whether a DYNAMIC Newton step
+  // may use a solve whose true relative residual stayed above
+  // kMaxLinearResidual (engine/steppers/newton_convergence.h) after
+  // max_linear_iterations; such solves are counted in the summary.
+  PreconditionerKind preconditioner = PreconditionerKind::kBlock;
+  bool accept_inexact_solves = false;
+  // MODAL: number of lowest modes; 0 means the default (10, or every degree
+  // of freedom when there are fewer).
+  int modes = 0;
+  // Numerical damping of GENERALIZED_ALPHA and HHT: the spectral radius of
+  // the amplification matrix at infinite frequency, in [0, 1] ([0.5, 1] for
+  // HHT); 1 conserves the energy of linear problems.
+  double rho_infinity = 0.5;
+  // Adaptive steps: the step grows and shrinks so that the estimated local
+  // error of every unknown stays below tolerance_m + relative_tolerance |z|.
+  bool adaptive = false;
+  double tolerance_m = 1e-4;
+  double relative_tolerance = 0;
+  // Adds an estimate of the run's largest probe-position error to the
+  // summary, from a companion run (RunScene).
+  bool error_estimate = false;
+  // Newton economy: keep the factorized Newton matrix across iterations and
+  // steps while Newton contracts fast enough (a fresh one otherwise).
+  // GENERALIZED_ALPHA, HHT, ENERGY_MOMENTUM (convert/ defaults it off for
+  // ENERGY_MOMENTUM: see README).
+  bool reuse_factorization = true;
+  InitialState initial_state = InitialState::kAsGiven;  // DYNAMIC only
+};
+
+// What a run writes besides the probes and energies.
+struct OutputSpec {
+  // Every cable node's position in every frame (Frame::nodes).
+  bool shape = false;
+};
+
+struct Scene {
+  std::string name;
+  ModelChoice model = ModelChoice::kAuto;
+  Eigen::Vector3d gravity_m_s2 = Eigen::Vector3d::Zero();
+  std::vector<CableSpec> cables;
+  std::vector<BodySpec> bodies;
+  std::vector<JointSpec> joints;
+  std::vector<LoadSpec> loads;
+  std::vector<ProbeSpec> probes;
+  InitialVelocitySpec initial_velocity;
+  SolverSettings solver;
+  OutputSpec output;
+  FluidSpec fluid;
+  SeabedSpec seabed;
+  std::vector<SheaveSpec> sheaves;
+};
+
+}  // namespace cablesim
+
+#endif  // CABLESIM_ENGINE_SCENE_SCENE_H_

@@ -1,0 +1,221 @@
+#include "engine/steppers/energy_momentum_stepper.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "absl/strings/str_format.h"
+#include "engine/steppers/newton_convergence.h"
+
+namespace cablesim {
+
+EnergyMomentumStepper::EnergyMomentumStepper(MultibodyModel* model,
+                                             const SolverSettings& settings)
+    : model_(model), settings_(settings) {
+  n_ = model->dofs();
+  m_ = model->multipliers();
+  solver_.Resize(model->envelope(), model->jacobian_pattern());
+  jac1_ = model->jacobian_pattern();
+  jacm_ = model->jacobian_pattern();
+  z_ = model->initial_z();
+  v_ = model->initial_v();
+  for (Eigen::VectorXd* x : {&a_, &abar_, &z1_, &v1_, &f_, &mdv_, &bt_mu_, &floor_, &abs_terms_,
+                            &f_floor_})
+    x->setZero(n_);
+  lambda_.setZero(m_);
+  lambda1_.setZero(m_);
+  phi_.setZero(m_);
+  phim_.setZero(m_);
+  for (Eigen::VectorXd* x : {&q0_, &q1_, &qm_, &qd_}) x->setZero(model->coordinates());
+  rhs_.setZero(n_ + m_);
+  dx_.setZero(n_ + m_);
+  z_old_ = z_;
+  v_old_ = v_;
+  a_old_ = a_;
+  abar_old_ = abar_;
+  lambda_old_ = lambda_;
+}
+
+void EnergyMomentumStepper::LoadMass() {
+  const SkylineLdlt& mass = model_->mass();
+  std::copy(mass.values(), mass.values() + mass.stored(), solver_.a().values());
+}
+
+bool EnergyMomentumStepper::Initialize(std::string* reason) {
+  kept_.have = false;  // the solver's matrices now hold M and Phi_z
+  model_->SetTime(t_);
+  model_->ToFull(z_, &qm_);
+  model_->NetForce(qm_, 1.0, &f_);
+  if (model_->has_damping()) {
+    model_->RateToFull(v_, &qd_);
+    model_->DampingForce(qm_, qd_, &f_);
+  }
+  model_->Constraints(qm_, &phi_, &solver_.b());
+  Eigen::VectorXd gamma(m_);
+  model_->RateToFull(v_, &qd_);
+  model_->ConstraintGamma(qm_, qd_, &gamma);
+  LoadMass();
+  if (!SolveInitialAcceleration(&solver_, settings_, f_, gamma, &rhs_, &dx_, reason)) return false;
+  a_ = dx_.head(n_);
+  abar_ = a_;
+  lambda_ = dx_.tail(m_);
+  a_old_ = a_;
+  abar_old_ = abar_;
+  lambda_old_ = lambda_;
+  return true;
+}
+
+void EnergyMomentumStepper::Restore() {
+  z_ = z_old_;
+  v_ = v_old_;
+  a_ = a_old_;
+  abar_ = abar_old_;
+  lambda_ = lambda_old_;
+  t_ = t_old_;
+  h_last_ = h_old_;
+}
+
+double EnergyMomentumStepper::LocalErrorNorm(double h, double atol, double rtol) const {
+  const double k = h * h / (6 * (1 + h_old_ / h));
+  double worst = 0;
+  for (int i = 0; i < n_; ++i)
+    worst = std::max(worst, k * std::abs(abar_(i) - abar_old_(i)) /
+                                (atol + rtol * std::abs(z_(i))));
+  return worst;
+}
+
+double EnergyMomentumStepper::Forces(double h, Eigen::VectorXd* f, SkylineLdlt* a,
+                                     Eigen::VectorXd* roundoff) {
+  // Loads, torques and the elastic force at zm and t + h/2, then the
+  // elastic force replaced by its discrete gradient.
+  model_->SetTime(t_ + 0.5 * h);
+  double size = model_->NetForce(qm_, 1.0, f, a, 0.25 * h * h, roundoff);
+  model_->SubtractDiscreteGradientCorrection(q0_, q1_, f);
+  if (model_->has_damping()) {
+    mdv_ = 0.5 * (v_ + v1_);  // scratch: the mean velocity
+    model_->RateToFull(mdv_, &qd_);
+    size = std::max(size, model_->DampingForce(qm_, qd_, f, a, 0.5 * h, roundoff));
+  }
+  return size;
+}
+
+Stepper::StepStats EnergyMomentumStepper::Step(double h) {
+  return SolveWithFreshRetry(settings_.reuse_factorization, kept_.refresh,
+                             [&](bool fresh) { return Solve(h, fresh); });
+}
+
+Stepper::StepStats EnergyMomentumStepper::Solve(double h, bool fresh) {
+  StepStats st;
+  const double tol = settings_.newton_tolerance;
+  const bool reuse = settings_.reuse_factorization;
+  const double c = 0.25 * h * h;
+  if (kept_.Stale(c)) fresh = true;
+  // Predictor: the mean acceleration of the last step.
+  v1_ = v_ + h * abar_;
+  lambda1_ = lambda_;
+  model_->ToFull(z_, &q0_);
+  double last_increment = 0, previous_increment = 0;
+  bool previous_at_floor = false;
+  SkylineLdlt& a = solver_.a();
+  for (int it = 0; it <= settings_.max_newton_iterations; ++it) {
+    z1_ = z_ + (0.5 * h) * (v_ + v1_);
+    model_->ToFull(z1_, &q1_);
+    qm_ = 0.5 * (q0_ + q1_);
+    const bool checking = it > 0 && last_increment <= tol * (1 + z1_.lpNorm<Eigen::Infinity>());
+    const bool judge = checking || it == settings_.max_newton_iterations;
+    const bool have_floor = checking && floor_expected_;
+    const bool assemble = fresh && !checking;
+    if (assemble) LoadMass();
+    const double force_size = Forces(h, &f_, assemble ? &a : nullptr,
+                                     have_floor ? &floor_ : nullptr);
+    // Phi(z1, t + h) (jac1_ only as its scratch), and Phi_z(zm).
+    model_->SetTime(t_ + h);
+    model_->Constraints(q1_, &phi_, &jac1_);
+    model_->Constraints(qm_, &phim_, &jacm_);
+    // R_v = M (v1 - v0) - h f + Phi_z(zm)^T (h lambda).
+    mdv_ = v1_ - v_;
+    model_->mass().Multiply(mdv_.data(), rhs_.data());
+    auto rv = rhs_.head(n_);
+    bt_mu_.setZero();
+    jacm_.AddTransposeMultiply(lambda1_.data(), bt_mu_.data());
+    bt_mu_ *= h;
+    const double scale = std::max({rv.lpNorm<Eigen::Infinity>(), h * force_size,
+                                   bt_mu_.lpNorm<Eigen::Infinity>(), 1e-300});
+    rv += bt_mu_ - h * f_;
+    if (m_ > 0) rhs_.tail(m_) = phi_ * (2 / h);
+    NewtonIterate iterate;
+    if (!BeginIterate(rv, scale, phi_, z1_, last_increment, previous_increment,
+                      previous_at_floor, &iterate)) {
+      st.reason = kNotFiniteResidual;
+      return st;
+    }
+    previous_at_floor = false;
+    const bool plain = iterate.residual <= tol && iterate.violation <= tol * iterate.zscale;
+    if (judge && !(checking && plain)) {
+      if (!have_floor) Forces(h, &f_floor_, nullptr, &floor_);
+      abs_terms_.setZero();
+      model_->mass().AddAbsMultiply(v1_.data(), abs_terms_.data());
+      model_->mass().AddAbsMultiply(v_.data(), abs_terms_.data());
+      jacm_.AddAbsTransposeMultiply(lambda1_.data(), abs_terms_.data(), h);
+      floor_ = h * floor_ + kSumRounding * abs_terms_;
+      MeasureResidual(rv, floor_, scale, &iterate);
+      previous_at_floor = iterate.excess <= tol;
+    }
+    if (checking && NewtonConverged(iterate, tol)) {
+      floor_expected_ = !plain;
+      AcceptIterate(iterate, &st);
+      break;
+    }
+    if (it == settings_.max_newton_iterations) {
+      st.reason = NewtonFailure(it, iterate);
+      if (reuse) kept_.refresh = true;
+      return st;
+    }
+    if (fresh) {
+      if (!assemble) {
+        LoadMass();
+        Forces(h, &f_floor_, &a, nullptr);
+      }
+      if (m_ > 0) model_->AddConstraintHessian(qm_, lambda1_, c, &a);
+      if (!FactorNewtonMatrix(&solver_, jacm_, c, &kept_, &st)) return st;
+      // Keep this matrix for the next iterations only when asked to.
+      fresh = !reuse;
+    }
+    if (!SolveNewtonSystem(&solver_, settings_, &rhs_, &dx_, &st)) {
+      if (reuse) kept_.refresh = true;
+      return st;
+    }
+    v1_ += dx_.head(n_);
+    if (m_ > 0) lambda1_ += dx_.tail(m_) / h;
+    const double increment = 0.5 * h * dx_.head(n_).lpNorm<Eigen::Infinity>();
+    if (!std::isfinite(increment) || increment > 1e6 * iterate.zscale) {
+      st.reason = "Newton diverged";
+      if (reuse) kept_.refresh = true;
+      return st;
+    }
+    // Safeguard of the kept matrix: slow contraction asks for a fresh one.
+    if (reuse && it > 0 && increment > 0.5 * last_increment) fresh = true;
+    previous_increment = last_increment;
+    last_increment = increment;
+  }
+  z_old_.swap(z_);
+  v_old_.swap(v_);
+  a_old_.swap(a_);
+  abar_old_.swap(abar_);
+  lambda_old_.swap(lambda_);
+  z_.swap(z1_);
+  v_.swap(v1_);
+  lambda_.swap(lambda1_);
+  abar_ = (v_ - v_old_) / h;
+  // a(t + h) ~ abar + (h / 2) (abar - abar_old) / ((h + h_last) / 2); on the
+  // first step abar_old is a(0), half a step before abar.
+  const double span = 0.5 * (h + h_last_);
+  a_ = abar_ + (0.5 * h / span) * (abar_ - abar_old_);
+  h_old_ = h_last_;
+  h_last_ = h;
+  t_old_ = t_;
+  t_ += h;
+  model_->SetTime(t_);
+  return st;
+}
+
+}  // namespace cablesim

@@ -1,0 +1,49 @@
+#include "engine/steppers/explicit_stepper.h"
+
+namespace cablesim {
+
+ExplicitStepper::ExplicitStepper(MultibodyModel* model, const SolverSettings& settings)
+    : model_(model), settings_(settings), acceleration_(model) {
+  n_ = model->dofs();
+  z_ = model->initial_z();
+  v_ = model->initial_v();
+  a_.setZero(n_);
+  lambda_.resize(0);
+  z_old_ = z_;
+  v_old_ = v_;
+  a_old_ = a_;
+}
+
+bool ExplicitStepper::Start(const char* stepper, double limit, const char* limit_text,
+                            double* omega_max, std::string* reason) {
+  if (!acceleration_.Prepare(stepper, settings_, z_, limit, limit_text, omega_max, reason))
+    return false;
+  if (!acceleration_.Evaluate(t_, z_, v_, &a_)) {
+    *reason = "the initial acceleration is not finite";
+    return false;
+  }
+  a_old_ = a_;
+  return true;
+}
+
+void ExplicitStepper::Accept(double h, Eigen::VectorXd* z1, Eigen::VectorXd* v1,
+                             Eigen::VectorXd* a1) {
+  z_old_.swap(z_);
+  v_old_.swap(v_);
+  a_old_.swap(a_);
+  z_.swap(*z1);
+  v_.swap(*v1);
+  a_.swap(*a1);
+  t_old_ = t_;
+  t_ += h;
+}
+
+void ExplicitStepper::Restore() {
+  z_.swap(z_old_);
+  v_.swap(v_old_);
+  a_.swap(a_old_);
+  t_ = t_old_;
+  model_->SetTime(t_);
+}
+
+}  // namespace cablesim

@@ -1,0 +1,308 @@
+#include "engine/steppers/generalized_alpha_stepper.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "absl/strings/str_format.h"
+#include "engine/steppers/newton_convergence.h"
+
+namespace cablesim {
+namespace {
+// A Newton correction below this times (1 + |z|_inf) changes z only in its
+// last few bits (16 machine epsilons).
+}  // namespace
+
+GeneralizedAlphaStepper::GeneralizedAlphaStepper(MultibodyModel* model,
+                                                 const SolverSettings& settings, Variant variant)
+    : model_(model), settings_(settings), variant_(variant) {
+  const double rho = std::clamp(settings.rho_infinity, 0.0, 1.0);
+  if (variant == Variant::kGeneralizedAlpha) {
+    alpha_m_ = (2 * rho - 1) / (rho + 1);
+    alpha_f_ = rho / (rho + 1);
+    gamma_ = 0.5 + alpha_f_ - alpha_m_;
+    beta_ = 0.25 * (gamma_ + 0.5) * (gamma_ + 0.5);
+    w_ = 1;
+  } else {
+    const double alpha = std::clamp((rho - 1) / (rho + 1), -1.0 / 3, 0.0);
+    beta_ = 0.25 * (1 - alpha) * (1 - alpha);
+    gamma_ = 0.5 - alpha;
+    w_ = 1 + alpha;
+  }
+  n_ = model->dofs();
+  m_ = model->multipliers();
+  solver_.Resize(model->envelope(), model->jacobian_pattern());
+  solver_.Configure(settings.preconditioner, settings.accept_inexact_solves);
+  jac_ = model->jacobian_pattern();
+  z_ = model->initial_z();
+  v_ = model->initial_v();
+  zdd_.setZero(n_);
+  acc_.setZero(n_);
+  acc_h_.setZero(n_);
+  lambda_.setZero(m_);
+  g_.setZero(n_);
+  for (Eigen::VectorXd* x : {&z_pred_, &v_pred_, &z1_, &zdd1_, &f_, &bt_lambda_, &floor_, &abs_terms_,
+                            &f_floor_})
+    x->setZero(n_);
+  lambda1_.setZero(m_);
+  phi_.setZero(m_);
+  q_.setZero(model->coordinates());
+  qd_.setZero(model->coordinates());
+  v1_.setZero(n_);
+  rhs_.setZero(n_ + m_);
+  dx_.setZero(n_ + m_);
+  z_old_ = z_;
+  v_old_ = v_;
+  zdd_old_ = zdd_;
+  acc_old_ = acc_;
+  lambda_old_ = lambda_;
+  g_old_ = g_;
+}
+
+double GeneralizedAlphaStepper::Forces(const Eigen::VectorXd& v, Eigen::VectorXd* f,
+                                       SkylineLdlt* a, double c, double cd,
+                                       Eigen::VectorXd* roundoff) {
+  double size = model_->NetForce(q_, 1.0, f, a, c, roundoff);
+  if (model_->has_damping()) {
+    model_->RateToFull(v, &qd_);
+    size = std::max(size, model_->DampingForce(q_, qd_, f, a, cd, roundoff));
+  }
+  return size;
+}
+
+void GeneralizedAlphaStepper::LoadMass() {
+  const SkylineLdlt& mass = model_->mass();
+  std::copy(mass.values(), mass.values() + mass.stored(), solver_.a().values());
+}
+
+bool GeneralizedAlphaStepper::Initialize(std::string* reason) {
+  model_->SetTime(t_);
+  model_->ToFull(z_, &q_);
+  Forces(v_, &f_, nullptr, 0, 0, nullptr);
+  model_->Constraints(q_, &phi_, &solver_.b());
+  Eigen::VectorXd qdot(model_->coordinates()), gamma(m_);
+  model_->RateToFull(v_, &qdot);
+  model_->ConstraintGamma(q_, qdot, &gamma);
+  LoadMass();
+  kept_.have = false;
+  if (!solver_.Prepare()) {
+    *reason = "the mass matrix could not be factorized";
+    return false;
+  }
+  rhs_.head(n_) = f_;
+  if (m_ > 0) rhs_.tail(m_) = gamma;
+  const auto stats = solver_.Solve(settings_.linear_solver, rhs_, 1e-12,
+                                   std::max(settings_.max_linear_iterations, 1000), &dx_);
+  if (!(stats.relative_residual <= 1e-8)) {
+    *reason = absl::StrFormat(
+        "the initial acceleration solve did not converge (relative residual %.3g)",
+        stats.relative_residual);
+    return false;
+  }
+  zdd_ = dx_.head(n_);
+  acc_ = zdd_;  // a_0 = zdd_0 (Arnold and Bruls' starting value)
+  lambda_ = dx_.tail(m_);
+  // g_0 = Phi_z^T lambda_0 - f_0.
+  g_ = -f_;
+  solver_.b().AddTransposeMultiply(lambda_.data(), g_.data());
+  zdd_old_ = zdd_;
+  acc_old_ = acc_;
+  lambda_old_ = lambda_;
+  g_old_ = g_;
+  return true;
+}
+
+void GeneralizedAlphaStepper::Restore() {
+  h_last_ = h_old_;
+  z_ = z_old_;
+  v_ = v_old_;
+  zdd_ = zdd_old_;
+  acc_ = acc_old_;
+  lambda_ = lambda_old_;
+  g_ = g_old_;
+  t_ = t_old_;
+}
+
+double GeneralizedAlphaStepper::LocalErrorNorm(double h, double atol, double rtol) const {
+  const double k = h * h * std::abs(beta_ - 1.0 / 6);
+  double worst = 0;
+  for (int i = 0; i < n_; ++i) {
+    worst = std::max(worst,
+                     k * std::abs(zdd_(i) - zdd_old_(i)) / (atol + rtol * std::abs(z_(i))));
+  }
+  return worst;
+}
+
+Stepper::StepStats GeneralizedAlphaStepper::Step(double h) {
+  model_->SetTime(t_ + h);
+  return SolveWithFreshRetry(settings_.reuse_factorization, kept_.refresh,
+                             [&](bool fresh) { return Solve(h, fresh); });
+}
+
+Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
+  StepStats st;
+  const double tol = settings_.newton_tolerance;
+  const bool reuse = settings_.reuse_factorization;
+  const bool ga = variant_ == Variant::kGeneralizedAlpha;
+  // Predictors: everything in z_{n+1}, v_{n+1} except s zdd_{n+1}.
+  double s, sv;
+  if (ga) {
+    const double k = 1 / (1 - alpha_m_);
+    // Variable steps: a_n approximates zdd(t_n + (alpha_m - alpha_f) h)
+    // (Arnold and Bruls, section 3), so a change of h shifts it, to first
+    // order a_n <- zdd_n + (h / h_last) (a_n - zdd_n). Without it, halving
+    // and regrowing the step feeds energy into the stiff modes.
+    acc_h_ = acc_;
+    if (h_last_ > 0 && h != h_last_) acc_h_ = zdd_ + (h / h_last_) * (acc_ - zdd_);
+    // a_{n+1} = k (alpha_f zdd_n - alpha_m a_n) + k (1 - alpha_f) zdd_{n+1}.
+    bt_lambda_ = k * (alpha_f_ * zdd_ - alpha_m_ * acc_h_);  // scratch: known part of a_{n+1}
+    z_pred_ = z_ + h * v_ + (h * h * (0.5 - beta_)) * acc_h_ + (h * h * beta_) * bt_lambda_;
+    v_pred_ = v_ + (h * (1 - gamma_)) * acc_h_ + (h * gamma_) * bt_lambda_;
+    s = h * h * beta_ * k * (1 - alpha_f_);
+    sv = h * gamma_ * k * (1 - alpha_f_);
+  } else {
+    z_pred_ = z_ + h * v_ + (h * h * (0.5 - beta_)) * zdd_;
+    v_pred_ = v_ + (h * (1 - gamma_)) * zdd_;
+    s = h * h * beta_;
+    sv = h * gamma_;
+  }
+  const double c = w_ * s;
+  // The damping's share of the Newton matrix: d v_{n+1} / d zdd = s_v.
+  const double cd = w_ * sv;
+  const bool damping = model_->has_damping();
+  // A kept matrix serves while c is within 20 % of its own (the last steps
+  // shortened to end on the duration, or resized by the error controller): Newton
+  // then still contracts by about that fraction, and the safeguard below
+  // catches it when it does not.
+  if (kept_.Stale(c)) fresh = true;
+  // Predictor: the acceleration extrapolated linearly from the last two
+  // steps (constant on the first step and after Restore()).
+  zdd1_ = zdd_;
+  if (h_last_ > 0) zdd1_ += (h / h_last_) * (zdd_ - zdd_old_);
+  lambda1_ = lambda_;
+  double last_increment = 0, previous_increment = 0;
+  bool previous_at_floor = false;
+  SkylineLdlt& a = solver_.a();
+  for (int it = 0; it <= settings_.max_newton_iterations; ++it) {
+    z1_ = z_pred_ + s * zdd1_;
+    model_->ToFull(z1_, &q_);
+    if (damping) v1_ = v_pred_ + sv * zdd1_;
+    const bool checking = it > 0 && last_increment <= tol * (1 + z1_.lpNorm<Eigen::Infinity>());
+    // The rounding floor is needed where convergence is judged (and for the
+    // message of the last iteration), unless the residual is below tol.
+    const bool judge = checking || it == settings_.max_newton_iterations;
+    // Assemble the Newton matrix with the forces when this iteration will
+    // need a fresh one and is not expected to be the converged one.
+    bool assembled = false, have_floor = false;
+    double force_size;
+    if (fresh && !checking) {
+      LoadMass();
+      force_size = Forces(v1_, &f_, &a, c, cd, nullptr);
+      assembled = true;
+    } else {
+      // The forces' rounding bound in the same pass when the last step was
+      // accepted at its floor: this one most likely will be too.
+      have_floor = judge && floor_expected_;
+      force_size = Forces(v1_, &f_, nullptr, 0, 0, have_floor ? &floor_ : nullptr);
+    }
+    model_->Constraints(q_, &phi_, &jac_);
+    // R = M zdd + w (Phi_z^T lambda - f) + (1 - w) g_n.
+    auto r = rhs_.head(n_);
+    if (have_floor) {
+      abs_terms_.setZero();
+      model_->mass().MultiplyWithAbs(zdd1_.data(), r.data(), abs_terms_.data());
+    } else {
+      model_->mass().Multiply(zdd1_.data(), r.data());
+    }
+    const double inertia = r.lpNorm<Eigen::Infinity>();
+    bt_lambda_.setZero();
+    jac_.AddTransposeMultiply(lambda1_.data(), bt_lambda_.data());
+    const double scale =
+        std::max({inertia, w_ * force_size, w_ * bt_lambda_.lpNorm<Eigen::Infinity>(),
+                  (1 - w_) * g_.lpNorm<Eigen::Infinity>(), 1e-300});
+    r += w_ * (bt_lambda_ - f_);
+    if (w_ != 1) r += (1 - w_) * g_;
+    if (m_ > 0) rhs_.tail(m_) = phi_ / s;
+    NewtonIterate iterate;
+    if (!BeginIterate(r, scale, phi_, z1_, last_increment, previous_increment,
+                      previous_at_floor, &iterate)) {
+      st.reason = kNotFiniteResidual;
+      return st;
+    }
+    previous_at_floor = false;
+    const bool plain = iterate.residual <= tol && iterate.violation <= tol * iterate.zscale;
+    if (judge && !(checking && plain)) {
+      // floor = w roundoff(f) + rounding of the other terms summed into R
+      // (the forces once more for their bound, unless it came with them).
+      if (!have_floor) {
+        Forces(v1_, &f_floor_, nullptr, 0, 0, &floor_);
+        abs_terms_.setZero();
+        model_->mass().AddAbsMultiply(zdd1_.data(), abs_terms_.data());
+      }
+      jac_.AddAbsTransposeMultiply(lambda1_.data(), abs_terms_.data(), w_);
+      floor_ = w_ * floor_ + kSumRounding * (abs_terms_ + (1 - w_) * g_.cwiseAbs());
+      MeasureResidual(r, floor_, scale, &iterate);
+      previous_at_floor = iterate.excess <= tol;
+    }
+    if (checking && NewtonConverged(iterate, tol)) {
+      floor_expected_ = !plain;
+      AcceptIterate(iterate, &st);
+      break;
+    }
+    if (it == settings_.max_newton_iterations) {
+      st.reason = NewtonFailure(it, iterate);
+      if (reuse) kept_.refresh = true;
+      return st;
+    }
+    if (fresh) {
+      if (!assembled) {
+        LoadMass();
+        Forces(v1_, &f_, &a, c, cd, nullptr);
+      }
+      if (m_ > 0) model_->AddConstraintHessian(q_, lambda1_, c, &a);
+      if (!FactorNewtonMatrix(&solver_, jac_, c, &kept_, &st)) return st;
+      // Keep this matrix for the next iterations only when asked to.
+      fresh = !reuse;
+    }
+    if (!SolveNewtonSystem(&solver_, settings_, &rhs_, &dx_, &st)) {
+      if (reuse) kept_.refresh = true;
+      return st;
+    }
+    zdd1_ += dx_.head(n_);
+    if (m_ > 0) lambda1_ += dx_.tail(m_) / w_;
+    const double increment = s * dx_.head(n_).lpNorm<Eigen::Infinity>();
+    if (!std::isfinite(increment) || increment > 1e6 * iterate.zscale) {
+      st.reason = "Newton diverged";
+      if (reuse) kept_.refresh = true;
+      return st;
+    }
+    // Safeguard of the kept matrix: slow contraction asks for a fresh one.
+    if (reuse && it > 0 && increment > 0.5 * last_increment) fresh = true;
+    previous_increment = last_increment;
+    last_increment = increment;
+  }
+  z_old_.swap(z_);
+  v_old_.swap(v_);
+  zdd_old_.swap(zdd_);
+  acc_old_.swap(acc_);
+  lambda_old_.swap(lambda_);
+  g_old_.swap(g_);
+  z_ = z1_;
+  v_ = v_pred_ + sv * zdd1_;
+  if (ga) {
+    const double k = 1 / (1 - alpha_m_);
+    acc_ = k * (alpha_f_ * zdd_old_ - alpha_m_ * acc_h_ + (1 - alpha_f_) * zdd1_);
+  } else {
+    acc_ = zdd1_;
+  }
+  zdd_ = zdd1_;
+  lambda_ = lambda1_;
+  h_old_ = h_last_;
+  h_last_ = h;
+  // g_{n+1} from the converged evaluation (forces and Jacobian at z_{n+1}).
+  g_ = bt_lambda_ - f_;
+  t_old_ = t_;
+  t_ += h;
+  return st;
+}
+
+}  // namespace cablesim

@@ -1,0 +1,216 @@
+#include "engine/steppers/implicit_euler_stepper.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "absl/strings/str_format.h"
+#include "engine/steppers/newton_convergence.h"
+
+namespace cablesim {
+
+ImplicitEulerStepper::ImplicitEulerStepper(MultibodyModel* model, const SolverSettings& settings)
+    : model_(model), settings_(settings) {
+  n_ = model->dofs();
+  m_ = model->multipliers();
+  solver_.Resize(model->envelope(), model->jacobian_pattern());
+  solver_.Configure(settings.preconditioner, settings.accept_inexact_solves);
+  z_ = model->initial_z();
+  v_ = model->initial_v();
+  a_.setZero(n_);
+  lambda_.setZero(m_);
+  z1_.setZero(n_);
+  v1_.setZero(n_);
+  lambda1_.setZero(m_);
+  q_.setZero(model->coordinates());
+  qd_.setZero(model->coordinates());
+  f_.setZero(n_);
+  phi_.setZero(m_);
+  mdv_.setZero(n_);
+  rhs_.setZero(n_ + m_);
+  dx_.setZero(n_ + m_);
+  bt_mu_.setZero(n_);
+  floor_.setZero(n_);
+  abs_terms_.setZero(n_);
+  f_floor_.setZero(n_);
+  z_old_ = z_;
+  v_old_ = v_;
+  a_old_ = a_;
+  lambda_old_ = lambda_;
+}
+
+void ImplicitEulerStepper::Restore() {
+  z_ = z_old_;
+  v_ = v_old_;
+  a_ = a_old_;
+  lambda_ = lambda_old_;
+  t_ = t_old_;
+}
+
+double ImplicitEulerStepper::LocalErrorNorm(double h, double atol, double rtol) const {
+  double worst = 0;
+  for (int i = 0; i < n_; ++i)
+    worst = std::max(worst, 0.5 * h * h * std::abs(a_(i)) / (atol + rtol * std::abs(z_(i))));
+  return worst;
+}
+
+bool ImplicitEulerStepper::Initialize(std::string* reason) {
+  model_->SetTime(t_);
+  model_->ToFull(z_, &q_);
+  Forces(v_, &f_, nullptr, 0, nullptr);
+  model_->Constraints(q_, &phi_, &solver_.b());
+  Eigen::VectorXd qdot(model_->coordinates()), gamma(m_);
+  model_->RateToFull(v_, &qdot);
+  model_->ConstraintGamma(q_, qdot, &gamma);
+  LoadMass();
+  if (!solver_.Prepare()) {
+    *reason = "the mass matrix could not be factorized";
+    return false;
+  }
+  rhs_.head(n_) = f_;
+  if (m_ > 0) rhs_.tail(m_) = gamma;
+  const auto stats = solver_.Solve(settings_.linear_solver, rhs_, 1e-12,
+                                   std::max(settings_.max_linear_iterations, 1000), &dx_);
+  if (!(stats.relative_residual <= 1e-8)) {
+    *reason = absl::StrFormat(
+        "the initial acceleration solve did not converge (relative residual %.3g)",
+        stats.relative_residual);
+    return false;
+  }
+  a_ = dx_.head(n_);
+  lambda_ = dx_.tail(m_);
+  a_old_ = a_;
+  lambda_old_ = lambda_;
+  return true;
+}
+
+void ImplicitEulerStepper::LoadMass() {
+  const SkylineLdlt& mass = model_->mass();
+  std::copy(mass.values(), mass.values() + mass.stored(), solver_.a().values());
+}
+
+double ImplicitEulerStepper::Forces(const Eigen::VectorXd& v, Eigen::VectorXd* f,
+                                    SkylineLdlt* a, double h, Eigen::VectorXd* roundoff) {
+  double size = model_->NetForce(q_, 1.0, f, a, h * h, roundoff);
+  if (model_->has_damping()) {
+    model_->RateToFull(v, &qd_);
+    size = std::max(size, model_->DampingForce(q_, qd_, f, a, h, roundoff));
+  }
+  return size;
+}
+
+double ImplicitEulerStepper::AssembleForces(double h) {
+  LoadMass();
+  return Forces(v1_, &f_, &solver_.a(), h, nullptr);
+}
+
+ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
+  StepStats st;
+  const double tol = settings_.newton_tolerance;
+  model_->SetTime(t_ + h);
+  v1_ = v_ + h * a_;
+  lambda1_ = lambda_;
+  double last_increment = 0, previous_increment = 0;
+  bool previous_at_floor = false;
+  SkylineLdlt& a = solver_.a();
+  for (int it = 0; it <= settings_.max_newton_iterations; ++it) {
+    z1_ = z_ + h * v1_;
+    model_->ToFull(z1_, &q_);
+    // Newton matrix M + h^2 (K_T + H_lambda), assembled with the forces
+    // unless this evaluation is expected to be the converged one.
+    const bool checking = it > 0 && last_increment <= tol * (1 + z1_.lpNorm<Eigen::Infinity>());
+    // The rounding floor is needed where convergence is judged (and for the
+    // message of the last iteration).
+    const bool judge = checking || it == settings_.max_newton_iterations;
+    // The forces' rounding bound in the same pass when the last step was
+    // accepted at its floor: this one most likely will be too.
+    const bool have_floor = checking && floor_expected_;
+    const double force_size =
+        checking ? Forces(v1_, &f_, nullptr, h, have_floor ? &floor_ : nullptr)
+                 : AssembleForces(h);
+    model_->Constraints(q_, &phi_, &solver_.b());
+    // R_v = M (v1 - v0) - h f + Phi_z^T (h lambda).
+    mdv_ = v1_ - v_;
+    model_->mass().Multiply(mdv_.data(), rhs_.data());
+    auto rv = rhs_.head(n_);
+    bt_mu_.setZero();
+    solver_.b().AddTransposeMultiply(lambda1_.data(), bt_mu_.data());
+    bt_mu_ *= h;
+    const double scale = std::max({rv.lpNorm<Eigen::Infinity>(), h * force_size,
+                                   bt_mu_.lpNorm<Eigen::Infinity>(), 1e-300});
+    rv += bt_mu_ - h * f_;
+    if (m_ > 0) rhs_.tail(m_) = phi_ / h;
+    NewtonIterate iterate;
+    if (!BeginIterate(rv, scale, phi_, z1_, last_increment, previous_increment,
+                      previous_at_floor, &iterate)) {
+      st.reason = kNotFiniteResidual;
+      return st;
+    }
+    previous_at_floor = false;
+    const bool plain = iterate.residual <= tol && iterate.violation <= tol * iterate.zscale;
+    if (judge && !(checking && plain)) {
+      // floor = h roundoff(f) + rounding of the other terms summed into R_v
+      // (M v1, M v0 and h Phi_z^T lambda); the forces once more, for their
+      // bound, only where it matters, unless it came with them.
+      if (!have_floor) Forces(v1_, &f_floor_, nullptr, h, &floor_);
+      abs_terms_.setZero();
+      model_->mass().AddAbsMultiply(v1_.data(), abs_terms_.data());
+      model_->mass().AddAbsMultiply(v_.data(), abs_terms_.data());
+      solver_.b().AddAbsTransposeMultiply(lambda1_.data(), abs_terms_.data(), h);
+      floor_ = h * floor_ + kSumRounding * abs_terms_;
+      MeasureResidual(rv, floor_, scale, &iterate);
+      previous_at_floor = iterate.excess <= tol;
+    }
+    if (checking && NewtonConverged(iterate, tol)) {
+      floor_expected_ = !plain;
+      AcceptIterate(iterate, &st);
+      break;
+    }
+    if (it == settings_.max_newton_iterations) {
+      st.reason = NewtonFailure(it, iterate);
+      return st;
+    }
+    if (checking) AssembleForces(h);
+    if (m_ > 0) model_->AddConstraintHessian(q_, lambda1_, h * h, &a);
+    if (!solver_.Prepare()) {
+      st.reason = "the Newton matrix has a non-finite pivot";
+      return st;
+    }
+    rhs_ = -rhs_;
+    ++st.factorizations;
+    const auto ls = solver_.Solve(settings_.linear_solver, rhs_, settings_.linear_tolerance,
+                                  settings_.max_linear_iterations, &dx_);
+    ++st.newton_iterations;
+    st.linear_iterations += ls.iterations;
+    st.max_linear_residual = std::max(st.max_linear_residual, ls.relative_residual);
+    st.direct_fallbacks += ls.fallback ? 1 : 0;
+    ++st.linear_solves;
+    st.inexact_solves += LinearSolveInexact(ls) ? 1 : 0;
+    if (!LinearSolveGoodEnough(ls)) {
+      st.reason = LinearSolveFailure(ls, settings_.linear_solver);
+      return st;
+    }
+    v1_ += dx_.head(n_);
+    if (m_ > 0) lambda1_ += dx_.tail(m_) / h;
+    previous_increment = last_increment;
+    last_increment = h * dx_.head(n_).lpNorm<Eigen::Infinity>();
+    if (!std::isfinite(last_increment) || last_increment > 1e6 * iterate.zscale) {
+      st.reason = "Newton diverged";
+      return st;
+    }
+  }
+  // Keep the previous state for Restore() (swaps, no copies: z1_, v1_ and
+  // lambda1_ are rewritten at the start of every step).
+  z_old_.swap(z_);
+  v_old_.swap(v_);
+  a_old_.swap(a_);
+  lambda_old_.swap(lambda_);
+  z_.swap(z1_);
+  v_.swap(v1_);
+  lambda_.swap(lambda1_);
+  a_ = (v_ - v_old_) / h;
+  t_old_ = t_;
+  t_ += h;
+  return st;
+}
+
+}  // namespace cablesim

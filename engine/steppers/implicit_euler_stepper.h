@@ -1,0 +1,96 @@
+#ifndef CABLESIM_ENGINE_STEPPERS_IMPLICIT_EULER_STEPPER_H_
+#define CABLESIM_ENGINE_STEPPERS_IMPLICIT_EULER_STEPPER_H_
+
+// The paper's stepper (docs/model.md section 4): backward Euler on the index-3
+// equations of motion,
+//
+//   v1 = v0 + h a1,   z1 = z0 + h v1,
+//   M (v1 - v0) + h (Q_k(z1) - Q_a(z1) + C(z1) v1) + Phi_z(z1)^T mu = 0,
+//   mu = h lambda,   Phi(z1) / h = 0,
+//
+// solved by Newton on (v1, mu) from the predictor v1 = v0 + h a0. Each Newton
+// step solves the symmetric saddle-point system
+//
+//   [ M + h C + h^2 (K_T + H_lambda)   Phi_z^T ] [dv ]     [ R_v ]
+//   [ Phi_z                            0       ] [dmu] = - [ R_c ]
+//
+// (C the damping matrix, MultibodyModel::DampingForce; absent without
+// damping) with MINRES (or GMRES) under SaddlePointSolver's preconditioner. Newton
+// stops when the position increment h |dv|_inf is below
+// tol (1 + |z|_inf), the momentum residual below tol times its largest term
+// and |Phi|_inf below tol (1 + |z|_inf) (a residual left above tol while the
+// corrections move z only in its last bits, 16 eps (1 + |z|), or by less
+// than tol / 1000 (1 + |z|), is the
+// rounding floor of the forces and is accepted when below sqrt(tol));
+// otherwise the step is reported as not converged and the caller retries with a smaller step. Nothing is
+// accepted silently.
+//
+// Backward Euler is first order and removes energy at high frequencies;
+// simulation.cc reports how much.
+//
+// Local error (for adaptive steps): against the second-order update
+// z0 + h (v0 + v1) / 2, backward Euler's position is off by
+// h (v1 - v0) / 2 = h^2 a1 / 2, the estimate LocalErrorNorm() uses.
+//
+// Step() allocates nothing.
+
+#include <string>
+
+#include <Eigen/Core>
+
+#include "engine/model/multibody_model.h"
+#include "engine/linear/saddle_point_solver.h"
+#include "engine/scene/scene.h"
+#include "engine/steppers/stepper.h"
+
+namespace cablesim {
+
+class ImplicitEulerStepper final : public Stepper {
+ public:
+  ImplicitEulerStepper(MultibodyModel* model, const SolverSettings& settings);
+
+  bool Initialize(std::string* reason) override;
+  StepStats Step(double h) override;
+  void Restore() override;
+  double LocalErrorNorm(double h, double atol, double rtol) const override;
+
+  const Eigen::VectorXd& z() const override { return z_; }
+  const Eigen::VectorXd& v() const override { return v_; }
+  const Eigen::VectorXd& a() const override { return a_; }
+  const Eigen::VectorXd& lambda() const override { return lambda_; }
+
+ private:
+  // Newton matrix block a = M.
+  void LoadMass();
+  // f = f(q_, v) (elastic, applied and damping forces: the damping's
+  // velocity is v) and, when `a` is not null, h^2 K_T + h C added to it;
+  // the force size (NetForce, DampingForce).
+  double Forces(const Eigen::VectorXd& v, Eigen::VectorXd* f, SkylineLdlt* a, double h,
+                Eigen::VectorXd* roundoff);
+  // a = M + h^2 K_T(q_) + h C and f_ = f(q_, v1_) in one pass; returns the
+  // force size.
+  double AssembleForces(double h);
+
+  MultibodyModel* model_;
+  SolverSettings settings_;
+  SaddlePointSolver solver_;
+  int n_ = 0, m_ = 0;
+  Eigen::VectorXd z_, v_, a_, lambda_;
+  Eigen::VectorXd z_old_, v_old_, a_old_, lambda_old_;  // before the last step
+  // Time [s] of the state, and before the last step: each step sets the
+  // model's time to its end (prescribed motions and varying loads at
+  // t_{n+1}, where backward Euler imposes Phi(z_{n+1}, t_{n+1}) = 0).
+  double t_ = 0, t_old_ = 0;
+  // Newton work vectors.
+  Eigen::VectorXd z1_, v1_, lambda1_, q_, qd_, f_, phi_, mdv_, rhs_, dx_, bt_mu_;
+  // The residual's rounding floor per unknown, and the terms summed into it.
+  Eigen::VectorXd floor_, abs_terms_, f_floor_;
+  // Whether the last accepted step needed the floor (its residual was above
+  // tol): the next step's checking iteration then bounds the forces'
+  // rounding in the same pass as the forces.
+  bool floor_expected_ = false;
+};
+
+}  // namespace cablesim
+
+#endif  // CABLESIM_ENGINE_STEPPERS_IMPLICIT_EULER_STEPPER_H_
