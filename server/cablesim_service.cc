@@ -368,7 +368,7 @@ grpc::Status CablesimServiceImpl::Run(grpc::ServerContext* context, const v1::Ru
   StreamingSink sink(writer, slot.watch(), BatchSize(request->frames_per_batch()),
                      checked->scene.name, checked->end_time_s);
   absl::StatusOr<RunSummary> summary =
-      RunSceneWithinMemory(checked->scene, &sink, ControlFor(context, limits_));
+      RunSceneWithinMemory(&*checked, &sink, ControlFor(context, limits_));
   if (!summary.ok()) return ToGrpc(summary.status());
   if (sink.gone() || context->IsCancelled()) {
     return grpc::Status(grpc::StatusCode::CANCELLED, "the client cancelled or went away");
@@ -579,7 +579,7 @@ grpc::Status CablesimServiceImpl::GetEnergy(grpc::ServerContext* context,
     StoredResult result;
     RowSink sink(&result);
     absl::StatusOr<RunSummary> summary =
-        RunSceneWithinMemory(checked->scene, &sink, ControlFor(context, limits_));
+        RunSceneWithinMemory(&*checked, &sink, ControlFor(context, limits_));
     if (!summary.ok()) return ToGrpc(summary.status());
     if (context->IsCancelled()) return grpc::Status(grpc::StatusCode::CANCELLED, "cancelled");
     *response = EnergyFromTrajectory(result.header, result.values, SummaryToProto(*summary));

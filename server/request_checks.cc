@@ -55,9 +55,10 @@ absl::Status CheckStringLengths(const google::protobuf::Message& message,
 
 namespace {
 
-absl::StatusOr<RunSummary> RunCatchingBadAlloc(const Scene& scene, FrameSink* sink,
-                                               const RunControl& control) {
+absl::StatusOr<RunSummary> RunCatchingBadAlloc(const Scene& scene, PreparedRun* prepared,
+                                               FrameSink* sink, const RunControl& control) {
   try {
+    if (prepared != nullptr && !prepared->used()) return RunPrepared(prepared, sink, control);
     return RunScene(scene, sink, control);
   } catch (const std::bad_alloc&) {
     int64_t elements = 0;
@@ -75,8 +76,10 @@ absl::StatusOr<RunSummary> RunCatchingBadAlloc(const Scene& scene, FrameSink* si
 
 }  // namespace
 
-absl::StatusOr<RunSummary> RunSceneWithinMemory(const Scene& scene, FrameSink* sink,
-                                                const RunControl& control) {
+namespace {
+
+absl::StatusOr<RunSummary> RunOnComputeThread(const Scene& scene, PreparedRun* prepared,
+                                              FrameSink* sink, const RunControl& control) {
   absl::StatusOr<RunSummary> result = absl::UnknownError("not run");
   std::thread compute([&] {
     // Linux: a thread's own nice value (setpriority on its thread id).
@@ -84,10 +87,22 @@ absl::StatusOr<RunSummary> RunSceneWithinMemory(const Scene& scene, FrameSink* s
     errno = 0;
     const int nice = ::getpriority(PRIO_PROCESS, tid);
     if (errno == 0) ::setpriority(PRIO_PROCESS, tid, std::min(19, nice + kComputeNice));
-    result = RunCatchingBadAlloc(scene, sink, control);
+    result = RunCatchingBadAlloc(scene, prepared, sink, control);
   });
   compute.join();
   return result;
+}
+
+}  // namespace
+
+absl::StatusOr<RunSummary> RunSceneWithinMemory(const Scene& scene, FrameSink* sink,
+                                                const RunControl& control) {
+  return RunOnComputeThread(scene, nullptr, sink, control);
+}
+
+absl::StatusOr<RunSummary> RunSceneWithinMemory(CheckedScene* checked, FrameSink* sink,
+                                                const RunControl& control) {
+  return RunOnComputeThread(checked->scene, checked->prepared.get(), sink, control);
 }
 
 absl::StatusOr<v1::Scene> SceneOfRequest(bool has_scene, const v1::Scene& scene,
@@ -193,9 +208,10 @@ absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimi
         absl::StrFormat("cables: %d elements asked for, the server's limit is %d (max_elements)",
                         requested_elements, limits.max_elements));
   }
-  absl::StatusOr<ModelInfo> info = DescribeModel(checked.scene, should_stop);
-  if (!info.ok()) return info.status();
-  checked.info = std::move(*info);
+  absl::StatusOr<PreparedRun> prepared = Prepare(checked.scene, should_stop);
+  if (!prepared.ok()) return prepared.status();
+  checked.info = prepared->info();
+  checked.prepared = std::make_shared<PreparedRun>(std::move(*prepared));
   if (checked.info.shape) {
     // output.shape adds x, y, z of every node to every row.
     const int64_t shape_values =

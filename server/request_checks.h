@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <limits>
 #include <string>
 #include <vector>
@@ -57,6 +58,10 @@ struct ServerLimits {
 
 struct CheckedScene {
   Scene scene;
+  // The model CheckScene built to cost the scene; a Run or GetEnergy call
+  // runs this one (RunSceneWithinMemory) instead of building it again.
+  // Shared so that CheckedScene stays copyable; it runs once.
+  std::shared_ptr<PreparedRun> prepared;
   ModelInfo info;
   double end_time_s = 0;      // duration (DYNAMIC) or 1 (STATIC)
   int64_t nominal_steps = 0;  // duration / step, or load steps
@@ -93,6 +98,10 @@ absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimi
 // (bench/server_load_bench.cc).
 inline constexpr int kComputeNice = 10;
 absl::StatusOr<RunSummary> RunSceneWithinMemory(const Scene& scene, FrameSink* sink,
+                                                const RunControl& control);
+// The same for a checked scene: runs the model CheckScene built (built
+// once per request), or builds it again when that one has run.
+absl::StatusOr<RunSummary> RunSceneWithinMemory(CheckedScene* checked, FrameSink* sink,
                                                 const RunControl& control);
 
 // ResourceExhausted naming the first string field of `message` (its path,

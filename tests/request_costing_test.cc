@@ -12,6 +12,8 @@
 
 #include "convert/scene_file.h"
 #include "engine/output/frame_columns.h"
+#include "engine/model/multibody_model.h"
+#include "engine/output/results.h"
 #include "server/request_checks.h"
 
 namespace cablesim {
@@ -46,6 +48,34 @@ TEST(RequestCostingTest, TrajectoryLimitCountsEveryColumnOfEveryFrame) {
     EXPECT_EQ(refused.code(), absl::StatusCode::kResourceExhausted) << name;
     EXPECT_NE(refused.message().find("max_trajectory_values"), std::string::npos) << name;
   }
+}
+
+// A Run request costs its scene on the built model and runs that same
+// model: one build, not one to cost and one to run (a scene of many
+// elements takes seconds to build). A second run of the same checked scene
+// must build again (a model runs once).
+TEST(RequestCostingTest, ARunBuildsItsModelOnce) {
+  class Discard : public FrameSink {
+   public:
+    absl::Status OnFrame(const Frame&) override { return absl::OkStatus(); }
+  } sink;
+  const int64_t before = MultibodyModel::BuildsStarted();
+  absl::StatusOr<CheckedScene> checked = CheckScene(SampleScene("falling-pendulum.json"), {});
+  ASSERT_TRUE(checked.ok()) << checked.status();
+  absl::StatusOr<RunSummary> ran = RunSceneWithinMemory(&*checked, &sink, {});
+  ASSERT_TRUE(ran.ok()) << ran.status();
+  EXPECT_EQ(ran->status, "ok");
+  EXPECT_EQ(MultibodyModel::BuildsStarted() - before, 1);
+  // The same answer as a run that builds its own model.
+  absl::StatusOr<RunSummary> again = RunSceneWithinMemory(checked->scene, &sink, {});
+  ASSERT_TRUE(again.ok()) << again.status();
+  EXPECT_EQ(MultibodyModel::BuildsStarted() - before, 2);
+  EXPECT_EQ(again->energy_final, ran->energy_final);
+  EXPECT_EQ(again->steps, ran->steps);
+  absl::StatusOr<RunSummary> rerun = RunSceneWithinMemory(&*checked, &sink, {});
+  ASSERT_TRUE(rerun.ok()) << rerun.status();
+  EXPECT_EQ(MultibodyModel::BuildsStarted() - before, 3);
+  EXPECT_EQ(rerun->energy_final, ran->energy_final);
 }
 
 }  // namespace

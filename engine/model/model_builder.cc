@@ -2,6 +2,7 @@
 #include "engine/scene/integrator_traits.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -1201,11 +1202,18 @@ MultibodyModel ModelBuilder::Finish() {
   return std::move(model_);
 }
 
+namespace {
+std::atomic<int64_t> builds_started{0};
+}  // namespace
+
+int64_t MultibodyModel::BuildsStarted() { return builds_started.load(std::memory_order_relaxed); }
+
 // MultibodyModel::Build is defined here, beside the steps it runs, so that
 // the model's own file does not need the builder (the builder needs the
 // model; not the other way round).
 absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene,
                                                     const std::function<bool()>& should_stop) {
+  builds_started.fetch_add(1, std::memory_order_relaxed);
   // The steps, what each computes and why, are in model_builder.h.
   ModelBuilder builder(scene, should_stop);
   const absl::Status stopped =

@@ -39,6 +39,7 @@
 // All vectors of size dofs() are "reduced"; of size coordinates() "full".
 
 #include <array>
+#include <cstdint>
 #include <functional>
 #include <optional>
 #include <string>
@@ -74,6 +75,9 @@ class MultibodyModel {
   // when it said stop.
   static absl::StatusOr<MultibodyModel> Build(const Scene& scene,
                                               const std::function<bool()>& should_stop = {});
+  // How many models Build has started in this process (a diagnostic: the
+  // server builds one per Run request, tests/request_costing_test.cc).
+  static int64_t BuildsStarted();
 
   // 2 (planar) or 3 (spatial), chosen by ChooseDimension (model_choice.h).
   int dimension() const { return dim_; }

@@ -592,41 +592,78 @@ bool StartFromEquilibrium(MultibodyModel* model, const SolverSettings& settings,
 
 }  // namespace
 
-absl::StatusOr<ModelInfo> DescribeModel(const Scene& scene,
-                                        const std::function<bool()>& should_stop) {
+struct PreparedModel {
+  Scene scene;
+  MultibodyModel model;
+  ModelInfo info;
+  int modes = 0;  // MODAL: the modes to compute
+  double build_seconds = 0;
+  bool used = false;
+};
+
+PreparedRun::PreparedRun() = default;
+PreparedRun::PreparedRun(PreparedRun&&) noexcept = default;
+PreparedRun& PreparedRun::operator=(PreparedRun&&) noexcept = default;
+PreparedRun::~PreparedRun() = default;
+const ModelInfo& PreparedRun::info() const { return model_->info; }
+bool PreparedRun::used() const { return model_->used; }
+
+absl::StatusOr<PreparedRun> Prepare(const Scene& scene,
+                                    const std::function<bool()>& should_stop) {
+  const auto start = Clock::now();
   absl::StatusOr<MultibodyModel> built = MultibodyModel::Build(scene, should_stop);
   if (!built.ok()) return built.status();
+  int modes = 0;
   if (scene.solver.analysis == Analysis::kModal) {
-    if (absl::StatusOr<int> modes = ModalSolver::ModeCount(*built, scene.solver); !modes.ok())
-      return modes.status();
+    absl::StatusOr<int> count = ModalSolver::ModeCount(*built, scene.solver);
+    if (!count.ok()) return count.status();
+    modes = *count;
   }
-  return built->Info();
+  PreparedRun prepared;
+  ModelInfo info = built->Info();
+  prepared.model_.reset(new PreparedModel{scene, std::move(*built), std::move(info), modes,
+                                          std::chrono::duration<double>(Clock::now() - start).count(),
+                                          false});
+  return prepared;
+}
+
+absl::StatusOr<ModelInfo> DescribeModel(const Scene& scene,
+                                        const std::function<bool()>& should_stop) {
+  absl::StatusOr<PreparedRun> prepared = Prepare(scene, should_stop);
+  if (!prepared.ok()) return prepared.status();
+  return prepared->info();
 }
 
 absl::StatusOr<RunSummary> RunScene(const Scene& scene, FrameSink* sink,
                                     const RunControl& control) {
   const auto start = Clock::now();
-  absl::StatusOr<MultibodyModel> built = MultibodyModel::Build(scene, control.should_stop);
-  if (absl::IsCancelled(built.status())) {
+  absl::StatusOr<PreparedRun> prepared = Prepare(scene, control.should_stop);
+  if (absl::IsCancelled(prepared.status())) {
     RunSummary stopped;
     stopped.status = "cancelled";
-    stopped.error = std::string(built.status().message());
+    stopped.error = std::string(prepared.status().message());
     stopped.analysis = std::string(AnalysisName(scene.solver.analysis));
     stopped.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
     return stopped;
   }
-  if (!built.ok()) return built.status();
-  MultibodyModel& model = *built;
+  if (!prepared.ok()) return prepared.status();
+  return RunPrepared(&*prepared, sink, control);
+}
+
+absl::StatusOr<RunSummary> RunPrepared(PreparedRun* prepared, FrameSink* sink,
+                                       const RunControl& control) {
+  if (prepared->model_ == nullptr || prepared->model_->used)
+    return absl::FailedPreconditionError("a prepared model runs once; prepare it again");
+  const auto start = Clock::now();
+  PreparedModel& p = *prepared->model_;
+  p.used = true;
+  MultibodyModel& model = p.model;
+  const Scene& scene = p.scene;
   RunSummary summary;
-  summary.info = model.Info();
+  summary.info = p.info;
   const SolverSettings& settings = scene.solver;
   summary.analysis = std::string(AnalysisName(settings.analysis));
-  int modes = 0;
-  if (settings.analysis == Analysis::kModal) {
-    absl::StatusOr<int> count = ModalSolver::ModeCount(model, settings);
-    if (!count.ok()) return count.status();
-    modes = *count;
-  }
+  const int modes = p.modes;
   summary.integrator = std::string(IntegratorName(settings.integrator));
   summary.linear_solver = std::string(LinearSolverName(settings.linear_solver));
   summary.linear_solver_used = std::string(LinearSolverName(
@@ -661,7 +698,8 @@ absl::StatusOr<RunSummary> RunScene(const Scene& scene, FrameSink* sink,
   if (settings.analysis == Analysis::kDynamic)
     summary.energy_dissipated =
         summary.energy_initial - summary.energy_final - summary.energy_damped;
-  summary.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  summary.wall_seconds =
+      p.build_seconds + std::chrono::duration<double>(Clock::now() - start).count();
   return summary;
 }
 

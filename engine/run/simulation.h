@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,42 @@
 #include "engine/scene/scene.h"
 
 namespace cablesim {
+
+struct PreparedModel;
+
+// A scene's model, built and checked, ready to run once (Prepare, then
+// RunPrepared). A caller that must cost a scene before running it (the
+// server checks the built model against its limits) builds the model once
+// and runs the same one. Movable, not copyable.
+class PreparedRun {
+ public:
+  PreparedRun();
+  PreparedRun(PreparedRun&&) noexcept;
+  PreparedRun& operator=(PreparedRun&&) noexcept;
+  ~PreparedRun();
+
+  // What the engine built (as DescribeModel).
+  const ModelInfo& info() const;
+  // Whether RunPrepared has already run it (a model runs once).
+  bool used() const;
+
+ private:
+  friend absl::StatusOr<PreparedRun> Prepare(const Scene&, const std::function<bool()>&);
+  friend absl::StatusOr<RunSummary> RunPrepared(PreparedRun*, FrameSink*, const RunControl&);
+  std::unique_ptr<PreparedModel> model_;
+};
+
+// Builds the model for `scene` (copied into the result) and checks what a
+// run needs before it starts (MODAL: the modes). InvalidArgument naming the
+// field that prevents it; Cancelled when `should_stop` (asked during the
+// build) said stop.
+absl::StatusOr<PreparedRun> Prepare(const Scene& scene,
+                                    const std::function<bool()>& should_stop = {});
+
+// Runs a prepared model, as RunScene. Its wall_seconds include the build's.
+// FailedPrecondition when `prepared` has run already.
+absl::StatusOr<RunSummary> RunPrepared(PreparedRun* prepared, FrameSink* sink,
+                                       const RunControl& control = {});
 
 // Builds the model for `scene` without running it: what the engine would
 // build, or InvalidArgument naming the field that prevents it; Cancelled
