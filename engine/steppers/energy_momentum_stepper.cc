@@ -10,34 +10,15 @@ namespace cablesim {
 
 EnergyMomentumStepper::EnergyMomentumStepper(MultibodyModel* model,
                                              const SolverSettings& settings)
-    : model_(model), settings_(settings) {
-  n_ = model->dofs();
-  m_ = model->multipliers();
-  solver_.Resize(model->envelope(), model->jacobian_pattern());
+    : ImplicitStepper(model, settings) {
   jac1_ = model->jacobian_pattern();
   jacm_ = model->jacobian_pattern();
-  z_ = model->initial_z();
-  v_ = model->initial_v();
-  for (Eigen::VectorXd* x : {&a_, &abar_, &z1_, &v1_, &f_, &mdv_, &bt_mu_, &floor_, &abs_terms_,
-                            &f_floor_})
-    x->setZero(n_);
-  lambda_.setZero(m_);
+  for (Eigen::VectorXd* x : {&abar_, &z1_, &v1_, &f_, &mdv_, &bt_mu_}) x->setZero(n_);
   lambda1_.setZero(m_);
   phi_.setZero(m_);
   phim_.setZero(m_);
   for (Eigen::VectorXd* x : {&q0_, &q1_, &qm_, &qd_}) x->setZero(model->coordinates());
-  rhs_.setZero(n_ + m_);
-  dx_.setZero(n_ + m_);
-  z_old_ = z_;
-  v_old_ = v_;
-  a_old_ = a_;
   abar_old_ = abar_;
-  lambda_old_ = lambda_;
-}
-
-void EnergyMomentumStepper::LoadMass() {
-  const SkylineLdlt& mass = model_->mass();
-  std::copy(mass.values(), mass.values() + mass.stored(), solver_.a().values());
 }
 
 bool EnergyMomentumStepper::Initialize(std::string* reason) {
@@ -58,21 +39,12 @@ bool EnergyMomentumStepper::Initialize(std::string* reason) {
   a_ = dx_.head(n_);
   abar_ = a_;
   lambda_ = dx_.tail(m_);
-  a_old_ = a_;
+  KeepInitialState();
   abar_old_ = abar_;
-  lambda_old_ = lambda_;
   return true;
 }
 
-void EnergyMomentumStepper::Restore() {
-  z_ = z_old_;
-  v_ = v_old_;
-  a_ = a_old_;
-  abar_ = abar_old_;
-  lambda_ = lambda_old_;
-  t_ = t_old_;
-  h_last_ = h_old_;
-}
+void EnergyMomentumStepper::RestoreScheme() { abar_ = abar_old_; }
 
 double EnergyMomentumStepper::LocalErrorNorm(double h, double atol, double rtol) const {
   const double k = h * h / (6 * (1 + h_old_ / h));
@@ -197,11 +169,8 @@ Stepper::StepStats EnergyMomentumStepper::Solve(double h, bool fresh) {
     previous_increment = last_increment;
     last_increment = increment;
   }
-  z_old_.swap(z_);
-  v_old_.swap(v_);
-  a_old_.swap(a_);
+  KeepPreviousState();
   abar_old_.swap(abar_);
-  lambda_old_.swap(lambda_);
   z_.swap(z1_);
   v_.swap(v1_);
   lambda_.swap(lambda1_);

@@ -67,26 +67,21 @@
 #include "engine/linear/saddle_point_solver.h"
 #include "engine/scene/scene.h"
 #include "engine/linear/sparse_rows.h"
+#include "engine/steppers/implicit_stepper.h"
 #include "engine/steppers/stepper.h"
 
 namespace cablesim {
 
-class EnergyMomentumStepper final : public Stepper {
+class EnergyMomentumStepper final : public ImplicitStepper {
  public:
   EnergyMomentumStepper(MultibodyModel* model, const SolverSettings& settings);
 
   bool Initialize(std::string* reason) override;
   StepStats Step(double h) override;
-  void Restore() override;
   double LocalErrorNorm(double h, double atol, double rtol) const override;
 
-  const Eigen::VectorXd& z() const override { return z_; }
-  const Eigen::VectorXd& v() const override { return v_; }
-  const Eigen::VectorXd& a() const override { return a_; }
-  const Eigen::VectorXd& lambda() const override { return lambda_; }
-
  private:
-  void LoadMass();
+  void RestoreScheme() override;
   // f = discrete-gradient forces between z_ and z1_ (qm_ and q1_ set) and,
   // when `a` is not null, (h^2/4) K_T(zm) + (h/2) C added to it; returns
   // the force size.
@@ -95,24 +90,14 @@ class EnergyMomentumStepper final : public Stepper {
   // matrix at the first iteration rather than keep the last one.
   StepStats Solve(double h, bool fresh);
 
-  MultibodyModel* model_;
-  SolverSettings settings_;
-  SaddlePointSolver solver_;
   SparseRows jac1_;  // Phi_z(z1) (its values unused; Constraints fills it with Phi)
   SparseRows jacm_;  // Phi_z(zm), copied into the solver when it factors
-  // solver.reuse_factorization: the factored Newton matrix kept across
-  // iterations and steps (c = h^2 / 4).
-  KeptNewtonMatrix kept_;
-  int n_ = 0, m_ = 0;
-  // State; abar_ the last step's mean acceleration (v1 - v0) / h.
-  Eigen::VectorXd z_, v_, a_, abar_, lambda_;
-  Eigen::VectorXd z_old_, v_old_, a_old_, abar_old_, lambda_old_;
-  double h_last_ = 0, h_old_ = 0;  // last step (0: none) and the one before
-  double t_ = 0, t_old_ = 0;
+  // The scheme's state beside ImplicitStepper's: abar_ the last step's mean
+  // acceleration (v1 - v0) / h. kept_ (solver.reuse_factorization) has
+  // c = h^2 / 4.
+  Eigen::VectorXd abar_, abar_old_;
   // Newton work vectors.
-  Eigen::VectorXd z1_, v1_, lambda1_, q0_, q1_, qm_, qd_, f_, phi_, phim_, mdv_, rhs_, dx_, bt_mu_;
-  Eigen::VectorXd floor_, abs_terms_, f_floor_;
-  bool floor_expected_ = false;
+  Eigen::VectorXd z1_, v1_, lambda1_, q0_, q1_, qm_, qd_, f_, phi_, phim_, mdv_, bt_mu_;
 };
 
 }  // namespace cablesim

@@ -14,7 +14,7 @@ namespace {
 
 GeneralizedAlphaStepper::GeneralizedAlphaStepper(MultibodyModel* model,
                                                  const SolverSettings& settings, Variant variant)
-    : model_(model), settings_(settings), variant_(variant) {
+    : ImplicitStepper(model, settings), variant_(variant) {
   const double rho = std::clamp(settings.rho_infinity, 0.0, 1.0);
   if (variant == Variant::kGeneralizedAlpha) {
     alpha_m_ = (2 * rho - 1) / (rho + 1);
@@ -28,33 +28,17 @@ GeneralizedAlphaStepper::GeneralizedAlphaStepper(MultibodyModel* model,
     gamma_ = 0.5 - alpha;
     w_ = 1 + alpha;
   }
-  n_ = model->dofs();
-  m_ = model->multipliers();
-  solver_.Resize(model->envelope(), model->jacobian_pattern());
-  solver_.Configure(settings.preconditioner, settings.accept_inexact_solves);
   jac_ = model->jacobian_pattern();
-  z_ = model->initial_z();
-  v_ = model->initial_v();
-  zdd_.setZero(n_);
   acc_.setZero(n_);
   acc_h_.setZero(n_);
-  lambda_.setZero(m_);
   g_.setZero(n_);
-  for (Eigen::VectorXd* x : {&z_pred_, &v_pred_, &z1_, &zdd1_, &f_, &bt_lambda_, &floor_, &abs_terms_,
-                            &f_floor_})
-    x->setZero(n_);
+  for (Eigen::VectorXd* x : {&z_pred_, &v_pred_, &z1_, &zdd1_, &f_, &bt_lambda_}) x->setZero(n_);
   lambda1_.setZero(m_);
   phi_.setZero(m_);
   q_.setZero(model->coordinates());
   qd_.setZero(model->coordinates());
   v1_.setZero(n_);
-  rhs_.setZero(n_ + m_);
-  dx_.setZero(n_ + m_);
-  z_old_ = z_;
-  v_old_ = v_;
-  zdd_old_ = zdd_;
   acc_old_ = acc_;
-  lambda_old_ = lambda_;
   g_old_ = g_;
 }
 
@@ -67,11 +51,6 @@ double GeneralizedAlphaStepper::Forces(const Eigen::VectorXd& v, Eigen::VectorXd
     size = std::max(size, model_->DampingForce(q_, qd_, f, a, cd, roundoff));
   }
   return size;
-}
-
-void GeneralizedAlphaStepper::LoadMass() {
-  const SkylineLdlt& mass = model_->mass();
-  std::copy(mass.values(), mass.values() + mass.stored(), solver_.a().values());
 }
 
 bool GeneralizedAlphaStepper::Initialize(std::string* reason) {
@@ -98,28 +77,21 @@ bool GeneralizedAlphaStepper::Initialize(std::string* reason) {
         stats.relative_residual);
     return false;
   }
-  zdd_ = dx_.head(n_);
-  acc_ = zdd_;  // a_0 = zdd_0 (Arnold and Bruls' starting value)
+  a_ = dx_.head(n_);
+  acc_ = a_;  // a_0 = zdd_0 (Arnold and Bruls' starting value)
   lambda_ = dx_.tail(m_);
   // g_0 = Phi_z^T lambda_0 - f_0.
   g_ = -f_;
   solver_.b().AddTransposeMultiply(lambda_.data(), g_.data());
-  zdd_old_ = zdd_;
+  KeepInitialState();
   acc_old_ = acc_;
-  lambda_old_ = lambda_;
   g_old_ = g_;
   return true;
 }
 
-void GeneralizedAlphaStepper::Restore() {
-  h_last_ = h_old_;
-  z_ = z_old_;
-  v_ = v_old_;
-  zdd_ = zdd_old_;
+void GeneralizedAlphaStepper::RestoreScheme() {
   acc_ = acc_old_;
-  lambda_ = lambda_old_;
   g_ = g_old_;
-  t_ = t_old_;
 }
 
 double GeneralizedAlphaStepper::LocalErrorNorm(double h, double atol, double rtol) const {
@@ -127,7 +99,7 @@ double GeneralizedAlphaStepper::LocalErrorNorm(double h, double atol, double rto
   double worst = 0;
   for (int i = 0; i < n_; ++i) {
     worst = std::max(worst,
-                     k * std::abs(zdd_(i) - zdd_old_(i)) / (atol + rtol * std::abs(z_(i))));
+                     k * std::abs(a_(i) - a_old_(i)) / (atol + rtol * std::abs(z_(i))));
   }
   return worst;
 }
@@ -143,7 +115,7 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
   const double tol = settings_.newton_tolerance;
   const bool reuse = settings_.reuse_factorization;
   const bool ga = variant_ == Variant::kGeneralizedAlpha;
-  // Predictors: everything in z_{n+1}, v_{n+1} except s zdd_{n+1}.
+  // Predictors: everything in z_{n+1}, v_{n+1} except s a_{n+1}.
   double s, sv;
   if (ga) {
     const double k = 1 / (1 - alpha_m_);
@@ -152,16 +124,16 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
     // order a_n <- zdd_n + (h / h_last) (a_n - zdd_n). Without it, halving
     // and regrowing the step feeds energy into the stiff modes.
     acc_h_ = acc_;
-    if (h_last_ > 0 && h != h_last_) acc_h_ = zdd_ + (h / h_last_) * (acc_ - zdd_);
-    // a_{n+1} = k (alpha_f zdd_n - alpha_m a_n) + k (1 - alpha_f) zdd_{n+1}.
-    bt_lambda_ = k * (alpha_f_ * zdd_ - alpha_m_ * acc_h_);  // scratch: known part of a_{n+1}
+    if (h_last_ > 0 && h != h_last_) acc_h_ = a_ + (h / h_last_) * (acc_ - a_);
+    // a_{n+1} = k (alpha_f zdd_n - alpha_m a_n) + k (1 - alpha_f) a_{n+1}.
+    bt_lambda_ = k * (alpha_f_ * a_ - alpha_m_ * acc_h_);  // scratch: known part of a_{n+1}
     z_pred_ = z_ + h * v_ + (h * h * (0.5 - beta_)) * acc_h_ + (h * h * beta_) * bt_lambda_;
     v_pred_ = v_ + (h * (1 - gamma_)) * acc_h_ + (h * gamma_) * bt_lambda_;
     s = h * h * beta_ * k * (1 - alpha_f_);
     sv = h * gamma_ * k * (1 - alpha_f_);
   } else {
-    z_pred_ = z_ + h * v_ + (h * h * (0.5 - beta_)) * zdd_;
-    v_pred_ = v_ + (h * (1 - gamma_)) * zdd_;
+    z_pred_ = z_ + h * v_ + (h * h * (0.5 - beta_)) * a_;
+    v_pred_ = v_ + (h * (1 - gamma_)) * a_;
     s = h * h * beta_;
     sv = h * gamma_;
   }
@@ -176,8 +148,8 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
   if (kept_.Stale(c)) fresh = true;
   // Predictor: the acceleration extrapolated linearly from the last two
   // steps (constant on the first step and after Restore()).
-  zdd1_ = zdd_;
-  if (h_last_ > 0) zdd1_ += (h / h_last_) * (zdd_ - zdd_old_);
+  zdd1_ = a_;
+  if (h_last_ > 0) zdd1_ += (h / h_last_) * (a_ - a_old_);
   lambda1_ = lambda_;
   double last_increment = 0, previous_increment = 0;
   bool previous_at_floor = false;
@@ -280,21 +252,18 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
     previous_increment = last_increment;
     last_increment = increment;
   }
-  z_old_.swap(z_);
-  v_old_.swap(v_);
-  zdd_old_.swap(zdd_);
+  KeepPreviousState();
   acc_old_.swap(acc_);
-  lambda_old_.swap(lambda_);
   g_old_.swap(g_);
   z_ = z1_;
   v_ = v_pred_ + sv * zdd1_;
   if (ga) {
     const double k = 1 / (1 - alpha_m_);
-    acc_ = k * (alpha_f_ * zdd_old_ - alpha_m_ * acc_h_ + (1 - alpha_f_) * zdd1_);
+    acc_ = k * (alpha_f_ * a_old_ - alpha_m_ * acc_h_ + (1 - alpha_f_) * zdd1_);
   } else {
     acc_ = zdd1_;
   }
-  zdd_ = zdd1_;
+  a_ = zdd1_;
   lambda_ = lambda1_;
   h_old_ = h_last_;
   h_last_ = h;

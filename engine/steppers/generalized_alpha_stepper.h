@@ -84,11 +84,12 @@
 #include "engine/linear/saddle_point_solver.h"
 #include "engine/scene/scene.h"
 #include "engine/linear/sparse_rows.h"
+#include "engine/steppers/implicit_stepper.h"
 #include "engine/steppers/stepper.h"
 
 namespace cablesim {
 
-class GeneralizedAlphaStepper final : public Stepper {
+class GeneralizedAlphaStepper final : public ImplicitStepper {
  public:
   enum class Variant { kGeneralizedAlpha, kHht };
 
@@ -98,13 +99,7 @@ class GeneralizedAlphaStepper final : public Stepper {
 
   bool Initialize(std::string* reason) override;
   StepStats Step(double h) override;
-  void Restore() override;
   double LocalErrorNorm(double h, double atol, double rtol) const override;
-
-  const Eigen::VectorXd& z() const override { return z_; }
-  const Eigen::VectorXd& v() const override { return v_; }
-  const Eigen::VectorXd& a() const override { return zdd_; }
-  const Eigen::VectorXd& lambda() const override { return lambda_; }
 
   double alpha_m() const { return alpha_m_; }
   double alpha_f() const { return alpha_f_; }
@@ -114,43 +109,29 @@ class GeneralizedAlphaStepper final : public Stepper {
  private:
   // One Newton solve of the step; `fresh` forces a new Newton matrix first.
   StepStats Solve(double h, bool fresh);
-  void LoadMass();
+  void RestoreScheme() override;
   // f = f(q_, v) (elastic, applied and damping forces, the damping's
   // velocity v) and, when `a` is not null, c K_T + cd C added to it; the
   // force size (NetForce, DampingForce).
   double Forces(const Eigen::VectorXd& v, Eigen::VectorXd* f, SkylineLdlt* a, double c,
                 double cd, Eigen::VectorXd* roundoff);
 
-  MultibodyModel* model_;
-  SolverSettings settings_;
   Variant variant_;
   double alpha_m_ = 0, alpha_f_ = 0, beta_ = 0.25, gamma_ = 0.5, w_ = 1;
-  SaddlePointSolver solver_;
   SparseRows jac_;  // Phi_z at the current iterate (solver_.b() holds the factored one)
-  int n_ = 0, m_ = 0;
-  // State: z, v, physical and algorithmic accelerations, multipliers, and
-  // g = Phi_z^T lambda - f at the state (HHT).
-  Eigen::VectorXd z_, v_, zdd_, acc_, lambda_, g_;
+  // The scheme's state beside ImplicitStepper's (z, v, a = the physical
+  // acceleration, lambda): the algorithmic acceleration, and
+  // g = Phi_z^T lambda - f at the state (HHT); kept_ is the factorization
+  // with c = w s. Every step sets the model's time to t_{n+1}: both
+  // variants impose Phi(z_{n+1}, t_{n+1}) = 0 and evaluate f at t_{n+1}
+  // (HHT's f_n is kept in g_ from the step before, so the alpha-weighted
+  // sum takes the load at t_n and t_{n+1}).
+  Eigen::VectorXd acc_, g_;
   Eigen::VectorXd acc_h_;  // a_n shifted to the current step (variable steps)
-  Eigen::VectorXd z_old_, v_old_, zdd_old_, acc_old_, lambda_old_, g_old_;
+  Eigen::VectorXd acc_old_, g_old_;
   // Newton work vectors.
   // v1_ and qd_: the iterate's velocity, with damping only.
-  Eigen::VectorXd z_pred_, v_pred_, z1_, v1_, zdd1_, lambda1_, q_, qd_, f_, phi_, bt_lambda_, rhs_, dx_;
-  // The residual's rounding floor per unknown, and the terms summed into it.
-  Eigen::VectorXd floor_, abs_terms_, f_floor_;
-  // Whether the last accepted step needed the floor (its residual was above
-  // tol): the next step's checking iteration then bounds the forces'
-  // rounding in the same pass as the forces.
-  bool floor_expected_ = false;
-  // The kept factorization (c = w s).
-  KeptNewtonMatrix kept_;
-  // The last step's size (0: none yet) and the one before, for the predictor.
-  double h_last_ = 0, h_old_ = 0;
-  // Time [s] of the state, and before the last step. Every step sets the
-  // model's time to t_{n+1}: both variants impose Phi(z_{n+1}, t_{n+1}) = 0
-  // and evaluate f at t_{n+1} (HHT's f_n is kept in g_ from the step
-  // before, so the alpha-weighted sum takes the load at t_n and t_{n+1}).
-  double t_ = 0, t_old_ = 0;
+  Eigen::VectorXd z_pred_, v_pred_, z1_, v1_, zdd1_, lambda1_, q_, qd_, f_, phi_, bt_lambda_;
 };
 
 }  // namespace cablesim

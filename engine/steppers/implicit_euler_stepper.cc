@@ -3,47 +3,17 @@
 #include <algorithm>
 #include <cmath>
 
-#include "absl/strings/str_format.h"
 #include "engine/steppers/newton_convergence.h"
 
 namespace cablesim {
 
 ImplicitEulerStepper::ImplicitEulerStepper(MultibodyModel* model, const SolverSettings& settings)
-    : model_(model), settings_(settings) {
-  n_ = model->dofs();
-  m_ = model->multipliers();
-  solver_.Resize(model->envelope(), model->jacobian_pattern());
-  solver_.Configure(settings.preconditioner, settings.accept_inexact_solves);
-  z_ = model->initial_z();
-  v_ = model->initial_v();
-  a_.setZero(n_);
-  lambda_.setZero(m_);
-  z1_.setZero(n_);
-  v1_.setZero(n_);
+    : ImplicitStepper(model, settings) {
+  for (Eigen::VectorXd* x : {&z1_, &v1_, &f_, &mdv_, &bt_mu_}) x->setZero(n_);
   lambda1_.setZero(m_);
+  phi_.setZero(m_);
   q_.setZero(model->coordinates());
   qd_.setZero(model->coordinates());
-  f_.setZero(n_);
-  phi_.setZero(m_);
-  mdv_.setZero(n_);
-  rhs_.setZero(n_ + m_);
-  dx_.setZero(n_ + m_);
-  bt_mu_.setZero(n_);
-  floor_.setZero(n_);
-  abs_terms_.setZero(n_);
-  f_floor_.setZero(n_);
-  z_old_ = z_;
-  v_old_ = v_;
-  a_old_ = a_;
-  lambda_old_ = lambda_;
-}
-
-void ImplicitEulerStepper::Restore() {
-  z_ = z_old_;
-  v_ = v_old_;
-  a_ = a_old_;
-  lambda_ = lambda_old_;
-  t_ = t_old_;
 }
 
 double ImplicitEulerStepper::LocalErrorNorm(double h, double atol, double rtol) const {
@@ -62,30 +32,11 @@ bool ImplicitEulerStepper::Initialize(std::string* reason) {
   model_->RateToFull(v_, &qdot);
   model_->ConstraintGamma(q_, qdot, &gamma);
   LoadMass();
-  if (!solver_.Prepare()) {
-    *reason = "the mass matrix could not be factorized";
-    return false;
-  }
-  rhs_.head(n_) = f_;
-  if (m_ > 0) rhs_.tail(m_) = gamma;
-  const auto stats = solver_.Solve(settings_.linear_solver, rhs_, 1e-12,
-                                   std::max(settings_.max_linear_iterations, 1000), &dx_);
-  if (!(stats.relative_residual <= 1e-8)) {
-    *reason = absl::StrFormat(
-        "the initial acceleration solve did not converge (relative residual %.3g)",
-        stats.relative_residual);
-    return false;
-  }
+  if (!SolveInitialAcceleration(&solver_, settings_, f_, gamma, &rhs_, &dx_, reason)) return false;
   a_ = dx_.head(n_);
   lambda_ = dx_.tail(m_);
-  a_old_ = a_;
-  lambda_old_ = lambda_;
+  KeepInitialState();
   return true;
-}
-
-void ImplicitEulerStepper::LoadMass() {
-  const SkylineLdlt& mass = model_->mass();
-  std::copy(mass.values(), mass.values() + mass.stored(), solver_.a().values());
 }
 
 double ImplicitEulerStepper::Forces(const Eigen::VectorXd& v, Eigen::VectorXd* f,
@@ -175,20 +126,8 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
       st.reason = "the Newton matrix has a non-finite pivot";
       return st;
     }
-    rhs_ = -rhs_;
     ++st.factorizations;
-    const auto ls = solver_.Solve(settings_.linear_solver, rhs_, settings_.linear_tolerance,
-                                  settings_.max_linear_iterations, &dx_);
-    ++st.newton_iterations;
-    st.linear_iterations += ls.iterations;
-    st.max_linear_residual = std::max(st.max_linear_residual, ls.relative_residual);
-    st.direct_fallbacks += ls.fallback ? 1 : 0;
-    ++st.linear_solves;
-    st.inexact_solves += LinearSolveInexact(ls) ? 1 : 0;
-    if (!LinearSolveGoodEnough(ls)) {
-      st.reason = LinearSolveFailure(ls, settings_.linear_solver);
-      return st;
-    }
+    if (!SolveNewtonSystem(&solver_, settings_, &rhs_, &dx_, &st)) return st;
     v1_ += dx_.head(n_);
     if (m_ > 0) lambda1_ += dx_.tail(m_) / h;
     previous_increment = last_increment;
@@ -200,10 +139,7 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
   }
   // Keep the previous state for Restore() (swaps, no copies: z1_, v1_ and
   // lambda1_ are rewritten at the start of every step).
-  z_old_.swap(z_);
-  v_old_.swap(v_);
-  a_old_.swap(a_);
-  lambda_old_.swap(lambda_);
+  KeepPreviousState();
   z_.swap(z1_);
   v_.swap(v1_);
   lambda_.swap(lambda1_);

@@ -41,27 +41,20 @@
 #include "engine/model/multibody_model.h"
 #include "engine/linear/saddle_point_solver.h"
 #include "engine/scene/scene.h"
+#include "engine/steppers/implicit_stepper.h"
 #include "engine/steppers/stepper.h"
 
 namespace cablesim {
 
-class ImplicitEulerStepper final : public Stepper {
+class ImplicitEulerStepper final : public ImplicitStepper {
  public:
   ImplicitEulerStepper(MultibodyModel* model, const SolverSettings& settings);
 
   bool Initialize(std::string* reason) override;
   StepStats Step(double h) override;
-  void Restore() override;
   double LocalErrorNorm(double h, double atol, double rtol) const override;
 
-  const Eigen::VectorXd& z() const override { return z_; }
-  const Eigen::VectorXd& v() const override { return v_; }
-  const Eigen::VectorXd& a() const override { return a_; }
-  const Eigen::VectorXd& lambda() const override { return lambda_; }
-
  private:
-  // Newton matrix block a = M.
-  void LoadMass();
   // f = f(q_, v) (elastic, applied and damping forces: the damping's
   // velocity is v) and, when `a` is not null, h^2 K_T + h C added to it;
   // the force size (NetForce, DampingForce).
@@ -71,24 +64,11 @@ class ImplicitEulerStepper final : public Stepper {
   // force size.
   double AssembleForces(double h);
 
-  MultibodyModel* model_;
-  SolverSettings settings_;
-  SaddlePointSolver solver_;
-  int n_ = 0, m_ = 0;
-  Eigen::VectorXd z_, v_, a_, lambda_;
-  Eigen::VectorXd z_old_, v_old_, a_old_, lambda_old_;  // before the last step
-  // Time [s] of the state, and before the last step: each step sets the
-  // model's time to its end (prescribed motions and varying loads at
-  // t_{n+1}, where backward Euler imposes Phi(z_{n+1}, t_{n+1}) = 0).
-  double t_ = 0, t_old_ = 0;
-  // Newton work vectors.
-  Eigen::VectorXd z1_, v1_, lambda1_, q_, qd_, f_, phi_, mdv_, rhs_, dx_, bt_mu_;
-  // The residual's rounding floor per unknown, and the terms summed into it.
-  Eigen::VectorXd floor_, abs_terms_, f_floor_;
-  // Whether the last accepted step needed the floor (its residual was above
-  // tol): the next step's checking iteration then bounds the forces'
-  // rounding in the same pass as the forces.
-  bool floor_expected_ = false;
+  // Newton work vectors (the state and the rounding floor's are
+  // ImplicitStepper's). Each step sets the model's time to its end
+  // (prescribed motions and varying loads at t_{n+1}, where backward Euler
+  // imposes Phi(z_{n+1}, t_{n+1}) = 0).
+  Eigen::VectorXd z1_, v1_, lambda1_, q_, qd_, f_, phi_, mdv_, bt_mu_;
 };
 
 }  // namespace cablesim

@@ -80,8 +80,8 @@ class Stepper {
   virtual const Eigen::VectorXd& lambda() const = 0;
 };
 
-// Shared pieces of the steppers' Newton solves (generalized-alpha, HHT and
-// energy-momentum; backward Euler still carries its own).
+// Shared pieces of the implicit steppers' Newton solves (backward Euler,
+// generalized-alpha, HHT and energy-momentum).
 //
 // The consistent initial acceleration: with solver->a() holding M and
 // solver->b() Phi_z, solves [M Phi_z^T; Phi_z 0] [a; lambda] = [f; gamma]
