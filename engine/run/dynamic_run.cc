@@ -1,0 +1,246 @@
+#include "engine/run/dynamic_run.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+
+#include "absl/strings/str_format.h"
+#include "engine/run/dense_output.h"
+#include "engine/run/energy_guard.h"
+#include "engine/run/external_work.h"
+#include "engine/run/step_control.h"
+#include "engine/scene/integrator_traits.h"
+#include "engine/steppers/make_stepper.h"
+#include "engine/steppers/stepper.h"
+
+namespace cablesim {
+
+void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const RunControl& control,
+                FrameRecorder* rec, RunSummary* summary) {
+  std::unique_ptr<Stepper> stepper_owner = MakeStepper(model, settings);
+  Stepper& stepper = *stepper_owner;
+  std::string reason;
+  if (!stepper.Initialize(&reason)) {
+    Fail(summary, 0, reason);
+    return;
+  }
+  ExternalWork external_work(model);
+  model->SetTime(0);
+  rec->AdvanceDamping(0, stepper.z(), stepper.v());
+  if (absl::Status s = rec->Emit(0, 1, stepper.z(), &stepper.v(), &stepper.a(), &stepper.lambda());
+      !s.ok()) {
+    summary->status = "cancelled";
+    summary->error = std::string(s.message());
+    return;
+  }
+  const double h_nominal = settings.step_s;
+  const double h_min = std::ldexp(h_nominal, -settings.max_step_halvings);
+  const double interval =
+      settings.output_interval_s > 0 ? settings.output_interval_s : settings.step_s;
+  const double duration = settings.duration_s;
+  const long frames = std::max(1L, std::lround(std::ceil(duration / interval - 1e-9)));
+  double t = 0;
+  double h = h_nominal;
+  int successes = 0;
+  // Fixed steps: the time reached counted in ticks of h_min (every step is
+  // h_nominal / 2^k, a whole number of ticks), so that whether t is on a
+  // step's grid is decided exactly, however many steps rounding had to
+  // accumulate over.
+  // t itself is the time of the last anchor (the start, a frame it was
+  // snapped to, or a step that was not a whole number of ticks) plus the
+  // ticks since, so it carries one rounding, not the sum of every step's.
+  int64_t tick = 0, tick_anchor = 0;
+  double t_anchor = 0;
+  auto ticks_of = [h_min](double step) { return std::llround(step / h_min); };
+  // Backward Euler never raises the energy; the second-order steppers may.
+  const bool check_steps = !TraitsOf(settings.integrator).never_raises_energy;
+  summary->min_step_s = settings.adaptive ? std::numeric_limits<double>::infinity() : h_nominal;
+  // Steps of h (the last one or two shortened to end on the duration);
+  // frames between step ends are interpolated (DenseOutput). A frame's
+  // energies and constraint violation are those of that interpolated state.
+  DenseOutput dense(stepper);
+  auto frame_time = [&](long k) { return std::min(duration, k * interval); };
+  // The energy guard on a state the stepper reached (a step's end): false
+  // (with the summary failed) when its energy rose beyond the limit.
+  // A winch does work that is not summed (MultibodyModel::winches): no
+  // energy guard there. Rises below the model's energy rounding are a
+  // scene at rest.
+  const EnergyGuard guard(model->winches() == 0, summary->energy_initial,
+                          model->energy_roundoff());
+  auto EnergyHolds = [&](const EnergySample& e, double t_state) {
+    if (guard.Fails(e, rec->energy_scale())) {
+      const double rise = guard.Rise(e), scale = EnergyGuard::Scale(e, rec->energy_scale());
+      Fail(summary, t_state,
+           absl::StrFormat("the total energy rose by %.3g J (more than %g %% of the largest "
+                           "energy term, %.3g J) by t = %.9g s: the stepper is unstable at this "
+                           "step; use a smaller solver.step, adaptive steps or a smaller "
+                           "rho_infinity",
+                           rise, 100 * EnergyGuard::kRiseLimit, scale, t_state));
+      return false;
+    }
+    return true;
+  };
+  // Delivers the evaluated frame; `guard`: it is a step's end state, whose
+  // energy is checked first. An interpolated frame is not guarded: its
+  // energy carries the interpolant's error (the stretch modes of a stiff
+  // cable oscillate within a step and a cubic does not follow them), which
+  // is not the stepper's; the step's end state that follows it is guarded.
+  auto CheckAndDeliver = [&](double tf, bool guard = true) {
+    if (guard && !EnergyHolds(rec->frame().energy, tf)) return false;
+    if (absl::Status st = rec->Deliver(/*reached=*/guard); !st.ok()) {
+      summary->status = "cancelled";
+      summary->error = std::string(st.message());
+      return false;
+    }
+    return true;
+  };
+  long next_frame = 1;
+  while (next_frame <= frames) {
+    // A frame already reached (a duration within rounding of the last).
+    if (const double tf = frame_time(next_frame); tf - t <= 1e-12 * std::max(1.0, tf)) {
+      model->SetTime(tf);
+      rec->Evaluate(tf, 1, stepper.z(), &stepper.v(), &stepper.a(), &stepper.lambda());
+      if (!CheckAndDeliver(tf)) return;
+      ++next_frame;
+      continue;
+    }
+    if (!MayStep(control, t, summary)) return;
+    const double remaining = duration - t;
+    // The last steps: one or two equal ones that end on the duration; when
+    // what is left is a whole number of steps to rounding, whole steps (the
+    // frame at the end snaps t onto the duration).
+    const double left = remaining / h;
+    const bool whole =
+        left >= 0.5 && std::abs(left - std::round(left)) <= 1e-9 * std::max(1.0, left);
+    const double h_try =
+        remaining < 2 * h && !whole ? remaining / std::ceil(left - 1e-9) : h;
+    dense.BeginStep(stepper);
+    external_work.Before(stepper.z(), t, stepper.lambda());
+    const auto st = stepper.Step(h_try);
+    summary->newton_iterations += st.newton_iterations;
+    summary->linear_iterations += st.linear_iterations;
+    summary->factorizations += st.factorizations;
+    summary->direct_fallbacks += st.direct_fallbacks;
+    summary->linear_solves += st.linear_solves;
+    summary->inexact_linear_solves += st.inexact_solves;
+    summary->max_linear_residual = std::max(summary->max_linear_residual, st.max_linear_residual);
+    if (st.converged && check_steps && guard.enabled() &&
+        st.newton_iterations >= EnergyGuard::kCheckAfterNewtonIterations) {
+      // A step Newton found hard may have landed on a spurious root (an
+      // element folded through itself: Green-Lagrange strain does not see
+      // it); its energy says so. Take it back and halve the step.
+      const EnergySample e = rec->StateEnergy(t + h_try, stepper.z(), stepper.v());
+      if (guard.Fails(e, rec->energy_scale())) {
+        stepper.Restore();
+        ++summary->rejected_steps;
+        successes = 0;
+        h = h_try / 2;
+        if (h < h_min * (1 - 1e-12)) {
+          Fail(summary, t + h_try,
+               absl::StrFormat("step from t = %.9g s raises the total energy by %.3g J down to "
+                               "h = %.3g s: the stepper is unstable here; use a smaller "
+                               "rho_infinity",
+                               t, guard.Rise(e), h_try));
+          return;
+        }
+        continue;
+      }
+    }
+    if (st.converged && settings.adaptive) {
+      // Adaptive steps: accept when the local error estimate meets the
+      // tolerance, and choose the next step from it either way.
+      const double err = stepper.LocalErrorNorm(h_try, settings.tolerance_m,
+                                                settings.relative_tolerance);
+      const double factor = StepFactor(err, TraitsOf(settings.integrator).local_error_order);
+      if (!(err <= 1)) {
+        stepper.Restore();
+        ++summary->rejected_steps;
+        h = h_try * factor;
+        if (h < h_min * (1 - 1e-12)) {
+          Fail(summary, t + h_try,
+               absl::StrFormat("step from t = %.9g s cannot meet the tolerance: the local "
+                               "error estimate is %.3g times the tolerance at h = %.3g s, the "
+                               "smallest step allowed is %.3g s",
+                               t, err, h_try, h_min));
+          return;
+        }
+        continue;
+      }
+      h = std::min(h_try * factor, stepper.stable_step());
+    }
+    if (st.converged) {
+      const double t0 = t;
+      if (!settings.adaptive && h_try == h) {
+        tick += ticks_of(h_try);
+        t = t_anchor + static_cast<double>(tick - tick_anchor) * h_min;
+      } else {
+        t += h_try;  // adaptive, or the last steps shortened to end on the duration
+        t_anchor = t;
+        tick_anchor = tick;
+      }
+      external_work.After(stepper.z(), t, stepper.lambda(), 1);
+      ++summary->steps;
+      summary->min_step_s = std::min(summary->min_step_s, h_try);
+      summary->max_step_s = std::max(summary->max_step_s, h_try);
+      summary->max_newton_residual = std::max(summary->max_newton_residual, st.residual);
+      summary->max_residual_floor = std::max(summary->max_residual_floor, st.residual_floor);
+      summary->end_time_s = t;
+      // After a run of good steps, go back up towards the nominal step, at
+      // a time on the doubled step's grid (a multiple of 2 h), so that steps
+      // return to the nominal grid and the frames on it are step ends again
+      // rather than interpolated.
+      if (!settings.adaptive && h < h_nominal && ++successes >= 4 &&
+          h_try == h && tick % (2 * ticks_of(h)) == 0) {
+        h = std::min(h_nominal, 2 * h);
+        successes = 0;
+      }
+      // Every frame this step reached: the step's end state where the
+      // frame is its end (within 1e-6 of the step, which also keeps t on
+      // the frames' grid), otherwise interpolated (dense output).
+      bool end_checked = false;
+      while (next_frame <= frames) {
+        const double tf = frame_time(next_frame);
+        const bool at_end = std::abs(tf - t) <= 1e-6 * h_try;
+        if (!at_end && tf > t) break;
+        if (at_end) {
+          t = tf;
+          t_anchor = tf;
+          tick_anchor = tick;
+          model->SetTime(tf);
+          rec->Evaluate(tf, 1, stepper.z(), &stepper.v(), &stepper.a(), &stepper.lambda());
+        } else {
+          // The step's end is guarded before any frame inside it goes out.
+          if (!end_checked) {
+            model->SetTime(t);
+            const EnergySample end = rec->StateEnergy(t, stepper.z(), stepper.v());
+            if (!EnergyHolds(end, t)) return;
+            rec->NoteReachedState(end);
+            end_checked = true;
+          }
+          dense.Interpolate((tf - t0) / h_try, h_try, stepper);
+          model->SetTime(tf);
+          rec->Evaluate(tf, 1, dense.z(), &dense.v(), &dense.a(), &dense.lambda());
+        }
+        if (!CheckAndDeliver(tf, /*guard=*/at_end)) return;
+        ++next_frame;
+      }
+      rec->AdvanceDamping(t, stepper.z(), stepper.v());
+      summary->end_time_s = t;
+      continue;
+    }
+    ++summary->rejected_steps;
+    successes = 0;
+    h = h_try / 2;
+    if (h < h_min * (1 - 1e-12)) {
+      Fail(summary, t + h_try,
+           absl::StrFormat("step from t = %.9g s failed %d times down to h = %.3g s: %s", t,
+                           settings.max_step_halvings + 1, h_try, st.reason));
+      return;
+    }
+  }
+}
+
+}  // namespace cablesim

@@ -1,0 +1,130 @@
+#ifndef CABLESIM_ENGINE_RUN_FRAME_RECORDER_H_
+#define CABLESIM_ENGINE_RUN_FRAME_RECORDER_H_
+
+// FrameRecorder: evaluates a state into a Frame (probes, energy and its
+// parts, support forces, shape, constraint violation), keeps energy.damped
+// (the dissipated power integrated over accepted steps) and the summary's
+// frame-level figures, and delivers frames to the caller's sink.
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Core>
+
+#include "absl/status/status.h"
+#include "engine/model/multibody_model.h"
+#include "engine/output/results.h"
+
+namespace cablesim {
+
+// Tracks the frame-level quantities of the summary.
+class FrameRecorder {
+ public:
+  FrameRecorder(MultibodyModel* model, FrameSink* sink, RunSummary* summary)
+      : model_(model), sink_(sink), summary_(summary) {
+    q_.setZero(model->coordinates());
+    qd_.setZero(model->coordinates());
+    qdd_.setZero(model->coordinates());
+    phi_.setZero(model->multipliers());
+  }
+
+  // Evaluates the frame at a state without delivering it (frame()).
+  // `lambda`: the multipliers, for the forces of moving supports.
+  void Evaluate(double t, double load_factor, const Eigen::VectorXd& z, const Eigen::VectorXd* v,
+                const Eigen::VectorXd* a, const Eigen::VectorXd* lambda = nullptr) {
+    model_->ToFull(z, &q_);
+    if (v) model_->RateToFull(*v, &qd_);
+    if (a) model_->RateToFull(*a, &qdd_);
+    frame_.t = t;
+    model_->Probes(q_, qd_, qdd_, &frame_.probes);
+    if (lambda) {
+      model_->ProbeForces(q_, *lambda, &frame_.support_forces);
+    } else {
+      // No multipliers at hand: the columns stay, with 0 (a row keeps its size).
+      frame_.support_forces.assign(model_->force_probe_count(), Eigen::Vector3d::Zero());
+    }
+    if (model_->shape()) model_->NodePositions(q_, &frame_.nodes);
+    frame_.energy = model_->Energy(q_, qd_, load_factor, &frame_.energy_parts);
+    frame_.energy.damped = Damped(t);
+    frame_.has_contact = model_->has_contact();
+    frame_.angular_momentum = model_->AngularMomentum(q_, qd_);
+    model_->Constraints(q_, &phi_, nullptr);
+    frame_.constraint_violation = phi_.size() ? phi_.lpNorm<Eigen::Infinity>() : 0.0;
+  }
+  const Frame& frame() const { return frame_; }
+
+  // Energy of a state at time t, without evaluating or delivering a frame.
+  EnergySample StateEnergy(double t, const Eigen::VectorXd& z, const Eigen::VectorXd& v) {
+    model_->SetTime(t);  // the damping power of waves depends on it
+    model_->ToFull(z, &q_);
+    model_->RateToFull(v, &qd_);
+    EnergySample e = model_->Energy(q_, qd_, 1.0);
+    e.damped = Damped(t);
+    return e;
+  }
+
+  // energy.damped: the trapezoidal rule on the dissipated power from the
+  // last accepted step's end (AdvanceDamping) to the state in q_, qd_ at t.
+  double Damped(double t) const {
+    if (!model_->has_damping()) return 0;
+    const double power = model_->DampingPower(q_, qd_);
+    return damped_ + 0.5 * (t - damped_t_) * (damped_power_ + power);
+  }
+  // Moves the start of that rule to an accepted step's end (t, z, v).
+  void AdvanceDamping(double t, const Eigen::VectorXd& z, const Eigen::VectorXd& v) {
+    if (!model_->has_damping()) return;
+    model_->SetTime(t);  // the damping power of waves depends on it
+    model_->ToFull(z, &q_);
+    model_->RateToFull(v, &qd_);
+    damped_ = Damped(t);
+    damped_t_ = t;
+    damped_power_ = model_->DampingPower(q_, qd_);
+  }
+
+  // Records the evaluated frame in the summary and delivers it. `reached`:
+  // the frame is a state the stepper reached (a step's end, or the start),
+  // not one interpolated between steps; only such states enter
+  // energy_max_increase and the energy scale (an interpolated state's
+  // energy carries the interpolant's error, not the stepper's).
+  absl::Status Deliver(bool reached = true) {
+    if (summary_->frames == 0) summary_->energy_initial = frame_.energy.total;
+    summary_->energy_final = frame_.energy.total;
+    summary_->energy_damped = frame_.energy.damped;
+    summary_->max_constraint_violation =
+        std::max(summary_->max_constraint_violation, frame_.constraint_violation);
+    ++summary_->frames;
+    if (reached) NoteReachedState(frame_.energy);
+    return sink_->OnFrame(frame_);
+  }
+  // A state the stepper reached, with energy e: its rise and its terms.
+  void NoteReachedState(const EnergySample& e) {
+    summary_->energy_max_increase = std::max(summary_->energy_max_increase,
+                                             e.total + e.damped - summary_->energy_initial);
+    energy_scale_ = std::max({energy_scale_, std::abs(e.kinetic), std::abs(e.potential),
+                              std::abs(e.axial) + std::abs(e.bending)});
+  }
+
+  absl::Status Emit(double t, double load_factor, const Eigen::VectorXd& z,
+                    const Eigen::VectorXd* v, const Eigen::VectorXd* a,
+                    const Eigen::VectorXd* lambda = nullptr) {
+    Evaluate(t, load_factor, z, v, a, lambda);
+    return Deliver();
+  }
+
+  // Largest energy term seen so far [J].
+  double energy_scale() const { return energy_scale_; }
+
+ private:
+  MultibodyModel* model_;
+  FrameSink* sink_;
+  RunSummary* summary_;
+  Frame frame_;
+  Eigen::VectorXd q_, qd_, qdd_, phi_;
+  double energy_scale_ = 0;
+  // energy.damped at damped_t_ and the dissipated power there.
+  double damped_ = 0, damped_t_ = 0, damped_power_ = 0;
+};
+
+}  // namespace cablesim
+
+#endif  // CABLESIM_ENGINE_RUN_FRAME_RECORDER_H_
