@@ -87,14 +87,19 @@ def run_page(page):
             expected = int(marks.get("expect exit", "0"))
             # A session of its own, so that what the block leaves running
             # (a server started with &) can be found and stopped at the end.
-            p = subprocess.Popen(prefix + argv, cwd=scratch, env=env, stdout=subprocess.PIPE,
-                                 stderr=subprocess.STDOUT, text=True, start_new_session=True)
+            # Output to a file, not a pipe: a server the block leaves running
+            # keeps its standard output open.
+            log = os.path.join(scratch, f".block-{i + 1}.log")
+            with open(log, "w") as out_file:
+                p = subprocess.Popen(prefix + argv, cwd=scratch, env=env, stdout=out_file,
+                                     stderr=subprocess.STDOUT, start_new_session=True)
             children.append(p.pid)
             try:
-                out, _ = p.communicate(timeout=300)
+                p.wait(timeout=300)
             except subprocess.TimeoutExpired:
                 os.killpg(p.pid, signal.SIGKILL)
-                out, _ = p.communicate()
+                p.wait()
+            out = open(log, errors="replace").read()
             ran += 1
             first = code.strip().split("\n")[0][:90]
             if p.returncode != expected:
@@ -103,6 +108,8 @@ def run_page(page):
                       f"expected {expected}\n{out}")
             else:
                 print(f"ok   {rel} block {i + 1} ({lang}: {first})")
+                if os.environ.get("CABLESIM_DOCS_VERBOSE"):
+                    print(out)
     finally:
         for pid in children:
             try:
