@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Runs every command of docs/getting-started.md and docs/tutorials/*.md as
-written (CTest docs_tutorials_test; docs/development.md).
+written (CTest docs_tutorials_slow_test; docs/development.md).
 
 Each page's fenced blocks run in order, in a scratch directory of their own
 where scenes/, sweeps/, docs/, client/, proto/ and deploy/ are the
