@@ -230,6 +230,15 @@ check("kubernetes: cert-manager's Certificate makes the Secret the servers mount
   expect(tokens.stringData && tokens.stringData.tokens, "cablesim-tokens has no key tokens");
 });
 
+check("kubernetes: the HorizontalPodAutoscaler scales the server Deployment on CPU", () => {
+  const [hpa] = find("HorizontalPodAutoscaler", "cablesim-server");
+  const [deployment] = find("Deployment", hpa.spec.scaleTargetRef.name);
+  expect(hpa.spec.scaleTargetRef.kind === "Deployment", "the target is not a Deployment");
+  expect(deployment.spec.template.spec.containers.every((c) => c.resources.requests.cpu),
+         "utilization needs CPU requests on every container");
+  expect(hpa.spec.minReplicas >= 1 && hpa.spec.maxReplicas > hpa.spec.minReplicas, "replica bounds");
+});
+
 check("kubernetes: sweep-job.py derives completions from the sweep", () => {
   const sweepFile = path.join(sourceDir, "sweeps", "pendulum-resolution.json");
   const out = execFileSync("python3", [path.join(manifestDir, "sweep-job.py"), sweepFile],
