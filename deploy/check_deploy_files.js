@@ -230,13 +230,21 @@ check("kubernetes: cert-manager's Certificate makes the Secret the servers mount
   expect(tokens.stringData && tokens.stringData.tokens, "cablesim-tokens has no key tokens");
 });
 
-check("kubernetes: the HorizontalPodAutoscaler scales the server Deployment on CPU", () => {
+check("kubernetes: the HorizontalPodAutoscaler scales the server Deployment on its queue and CPU", () => {
   const [hpa] = find("HorizontalPodAutoscaler", "cablesim-server");
   const [deployment] = find("Deployment", hpa.spec.scaleTargetRef.name);
   expect(hpa.spec.scaleTargetRef.kind === "Deployment", "the target is not a Deployment");
   expect(deployment.spec.template.spec.containers.every((c) => c.resources.requests.cpu),
          "utilization needs CPU requests on every container");
   expect(hpa.spec.minReplicas >= 1 && hpa.spec.maxReplicas > hpa.spec.minReplicas, "replica bounds");
+  const external = hpa.spec.metrics.find((m) => m.type === "External");
+  expect(external && external.external.metric.name === "cablesim_jobs_queued", "no queue metric");
+  for (const c of deployment.spec.template.spec.containers) {
+    const flag = c.args.find((a) => a.startsWith("--metrics-listen="));
+    expect(flag, `${c.name}: no --metrics-listen`);
+    const port = Number(flag.split(":").pop());
+    expect(c.ports.some((p) => p.containerPort === port), `${c.name}: metrics port ${port} not declared`);
+  }
 });
 
 check("kubernetes: sweep-job.py derives completions from the sweep", () => {

@@ -22,6 +22,8 @@ credentials directory):
   Kubernetes probes' exec commands) must report SERVING;
 - `cablesim run SCENE --server localhost:50051 --tls-ca CA --token-file T`
   must succeed, and the same without the token must be refused;
+- where the file turns the metrics endpoint on (--metrics-listen),
+  GET /metrics must answer;
 - SIGTERM must stop the server with exit status 0;
 - the systemd server runs under strace: every system call it makes must be
   allowed by the unit's SystemCallFilter (expanded by systemd-analyze
@@ -249,6 +251,12 @@ def serve_and_check(name, ns, argv, mounts, user, env, health_commands, ca, toke
         r = run(["ip", "netns", "exec", ns.name] + client)
         ok &= check(r.returncode != 0 and "token" in r.stderr,
                     f"{name}: the same without a token is refused (exit {r.returncode})")
+        for flag in (a for a in argv if a.startswith("--metrics-listen=")):
+            port = flag.rsplit(":", 1)[1]
+            r = run(["ip", "netns", "exec", ns.name, "curl", "-s", f"http://127.0.0.1:{port}/metrics"])
+            ok &= check(r.returncode == 0 and "\ncablesim_jobs_queued 0\n" in r.stdout
+                        and 'cablesim_jobs_finished_total{state="SUCCEEDED"}' in r.stdout,
+                        f"{name}: GET /metrics on port {port} answers (exit {r.returncode})")
         if os.path.exists(out):
             os.remove(out)
     if server.poll() is None:
@@ -275,7 +283,7 @@ def main():
     if os.geteuid() != 0:
         skip("starting the deployments needs root (network and mount namespaces); "
              "run as root, as CI does")
-    for tool in ("ip", "unshare", "openssl", "setpriv", "strace", "runuser"):
+    for tool in ("ip", "unshare", "openssl", "setpriv", "strace", "runuser", "curl"):
         if shutil.which(tool) is None:
             skip(f"no {tool} (deploy/install-deps.sh installs it)")
     if not glob.glob("/usr/lib/postgresql/*/bin/initdb"):
