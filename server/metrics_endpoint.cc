@@ -174,22 +174,17 @@ std::string MetricsEndpoint::Render() {
     at_newest = std::move(next_at_newest);
   }
   std::string out;
-  absl::StrAppend(&out,
-                  "# HELP cablesim_jobs_queued Jobs waiting in the job store (a shared store: "
-                  "every server's).\n# TYPE cablesim_jobs_queued gauge\ncablesim_jobs_queued ",
-                  queued, "\n");
-  absl::StrAppend(&out,
-                  "# HELP cablesim_jobs_running Jobs running (a shared store: on every server).\n"
-                  "# TYPE cablesim_jobs_running gauge\ncablesim_jobs_running ",
-                  running, "\n");
-  absl::StrAppend(&out,
-                  "# HELP cablesim_workers Job worker threads of this server.\n"
-                  "# TYPE cablesim_workers gauge\ncablesim_workers ",
-                  workers_, "\n");
-  absl::StrAppend(&out,
-                  "# HELP cablesim_steps_total Time steps of the jobs seen finished.\n"
-                  "# TYPE cablesim_steps_total counter\ncablesim_steps_total ",
-                  steps_, "\n");
+  // One series without labels: its HELP and TYPE lines, then its value.
+  auto series = [&out](const char* name, const char* type, const char* help, int64_t value) {
+    absl::StrAppend(&out, "# HELP ", name, " ", help, "\n# TYPE ", name, " ", type, "\n", name,
+                    " ", value, "\n");
+  };
+  series("cablesim_jobs_queued", "gauge",
+         "Jobs waiting in the job store (a shared store: every server's).", queued);
+  series("cablesim_jobs_running", "gauge", "Jobs running (a shared store: on every server).",
+         running);
+  series("cablesim_workers", "gauge", "Job worker threads of this server.", workers_);
+  series("cablesim_steps_total", "counter", "Time steps of the jobs seen finished.", steps_);
   absl::StrAppend(&out,
                   "# HELP cablesim_jobs_finished_total Jobs seen finished, by final state.\n"
                   "# TYPE cablesim_jobs_finished_total counter\n");
