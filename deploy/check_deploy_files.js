@@ -78,6 +78,9 @@ function modelClass(apiVersion, kind) {
 }
 
 for (const { file, o } of objects) {
+  // cert-manager's Certificate is a custom resource kubernetes-models has no
+  // schema for: its shape is checked below.
+  if (o.apiVersion === "cert-manager.io/v1") continue;
   check(`kubernetes/${file}: ${o.kind} ${o.metadata && o.metadata.name} against the schema`, () => {
     expect(o.apiVersion && o.kind, "no apiVersion or kind");
     const Model = modelClass(o.apiVersion, o.kind);
@@ -103,10 +106,25 @@ check("kubernetes: the server Deployment's probes, resources and Secret", () => 
   expect(pod.spec.securityContext.runAsNonRoot === true, "runAsNonRoot is not set");
   for (const c of pod.spec.containers) {
     const ports = (c.ports || []).map((p) => p.containerPort);
+    // Kubernetes' grpc probe speaks no TLS: the probes run `cablesim health`
+    // over TLS on the container's port (tests/deploy_start_test.py runs them).
     for (const probe of ["readinessProbe", "livenessProbe"]) {
-      expect(c[probe] && c[probe].grpc, `${c.name}: no gRPC ${probe}`);
-      expect(ports.includes(c[probe].grpc.port), `${c.name}: ${probe} not on a container port`);
-      expect(!c[probe].grpc.service, `${c.name}: ${probe} asks a named service, not the server`);
+      const command = c[probe] && c[probe].exec && c[probe].exec.command;
+      expect(command && command.slice(0, 2).join(" ") === "cablesim health",
+             `${c.name}: ${probe} is not \`cablesim health\``);
+      const server = command[command.indexOf("--server") + 1] || "";
+      expect(ports.includes(Number(server.split(":").pop())), `${c.name}: ${probe} not on a container port`);
+      expect(command.includes("--tls-ca"), `${c.name}: ${probe} without --tls-ca`);
+    }
+    for (const flag of ["--tls-cert=", "--tls-key=", "--token-file="]) {
+      expect(c.args.some((a) => a.startsWith(flag)), `${c.name}: no ${flag}`);
+    }
+    const mounted = (c.volumeMounts || []).map((m) => m.name);
+    const secretNames = deployment.spec.template.spec.volumes
+        .filter((v) => mounted.includes(v.name) && v.projected)
+        .flatMap((v) => v.projected.sources.map((src) => src.secret && src.secret.name));
+    for (const name of ["cablesim-tls", "cablesim-tokens"]) {
+      expect(secretNames.includes(name), `${c.name}: Secret ${name} is not mounted`);
     }
     for (const part of ["requests", "limits"]) {
       for (const resource of ["cpu", "memory"]) {
@@ -201,13 +219,55 @@ check("kubernetes: pod I of the Indexed Job runs sweep item I (run here)", () =>
   }
 });
 
+check("kubernetes: cert-manager's Certificate makes the Secret the servers mount", () => {
+  const [certificate] = find("Certificate", "cablesim-server");
+  expect(certificate.spec.secretName === "cablesim-tls", "secretName is not cablesim-tls");
+  expect(certificate.spec.issuerRef && certificate.spec.issuerRef.name, "no issuerRef");
+  expect(certificate.spec.dnsNames.includes("localhost"), "no localhost (the probes' name)");
+  const [service] = find("Service", "cablesim-server");
+  expect(certificate.spec.dnsNames.includes(service.metadata.name), "the Service's name is not covered");
+  const [tokens] = find("Secret", "cablesim-tokens");
+  expect(tokens.stringData && tokens.stringData.tokens, "cablesim-tokens has no key tokens");
+});
+
+check("kubernetes: the HorizontalPodAutoscaler scales the server Deployment on its queue and CPU", () => {
+  const [hpa] = find("HorizontalPodAutoscaler", "cablesim-server");
+  const [deployment] = find("Deployment", hpa.spec.scaleTargetRef.name);
+  expect(hpa.spec.scaleTargetRef.kind === "Deployment", "the target is not a Deployment");
+  expect(deployment.spec.template.spec.containers.every((c) => c.resources.requests.cpu),
+         "utilization needs CPU requests on every container");
+  expect(hpa.spec.minReplicas >= 1 && hpa.spec.maxReplicas > hpa.spec.minReplicas, "replica bounds");
+  const external = hpa.spec.metrics.find((m) => m.type === "External");
+  expect(external && external.external.metric.name === "cablesim_jobs_queued", "no queue metric");
+  for (const c of deployment.spec.template.spec.containers) {
+    const flag = c.args.find((a) => a.startsWith("--metrics-listen="));
+    expect(flag, `${c.name}: no --metrics-listen`);
+    const port = Number(flag.split(":").pop());
+    expect(c.ports.some((p) => p.containerPort === port), `${c.name}: metrics port ${port} not declared`);
+  }
+});
+
+check("kubernetes: sweep-job.py derives completions from the sweep", () => {
+  const sweepFile = path.join(sourceDir, "sweeps", "pendulum-resolution.json");
+  const out = execFileSync("python3", [path.join(manifestDir, "sweep-job.py"), sweepFile],
+                           { encoding: "utf8" });
+  const docs = YAML.parseAllDocuments(out).map((d) => d.toJS());
+  const sweep = JSON.parse(fs.readFileSync(sweepFile, "utf8"));
+  const items = sweep.axes.reduce((n, a) => n * a.values.length, 1);
+  const job = docs.find((d) => d.kind === "Job");
+  expect(job.spec.completions === items, `completions ${job.spec.completions}, the sweep has ${items} items`);
+  const map = docs.find((d) => d.kind === "ConfigMap");
+  expect(JSON.parse(map.data["sweep.json"]).base_file in map.data, "the base scene is not beside sweep.json");
+});
+
 // ---- compose -----------------------------------------------------------------
 
 check("compose.yaml: PostgreSQL and two servers on its queue, with health checks", () => {
   const [compose] = parseYaml(path.join(deployDir, "compose.yaml"), { merge: true });
   const services = compose.services;
   expect(services.postgres && services.postgres.healthcheck, "no postgres service with a healthcheck");
-  const servers = Object.entries(services).filter(([name]) => name !== "postgres");
+  const servers = Object.entries(services).filter(
+      ([, s]) => (s.command || []).some((a) => a.startsWith("--listen")));
   expect(servers.length === 2, `${servers.length} servers, not 2`);
   const hostPorts = new Set();
   for (const [name, s] of servers) {

@@ -14,6 +14,8 @@ packages=(
   python3 python3-grpcio python3-protobuf python3-numpy python3-matplotlib python3-pil
   python3-venv python3-setuptools python3-wheel python3-pandas
   clang libclang-rt-14-dev
+  openssl iproute2 strace curl systemd python3-yaml
+  mkdocs mkdocs-material
 )
 as_root=()
 if [ "$(id -u)" -ne 0 ]; then as_root=(sudo); fi

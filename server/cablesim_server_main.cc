@@ -32,6 +32,7 @@
 #include "absl/strings/ascii.h"
 #include "cablesim/version.h"
 #include "server/cablesim_server.h"
+#include "server/metrics_endpoint.h"
 
 ABSL_FLAG(std::string, listen, "127.0.0.1:50051", "host:port to listen on (port 0: any free)");
 ABSL_FLAG(std::string, data_dir, "",
@@ -52,6 +53,8 @@ ABSL_FLAG(std::string, token_file, "",
           "bearer tokens a client must send, one \"TOKEN TENANT\" per line (# comments)");
 ABSL_FLAG(bool, insecure, false,
           "allow listening beyond loopback without TLS and tokens (never on a shared network)");
+ABSL_FLAG(std::string, metrics_listen, "",
+          "serve Prometheus metrics (GET /metrics, plain HTTP) on this IPv4 host:port (empty: off)");
 ABSL_FLAG(int, max_elements, 5000, "limit: cable elements per scene");
 ABSL_FLAG(int64_t, max_steps, 5'000'000, "limit: time steps (or load steps) per run");
 ABSL_FLAG(int64_t, max_frames, 200'000, "limit: output frames per run");
@@ -288,6 +291,20 @@ int main(int argc, char** argv) {
   }
   std::cerr << "cablesim-server: listening on port " << (*server)->port() << " (" << options.listen
             << "), jobs in " << (*server)->store_description() << ", " << options.workers << " workers\n";
+  std::unique_ptr<cablesim::MetricsEndpoint> metrics;
+  if (const std::string listen = absl::GetFlag(FLAGS_metrics_listen); !listen.empty()) {
+    absl::StatusOr<std::unique_ptr<cablesim::MetricsEndpoint>> started =
+        cablesim::MetricsEndpoint::Start(listen, (*server)->InProcessChannel(), options.tokens,
+                                         options.workers);
+    if (!started.ok()) {
+      std::cerr << "cablesim-server: " << started.status().message() << "\n";
+      (*server)->Shutdown(absl::ZeroDuration());
+      return 1;
+    }
+    metrics = std::move(*started);
+    std::cerr << "cablesim-server: metrics on port " << metrics->port() << " (" << listen
+              << ", GET /metrics)\n";
+  }
   const std::string port_file = absl::GetFlag(FLAGS_port_file);
   if (!port_file.empty()) {
     const std::string tmp = port_file + ".tmp";
@@ -297,6 +314,7 @@ int main(int argc, char** argv) {
   int signal = 0;
   sigwait(&signals, &signal);
   std::cerr << "cablesim-server: signal " << signal << ", shutting down\n";
+  metrics.reset();
   (*server)->Shutdown(absl::Seconds(absl::GetFlag(FLAGS_shutdown_grace_s)));
   std::cerr << "cablesim-server: stopped\n";
   return 0;

@@ -4,6 +4,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -52,13 +53,36 @@ TEST(ReadmeLinksTest, TheReadmeNamesOnlyFilesOfTheRepository) {
   EXPECT_THAT(MissingFiles(root / "README.md", root), ::testing::IsEmpty());
 }
 
+// Every page under docs/ (the MkDocs site; symbolic links such as
+// docs/bench-results are not followed: their files are checked where they
+// live).
 TEST(ReadmeLinksTest, TheDocsNameOnlyFilesOfTheRepository) {
   const fs::path root = CABLESIM_SOURCE_DIR;
   ASSERT_TRUE(fs::exists(root / "docs" / "model.md"));
-  for (const auto& entry : fs::directory_iterator(root / "docs")) {
+  int pages = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(root / "docs")) {
     if (entry.path().extension() != ".md") continue;
+    ++pages;
     EXPECT_THAT(MissingFiles(entry.path(), root), ::testing::IsEmpty()) << entry.path();
   }
+  EXPECT_GE(pages, 20) << "docs/tutorials/, docs/reference/, docs/features/ not found";
+}
+
+// The README is read in minutes: under 150 lines, opening with the two
+// commands (the sample built and run; every test), the second exactly the
+// one .ci/run runs.
+TEST(ReadmeLinksTest, TheReadmeIsShortAndStartsWithTheTwoCommands) {
+  const fs::path root = CABLESIM_SOURCE_DIR;
+  const std::string readme = Read(root / "README.md");
+  const auto lines = std::count(readme.begin(), readme.end(), '\n');
+  EXPECT_LT(lines, 150);
+  const std::string head =
+      "# cablesim\n\n```sh\n"
+      "deploy/install-deps.sh && cmake -S . -B build && cmake --build build -j2 --target cablesim "
+      "&& build/bin/cablesim run scenes/falling-pendulum.json --out falling-pendulum.csv\n"
+      "cmake -S . -B build && cmake --build build -j2 && ctest --test-dir build "
+      "--output-on-failure\n```\n";
+  EXPECT_EQ(readme.substr(0, head.size()), head);
 }
 
 }  // namespace

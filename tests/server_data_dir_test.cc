@@ -1,6 +1,6 @@
 // The data directory on a first start: a missing one is created private
 // (0700) and the server serves; one that cannot be created ends the start
-// with a message naming it (exit 1). The README's CI recipe, run as
+// with a message naming it (exit 1). The CI recipe of docs/tutorials/sweep-in-ci.md, run as
 // written, ends at once with the server's status and message instead of
 // waiting for a port file that never comes.
 
@@ -107,9 +107,9 @@ TEST(ServerDataDirTest, TheStoreFlagTakesSqliteOrPostgresql) {
   EXPECT_TRUE(std::filesystem::exists(dir + "/cablesim.db"));
 }
 
-// The block of README.md that follows "A CI job against a daemon".
+// The block of docs/tutorials/sweep-in-ci.md that follows "A CI job against a daemon".
 std::string ReadmeCiRecipe() {
-  const std::string readme = ReadAll(absl::StrCat(CABLESIM_SOURCE_DIR, "/README.md"));
+  const std::string readme = ReadAll(absl::StrCat(CABLESIM_SOURCE_DIR, "/docs/tutorials/sweep-in-ci.md"));
   const size_t intro = readme.find("A CI job against a daemon");
   const size_t start = readme.find("```sh\n", intro);
   const size_t end = readme.find("```\n", start + 6);

@@ -17,10 +17,28 @@ __path__ = __import__("pkgutil").extend_path(__path__, __name__)
 
 __version__ = "0.15.0"
 
-from cablesim.animation import animate  # noqa: E402
-from cablesim.client import Client, Error, open_channel, read_token  # noqa: E402
-from cablesim.results import Energy, Job, Record, Result, SweepResult  # noqa: E402
-from cablesim.scenes import load_scene, scene_to_dict  # noqa: E402
+# The names below import grpc, protobuf and numpy when first used (PEP 562),
+# so that `import cablesim` and cablesim.errors work without them.
+_LAZY = {
+    "animate": "cablesim.animation",
+    "Client": "cablesim.client", "open_channel": "cablesim.client", "read_token": "cablesim.client",
+    "Energy": "cablesim.results", "Job": "cablesim.results", "Record": "cablesim.results",
+    "Result": "cablesim.results", "SweepResult": "cablesim.results",
+    "load_scene": "cablesim.scenes", "scene_to_dict": "cablesim.scenes",
+}
 
-__all__ = ["animate", "Client", "Energy", "Error", "Job", "Record", "Result", "SweepResult", "load_scene",
-           "open_channel", "read_token", "scene_to_dict"]
+from cablesim.errors import Error, SceneError  # noqa: E402
+
+
+def __getattr__(name):
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError("module 'cablesim' has no attribute %r" % name)
+    import importlib
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+__all__ = ["animate", "Client", "Energy", "Error", "Job", "Record", "Result", "SceneError",
+           "SweepResult", "load_scene", "open_channel", "read_token", "scene_to_dict"]

@@ -8,26 +8,11 @@ from typing import Iterable, Mapping, Optional, Sequence, Tuple, Union
 
 import grpc
 
+from cablesim.errors import Error
+from cablesim.progress import Progress, Reporter
 from cablesim.results import Energy, Job, Record, Result, SweepResult, result_from_events, to_record
 from cablesim.scenes import SceneLike, load_scene
 from cablesim.v1 import service_pb2, service_pb2_grpc
-
-
-class Error(Exception):
-    """A call the service refused or could not complete. `code` is the gRPC
-    status name ("INVALID_ARGUMENT", "NOT_FOUND", "UNAVAILABLE", ...),
-    `details` the server's message; for a bad scene it starts with the
-    field's path, which is `field` (e.g. "cables[0].length")."""
-
-    def __init__(self, code: str, details: str):
-        super().__init__("%s: %s" % (code, details))
-        self.code = code
-        self.details = details
-
-    @property
-    def field(self) -> Optional[str]:
-        head, sep, _ = self.details.partition(": ")
-        return head if sep and self.code == "INVALID_ARGUMENT" and " " not in head else None
 
 
 def _raises_error(method):
@@ -144,11 +129,23 @@ class Client:
 
     @_raises_error
     def run(self, scene: SceneLike, *, frames_per_batch: int = 256,
-            timeout: Optional[float] = None) -> Result:
+            timeout: Optional[float] = None, progress: Progress = None) -> Result:
         """Runs `scene` and returns its trajectory. A numerical failure is not
-        an error: `result.summary.status` is "failed" with the reason."""
-        request = service_pb2.RunRequest(scene=load_scene(scene), frames_per_batch=frames_per_batch)
-        return result_from_events(self.stub.Run(request, timeout=timeout))
+        an error: `result.summary.status` is "failed" with the reason.
+        `progress`: True for a bar (tqdm when installed), or a function
+        called with (simulated seconds done, end time) as frames arrive (for
+        STATIC, the load factor out of 1)."""
+        message = load_scene(scene)
+        request = service_pb2.RunRequest(scene=message, frames_per_batch=frames_per_batch)
+        if not progress:
+            return result_from_events(self.stub.Run(request, timeout=timeout))
+        static = message.solver.analysis == message.solver.STATIC
+        total = 1.0 if static else (message.solver.duration or None)
+        reporter = Reporter(progress, "s", total, message.name)
+        try:
+            return result_from_events(self.stub.Run(request, timeout=timeout), reporter.update)
+        finally:
+            reporter.close()
 
     @_raises_error
     def submit(self, scene: SceneLike) -> str:
@@ -161,12 +158,19 @@ class Client:
         return Job.from_message(self.stub.GetJob(service_pb2.GetJobRequest(id=job_id)))
 
     @_raises_error
-    def wait(self, job_id: str, timeout: Optional[float] = None) -> Job:
+    def wait(self, job_id: str, timeout: Optional[float] = None,
+             progress: Progress = None) -> Job:
         """Follows the job until it finished; returns it (state SUCCEEDED,
-        FAILED or CANCELLED)."""
+        FAILED or CANCELLED). `progress` as for run(): simulated seconds."""
         job = None
-        for job in self.stub.WatchJob(service_pb2.WatchJobRequest(id=job_id), timeout=timeout):
-            pass
+        reporter = Reporter(progress, "s", None, job_id) if progress else None
+        try:
+            for job in self.stub.WatchJob(service_pb2.WatchJobRequest(id=job_id), timeout=timeout):
+                if reporter is not None and job.end_time_s > 0:
+                    reporter.update(job.progress_time_s, job.end_time_s)
+        finally:
+            if reporter is not None:
+                reporter.close()
         return Job.from_message(job)
 
     @_raises_error
@@ -210,13 +214,24 @@ class Client:
             self.stub.GetSweepResults(service_pb2.GetSweepResultsRequest(id=sweep_id)))
 
     @_raises_error
-    def wait_sweep(self, sweep_id: str, timeout: Optional[float] = None) -> SweepResult:
-        """Follows the sweep until every item finished; returns its table."""
-        for _ in self.stub.WatchSweep(service_pb2.WatchSweepRequest(id=sweep_id), timeout=timeout):
-            pass
+    def wait_sweep(self, sweep_id: str, timeout: Optional[float] = None,
+                   progress: Progress = None) -> SweepResult:
+        """Follows the sweep until every item finished; returns its table.
+        `progress`: True for a bar (tqdm when installed), or a function
+        called with (items finished, items)."""
+        reporter = Reporter(progress, "item", None, sweep_id) if progress else None
+        try:
+            for event in self.stub.WatchSweep(service_pb2.WatchSweepRequest(id=sweep_id),
+                                              timeout=timeout):
+                if reporter is not None:
+                    reporter.update(event.progress.finished, event.progress.items)
+        finally:
+            if reporter is not None:
+                reporter.close()
         return self.sweep_results(sweep_id)
 
     def sweep(self, base: SceneLike, axes: Axes, name: str = "",
-              timeout: Optional[float] = None) -> SweepResult:
+              timeout: Optional[float] = None, progress: Progress = None) -> SweepResult:
         """Queues a sweep (see submit_sweep()) and waits for its table."""
-        return self.wait_sweep(self.submit_sweep(base, axes, name), timeout=timeout)
+        return self.wait_sweep(self.submit_sweep(base, axes, name), timeout=timeout,
+                               progress=progress)

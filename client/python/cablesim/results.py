@@ -4,6 +4,7 @@ summaries with enums as names. Units are SI: s, m, m/s, m/s^2, J.
 """
 
 import dataclasses
+import datetime
 from typing import Any, Dict, List, Optional
 
 import numpy as np
@@ -129,9 +130,9 @@ class Result:
         plt.close(fig)
 
 
-def result_from_events(events) -> Result:
+def result_from_events(events, on_time=None) -> Result:
     """Collects a Run (or GetJobResult) stream: header, frame batches,
-    summary."""
+    summary. `on_time(t)`: called with the last frame's time of each batch."""
     header, summary, chunks = None, None, []
     for event in events:
         kind = event.WhichOneof("event")
@@ -139,6 +140,8 @@ def result_from_events(events) -> Result:
             header = event.header
         elif kind == "frames":
             chunks.append(np.asarray(event.frames.values, dtype=np.float64))
+            if on_time is not None and header is not None and len(chunks[-1]):
+                on_time(float(chunks[-1][-len(header.columns)]))
         elif kind == "summary":
             summary = event.summary
     if header is None or summary is None:
@@ -149,11 +152,20 @@ def result_from_events(events) -> Result:
                   scene_name=header.scene_name)
 
 
+def _datetime(unix_ms: int) -> Optional[datetime.datetime]:
+    """A time in milliseconds since the Unix epoch as an aware UTC datetime
+    (None for 0: not yet)."""
+    if not unix_ms:
+        return None
+    return datetime.datetime.fromtimestamp(unix_ms / 1000.0, tz=datetime.timezone.utc)
+
+
 @dataclasses.dataclass
 class Job:
     """A durable job. `state` is a name: "QUEUED", "RUNNING", "SUCCEEDED",
     "FAILED" or "CANCELLED"; `summary` is set once it finished. Times in
-    milliseconds since the Unix epoch (0: not yet)."""
+    milliseconds since the Unix epoch (0: not yet), and as datetimes in UTC
+    (`created`, `started`, `finished_at`; None: not yet)."""
 
     id: str
     state: str
@@ -171,6 +183,18 @@ class Job:
     @property
     def finished(self) -> bool:
         return self.state in ("SUCCEEDED", "FAILED", "CANCELLED")
+
+    @property
+    def created(self) -> Optional[datetime.datetime]:
+        return _datetime(self.created_unix_ms)
+
+    @property
+    def started(self) -> Optional[datetime.datetime]:
+        return _datetime(self.started_unix_ms)
+
+    @property
+    def finished_at(self) -> Optional[datetime.datetime]:
+        return _datetime(self.finished_unix_ms)
 
     @classmethod
     def from_message(cls, job) -> "Job":
