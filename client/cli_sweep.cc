@@ -220,6 +220,16 @@ int SweepCommand(const Arguments& a, std::ostream& out, std::ostream& err) {
   for (const std::string& column : results.final_columns()) {
     table << "," << CsvCell(absl::StrCat("final.", column));
   }
+  // Then per threshold the value it judged: max.COLUMN or min.COLUMN (a
+  // threshold with both: both).
+  std::vector<std::pair<std::string, bool>> judged;  // column, is max
+  for (const v1::SweepThreshold& t : request->thresholds()) {
+    if (t.has_max()) judged.emplace_back(t.column(), true);
+    if (t.has_min()) judged.emplace_back(t.column(), false);
+  }
+  for (const auto& [column, is_max] : judged) {
+    table << "," << CsvCell(absl::StrCat(is_max ? "max." : "min.", column));
+  }
   table << "\n";
   int failed = 0, violations = 0;
   // Per item, for --junit: its name and why it failed (empty: passed).
@@ -240,6 +250,13 @@ int SweepCommand(const Arguments& a, std::ostream& out, std::ostream& err) {
       table << ","
             << (k < item.final_values_size() ? absl::StrFormat("%.17g", item.final_values(k))
                                              : std::string());
+    }
+    for (const auto& [column, is_max] : judged) {
+      std::string cell;
+      for (const v1::ColumnStatistics& c : s.statistics().columns()) {
+        if (c.column() == column) cell = absl::StrFormat("%.17g", is_max ? c.max() : c.min());
+      }
+      table << "," << cell;
     }
     table << "\n";
     // The item by its index, its axis values and its job.

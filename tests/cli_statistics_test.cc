@@ -5,14 +5,13 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
-#include <cstdio>
 #include <fstream>
 #include <string>
 
 #include "absl/strings/str_cat.h"
+#include "tests/process_util.h"
 
 namespace cablesim {
 namespace {
@@ -20,22 +19,10 @@ namespace {
 using ::testing::HasSubstr;
 using ::testing::Not;
 
-struct Process {
-  int exit_code = -1;
-  std::string out;  // stdout, then stderr (2>&1)
-};
+using ::cablesim::testing::Process;
 
-Process Sh(const std::string& command) {
-  Process result;
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  if (pipe == nullptr) return result;
-  char buffer[4096];
-  size_t n;
-  while ((n = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0) result.out.append(buffer, n);
-  const int status = pclose(pipe);
-  if (status != -1 && WIFEXITED(status)) result.exit_code = WEXITSTATUS(status);
-  return result;
-}
+// Runs `command`, its stderr after its stdout.
+Process Sh(const std::string& command) { return testing::RunCommand(command + " 2>&1"); }
 
 std::string Cablesim(const std::string& args) {
   return absl::StrCat(CABLESIM_BIN_DIR, "/cablesim ", args);
@@ -118,9 +105,12 @@ Process ReadJUnit(const std::string& path) {
 TEST(CliStatisticsTest, SweepThresholdFailsTheItemNamingItsAxisValues) {
   const std::string junit = absl::StrCat(::testing::TempDir(), "/cli_statistics_", ::getpid(),
                                          "_junit.xml");
-  const Process r = Sh(Cablesim(absl::StrCat("sweep ", SweepFile(), " --workers 1 --out /dev/null",
+  const Process r = Sh(Cablesim(absl::StrCat("sweep ", SweepFile(), " --workers 1",
                                              " --min end.y=-1e-6 --max end.y=1 --junit ", junit)));
   EXPECT_EQ(r.exit_code, 3) << r.out;
+  // The table ends with the judged values: min.end.y, max.end.y.
+  EXPECT_THAT(r.out, HasSubstr(",final.end.x,"));
+  EXPECT_THAT(r.out, HasSubstr(",final.loads.energy.potential,min.end.y,max.end.y\n"));
   EXPECT_THAT(r.out, HasSubstr("sweep item 1 (gravity.y=-9.81; j-"));
   EXPECT_THAT(r.out, HasSubstr("): end.y min -"));
   EXPECT_THAT(r.out, HasSubstr(" is below -1e-06"));
