@@ -253,6 +253,14 @@ void BM_FallingPendulum_Fastest_NoReuse(benchmark::State& state) {
   scene.solver.reuse_factorization = false;
   RunBenchmark(state, scene);
 }
+// The same with output.statistics and a rainflow count of the tip's y
+// (docs/outputs-statistics.md): what asking for them costs.
+void BM_FallingPendulum_Fastest_Statistics(benchmark::State& state) {
+  Scene scene = Fastest();
+  scene.output.statistics = true;
+  scene.output.rainflow = {{"tip.y"}, 3, 1e7};
+  RunBenchmark(state, scene);
+}
 // HHT needs rho_infinity 0.9 (alpha = -0.053) for the same error bound.
 void BM_FallingPendulum_Fastest_Hht(benchmark::State& state) {
   Scene scene = Fastest();
@@ -405,6 +413,7 @@ CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_GeneralizedAlpha_Direct_h1e4);
 CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_Hht_Direct_h1e4);
 CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_ImplicitEuler_Direct_h1e4);
 CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_Fastest);
+CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_Fastest_Statistics);
 CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_Fastest_NoReuse);
 CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_Fastest_Hht);
 CABLESIM_RUN_BENCHMARK(BM_FallingPendulum_Fastest_Minres);

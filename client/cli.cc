@@ -58,7 +58,10 @@ const std::set<std::string>& ValueOptions() {
                                 "tls-ca",
                                 "token-file",
                                 "item",
-                                "shape"};
+                                "shape",
+                                "max",
+                                "min",
+                                "junit"};
   return *options;
 }
 
@@ -124,6 +127,7 @@ absl::StatusOr<Arguments> ParseArguments(const std::vector<std::string>& args) {
       parsed.server = *value;
     } else {
       parsed.options[name] = *value;
+      if (name == "max" || name == "min") parsed.repeated.emplace_back(name, *value);
     }
   }
   return parsed;
@@ -267,12 +271,17 @@ std::string CliUsage() {
   cablesim sweep SWEEP.json [--out results.csv] [--server HOST:PORT]
                  [--workers N] [--max-energy-drift X] [--max-wall-seconds X]
                  [--max-constraint-violation X] [--allow-outside] [--item I]
+                 [--max COLUMN=X]... [--min COLUMN=X]... [--junit FILE.xml]
       Queue a parameter sweep, wait for every item and write one row per
       item (axis values, summary, final probe values). Without --server the
       sweep runs in this process on N workers (default: the cores). The
       sweep file's base_file must lie under the sweep file's directory
       unless --allow-outside. With --item I only item I (0-based, the last
       axis varying fastest) runs and its row is written, under index I.
+      --max/--min (repeatable): an item fails when the frame column's
+      largest value over its run is above X (smallest below X), e.g.
+      --max hook.y=1.2 --min top.fz=0 (docs/outputs-statistics.md).
+      --junit writes a JUnit XML report, one testcase per item.
   cablesim health --server HOST:PORT
       Ask the server's gRPC health service whether it is serving; print one
       JSON line; exit 0 only when it is SERVING.

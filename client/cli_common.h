@@ -10,6 +10,7 @@
 #include <optional>
 #include <ostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -29,6 +30,8 @@ struct Arguments {
   std::optional<std::string> out;              // --out
   std::optional<std::string> server;           // --server
   std::map<std::string, std::string> options;  // the other --name value
+  // The options that may repeat (--max, --min), in order: name, value.
+  std::vector<std::pair<std::string, std::string>> repeated;
   bool help = false;
   bool version = false;  // --version
 };

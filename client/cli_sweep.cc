@@ -2,15 +2,20 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/match.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
 #include "client/json_line.h"
 #include "client/progress.h"
 #include "convert/sweep_file.h"
@@ -36,6 +41,60 @@ absl::StatusOr<double> DoubleOption(const Arguments& a, const std::string& name)
     return absl::InvalidArgumentError(absl::StrCat("--", name, ": not a number >= 0"));
   }
   return value;
+}
+
+// "path=value, path=value" of an item's axis values.
+std::string AxisValuesText(const v1::SweepResults& results, const v1::SweepItem& item) {
+  std::string text;
+  for (int k = 0; k < results.sweep().axes_size() && k < item.axis_values_size(); ++k) {
+    absl::StrAppend(&text, k ? ", " : "", results.sweep().axes(k).path(), "=",
+                    JsonLine::Number(item.axis_values(k)));
+  }
+  return text;
+}
+
+// The thresholds of --max and --min (NAME=VALUE each, in order), and the
+// flag each came from (for messages).
+absl::Status ParseThresholds(const Arguments& a, v1::SubmitSweepRequest* request,
+                             std::vector<std::string>* flags) {
+  for (const auto& [name, value] : a.repeated) {
+    const std::string flag = absl::StrCat("--", name, " ", value);
+    const size_t eq = value.rfind('=');
+    double limit = 0;
+    if (eq == std::string::npos || eq == 0) {
+      return absl::InvalidArgumentError(absl::StrCat(flag, ": expected COLUMN=VALUE"));
+    }
+    if (!absl::SimpleAtod(value.substr(eq + 1), &limit) || !std::isfinite(limit)) {
+      return absl::InvalidArgumentError(absl::StrCat(flag, ": VALUE is not a finite number"));
+    }
+    v1::SweepThreshold* t = request->add_thresholds();
+    t->set_column(value.substr(0, eq));
+    if (name == "max") {
+      t->set_max(limit);
+    } else {
+      t->set_min(limit);
+    }
+    flags->push_back(flag);
+  }
+  return absl::OkStatus();
+}
+
+// `text` with &, <, >, " and ' escaped, and the control characters XML 1.0
+// cannot hold replaced by '?'.
+std::string XmlEscape(const std::string& text) {
+  std::string out;
+  for (char ch : text) {
+    switch (ch) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&apos;"; break;
+      default:
+        out += (static_cast<unsigned char>(ch) < 0x20 && ch != '\n' && ch != '\t') ? '?' : ch;
+    }
+  }
+  return out;
 }
 
 }  // namespace
@@ -75,6 +134,10 @@ int SweepCommand(const Arguments& a, std::ostream& out, std::ostream& err) {
     err << "cablesim: " << request.status().message() << "\n";
     return kExitBadInput;
   }
+  std::vector<std::string> threshold_flags;
+  if (absl::Status s = ParseThresholds(a, &*request, &threshold_flags); !s.ok()) {
+    return UsageError(err, s.message());
+  }
   // --item I: the sweep narrowed to its item I (each axis to the one value
   // it takes there), reported under index I.
   int first_index = 0;
@@ -102,7 +165,15 @@ int SweepCommand(const Arguments& a, std::ostream& out, std::ostream& err) {
   {
     grpc::ClientContext context;
     const absl::Status status = FromGrpc(c->stub->SubmitSweep(&context, *request, &sweep));
-    if (!status.ok()) return CallFailed(err, status, path);
+    if (!status.ok()) {
+      // A threshold's error names the flag it came from.
+      for (size_t k = 0; k < threshold_flags.size(); ++k) {
+        if (absl::StartsWith(status.message(), absl::StrCat("thresholds[", k, "]"))) {
+          return CallFailed(err, status, threshold_flags[k]);
+        }
+      }
+      return CallFailed(err, status, path);
+    }
   }
   err << "cablesim: sweep " << sweep.id() << ": " << sweep.items() << " items queued\n";
   {
@@ -149,8 +220,20 @@ int SweepCommand(const Arguments& a, std::ostream& out, std::ostream& err) {
   for (const std::string& column : results.final_columns()) {
     table << "," << CsvCell(absl::StrCat("final.", column));
   }
+  // Then per threshold the value it judged: max.COLUMN or min.COLUMN (a
+  // threshold with both: both).
+  std::vector<std::pair<std::string, bool>> judged;  // column, is max
+  for (const v1::SweepThreshold& t : request->thresholds()) {
+    if (t.has_max()) judged.emplace_back(t.column(), true);
+    if (t.has_min()) judged.emplace_back(t.column(), false);
+  }
+  for (const auto& [column, is_max] : judged) {
+    table << "," << CsvCell(absl::StrCat(is_max ? "max." : "min.", column));
+  }
   table << "\n";
   int failed = 0, violations = 0;
+  // Per item, for --junit: its name and why it failed (empty: passed).
+  std::vector<std::pair<std::string, std::vector<std::string>>> verdicts;
   for (const v1::SweepItem& item : results.items()) {
     const v1::RunSummary& s = item.summary();
     table << first_index + item.index() << "," << item.job_id() << "," << v1::JobState_Name(item.state());
@@ -168,25 +251,80 @@ int SweepCommand(const Arguments& a, std::ostream& out, std::ostream& err) {
             << (k < item.final_values_size() ? absl::StrFormat("%.17g", item.final_values(k))
                                              : std::string());
     }
+    for (const auto& [column, is_max] : judged) {
+      std::string cell;
+      for (const v1::ColumnStatistics& c : s.statistics().columns()) {
+        if (c.column() == column) cell = absl::StrFormat("%.17g", is_max ? c.max() : c.min());
+      }
+      table << "," << cell;
+    }
     table << "\n";
-    const std::string who =
-        absl::StrCat("sweep item ", first_index + item.index(), " (", item.job_id(), ")");
+    // The item by its index, its axis values and its job.
+    const std::string axes = AxisValuesText(results, item);
+    const std::string who = absl::StrCat("sweep item ", first_index + item.index(), " (", axes,
+                                         axes.empty() ? "" : "; ", item.job_id(), ")");
+    verdicts.emplace_back(absl::StrCat("item ", first_index + item.index(),
+                                       axes.empty() ? "" : ": ", axes),
+                          std::vector<std::string>());
+    std::vector<std::string>& reasons = verdicts.back().second;
     if (item.state() != v1::SUCCEEDED) {
       ++failed;
-      err << "cablesim: " << who << ": " << v1::JobState_Name(item.state())
-          << (s.error().empty() ? "" : absl::StrCat(": ", s.error())) << "\n";
+      reasons.push_back(absl::StrCat(v1::JobState_Name(item.state()),
+                                     s.error().empty() ? "" : absl::StrCat(": ", s.error())));
+      err << "cablesim: " << who << ": " << reasons.back() << "\n";
       continue;
     }
     auto check = [&](double limit, double value, const char* what) {
       if (limit >= 0 && !(std::abs(value) <= limit)) {
         ++violations;
-        err << "cablesim: " << who << ": " << what << " " << JsonLine::Number(value) << " exceeds "
-            << JsonLine::Number(limit) << "\n";
+        reasons.push_back(absl::StrCat(what, " ", JsonLine::Number(value), " exceeds ",
+                                       JsonLine::Number(limit)));
+        err << "cablesim: " << who << ": " << reasons.back() << "\n";
       }
     };
     check(*max_drift, item.energy().relative_drift(), "energy drift");
     check(*max_wall, s.wall_seconds(), "wall time [s]");
     check(*max_violation, s.max_constraint_violation(), "constraint violation");
+    for (const std::string& failure : item.threshold_failures()) {
+      ++violations;
+      reasons.push_back(failure);
+      err << "cablesim: " << who << ": " << failure << "\n";
+    }
+  }
+  if (auto it = a.options.find("junit"); it != a.options.end()) {
+    // JUnit XML (the schema CI systems read): one testsuite, one testcase
+    // per item, a <failure> with the reasons when it failed.
+    const std::string suite = results.sweep().name().empty() ? sweep.id() : results.sweep().name();
+    int failures = 0;
+    for (const auto& verdict : verdicts) failures += verdict.second.empty() ? 0 : 1;
+    std::ostringstream xml;
+    xml << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+        << "<testsuites tests=\"" << verdicts.size() << "\" failures=\"" << failures << "\">\n"
+        << "  <testsuite name=\"" << XmlEscape(suite) << "\" id=\"" << XmlEscape(sweep.id())
+        << "\" tests=\"" << verdicts.size() << "\" failures=\"" << failures
+        << "\" errors=\"0\">\n";
+    for (size_t k = 0; k < verdicts.size(); ++k) {
+      const auto& [name, reasons] = verdicts[k];
+      const v1::SweepItem& item = results.items(static_cast<int>(k));
+      xml << "    <testcase classname=\"" << XmlEscape(absl::StrCat("cablesim.sweep.", suite))
+          << "\" name=\"" << XmlEscape(name) << "\" time=\""
+          << absl::StrFormat("%.6f", item.summary().wall_seconds()) << "\"";
+      if (reasons.empty()) {
+        xml << "/>\n";
+        continue;
+      }
+      xml << ">\n      <failure message=\"" << XmlEscape(reasons.front()) << "\" type=\""
+          << (item.state() != v1::SUCCEEDED ? v1::JobState_Name(item.state()) : "threshold")
+          << "\">" << XmlEscape(absl::StrJoin(reasons, "\n")) << "</failure>\n    </testcase>\n";
+    }
+    xml << "  </testsuite>\n</testsuites>\n";
+    std::ofstream file(it->second);
+    file << xml.str();
+    file.close();
+    if (!file) {
+      err << "cablesim: " << it->second << ": cannot write\n";
+      return kExitIoError;
+    }
   }
   if (a.out.has_value()) {
     std::ofstream file(*a.out);

@@ -27,6 +27,13 @@ class JsonLine {
   // A JSON array of numbers, each written as by Add(key, double).
   JsonLine& Add(std::string_view key, const std::vector<double>& values);
 
+  // Adds `"key":json` with `json` already JSON (an object or array built
+  // with JsonLine), written as is.
+  JsonLine& AddJson(std::string_view key, std::string_view json) {
+    AddRaw(key, json);
+    return *this;
+  }
+
   // The object, e.g. `{"status":"ok","steps":10}`, without a newline.
   std::string ToString() const { return body_ + "}"; }
 

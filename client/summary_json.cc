@@ -1,8 +1,45 @@
 #include "client/summary_json.h"
 
+#include "absl/strings/str_cat.h"
 #include "client/json_line.h"
 
 namespace cablesim {
+
+std::string StatisticsToJson(const RunStatistics& statistics) {
+  std::string columns = "[";
+  for (const ColumnStatistics& c : statistics.columns) {
+    JsonLine item;
+    item.Add("column", c.column)
+        .Add("count", c.count)
+        .Add("min", c.min)
+        .Add("min_t", c.min_t)
+        .Add("max", c.max)
+        .Add("max_t", c.max_t)
+        .Add("mean", c.mean)
+        .Add("stddev", c.stddev);
+    absl::StrAppend(&columns, columns.size() > 1 ? "," : "", item.ToString());
+  }
+  columns += "]";
+  std::string rainflow = "[";
+  for (const RainflowStatistics& r : statistics.rainflow) {
+    JsonLine item;
+    item.Add("column", r.column)
+        .Add("cycles", r.cycles)
+        .Add("half_cycles", r.half_cycles)
+        .Add("max_range", r.max_range)
+        .Add("damage_equivalent_load", r.damage_equivalent_load);
+    absl::StrAppend(&rainflow, rainflow.size() > 1 ? "," : "", item.ToString());
+  }
+  rainflow += "]";
+  JsonLine json;
+  json.AddJson("columns", columns);
+  if (!statistics.rainflow.empty()) {
+    json.Add("sn_slope", statistics.sn_slope)
+        .Add("equivalent_cycles", statistics.equivalent_cycles)
+        .AddJson("rainflow", rainflow);
+  }
+  return json.ToString();
+}
 
 std::string SummaryToJson(const RunSummary& summary) {
   JsonLine json;
@@ -56,6 +93,7 @@ std::string SummaryToJson(const RunSummary& summary) {
           .Add("error_estimate_seconds", summary.error_estimate_seconds);
     }
   }
+  if (summary.has_statistics) json.AddJson("statistics", StatisticsToJson(summary.statistics));
   return json.ToString();
 }
 

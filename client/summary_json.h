@@ -17,8 +17,16 @@ namespace cablesim {
 //   wall_seconds, energy_initial, energy_final, energy_dissipated,
 //   energy_max_increase, max_constraint_violation, max_newton_residual,
 //   max_linear_residual.
+// Then, with the scene's output.statistics or output.rainflow, `statistics`:
+//   {"columns":[{"column","count","min","min_t","max","max_t","mean",
+//   "stddev"}...]} and, with rainflow columns, "sn_slope",
+//   "equivalent_cycles", "rainflow":[{"column","cycles","half_cycles",
+//   "max_range","damage_equivalent_load"}...] (docs/outputs-statistics.md).
 // Units as in RunSummary (s, J, m). Non-finite numbers are written as null.
 std::string SummaryToJson(const RunSummary& summary);
+
+// The `statistics` object of SummaryToJson.
+std::string StatisticsToJson(const RunStatistics& statistics);
 
 }  // namespace cablesim
 

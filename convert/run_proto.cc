@@ -42,6 +42,47 @@ ModelInfo ModelInfoFromProto(const v1::ModelInfo& p) {
   return info;
 }
 
+v1::RunStatistics StatisticsToProto(const RunStatistics& s) {
+  v1::RunStatistics p;
+  for (const ColumnStatistics& c : s.columns) {
+    v1::ColumnStatistics* q = p.add_columns();
+    q->set_column(c.column);
+    q->set_count(c.count);
+    q->set_min(c.min);
+    q->set_min_t(c.min_t);
+    q->set_max(c.max);
+    q->set_max_t(c.max_t);
+    q->set_mean(c.mean);
+    q->set_stddev(c.stddev);
+  }
+  p.set_sn_slope(s.sn_slope);
+  p.set_equivalent_cycles(s.equivalent_cycles);
+  for (const RainflowStatistics& r : s.rainflow) {
+    v1::RainflowStatistics* q = p.add_rainflow();
+    q->set_column(r.column);
+    q->set_cycles(r.cycles);
+    q->set_half_cycles(r.half_cycles);
+    q->set_max_range(r.max_range);
+    q->set_damage_equivalent_load(r.damage_equivalent_load);
+  }
+  return p;
+}
+
+RunStatistics StatisticsFromProto(const v1::RunStatistics& p) {
+  RunStatistics s;
+  for (const v1::ColumnStatistics& q : p.columns()) {
+    s.columns.push_back({q.column(), q.count(), q.min(), q.min_t(), q.max(), q.max_t(),
+                         q.mean(), q.stddev()});
+  }
+  s.sn_slope = p.sn_slope();
+  s.equivalent_cycles = p.equivalent_cycles();
+  for (const v1::RainflowStatistics& q : p.rainflow()) {
+    s.rainflow.push_back(
+        {q.column(), q.cycles(), q.half_cycles(), q.max_range(), q.damage_equivalent_load()});
+  }
+  return s;
+}
+
 v1::RunSummary SummaryToProto(const RunSummary& s) {
   v1::RunSummary p;
   p.set_status(s.status);
@@ -81,6 +122,7 @@ v1::RunSummary SummaryToProto(const RunSummary& s) {
   p.set_error_estimate_m(s.error_estimate_m);
   p.set_error_estimate_method(s.error_estimate_method);
   p.set_error_estimate_seconds(s.error_estimate_seconds);
+  if (s.has_statistics) *p.mutable_statistics() = StatisticsToProto(s.statistics);
   return p;
 }
 
@@ -123,6 +165,8 @@ RunSummary SummaryFromProto(const v1::RunSummary& p) {
   s.error_estimate_m = p.error_estimate_m();
   s.error_estimate_method = p.error_estimate_method();
   s.error_estimate_seconds = p.error_estimate_seconds();
+  s.has_statistics = p.has_statistics();
+  if (s.has_statistics) s.statistics = StatisticsFromProto(p.statistics());
   return s;
 }
 

@@ -26,6 +26,9 @@ v1::ModelInfo ModelInfoToProto(const ModelInfo& info);
 ModelInfo ModelInfoFromProto(const v1::ModelInfo& proto);
 
 v1::RunSummary SummaryToProto(const RunSummary& summary);
+// RunSummary::statistics and RunSummary.statistics.
+v1::RunStatistics StatisticsToProto(const RunStatistics& statistics);
+RunStatistics StatisticsFromProto(const v1::RunStatistics& proto);
 RunSummary SummaryFromProto(const v1::RunSummary& proto);
 
 // Appends `frame` as one row to `values`.

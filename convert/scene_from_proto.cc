@@ -305,6 +305,13 @@ class SceneConverter {
     }
     CABLESIM_ASSIGN_OR_RETURN(scene_.gravity_m_s2, VectorInRange("gravity", proto_.gravity(), plausible::kGravity));
     scene_.output.shape = proto_.output().shape();
+    scene_.output.statistics = proto_.output().statistics();
+    {
+      const v1::Rainflow& r = proto_.output().rainflow();
+      scene_.output.rainflow.columns.assign(r.columns().begin(), r.columns().end());
+      scene_.output.rainflow.sn_slope = r.sn_slope();
+      scene_.output.rainflow.equivalent_cycles = r.equivalent_cycles();
+    }
     if (proto_.cables_size() == 0 && proto_.bodies_size() == 0) {
       return Invalid("cables", "a scene needs at least one cable or body");
     }

@@ -639,6 +639,10 @@ v1::SweepItem ItemOf(JobManager* jobs, const v1::Sweep& sweep, const v1::Job& jo
       *item.mutable_energy() =
           EnergyFromTrajectory(result->header, result->values, job.summary()).report();
     }
+    if (job.state() == v1::SUCCEEDED) {
+      for (std::string& f : ThresholdFailures(sweep.thresholds(), job.summary()))
+        item.add_threshold_failures(std::move(f));
+    }
   }
   return item;
 }

@@ -468,6 +468,7 @@ absl::StatusOr<v1::Sweep> PostgresJobStore::InsertSweep(const v1::SubmitSweepReq
     }
     v1::Sweep axes;
     *axes.mutable_axes() = request.axes();
+    *axes.mutable_thresholds() = request.thresholds();  // kept with the axes
     const int64_t now = NowUnixMs();
     PgResult s(Params()
                    .Text(request.name())

@@ -16,6 +16,7 @@
 #include "convert/scene_field_path.h"
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
+#include "engine/output/run_statistics.h"
 
 namespace cablesim {
 
@@ -294,6 +295,18 @@ absl::StatusOr<std::vector<v1::Scene>> ExpandSweep(const v1::SubmitSweepRequest&
                           limits.max_sweep_items));
     }
   }
+  for (int k = 0; k < request.thresholds_size(); ++k) {
+    const v1::SweepThreshold& t = request.thresholds(k);
+    const std::string field = absl::StrCat("thresholds[", k, "]");
+    if (t.column().empty()) return absl::InvalidArgumentError(field + ".column: empty");
+    if (!t.has_max() && !t.has_min()) {
+      return absl::InvalidArgumentError(field + ": set max, min or both");
+    }
+    if ((t.has_max() && !std::isfinite(t.max())) || (t.has_min() && !std::isfinite(t.min()))) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          field, t.has_max() && !std::isfinite(t.max()) ? ".max" : ".min", ": not finite"));
+    }
+  }
   std::vector<v1::Scene> scenes;
   end_times_s->clear();
   for (int64_t i = 0; i < items; ++i) {
@@ -312,7 +325,18 @@ absl::StatusOr<std::vector<v1::Scene>> ExpandSweep(const v1::SubmitSweepRequest&
             absl::StrCat("axes[", a, "].values[", which[a], "]: ", s.message()));
       }
     }
+    // Thresholds are judged on the items' statistics.
+    if (request.thresholds_size() > 0) scene.mutable_output()->set_statistics(true);
     absl::StatusOr<CheckedScene> checked = CheckScene(scene, limits);
+    if (checked.ok()) {
+      for (int k = 0; k < request.thresholds_size(); ++k) {
+        if (absl::Status s = CheckStatisticsColumn(checked->info, request.thresholds(k).column(),
+                                                   absl::StrCat("thresholds[", k, "].column"));
+            !s.ok()) {
+          return s;
+        }
+      }
+    }
     if (!checked.ok()) {
       // Name the axis values that make the item invalid.
       std::string where;
@@ -327,6 +351,37 @@ absl::StatusOr<std::vector<v1::Scene>> ExpandSweep(const v1::SubmitSweepRequest&
     scenes.push_back(std::move(scene));
   }
   return scenes;
+}
+
+}  // namespace cablesim
+
+namespace cablesim {
+
+std::vector<std::string> ThresholdFailures(
+    const google::protobuf::RepeatedPtrField<v1::SweepThreshold>& thresholds,
+    const v1::RunSummary& summary) {
+  std::vector<std::string> failures;
+  for (const v1::SweepThreshold& t : thresholds) {
+    const v1::ColumnStatistics* found = nullptr;
+    for (const v1::ColumnStatistics& c : summary.statistics().columns()) {
+      if (c.column() == t.column()) found = &c;
+    }
+    if (found == nullptr || found->count() == 0) {
+      failures.push_back(absl::StrCat(t.column(), ": no statistics in the item's summary"));
+      continue;
+    }
+    if (t.has_max() && !(found->max() <= t.max())) {
+      failures.push_back(absl::StrCat(t.column(), " max ", absl::StrFormat("%.9g", found->max()),
+                                      " at t = ", absl::StrFormat("%.9g", found->max_t()),
+                                      " s exceeds ", absl::StrFormat("%.9g", t.max())));
+    }
+    if (t.has_min() && !(found->min() >= t.min())) {
+      failures.push_back(absl::StrCat(t.column(), " min ", absl::StrFormat("%.9g", found->min()),
+                                      " at t = ", absl::StrFormat("%.9g", found->min_t()),
+                                      " s is below ", absl::StrFormat("%.9g", t.min())));
+    }
+  }
+  return failures;
 }
 
 }  // namespace cablesim

@@ -109,6 +109,12 @@ absl::StatusOr<RunSummary> RunSceneWithinMemory(CheckedScene* checked, FrameSink
 absl::Status CheckStringLengths(const google::protobuf::Message& message,
                                 const ServerLimits& limits, const std::string& prefix = "");
 
+// The broken thresholds of a finished sweep item with `summary`, one line
+// each (SweepItem.threshold_failures), in the order of `thresholds`.
+std::vector<std::string> ThresholdFailures(
+    const google::protobuf::RepeatedPtrField<v1::SweepThreshold>& thresholds,
+    const v1::RunSummary& summary);
+
 // The items of a sweep (cartesian product, last axis fastest), each
 // checked with CheckScene; `end_times_s` receives each item's end time.
 absl::StatusOr<std::vector<v1::Scene>> ExpandSweep(const v1::SubmitSweepRequest& request,

@@ -493,6 +493,7 @@ absl::StatusOr<v1::Sweep> SqliteJobStore::InsertSweep(const v1::SubmitSweepReque
     if (!sweep_pid.ok()) return rollback(sweep_pid.status());
     v1::Sweep axes;
     *axes.mutable_axes() = request.axes();
+    *axes.mutable_thresholds() = request.thresholds();  // kept with the axes
     const std::string axes_blob = axes.SerializeAsString();
     const int64_t now = NowUnixMs();
     {

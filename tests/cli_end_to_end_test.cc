@@ -16,6 +16,7 @@
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "cablesim/version.h"
+#include "tests/process_util.h"
 
 namespace cablesim {
 namespace {
@@ -33,23 +34,8 @@ constexpr char kCableEnergyColumns[] =
     "cables[0].energy.bending";
 constexpr char kLoadsColumn[] = "loads.energy.potential";
 
-struct Process {
-  int exit_code = -1;
-  std::string out;
-};
-
-// Runs `command` with /bin/sh, capturing its stdout (stderr passes through).
-Process RunCommand(const std::string& command) {
-  Process result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return result;
-  char buffer[4096];
-  size_t n;
-  while ((n = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0) result.out.append(buffer, n);
-  const int status = pclose(pipe);
-  if (status != -1 && WIFEXITED(status)) result.exit_code = WEXITSTATUS(status);
-  return result;
-}
+using ::cablesim::testing::Process;
+using ::cablesim::testing::RunCommand;
 
 std::string ProbeColumns(const std::string& name) {
   std::vector<std::string> columns;

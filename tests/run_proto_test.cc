@@ -58,6 +58,12 @@ RunSummary EveryFieldSet() {
   s.error_estimate_m = 0.032;
   s.error_estimate_method = "richardson";
   s.error_estimate_seconds = 0.033;
+  s.has_statistics = true;
+  s.statistics.columns = {{"tip.y", 43, -0.44, 0.45, 0.046, 0.047, -0.048, 0.049},
+                          {"energy.total", 43, 1.5, 0.1, 2.5, 0.2, 2.0, 0.3}};
+  s.statistics.sn_slope = 3.5;
+  s.statistics.equivalent_cycles = 1e7;
+  s.statistics.rainflow = {{"tip.y", 4.5, 3, 0.51, 0.052}};
   return s;
 }
 
@@ -66,6 +72,36 @@ TEST(RunProtoTest, SummaryRoundTripKeepsEveryKeyOfTheSummaryLine) {
   EXPECT_EQ(SummaryToJson(SummaryFromProto(SummaryToProto(s))), SummaryToJson(s));
   s.analysis = "MODAL";  // frequencies_hz is printed for MODAL only
   EXPECT_EQ(SummaryToJson(SummaryFromProto(SummaryToProto(s))), SummaryToJson(s));
+  EXPECT_NE(SummaryToJson(s).find(
+                R"("statistics":{"columns":[{"column":"tip.y","count":43,"min":-0.44,"min_t":0.45,)"
+                R"("max":0.046,"max_t":0.047,"mean":-0.048,"stddev":0.049},)"),
+            std::string::npos)
+      << SummaryToJson(s);
+  EXPECT_NE(SummaryToJson(s).find(
+                R"("sn_slope":3.5,"equivalent_cycles":1e+07,"rainflow":[{"column":"tip.y",)"
+                R"("cycles":4.5,"half_cycles":3,"max_range":0.51,"damage_equivalent_load":0.052}]}})"),
+            std::string::npos)
+      << SummaryToJson(s);
+}
+
+// Every field of the statistics reaches the proto, and back.
+TEST(RunProtoTest, StatisticsCarryEveryField) {
+  const v1::RunStatistics p = StatisticsToProto(EveryFieldSet().statistics);
+  for (const google::protobuf::Message* m :
+       {static_cast<const google::protobuf::Message*>(&p),
+        static_cast<const google::protobuf::Message*>(&p.columns(0)),
+        static_cast<const google::protobuf::Message*>(&p.rainflow(0))}) {
+    const auto* d = m->GetDescriptor();
+    for (int i = 0; i < d->field_count(); ++i) {
+      const auto* f = d->field(i);
+      if (f->is_repeated()) {
+        EXPECT_GT(m->GetReflection()->FieldSize(*m, f), 0) << f->full_name();
+      } else {
+        EXPECT_TRUE(m->GetReflection()->HasField(*m, f)) << f->full_name();
+      }
+    }
+  }
+  EXPECT_EQ(StatisticsToProto(StatisticsFromProto(p)).SerializeAsString(), p.SerializeAsString());
 }
 
 TEST(RunProtoTest, ProtoCarriesEveryFieldTheStructHas) {

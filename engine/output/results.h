@@ -129,6 +129,36 @@ class FrameSink {
   virtual absl::Status OnFrame(const Frame& frame) = 0;
 };
 
+// The statistics of one frame column (engine/output/frame_columns.h) over
+// the frames of a run, in the column's unit; times are Frame::t (the load
+// factor for STATIC). The first frame holding the extreme gives its time.
+struct ColumnStatistics {
+  std::string column;
+  int64_t count = 0;  // frames
+  double min = 0, min_t = 0;
+  double max = 0, max_t = 0;
+  double mean = 0;    // over frames (a time mean when frames are evenly spaced)
+  double stddev = 0;  // population standard deviation over frames
+};
+
+// Rainflow counting (ASTM E1049-85 5.4.4) of one column's frame series.
+struct RainflowStatistics {
+  std::string column;
+  double cycles = 0;       // full cycles, a half cycle counting 0.5
+  double half_cycles = 0;  // how many half cycles (each adds 0.5 to cycles)
+  double max_range = 0;    // largest counted range
+  // (sum n_i S_i^m / N_eq)^(1/m), S_i the ranges, n_i their counts.
+  double damage_equivalent_load = 0;
+};
+
+// output.statistics and output.rainflow (engine/output/run_statistics.h).
+struct RunStatistics {
+  std::vector<ColumnStatistics> columns;  // frame column order, `t` left out
+  double sn_slope = 0;                    // of the rainflow's DEL
+  double equivalent_cycles = 0;
+  std::vector<RainflowStatistics> rainflow;  // in output.rainflow.columns order
+};
+
 struct RunSummary {
   std::string status = "ok";  // "ok", "failed" or "cancelled"
   std::string error;          // why, when not ok (with the time)
@@ -185,6 +215,9 @@ struct RunSummary {
   double error_estimate_m = -1;
   std::string error_estimate_method;
   double error_estimate_seconds = 0;  // wall time of the companion run
+  // output.statistics or output.rainflow: what the frames say.
+  bool has_statistics = false;
+  RunStatistics statistics;
 };
 
 }  // namespace cablesim

@@ -8,6 +8,7 @@
 #include "engine/analysis/modal_solver.h"
 #include "engine/linear/saddle_point_solver.h"
 #include "engine/model/multibody_model.h"
+#include "engine/output/run_statistics.h"
 #include "engine/run/dynamic_run.h"
 #include "engine/run/error_estimate.h"
 #include "engine/run/frame_recorder.h"
@@ -50,6 +51,10 @@ absl::StatusOr<PreparedRun> Prepare(const Scene& scene,
   }
   PreparedRun prepared;
   ModelInfo info = built->Info();
+  if (absl::Status s = CheckStatisticsSpec(scene.output, info,
+                                           scene.solver.analysis == Analysis::kModal);
+      !s.ok())
+    return s;
   prepared.model_.reset(new PreparedModel{scene, std::move(*built), std::move(info), modes,
                                           std::chrono::duration<double>(Clock::now() - start).count(),
                                           false});
@@ -101,6 +106,13 @@ absl::StatusOr<RunSummary> RunPrepared(PreparedRun* prepared, FrameSink* sink,
   if (TraitsOf(settings.integrator).has_rho_infinity)
     summary.rho_infinity = settings.rho_infinity;
   const bool estimate = settings.analysis == Analysis::kDynamic && settings.error_estimate;
+  // output.statistics, output.rainflow: a sink in front of the caller's
+  // (none otherwise, so that a run without them costs nothing more).
+  std::unique_ptr<StatisticsSink> statistics;
+  if (WantsStatistics(scene.output) && settings.analysis != Analysis::kModal) {
+    statistics = std::make_unique<StatisticsSink>(sink, scene.output);
+    sink = statistics.get();
+  }
   ProbeRecordingSink recording(sink);
   FrameSink* out = estimate ? &recording : sink;
   if (absl::Status s = out->OnStart(summary.info); !s.ok()) return s;
@@ -123,6 +135,10 @@ absl::StatusOr<RunSummary> RunPrepared(PreparedRun* prepared, FrameSink* sink,
         summary.error_estimate_method = "none: the run did not finish";
       }
     }
+  }
+  if (statistics != nullptr) {
+    summary.has_statistics = true;
+    summary.statistics = statistics->Finish();
   }
   if (settings.analysis == Analysis::kDynamic)
     summary.energy_dissipated =

@@ -330,9 +330,24 @@ struct SolverSettings {
 };
 
 // What a run writes besides the probes and energies.
+// Rainflow cycle counting of chosen frame columns (ASTM E1049-85 5.4.4) and
+// their damage-equivalent load (engine/output/run_statistics.h).
+struct RainflowSpec {
+  // Frame column names (engine/output/frame_columns.h), e.g. "top.fz".
+  std::vector<std::string> columns;
+  // S-N slope m (> 0) and the reference cycle count N_eq (> 0) of
+  // DEL = (sum n_i S_i^m / N_eq)^(1/m).
+  double sn_slope = 0;
+  double equivalent_cycles = 0;
+};
+
 struct OutputSpec {
   // Every cable node's position in every frame (Frame::nodes).
   bool shape = false;
+  // Per frame column, minimum, maximum (with their times), mean and standard
+  // deviation over the run's frames (RunSummary::statistics).
+  bool statistics = false;
+  RainflowSpec rainflow;
 };
 
 struct Scene {
