@@ -32,6 +32,7 @@
 #include "absl/strings/ascii.h"
 #include "cablesim/version.h"
 #include "server/cablesim_server.h"
+#include "server/listen_address.h"
 #include "server/metrics_endpoint.h"
 
 ABSL_FLAG(std::string, listen, "127.0.0.1:50051", "host:port to listen on (port 0: any free)");
@@ -254,17 +255,20 @@ int main(int argc, char** argv) {
     }
   }
   // Beyond loopback, only with TLS and tokens (or when told it is fine).
+  // The address is resolved once, here: the check looks at the address
+  // bound, not at how its name is spelled (127.evil.example is not local).
   {
-    std::string host = options.listen.substr(0, options.listen.rfind(':'));
-    const bool loopback = absl::StartsWith(host, "127.") || host == "localhost" ||
-                          host == "[::1]" || absl::StartsWith(options.listen, "unix:");
-    if (!loopback && (options.tls_cert_pem.empty() || options.tokens.empty()) &&
+    absl::StatusOr<cablesim::ListenAddress> listen =
+        cablesim::ResolveListenAddress(options.listen);
+    if (!listen.ok()) return UsageError(std::string(listen.status().message()));
+    if (!listen->loopback && (options.tls_cert_pem.empty() || options.tokens.empty()) &&
         !absl::GetFlag(FLAGS_insecure)) {
       return UsageError(absl::StrCat(
-          "--listen ", options.listen,
-          ": beyond loopback the server needs --tls-cert/--tls-key and --token-file "
+          "--listen ", options.listen, " (", listen->bind,
+          "): beyond loopback the server needs --tls-cert/--tls-key and --token-file "
           "(or --insecure, to accept anyone who can reach the port)"));
     }
+    options.listen = listen->bind;
   }
   // Only the tests set this (tests/server_test_util.h); no flag, so it is
   // not offered in --help, and it is announced loudly when present.

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "client/cli.h"
+#include "server/listen_address.h"
 #include "server_test_util.h"
 
 namespace cablesim {
@@ -271,6 +272,62 @@ TEST(ServerAuthTest, BeyondLoopbackOnlyWithTlsAndTokensOrInsecure) {
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 2);
   EXPECT_THAT(ReadText(log), HasSubstr("--insecure"));
+}
+
+// The review's reproducer: --listen 127.evil.example:PORT passed a check on
+// the spelling ("starts with 127.") and bound whatever the name resolved
+// to, in plain text. Now the name is resolved first and the address it
+// resolves to decides.
+TEST(ServerAuthTest, ALoopbackLookingNameIsJudgedByTheAddressItResolvesTo) {
+  auto resolver = [](const std::string& host) -> absl::StatusOr<std::vector<std::string>> {
+    if (host == "127.evil.example") return std::vector<std::string>{"203.0.113.7"};
+    if (host == "localhost") return std::vector<std::string>{"127.0.0.1", "::1"};
+    if (host == "sixlocal") return std::vector<std::string>{"::1"};
+    if (host == "mapped") return std::vector<std::string>{"::ffff:127.0.0.2"};
+    if (host == "nothing") return std::vector<std::string>{};
+    return std::vector<std::string>{host};  // numeric
+  };
+  absl::StatusOr<ListenAddress> evil = ResolveListenAddress("127.evil.example:5000", resolver);
+  ASSERT_TRUE(evil.ok()) << evil.status();
+  EXPECT_FALSE(evil->loopback);
+  EXPECT_EQ(evil->bind, "203.0.113.7:5000");  // bound to what was checked, not re-resolved
+  absl::StatusOr<ListenAddress> local = ResolveListenAddress("localhost:0", resolver);
+  ASSERT_TRUE(local.ok());
+  EXPECT_TRUE(local->loopback);
+  EXPECT_EQ(local->bind, "127.0.0.1:0");
+  EXPECT_TRUE(ResolveListenAddress("sixlocal:7", resolver)->loopback);
+  EXPECT_EQ(ResolveListenAddress("sixlocal:7", resolver)->bind, "[::1]:7");
+  EXPECT_TRUE(ResolveListenAddress("mapped:7", resolver)->loopback);
+  EXPECT_TRUE(ResolveListenAddress("[::1]:7", resolver)->loopback);
+  EXPECT_TRUE(ResolveListenAddress("127.0.0.9:7", resolver)->loopback);
+  EXPECT_FALSE(ResolveListenAddress("0.0.0.0:7", resolver)->loopback);
+  EXPECT_FALSE(ResolveListenAddress("[::]:7", resolver)->loopback);
+  EXPECT_FALSE(ResolveListenAddress("128.0.0.1:7", resolver)->loopback);
+  EXPECT_TRUE(ResolveListenAddress("unix:/tmp/sock", resolver)->loopback);
+  EXPECT_THAT(ResolveListenAddress("nothing:7", resolver).status().message(),
+              HasSubstr("resolves to no address"));
+  EXPECT_FALSE(ResolveListenAddress("127.0.0.1:http", resolver).ok());
+  EXPECT_FALSE(ResolveListenAddress("127.0.0.1", resolver).ok());
+  // The real resolver: localhost is loopback after resolution.
+  absl::StatusOr<ListenAddress> real = ResolveListenAddress("localhost:0");
+  ASSERT_TRUE(real.ok()) << real.status();
+  EXPECT_TRUE(real->loopback);
+}
+
+// The binary refuses 127.evil.example: it either does not resolve (this
+// machine has no DNS) or resolves to something that is not loopback;
+// usage error (2) either way, before anything is bound.
+TEST(ServerAuthTest, TheServerRefusesALoopbackLookingName) {
+  const std::string dir = testing::FreshDir("auth_evil");
+  const std::string log = dir + "/refused.log";
+  const int status = std::system(
+      absl::StrCat("timeout 60 '", CABLESIM_BIN_DIR,
+                   "/cablesim-server' --listen=127.evil.example:0 --data-dir='", dir, "' 2>'",
+                   log, "'")
+          .c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 2) << ReadText(log);
+  EXPECT_THAT(ReadText(log), HasSubstr("--listen 127.evil.example:0"));
 }
 
 }  // namespace
