@@ -10,6 +10,7 @@
 // (useful with port 0) is written to that file once the server serves.
 
 #include <signal.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -27,6 +28,7 @@
 #include "absl/flags/reflection.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
 #include "absl/strings/ascii.h"
@@ -231,6 +233,17 @@ int main(int argc, char** argv) {
     }
   }
   if (!token_file.empty()) {
+    // The tokens are passwords: a file that others can read is refused
+    // (as ssh does with a private key), naming the file and its mode.
+    struct stat info;
+    if (::stat(token_file.c_str(), &info) == 0 && (info.st_mode & (S_IRWXG | S_IRWXO)) != 0) {
+      std::cerr << "cablesim-server: " << token_file << ": mode "
+                << absl::StrFormat("%04o", info.st_mode & 07777)
+                << " lets its group or others read or change the tokens; "
+                   "make it readable by its owner only (chmod 600 "
+                << token_file << ")\n";
+      return 1;
+    }
     std::string text;
     if (!read_file(token_file, &text)) {
       std::cerr << "cablesim-server: cannot read " << token_file << "\n";

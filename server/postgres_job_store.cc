@@ -81,10 +81,19 @@ ALTER TABLE results ADD COLUMN encoding INTEGER NOT NULL DEFAULT 0;  -- 0: raw d
 // An arbitrary constant: the advisory lock under which migrations run.
 constexpr int64_t kMigrationLock = 0x63626c73696d;  // "cblsim"
 
+std::string ConnectionError(PGconn* conn) {
+  std::string text = conn != nullptr ? PQerrorMessage(conn) : "out of memory";
+  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+  return text;
+}
+
 // A query result (binary format); cleared on destruction.
 class PgResult {
  public:
-  explicit PgResult(PGresult* r) : r_(r) {}
+  // `conn`: the connection that gave `r`, for its error message when `r`
+  // is null (the connection lost or never made, or out of memory).
+  PgResult(PGresult* r, PGconn* conn)
+      : r_(r), no_result_(r == nullptr ? ConnectionError(conn) : std::string()) {}
   ~PgResult() { PQclear(r_); }
   PgResult(const PgResult&) = delete;
   PgResult& operator=(const PgResult&) = delete;
@@ -95,8 +104,13 @@ class PgResult {
   }
   absl::Status status() const {
     if (ok()) return absl::OkStatus();
-    const char* message = r_ != nullptr ? PQresultErrorMessage(r_) : "no result (out of memory?)";
-    std::string text = message != nullptr ? message : "error";
+    std::string text;
+    if (r_ == nullptr) {
+      text = absl::StrCat("the database is unreachable: ", no_result_);
+    } else {
+      const char* message = PQresultErrorMessage(r_);
+      text = message != nullptr ? message : "error";
+    }
     while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
     // Lost connection, or the database shutting down: try again later.
     const char* state = r_ != nullptr ? PQresultErrorField(r_, PG_DIAG_SQLSTATE) : nullptr;
@@ -148,6 +162,7 @@ class PgResult {
 
  private:
   PGresult* r_;
+  std::string no_result_;
 };
 
 // Query parameters: numbers and text as text, blobs as binary.
@@ -161,15 +176,17 @@ class Params {
     return Add(std::string(static_cast<const char*>(data), bytes), 1);
   }
 
-  PGresult* Run(PGconn* conn, const std::string& sql) const {
+  PgResult Run(PGconn* conn, const std::string& sql) const {
     std::vector<const char*> values;
     std::vector<int> lengths;
     for (const std::string& v : values_) {
       values.push_back(v.data());
       lengths.push_back(static_cast<int>(v.size()));
     }
-    return PQexecParams(conn, sql.c_str(), static_cast<int>(values_.size()), nullptr,
-                        values.data(), lengths.data(), formats_.data(), /*resultFormat=*/1);
+    return PgResult(PQexecParams(conn, sql.c_str(), static_cast<int>(values_.size()), nullptr,
+                                 values.data(), lengths.data(), formats_.data(),
+                                 /*resultFormat=*/1),
+                    conn);
   }
 
  private:
@@ -187,7 +204,7 @@ class Params {
 class Transaction {
  public:
   explicit Transaction(PGconn* conn) : conn_(conn) {
-    PgResult r(PQexec(conn_, "BEGIN"));
+    PgResult r(PQexec(conn_, "BEGIN"), conn_);
     begun_ = r.status();
   }
   ~Transaction() {
@@ -196,7 +213,7 @@ class Transaction {
   const absl::Status& begun() const { return begun_; }
   absl::Status Commit() {
     done_ = true;
-    PgResult r(PQexec(conn_, "COMMIT"));
+    PgResult r(PQexec(conn_, "COMMIT"), conn_);
     return r.status();
   }
 
@@ -239,12 +256,6 @@ v1::Job JobFromRow(const PgResult& r, int row) {
 std::string DescribeConnection(PGconn* conn) {
   return absl::StrCat("postgresql://", PQuser(conn), "@", PQhost(conn), ":", PQport(conn), "/",
                       PQdb(conn));
-}
-
-std::string ConnectionError(PGconn* conn) {
-  std::string text = conn != nullptr ? PQerrorMessage(conn) : "out of memory";
-  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
-  return text;
 }
 
 constexpr char kFinishedStates[] = "(3, 4, 5)";  // SUCCEEDED, FAILED, CANCELLED
@@ -308,7 +319,7 @@ void PostgresJobStore::EnsureConnected() {
 }
 
 absl::Status PostgresJobStore::Exec(const std::string& sql) {
-  PgResult r(PQexec(conn_, sql.c_str()));
+  PgResult r(PQexec(conn_, sql.c_str()), conn_);
   return r.status();
 }
 
@@ -371,7 +382,7 @@ void PostgresJobStore::Listen() {
     if (conn == nullptr || PQstatus(conn) != CONNECTION_OK) {
       PQfinish(conn);
       conn = PQconnectdb(url_.c_str());
-      PgResult r(PQexec(conn, "LISTEN cablesim"));
+      PgResult r(PQexec(conn, "LISTEN cablesim"), conn);
       if (!r.ok()) {
         // The database is away: the workers' polls carry on meanwhile.
         absl::SleepFor(absl::Milliseconds(500));

@@ -6,12 +6,15 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
 #include <sstream>
 #include <string>
 
+#include "absl/strings/str_format.h"
 #include "client/cli.h"
 #include "server/listen_address.h"
 #include "server_test_util.h"
@@ -40,7 +43,7 @@ grpc::Status Info(v1::CablesimService::Stub* stub, const std::string& token = ""
 TEST(ServerAuthTest, ACallWithoutAKnownTokenIsUnauthenticated) {
   const std::string dir = testing::FreshDir("auth_tokens");
   const std::string tokens = dir + "/tokens";
-  std::ofstream(tokens) << "# token tenant\n" << kToken << " alice\n";
+  testing::WritePrivateFile(tokens, absl::StrCat("# token tenant\n", kToken, " alice\n"));
   ServerProcess server(dir, {"--token-file=" + tokens});
   auto stub = server.Stub();
   grpc::Status s = Info(stub.get());
@@ -64,7 +67,7 @@ TEST(ServerAuthTest, ATenantSeesOnlyItsOwnJobsAndSweeps) {
   const std::string dir = testing::FreshDir("auth_tenants");
   const std::string tokens = dir + "/tokens";
   const std::string alice = kToken, bob = "tok-bob-0123456789ab";
-  std::ofstream(tokens) << alice << " alice\n" << bob << " bob\n";
+  testing::WritePrivateFile(tokens, absl::StrCat(alice, " alice\n", bob, " bob\n"));
   ServerProcess server(dir, {"--token-file=" + tokens, "--workers=1"});
   auto stub = server.Stub();
   auto as = [](grpc::ClientContext* context, const std::string& token) {
@@ -245,7 +248,7 @@ TEST(ServerAuthTest, TheCommandLineTakesTlsCaAndTokenFile) {
   const std::string dir = testing::FreshDir("auth_cli");
   MakeCertificates(dir);
   const std::string tokens = dir + "/tokens", mine = dir + "/my-token";
-  std::ofstream(tokens) << kToken << " alice\n";
+  testing::WritePrivateFile(tokens, absl::StrCat(kToken, " alice\n"));
   std::ofstream(mine) << "# issued to alice\n" << kToken << "\n";
   ServerProcess server(dir, {"--tls-cert=" + dir + "/server.pem",
                              "--tls-key=" + dir + "/server.key", "--token-file=" + tokens});
@@ -328,6 +331,31 @@ TEST(ServerAuthTest, TheServerRefusesALoopbackLookingName) {
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 2) << ReadText(log);
   EXPECT_THAT(ReadText(log), HasSubstr("--listen 127.evil.example:0"));
+}
+
+// A token file that its group or others can read is refused, naming the
+// file and its mode (the review found a world-readable one accepted
+// silently); the same file made private is accepted.
+TEST(ServerAuthTest, ATokenFileOthersCanReadIsRefused) {
+  const std::string dir = testing::FreshDir("auth_token_mode");
+  const std::string tokens = dir + "/tokens", log = dir + "/refused.log";
+  testing::WritePrivateFile(tokens, absl::StrCat(kToken, " alice\n"));
+  for (const int mode : {0644, 0640, 0604}) {
+    ASSERT_EQ(::chmod(tokens.c_str(), mode), 0);
+    const int status = std::system(
+        absl::StrCat("timeout 60 '", CABLESIM_BIN_DIR,
+                     "/cablesim-server' --listen=127.0.0.1:0 --data-dir='", dir,
+                     "' --token-file='", tokens, "' 2>'", log, "'")
+            .c_str());
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 1) << mode;
+    EXPECT_THAT(ReadText(log), HasSubstr(tokens + ": mode 0" + absl::StrFormat("%o", mode)));
+    EXPECT_THAT(ReadText(log), HasSubstr("chmod 600"));
+  }
+  ASSERT_EQ(::chmod(tokens.c_str(), 0600), 0);
+  ServerProcess server(dir, {"--token-file=" + tokens});
+  auto stub = server.Stub();
+  EXPECT_TRUE(Info(stub.get(), kToken).ok());
 }
 
 }  // namespace

@@ -223,7 +223,7 @@ TEST_P(ServerPageTokenTest, AnotherTenantsTokenIsRefused) {
   if (skipped_) GTEST_SKIP() << "PostgreSQL is not installed";
   const std::string dir = testing::FreshDir("page_tenant_" + GetParam());
   const std::string alice = "tok-alice-0123456789", bob = "tok-bob-0123456789ab";
-  std::ofstream(dir + "/tokens") << alice << " alice\n" << bob << " bob\n";
+  testing::WritePrivateFile(dir + "/tokens", absl::StrCat(alice, " alice\n", bob, " bob\n"));
   flags.push_back("--token-file=" + dir + "/tokens");
   ServerProcess server(dir, flags);
   auto stub = server.Stub();
