@@ -119,6 +119,25 @@ absl::StatusOr<v1::Scene> SceneOfRequest(bool has_scene, const v1::Scene& scene,
   return parsed;
 }
 
+ServerLimits DefaultServerLimits() {
+  ServerLimits limits;
+  limits.max_elements = 5000;
+  limits.max_steps = 5'000'000;
+  limits.max_frames = 200'000;
+  limits.max_trajectory_values = 32 << 20;
+  limits.max_sweep_items = 1000;
+  limits.max_streams = 64;
+  limits.max_streams_per_peer = 16;
+  limits.max_queued_jobs_per_peer = 1000;
+  limits.max_modes = 200;
+  limits.max_modal_bytes = int64_t{1} << 30;
+  limits.max_name_bytes = 256;
+  limits.max_coordinates = 1'000'000;
+  limits.max_message_bytes = 16 << 20;
+  limits.stall_timeout = absl::Seconds(30);
+  return limits;
+}
+
 absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimits& limits,
                                         const std::function<bool()>& should_stop) {
   CheckedScene checked;

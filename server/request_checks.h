@@ -56,6 +56,10 @@ struct ServerLimits {
   int64_t retention_max_bytes = std::numeric_limits<int64_t>::max();
 };
 
+// The limits cablesim-server applies by default (its flags' defaults) and
+// `cablesim` applies to its in-process runs unless --no-limits.
+ServerLimits DefaultServerLimits();
+
 struct CheckedScene {
   Scene scene;
   // The model CheckScene built to cost the scene; a Run or GetEnergy call

@@ -16,6 +16,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "postgres_test_util.h"
+#include "server/request_checks.h"
 #include "server_test_util.h"
 
 namespace cablesim {
@@ -62,6 +63,39 @@ TEST(ServerHardeningTest, DatabaseDownIsLoggedAsSuchAndRateLimited) {
   EXPECT_THAT(log, Not(HasSubstr("out of memory")));
   EXPECT_LE(CountLines(log, "the job store is unreachable"), 2) << log;
   EXPECT_EQ(CountLines(log, "claiming a job"), 0) << log;
+}
+
+// The limits `cablesim` applies in-process (DefaultServerLimits) are the
+// server's flags' defaults: its --help lists the same numbers.
+TEST(ServerHardeningTest, TheServersFlagDefaultsAreDefaultServerLimits) {
+  const std::string dir = testing::FreshDir("help_defaults");
+  ASSERT_EQ(std::system(absl::StrCat("'", CABLESIM_BIN_DIR, "/cablesim-server' --help >'", dir,
+                                     "/help'")
+                            .c_str()),
+            0);
+  const std::string help = ReadText(dir + "/help");
+  const ServerLimits l = DefaultServerLimits();
+  const std::vector<std::pair<std::string, int64_t>> flags = {
+      {"max-elements", l.max_elements},
+      {"max-steps", l.max_steps},
+      {"max-frames", l.max_frames},
+      {"max-trajectory-values", l.max_trajectory_values},
+      {"max-sweep-items", l.max_sweep_items},
+      {"max-streams", l.max_streams},
+      {"max-streams-per-peer", l.max_streams_per_peer},
+      {"max-queued-jobs-per-peer", l.max_queued_jobs_per_peer},
+      {"max-modes", l.max_modes},
+      {"max-modal-bytes", l.max_modal_bytes},
+      {"max-name-bytes", l.max_name_bytes},
+      {"max-coordinates", l.max_coordinates},
+      {"max-message-bytes", l.max_message_bytes},
+      {"stall-timeout-s", static_cast<int64_t>(absl::ToDoubleSeconds(l.stall_timeout))}};
+  for (const auto& [name, value] : flags) {
+    const size_t at = help.find("--" + name + "  ");
+    ASSERT_NE(at, std::string::npos) << name;
+    const std::string line = help.substr(at, help.find('\n', at) - at);
+    EXPECT_THAT(line, HasSubstr(absl::StrCat("(default: ", value, ")"))) << line;
+  }
 }
 
 }  // namespace
