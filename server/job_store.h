@@ -76,6 +76,17 @@ struct StoreOptions {
   bool notifications = true;
 };
 
+// The claim order of both stores (SQL for SQLite and PostgreSQL alike,
+// over `jobs j`): first the jobs of the tenant (without a tenant: of the
+// client address) whose latest start is oldest, a tenant that never ran
+// anything first of all; then the oldest job. Serving whoever waited
+// longest since their last start is round-robin across tenants.
+inline constexpr char kFairShareOrder[] =
+    "(CASE WHEN j.tenant <> '' "
+    "THEN (SELECT COALESCE(MAX(s.started_ms), 0) FROM jobs s WHERE s.tenant = j.tenant) "
+    "ELSE (SELECT COALESCE(MAX(s.started_ms), 0) FROM jobs s "
+    "WHERE s.tenant = '' AND s.peer = j.peer) END), j.seq";
+
 class JobStore {
  public:
   // `spec`: `sqlite:DIR` or a bare DIR (SqliteJobStore), or a libpq URL
@@ -139,10 +150,13 @@ class JobStore {
   // Ids of QUEUED jobs, oldest first.
   virtual absl::StatusOr<std::vector<std::string>> QueuedJobIds() = 0;
 
-  // Takes the oldest QUEUED job (shared stores: or a RUNNING one whose
+  // Takes the next QUEUED job (shared stores: or a RUNNING one whose
   // lease has expired) for this store's owner: QUEUED -> RUNNING,
   // attempts + 1. Nullopt when there is none. Two claims never get the
-  // same job (shared stores: FOR UPDATE SKIP LOCKED).
+  // same job (shared stores: FOR UPDATE SKIP LOCKED). Fair share
+  // (kFairShareOrder): round-robin across tenants (without tokens, across
+  // client addresses), oldest first within one, so that one tenant's
+  // thousand queued jobs do not hold back another's one.
   virtual absl::StatusOr<std::optional<Claim>> ClaimNext() = 0;
   // QUEUED -> RUNNING (attempts + 1); false when the job was not QUEUED.
   virtual absl::StatusOr<bool> MarkRunning(const std::string& id) = 0;

@@ -76,6 +76,10 @@ ALTER TABLE jobs ADD COLUMN progress_time_s DOUBLE PRECISION NOT NULL DEFAULT 0;
     {3, "results compressed: how each row's vals are encoded (result_codec.h)", R"sql(
 ALTER TABLE results ADD COLUMN encoding INTEGER NOT NULL DEFAULT 0;  -- 0: raw doubles, 1: zstd
 )sql"},
+    {4, "fair share: the last start of each tenant's (or client's) jobs found by index", R"sql(
+CREATE INDEX IF NOT EXISTS jobs_by_tenant_start ON jobs(tenant, started_ms);
+CREATE INDEX IF NOT EXISTS jobs_by_tenant_peer_start ON jobs(tenant, peer, started_ms);
+)sql"},
 };
 
 // An arbitrary constant: the advisory lock under which migrations run.
@@ -603,17 +607,18 @@ absl::StatusOr<std::vector<std::string>> PostgresJobStore::QueuedJobIds() {
 absl::StatusOr<std::optional<Claim>> PostgresJobStore::ClaimNext() {
   absl::MutexLock lock(&mu_);
   EnsureConnected();
-  // The oldest job no live claim holds; rows another server is claiming
-  // right now are skipped, not waited for.
+  // A job no live claim holds, round-robin across tenants (JobStore::
+  // ClaimNext); rows another server is claiming right now are skipped,
+  // not waited for.
   PgResult r(Params().Text(owner_).Int(options_.lease_ms).Run(
       conn_,
       absl::StrCat("UPDATE jobs SET state = 2, owner = $1, lease_until_ms = ", kNowMs,
                    " + $2::bigint, started_ms = ", kNowMs,
                    ", attempts = attempts + 1, cancel_requested = FALSE, progress_time_s = 0 "
-                   "WHERE seq = (SELECT seq FROM jobs WHERE state = 1 OR (state = 2 AND "
+                   "WHERE seq = (SELECT seq FROM jobs j WHERE state = 1 OR (state = 2 AND "
                    "lease_until_ms < ",
-                   kNowMs,
-                   ") ORDER BY seq LIMIT 1 FOR UPDATE SKIP LOCKED) "
+                   kNowMs, ") ORDER BY ", kFairShareOrder,
+                   " LIMIT 1 FOR UPDATE SKIP LOCKED) "
                    "RETURNING pid, attempts")));
   if (!r.ok()) return r.status();
   if (r.rows() == 0) return std::nullopt;

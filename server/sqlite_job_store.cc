@@ -373,6 +373,14 @@ absl::Status SqliteJobStore::CheckAndMigrate(const std::string& dir) {
       return s;
     }
   }
+  // Fair share (kFairShareOrder): each tenant's, or client's, latest start
+  // by index.
+  if (absl::Status s = Exec(
+          "CREATE INDEX IF NOT EXISTS jobs_by_tenant_start ON jobs(tenant, started_ms); "
+          "CREATE INDEX IF NOT EXISTS jobs_by_tenant_peer_start ON jobs(tenant, peer, started_ms)");
+      !s.ok()) {
+    return s;
+  }
   {
     std::vector<std::pair<int64_t, int64_t>> sums;
     Stmt missing(db_, "SELECT job_seq, header, vals FROM results WHERE checksum IS NULL");
@@ -618,7 +626,9 @@ absl::StatusOr<std::optional<Claim>> SqliteJobStore::ClaimNext() {
   absl::MutexLock lock(&mu_);
   // One connection, one server (the flock): nothing else can claim
   // between the look and the update.
-  Stmt s(db_, "SELECT seq, pid, attempts FROM jobs WHERE state = ?1 ORDER BY seq LIMIT 1");
+  Stmt s(db_, absl::StrCat("SELECT seq, pid, attempts FROM jobs j WHERE state = ?1 ORDER BY ",
+                          kFairShareOrder, " LIMIT 1")
+                 .c_str());
   s.Bind(1, int64_t{v1::QUEUED});
   const int rc = s.Step();
   if (rc == SQLITE_DONE) return std::nullopt;
