@@ -5,6 +5,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <libpq-fe.h>
+#include <sqlite3.h>
 
 #include <chrono>
 #include <fstream>
@@ -177,6 +178,70 @@ TEST_P(FairQueueTest, AnotherTenantsJobStartsNextNotAfterTheQueue) {
 
 INSTANTIATE_TEST_SUITE_P(BothStores, FairQueueTest, ::testing::Values("sqlite", "postgresql"),
                          [](const auto& info) { return info.param; });
+
+// A damaged job row through the service: GetJob answers DATA_LOSS for
+// that job alone, ListJobs serves the others and counts it, and
+// `cablesim-server --check DIR` lists it (exit 1; 0 on a sound store).
+TEST(ServerHardeningTest, ADamagedJobRowIsDataLossAndSkippedByListJobs) {
+  const std::string dir = testing::FreshDir("damaged_row");
+  std::vector<std::string> ids;
+  {
+    ServerProcess server(dir, {"--workers=1"});
+    auto stub = server.Stub();
+    for (int i = 0; i < 3; ++i) ids.push_back(testing::Submit(stub.get(), testing::Pendulum(0.01, 1e-3, 1e-2)).id());
+    for (const std::string& id : ids) EXPECT_EQ(testing::WaitForJob(stub.get(), id), v1::SUCCEEDED);
+    server.Kill(SIGTERM);
+  }
+  const std::string check = absl::StrCat("'", CABLESIM_BIN_DIR, "/cablesim-server' --check '", dir,
+                                         "' >'", dir, "/check.txt' 2>&1");
+  int status = std::system(check.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << ReadText(dir + "/check.txt");
+  EXPECT_THAT(ReadText(dir + "/check.txt"), HasSubstr(": 0 damaged rows"));
+  // The summary of the middle job altered behind the store's back (as a
+  // flipped bit would): its checksum no longer matches.
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open((dir + "/cablesim.db").c_str(), &db), SQLITE_OK);
+  char* error = nullptr;
+  ASSERT_EQ(sqlite3_exec(db,
+                         absl::StrCat("UPDATE jobs SET row_sum = row_sum + 1 WHERE pid = '",
+                                      ids[1], "'")
+                             .c_str(),
+                         nullptr, nullptr, &error),
+            SQLITE_OK)
+      << error;
+  sqlite3_close(db);
+  status = std::system(check.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+  EXPECT_THAT(ReadText(dir + "/check.txt"), HasSubstr("damaged: job " + ids[1]));
+  EXPECT_THAT(ReadText(dir + "/check.txt"), HasSubstr(": 1 damaged rows"));
+
+  ServerProcess server(dir, {"--workers=1"});
+  auto stub = server.Stub();
+  {
+    grpc::ClientContext context;
+    v1::GetJobRequest request;
+    request.set_id(ids[1]);
+    v1::Job job;
+    const grpc::Status s = stub->GetJob(&context, request, &job);
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::DATA_LOSS);
+    EXPECT_THAT(s.error_message(), HasSubstr("fails its checksum"));
+  }
+  {
+    grpc::ClientContext context;
+    v1::GetJobRequest request;
+    request.set_id(ids[0]);
+    v1::Job job;
+    EXPECT_TRUE(stub->GetJob(&context, request, &job).ok());
+  }
+  grpc::ClientContext context;
+  v1::ListJobsRequest request;
+  v1::ListJobsResponse response;
+  ASSERT_TRUE(stub->ListJobs(&context, request, &response).ok());
+  EXPECT_EQ(response.jobs_size(), 2);
+  EXPECT_EQ(response.damaged_skipped(), 1);
+}
 
 }  // namespace
 }  // namespace cablesim
