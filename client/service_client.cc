@@ -123,6 +123,9 @@ absl::StatusOr<std::unique_ptr<Connection>> Connect(const std::optional<std::str
     options.limits.max_streams = std::numeric_limits<int>::max() / 2;
     options.limits.max_streams_per_peer = std::numeric_limits<int>::max() / 2;
     options.limits.max_queued_jobs_per_peer = std::numeric_limits<int64_t>::max();
+    options.limits.max_unary_calls = std::numeric_limits<int>::max();
+    options.limits.max_unary_calls_per_peer = std::numeric_limits<int>::max();
+    options.limits.max_inflight_bytes = std::numeric_limits<int64_t>::max();
     options.limits.stall_timeout = absl::Hours(24 * 365);
     options.log = false;
     options.workers = workers > 0 ? workers : std::max(1u, std::thread::hardware_concurrency());

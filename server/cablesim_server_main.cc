@@ -76,6 +76,14 @@ ABSL_FLAG(int64_t, max_name_bytes, 256,
           "bounded by the scene format (256)");
 ABSL_FLAG(int64_t, max_coordinates, 1'000'000, "limit: coordinates of a scene's model");
 ABSL_FLAG(int, max_message_bytes, 16 << 20, "limit: gRPC message size");
+ABSL_FLAG(int, max_unary_calls, cablesim::DefaultServerLimits().max_unary_calls,
+          "limit: scene-carrying unary calls (Validate, SubmitJob, SubmitSweep) at once");
+ABSL_FLAG(int, max_unary_calls_per_peer,
+          cablesim::DefaultServerLimits().max_unary_calls_per_peer,
+          "limit: scene-carrying unary calls at once of one client (tenant or address)");
+ABSL_FLAG(int64_t, max_inflight_bytes, cablesim::DefaultServerLimits().max_inflight_bytes,
+          "limit: memory budget of the requests in flight, each counted as 20 x its size "
+          "(the parsed scene and the model built from it)");
 ABSL_FLAG(double, retention_max_age_s, 0,
           "delete finished jobs and sweeps this many seconds after they finished (0: keep)");
 ABSL_FLAG(int64_t, retention_max_bytes, 0,
@@ -230,6 +238,9 @@ int main(int argc, char** argv) {
   limits.max_coordinates = absl::GetFlag(FLAGS_max_coordinates);
   limits.max_streams_per_peer = absl::GetFlag(FLAGS_max_streams_per_peer);
   limits.max_queued_jobs_per_peer = absl::GetFlag(FLAGS_max_queued_jobs_per_peer);
+  limits.max_unary_calls = absl::GetFlag(FLAGS_max_unary_calls);
+  limits.max_unary_calls_per_peer = absl::GetFlag(FLAGS_max_unary_calls_per_peer);
+  limits.max_inflight_bytes = absl::GetFlag(FLAGS_max_inflight_bytes);
   if (const double age = absl::GetFlag(FLAGS_retention_max_age_s); age > 0) {
     limits.retention_max_age = absl::Seconds(age);
   } else if (age < 0) {

@@ -87,6 +87,70 @@ class StreamSlot {
   std::string refusal_;
 };
 
+// Holds one scene-carrying unary call's place (ServerLimits::
+// max_unary_calls, max_unary_calls_per_peer) and its estimated memory
+// (max_inflight_bytes): a call that would go beyond any of them is
+// refused at once, naming the budget, instead of growing the server.
+class UnarySlot {
+ public:
+  UnarySlot(CablesimServiceImpl* service, const std::string& client, int64_t request_bytes)
+      : service_(service),
+        client_(client),
+        bytes_(request_bytes > std::numeric_limits<int64_t>::max() / kRequestMemoryFactor
+                   ? std::numeric_limits<int64_t>::max()
+                   : request_bytes * kRequestMemoryFactor) {
+    absl::MutexLock lock(&service_->mu_);
+    const ServerLimits& limits = service_->limits_;
+    int& mine = service_->peer_unary_calls_[client_];
+    if (service_->unary_calls_ >= limits.max_unary_calls) {
+      refusal_ = absl::StrCat("the server is already checking ", service_->unary_calls_,
+                              " scenes, its limit is ", limits.max_unary_calls,
+                              " (max_unary_calls); try again later");
+    } else if (mine >= limits.max_unary_calls_per_peer) {
+      refusal_ = absl::StrCat("this client (", client_, ") already has ", mine,
+                              " scenes being checked, the server's limit is ",
+                              limits.max_unary_calls_per_peer,
+                              " (max_unary_calls_per_peer); try again later");
+    } else if (bytes_ > limits.max_inflight_bytes - service_->inflight_bytes_) {
+      refusal_ = absl::StrCat(
+          "this request would hold about ", bytes_, " bytes while it is checked (",
+          kRequestMemoryFactor, " x its ", request_bytes, " bytes) with ",
+          service_->inflight_bytes_, " bytes already held by requests in flight: over the "
+          "server's memory budget of ", limits.max_inflight_bytes,
+          " bytes (max_inflight_bytes); try again later");
+    }
+    acquired_ = refusal_.empty();
+    if (acquired_) {
+      ++service_->unary_calls_;
+      ++mine;
+      service_->inflight_bytes_ += bytes_;
+    } else if (mine == 0) {
+      service_->peer_unary_calls_.erase(client_);
+    }
+  }
+  ~UnarySlot() {
+    if (!acquired_) return;
+    absl::MutexLock lock(&service_->mu_);
+    --service_->unary_calls_;
+    if (--service_->peer_unary_calls_[client_] == 0) service_->peer_unary_calls_.erase(client_);
+    service_->inflight_bytes_ -= bytes_;
+  }
+  UnarySlot(const UnarySlot&) = delete;
+  UnarySlot& operator=(const UnarySlot&) = delete;
+  // OK, or RESOURCE_EXHAUSTED naming the budget.
+  grpc::Status status() const {
+    return acquired_ ? grpc::Status::OK
+                     : grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, refusal_);
+  }
+
+ private:
+  CablesimServiceImpl* service_;
+  const std::string client_;
+  const int64_t bytes_;
+  bool acquired_ = false;
+  std::string refusal_;
+};
+
 namespace {
 
 int64_t NowNs() {
@@ -318,6 +382,9 @@ grpc::Status CablesimServiceImpl::Validate(grpc::ServerContext* context,
                                            v1::ValidateResponse* response) {
   std::string tenant;
   if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
+  UnarySlot slot(this, ClientKey(context, tenant),
+                 static_cast<int64_t>(request->ByteSizeLong()));
+  if (grpc::Status held = slot.status(); !held.ok()) return held;
   // The same checks as Run and SubmitJob, limits included (so a scene the
   // server would refuse is never called valid, and costs no more to
   // validate than to refuse).
@@ -387,6 +454,9 @@ grpc::Status CablesimServiceImpl::SubmitJob(grpc::ServerContext* context,
                                             v1::Job* response) {
   std::string tenant;
   if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
+  UnarySlot slot(this, ClientKey(context, tenant),
+                 static_cast<int64_t>(request->ByteSizeLong()));
+  if (grpc::Status held = slot.status(); !held.ok()) return held;
   if (jobs_ == nullptr) return NoJobs();
   const absl::StatusOr<v1::Scene> scene =
       SceneOfRequest(request->has_scene(), request->scene(), request->scene_json());
@@ -607,6 +677,9 @@ grpc::Status CablesimServiceImpl::SubmitSweep(grpc::ServerContext* context,
                                               v1::Sweep* response) {
   std::string tenant;
   if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
+  UnarySlot slot(this, ClientKey(context, tenant),
+                 static_cast<int64_t>(request->ByteSizeLong()));
+  if (grpc::Status held = slot.status(); !held.ok()) return held;
   if (jobs_ == nullptr) return NoJobs();
   v1::SubmitSweepRequest submitted = *request;
   if (!request->base_json().empty()) {

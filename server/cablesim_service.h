@@ -108,7 +108,14 @@ class CablesimServiceImpl final : public v1::CablesimService::Service {
   bool stop_ ABSL_GUARDED_BY(mu_) = false;
   std::thread watchdog_;
 
+  // Scene-carrying unary calls in progress, in all and per client, and
+  // the memory they are estimated to hold (UnarySlot).
+  int unary_calls_ ABSL_GUARDED_BY(mu_) = 0;
+  std::map<std::string, int> peer_unary_calls_ ABSL_GUARDED_BY(mu_);
+  int64_t inflight_bytes_ ABSL_GUARDED_BY(mu_) = 0;
+
   friend class StreamSlot;
+  friend class UnarySlot;
 };
 
 }  // namespace cablesim

@@ -135,6 +135,9 @@ ServerLimits DefaultServerLimits() {
   limits.max_coordinates = 1'000'000;
   limits.max_message_bytes = 16 << 20;
   limits.stall_timeout = absl::Seconds(30);
+  limits.max_unary_calls = 64;
+  limits.max_unary_calls_per_peer = 16;
+  limits.max_inflight_bytes = int64_t{1} << 30;
   return limits;
 }
 
