@@ -84,6 +84,9 @@ ABSL_FLAG(int, max_unary_calls_per_peer,
 ABSL_FLAG(int64_t, max_inflight_bytes, cablesim::DefaultServerLimits().max_inflight_bytes,
           "limit: memory budget of the requests in flight, each counted as 20 x its size "
           "(the parsed scene and the model built from it)");
+ABSL_FLAG(int64_t, max_work_units, cablesim::DefaultServerLimits().max_work_units,
+          "limit: a run's work, steps x (elements x Gauss points x (1 + wave components) + "
+          "contact points + sheave wraps)");
 ABSL_FLAG(double, retention_max_age_s, 0,
           "delete finished jobs and sweeps this many seconds after they finished (0: keep)");
 ABSL_FLAG(int64_t, retention_max_bytes, 0,
@@ -241,6 +244,7 @@ int main(int argc, char** argv) {
   limits.max_unary_calls = absl::GetFlag(FLAGS_max_unary_calls);
   limits.max_unary_calls_per_peer = absl::GetFlag(FLAGS_max_unary_calls_per_peer);
   limits.max_inflight_bytes = absl::GetFlag(FLAGS_max_inflight_bytes);
+  limits.max_work_units = absl::GetFlag(FLAGS_max_work_units);
   if (const double age = absl::GetFlag(FLAGS_retention_max_age_s); age > 0) {
     limits.retention_max_age = absl::Seconds(age);
   } else if (age < 0) {
