@@ -19,6 +19,10 @@
 
 namespace cablesim {
 
+namespace {
+int64_t NowNs();
+}  // namespace
+
 // Holds one of the limited stream slots and registers the stream with the
 // stall watchdog.
 class StreamSlot {
@@ -30,18 +34,31 @@ class StreamSlot {
   StreamSlot(CablesimServiceImpl* service, grpc::ServerContext* context, bool counted = true,
              const std::string& client = "")
       : service_(service), watch_{context}, counted_(counted) {
+    watch_.counted = counted_;
     if (counted_) peer_ = client.empty() ? PeerOf(context) : client;
     absl::MutexLock lock(&service_->mu_);
     if (counted_) {
       const ServerLimits& limits = service_->limits_;
       int& mine = service_->peer_streams_[peer_];
-      if (service_->streams_ >= limits.max_streams) {
-        refusal_ = absl::StrCat("the server already runs ", limits.max_streams,
-                                " streams (max_streams); try again later");
-      } else if (mine >= limits.max_streams_per_peer) {
+      // Streams whose clients stopped reading count against those clients
+      // only (CablesimServiceImpl::kStalledAfterNs).
+      int stalled = 0;
+      const int64_t now = NowNs();
+      for (const auto& [watch, unused] : service_->watched_) {
+        const int64_t started = watch->write_started_ns.load();
+        stalled += watch->counted && started != 0 &&
+                   now - started > CablesimServiceImpl::kStalledAfterNs;
+      }
+      // The client's own share first: a client that holds it (reading or
+      // not) is told so.
+      if (mine >= limits.max_streams_per_peer) {
         refusal_ = absl::StrCat("this client (", peer_, ") already runs ", mine,
                                 " streams, the server's limit is ", limits.max_streams_per_peer,
                                 " (max_streams_per_peer); try again later");
+      } else if (service_->streams_ - stalled >= limits.max_streams ||
+                 service_->streams_ >= 2 * static_cast<int64_t>(limits.max_streams)) {
+        refusal_ = absl::StrCat("the server already runs ", limits.max_streams,
+                                " streams (max_streams); try again later");
       }
       acquired_ = refusal_.empty();
       if (acquired_) {
