@@ -16,7 +16,9 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "both_stores_test_util.h"
 #include "postgres_test_util.h"
+#include "convert/scene_file.h"
 #include "server/request_checks.h"
 #include "server_test_util.h"
 
@@ -93,7 +95,8 @@ TEST(ServerHardeningTest, TheServersFlagDefaultsAreDefaultServerLimits) {
       {"stall-timeout-s", static_cast<int64_t>(absl::ToDoubleSeconds(l.stall_timeout))},
       {"max-unary-calls", l.max_unary_calls},
       {"max-unary-calls-per-peer", l.max_unary_calls_per_peer},
-      {"max-inflight-bytes", l.max_inflight_bytes}};
+      {"max-inflight-bytes", l.max_inflight_bytes},
+      {"max-work-units", l.max_work_units}};
   for (const auto& [name, value] : flags) {
     const size_t at = help.find("--" + name + "  ");
     ASSERT_NE(at, std::string::npos) << name;
@@ -102,29 +105,7 @@ TEST(ServerHardeningTest, TheServersFlagDefaultsAreDefaultServerLimits) {
   }
 }
 
-// The flags of a fresh store of kind GetParam(): none for SQLite (the data
-// directory), --store=URL for PostgreSQL; `skipped_` when PostgreSQL is
-// not installed.
-class BothStoresTest : public ::testing::TestWithParam<std::string> {
- protected:
-  std::vector<std::string> StoreFlags(const std::string& name) {
-    if (GetParam() == "sqlite") return {};
-    std::string why;
-    testing::TestPostgres* pg = testing::TestPostgres::Get(&why);
-    if (pg == nullptr) {
-      if (testing::TestPostgres::NotInstalled(why)) {
-        skipped_ = true;
-        return {};
-      }
-      ADD_FAILURE() << "PostgreSQL is installed but cannot start: " << why;
-      return {};
-    }
-    return {"--store=" + pg->NewDatabase(name)};
-  }
-  bool skipped_ = false;
-};
-
-using FairQueueTest = BothStoresTest;
+using FairQueueTest = testing::BothStoresTest;
 
 v1::Job GetJob(v1::CablesimService::Stub* stub, const std::string& token, const std::string& id) {
   grpc::ClientContext context;
@@ -344,6 +325,190 @@ TEST(ServerHardeningTest, ConcurrentUnaryCallsPerClientAreBounded) {
     EXPECT_THAT(s.error_message(), HasSubstr("max_unary_calls_per_peer"));
   }
   EXPECT_GT(refused, 0);
+}
+
+// The review's scene, scaled: a mooring line in `seas` JONSWAP sea states
+// of 1,000 components each, within every limit, whose one step sums
+// seas x 1,000 components at every Gauss point of every element in every
+// Newton iteration (seconds per step).
+v1::Scene WaveScene(int seas, double duration_s, double step_s) {
+  absl::StatusOr<v1::Scene> scene = ParseSceneJson(absl::StrCat(R"({
+    "name": "heavy-seas",
+    "gravity": {"y": -9.81},
+    "fluid": {"density": 1025, "still_water_level": 50, "water_depth": 100},
+    "cables": [{"name": "line", "length": 40, "elements": 40,
+                "start": {"x": 0, "y": 0}, "direction": {"x": 1},
+                "density": 7800, "youngs_modulus": 2e11, "diameter": 0.05,
+                "hydrodynamics": {"normal_drag": 1.2, "added_mass": 1}}],
+    "joints": [{"type": "PIN", "a": {"cable": "line", "s": 0}}],
+    "probes": [{"name": "end", "cable": "line", "s": 40}],
+    "solver": {"duration": )", duration_s, R"(, "step": )", step_s, R"(}})"));
+  EXPECT_TRUE(scene.ok()) << scene.status();
+  for (int i = 0; i < seas; ++i) {
+    v1::Waves::Jonswap* sea = scene->mutable_fluid()->mutable_waves()->add_jonswap();
+    sea->set_significant_height(1 + 0.01 * i);
+    sea->set_peak_period(8);
+    sea->set_components(1000);
+    sea->set_seed(i + 1);
+  }
+  return *scene;
+}
+
+// CPU seconds the process has used (user + system).
+double CpuSeconds(pid_t pid) {
+  std::ifstream in(absl::StrCat("/proc/", pid, "/stat"));
+  std::string stat((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::vector<std::string> fields =
+      absl::StrSplit(stat.substr(stat.rfind(')') + 2), ' ');
+  return (std::stod(fields[11]) + std::stod(fields[12])) / sysconf(_SC_CLK_TCK);
+}
+
+// The review: after a client's deadline the server computed on for 67 s
+// (100 sea states), since cancellation was asked only between steps.
+// Here a Run of 100 sea states with a 2 s deadline: within 1 s after the
+// deadline the server's CPU is idle (less than 0.15 s of CPU over the
+// following second), though one step takes far longer.
+TEST(ServerHardeningTest, ADeadlineStopsAStepOfManyWaveComponentsWithinASecond) {
+  const std::string dir = testing::FreshDir("cancel_in_step");
+  ServerProcess server(dir, {"--workers=1"});
+  auto stub = server.Stub();
+  v1::RunRequest request;
+  *request.mutable_scene() = WaveScene(100, 0.1, 0.01);
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(2));
+  auto reader = stub->Run(&context, request);
+  v1::RunEvent event;
+  while (reader->Read(&event)) {
+  }
+  const grpc::Status status = reader->Finish();
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED) << status.error_message();
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  const double cpu0 = CpuSeconds(server.pid());
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  const double cpu1 = CpuSeconds(server.pid());
+  std::cerr << "[ cancel ] CPU from 1 s to 2 s after the deadline: " << cpu1 - cpu0 << " s\n";
+  EXPECT_LT(cpu1 - cpu0, 0.15);
+}
+
+// SIGTERM while a job is inside such a step: the server stops within its
+// 2 s grace (the review: it hung past 30 s), and the job stays queued.
+TEST(ServerHardeningTest, SigtermEndsAStepOfManyWaveComponentsWithinTheGrace) {
+  const std::string dir = testing::FreshDir("sigterm_in_step");
+  ServerProcess server(dir, {"--workers=1", "--shutdown-grace-s=2"});
+  auto stub = server.Stub();
+  const v1::Job job = testing::Submit(stub.get(), WaveScene(100, 0.1, 0.01));
+  EXPECT_EQ(testing::WaitForState(stub.get(), job.id(), v1::RUNNING).state(), v1::RUNNING);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  const auto start = std::chrono::steady_clock::now();
+  const int status = server.Kill(SIGTERM);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::cerr << "[ sigterm ] exited " << seconds << " s after SIGTERM\n";
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
+  EXPECT_LT(seconds, 3.0);
+  server.Restart();
+  auto again = server.Stub();
+  grpc::ClientContext context;
+  v1::GetJobRequest get;
+  get.set_id(job.id());
+  v1::Job after;
+  ASSERT_TRUE(again->GetJob(&context, get, &after).ok());
+  EXPECT_NE(after.state(), v1::FAILED);
+  {
+    grpc::ClientContext cancel_context;
+    v1::CancelJobRequest cancel;
+    cancel.set_id(job.id());
+    v1::Job cancelled;
+    (void)again->CancelJob(&cancel_context, cancel, &cancelled);
+  }
+}
+
+// The costing counts wave components: the same scene over 1,000 steps is
+// refused at once, naming max_work_units; with one sea state it is not.
+TEST(ServerHardeningTest, TheCostingCountsWaveComponents) {
+  const std::string dir = testing::FreshDir("work_units");
+  ServerProcess server(dir);
+  auto stub = server.Stub();
+  for (const auto& [seas, refused] : {std::pair{100, true}, std::pair{1, false}}) {
+    grpc::ClientContext context;
+    v1::ValidateRequest request;
+    *request.mutable_scene() = WaveScene(seas, 10, 0.01);
+    v1::ValidateResponse response;
+    const auto start = std::chrono::steady_clock::now();
+    ASSERT_TRUE(stub->Validate(&context, request, &response).ok());
+    EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5));
+    EXPECT_EQ(response.valid(), !refused) << seas;
+    if (refused) {
+      ASSERT_EQ(response.errors_size(), 1);
+      EXPECT_THAT(response.errors(0).message(), HasSubstr("max_work_units"));
+    }
+  }
+}
+
+// The review: 64 streams that stop reading locked every client out of Run
+// for the 30 s stall timeout (with tokens 4 tenants sufficed). Here, with
+// --max-streams=4: two tenants hold 2 streams each and read nothing past
+// the header; a third tenant's Run is served at once (not refused, not
+// kept waiting) while they stall, and each stalling tenant is still held
+// to its own max_streams_per_peer.
+TEST(ServerHardeningTest, StreamsThatStopReadingDoNotLockOthersOutOfRun) {
+  const std::string dir = testing::FreshDir("stalled_streams");
+  const std::vector<std::string> tokens = {"tok-tenant-a-0123456", "tok-tenant-b-0123456",
+                                           "tok-tenant-c-0123456"};
+  testing::WritePrivateFile(dir + "/tokens", absl::StrCat(tokens[0], " a\n", tokens[1], " b\n",
+                                                          tokens[2], " c\n"));
+  ServerProcess server(dir, {"--token-file=" + dir + "/tokens", "--max-streams=4",
+                             "--max-streams-per-peer=2", "--stall-timeout-s=60"});
+  grpc::ChannelArguments small_window;
+  small_window.SetInt("grpc.http2.bdp_probe", 0);
+  std::vector<std::unique_ptr<grpc::ClientContext>> contexts;
+  std::vector<std::unique_ptr<grpc::ClientReader<v1::RunEvent>>> readers;
+  std::vector<std::unique_ptr<v1::CablesimService::Stub>> stubs;
+  v1::RunRequest request;
+  *request.mutable_scene() = testing::Pendulum(15, 1e-3, 1e-3);
+  for (int t = 0; t < 2; ++t) {
+    for (int k = 0; k < 2; ++k) {
+      stubs.push_back(v1::CablesimService::NewStub(server.Channel(small_window)));
+      contexts.push_back(std::make_unique<grpc::ClientContext>());
+      contexts.back()->AddMetadata("authorization", "Bearer " + tokens[t]);
+      readers.push_back(stubs.back()->Run(contexts.back().get(), request));
+      v1::RunEvent event;
+      ASSERT_TRUE(readers.back()->Read(&event));
+      ASSERT_TRUE(event.has_header());
+    }
+  }
+  // Until the four are stalled (their writes wait on their clients).
+  std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+  auto run = [&](const std::string& token) {
+    auto stub = server.Stub();
+    grpc::ClientContext context;
+    context.AddMetadata("authorization", "Bearer " + token);
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(20));
+    v1::RunRequest small;
+    *small.mutable_scene() = testing::Pendulum(0.01, 1e-3, 1e-3);
+    auto reader = stub->Run(&context, small);
+    v1::RunEvent event;
+    bool summary = false;
+    while (reader->Read(&event)) summary |= event.has_summary();
+    const grpc::Status status = reader->Finish();
+    return std::pair{status, summary};
+  };
+  const auto start = std::chrono::steady_clock::now();
+  const auto [status, summary] = run(tokens[2]);
+  EXPECT_TRUE(status.ok()) << status.error_message();
+  EXPECT_TRUE(summary);
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5));
+  // A stalling tenant is held to its own share.
+  const auto [mine, unused] = run(tokens[0]);
+  EXPECT_EQ(mine.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(mine.error_message(), HasSubstr("max_streams_per_peer"));
+  for (auto& context : contexts) context->TryCancel();
+  for (auto& reader : readers) {
+    v1::RunEvent event;
+    while (reader->Read(&event)) {
+    }
+    reader->Finish();
+  }
 }
 
 }  // namespace

@@ -20,6 +20,7 @@
 #include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
 #include "server/page_token.h"
+#include "both_stores_test_util.h"
 #include "postgres_test_util.h"
 #include "server_test_util.h"
 
@@ -128,26 +129,7 @@ TEST(PageTokenCodecTest, TokensAreAes256GcmAndOldTokensAreRefused) {
   EXPECT_THAT(old.status().message(), HasSubstr("page_token"));
 }
 
-// The server flags of a fresh store of kind `store`; "" when the test was
-// skipped or failed (PostgreSQL not installed or not starting).
-class ServerPageTokenTest : public ::testing::TestWithParam<std::string> {
- protected:
-  std::vector<std::string> StoreFlags(const std::string& name) {
-    if (GetParam() == "sqlite") return {};
-    std::string why;
-    testing::TestPostgres* pg = testing::TestPostgres::Get(&why);
-    if (pg == nullptr) {
-      if (testing::TestPostgres::NotInstalled(why)) {
-        skipped_ = true;
-        return {};
-      }
-      ADD_FAILURE() << "PostgreSQL is installed but cannot start: " << why;
-      return {};
-    }
-    return {"--store=" + pg->NewDatabase(name)};
-  }
-  bool skipped_ = false;
-};
+using ServerPageTokenTest = testing::BothStoresTest;
 
 TEST_P(ServerPageTokenTest, ThreePagesWithDeletionsListEveryRemainingJobOnceInOrder) {
   std::vector<std::string> flags = StoreFlags("page_delete");
