@@ -276,16 +276,26 @@ int main(int argc, char** argv) {
     }
   }
   if (!token_file.empty()) {
-    // The tokens are passwords: a file that others can read is refused
-    // (as ssh does with a private key), naming the file and its mode.
+    // The tokens are passwords: a file that others can read or change is
+    // refused (as ssh does with a private key), naming the file and its
+    // mode. Group access is only warned about: Kubernetes mounts secrets
+    // 0440 for the pod's own group (fsGroup).
     struct stat info;
-    if (::stat(token_file.c_str(), &info) == 0 && (info.st_mode & (S_IRWXG | S_IRWXO)) != 0) {
-      std::cerr << "cablesim-server: " << token_file << ": mode "
-                << absl::StrFormat("%04o", info.st_mode & 07777)
-                << " lets its group or others read or change the tokens; "
-                   "make it readable by its owner only (chmod 600 "
-                << token_file << ")\n";
-      return 1;
+    if (::stat(token_file.c_str(), &info) == 0) {
+      const std::string mode = absl::StrFormat("%04o", info.st_mode & 07777);
+      if ((info.st_mode & S_IRWXO) != 0) {
+        std::cerr << "cablesim-server: " << token_file << ": mode " << mode
+                  << " lets others read or change the tokens; make it readable by its owner "
+                     "only (chmod 600 "
+                  << token_file << ")\n";
+        return 1;
+      }
+      if ((info.st_mode & S_IRWXG) != 0) {
+        std::cerr << "cablesim-server: WARNING: " << token_file << ": mode " << mode
+                  << " lets its group read the tokens; fine when the group is the server's own "
+                     "(a Kubernetes secret with fsGroup), else chmod 600 "
+                  << token_file << "\n";
+      }
     }
     std::string text;
     if (!read_file(token_file, &text)) {

@@ -333,14 +333,16 @@ TEST(ServerAuthTest, TheServerRefusesALoopbackLookingName) {
   EXPECT_THAT(ReadText(log), HasSubstr("--listen 127.evil.example:0"));
 }
 
-// A token file that its group or others can read is refused, naming the
+// A token file that others can read or change is refused, naming the
 // file and its mode (the review found a world-readable one accepted
-// silently); the same file made private is accepted.
+// silently); one its group can read starts with a warning saying why
+// (Kubernetes mounts secrets 0440 for the pod's group); a private one
+// starts quietly.
 TEST(ServerAuthTest, ATokenFileOthersCanReadIsRefused) {
   const std::string dir = testing::FreshDir("auth_token_mode");
   const std::string tokens = dir + "/tokens", log = dir + "/refused.log";
   testing::WritePrivateFile(tokens, absl::StrCat(kToken, " alice\n"));
-  for (const int mode : {0644, 0640, 0604}) {
+  for (const int mode : {0644, 0604, 0606}) {
     ASSERT_EQ(::chmod(tokens.c_str(), mode), 0);
     const int status = std::system(
         absl::StrCat("timeout 60 '", CABLESIM_BIN_DIR,
@@ -351,6 +353,13 @@ TEST(ServerAuthTest, ATokenFileOthersCanReadIsRefused) {
     EXPECT_EQ(WEXITSTATUS(status), 1) << mode;
     EXPECT_THAT(ReadText(log), HasSubstr(tokens + ": mode 0" + absl::StrFormat("%o", mode)));
     EXPECT_THAT(ReadText(log), HasSubstr("chmod 600"));
+  }
+  ASSERT_EQ(::chmod(tokens.c_str(), 0640), 0);
+  {
+    ServerProcess server(dir, {"--token-file=" + tokens});
+    auto stub = server.Stub();
+    EXPECT_TRUE(Info(stub.get(), kToken).ok());
+    EXPECT_TRUE(server.WaitForLog("WARNING: " + tokens + ": mode 0640 lets its group read"));
   }
   ASSERT_EQ(::chmod(tokens.c_str(), 0600), 0);
   ServerProcess server(dir, {"--token-file=" + tokens});
