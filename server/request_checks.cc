@@ -139,7 +139,9 @@ ServerLimits DefaultServerLimits() {
   limits.max_unary_calls = 64;
   limits.max_unary_calls_per_peer = 16;
   limits.max_inflight_bytes = int64_t{1} << 30;
-  limits.max_work_units = 20'000'000'000;
+  // What max_steps and max_elements allow a plain cable (2e11): only
+  // wave components (and contacts, wraps) beyond that are refused.
+  limits.max_work_units = limits.max_steps * limits.max_elements * GaussRule::kMaxPoints;
   return limits;
 }
 

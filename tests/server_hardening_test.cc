@@ -423,8 +423,9 @@ TEST(ServerHardeningTest, SigtermEndsAStepOfManyWaveComponentsWithinTheGrace) {
   }
 }
 
-// The costing counts wave components: the same scene over 1,000 steps is
-// refused at once, naming max_work_units; with one sea state it is not.
+// The costing counts wave components: the same scene over 10,000 steps
+// (3.2e11 units: 40 elements x 8 Gauss points x 100,001) is refused at
+// once, naming max_work_units; with one sea state (3.2e9) it is not.
 TEST(ServerHardeningTest, TheCostingCountsWaveComponents) {
   const std::string dir = testing::FreshDir("work_units");
   ServerProcess server(dir);
@@ -432,7 +433,7 @@ TEST(ServerHardeningTest, TheCostingCountsWaveComponents) {
   for (const auto& [seas, refused] : {std::pair{100, true}, std::pair{1, false}}) {
     grpc::ClientContext context;
     v1::ValidateRequest request;
-    *request.mutable_scene() = WaveScene(seas, 10, 0.01);
+    *request.mutable_scene() = WaveScene(seas, 100, 0.01);
     v1::ValidateResponse response;
     const auto start = std::chrono::steady_clock::now();
     ASSERT_TRUE(stub->Validate(&context, request, &response).ok());
