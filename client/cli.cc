@@ -67,7 +67,8 @@ const std::set<std::string>& ValueOptions() {
 
 // Options that take no value.
 const std::set<std::string>& FlagOptions() {
-  static const std::set<std::string>* flags = new std::set<std::string>{"allow-outside"};
+  static const std::set<std::string>* flags =
+      new std::set<std::string>{"allow-outside", "no-limits"};
   return *flags;
 }
 
@@ -299,6 +300,10 @@ store (ipv4:127.0.0.1:50051,127.0.0.1:50052) or a DNS name with several
 addresses (dns:///cablesim.example:50051); calls are spread over them
 (gRPC's round_robin policy) and go on when one of them stops.
 
+Without --server, scenes run in this process under the server's default
+limits (cablesim-server --help lists them: elements, steps, frames, ...);
+--no-limits lifts them.
+
 With --server, every command also takes --tls-ca CA.pem (TLS, the server's
 certificate checked against that CA) and --token-file FILE (the first word
 of its first line that is not a # comment is sent as a bearer token).
@@ -369,6 +374,12 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
       }
       continue;
     }
+    if (name == "no-limits") {
+      if (a.server.has_value()) {
+        return UsageError(err, "--no-limits is for runs in this process (a server sets its own)");
+      }
+      continue;
+    }
     const bool allowed =
         (command == "run" && name == "shape") ||
         (command == "jobs" && (name == "state" || name == "sweep" || name == "limit")) ||
@@ -380,6 +391,7 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
     return UsageError(err, absl::StrCat(command, ": --out is only for run"));
   }
   SetRemoteSecurity(security);
+  SetInProcessLimits(a.options.count("no-limits") == 0);
   if (command == "validate") return Validate(a.positional[1], a.server, out, err);
   if (command == "run") {
     std::optional<std::string> shape;

@@ -55,6 +55,26 @@ class TokenInterceptorFactory : public grpc::experimental::ClientInterceptorFact
 
 void SetRemoteSecurity(RemoteSecurity security) { Security() = std::move(security); }
 
+namespace {
+bool& InProcessLimitsOn() {
+  static bool on = true;
+  return on;
+}
+}  // namespace
+
+void SetInProcessLimits(bool on) { InProcessLimitsOn() = on; }
+
+ServerLimits InProcessLimits() {
+  if (InProcessLimitsOn()) return DefaultServerLimits();
+  ServerLimits none;  // no limits beyond the engine's
+  none.max_elements = std::numeric_limits<int>::max();
+  none.max_steps = std::numeric_limits<int64_t>::max() / 4;
+  none.max_frames = std::numeric_limits<int64_t>::max();
+  none.max_trajectory_values = std::numeric_limits<int64_t>::max();
+  none.max_sweep_items = std::numeric_limits<int>::max();
+  return none;
+}
+
 Connection::~Connection() {
   stub.reset();
   channel.reset();
@@ -95,13 +115,17 @@ absl::StatusOr<std::unique_ptr<Connection>> Connect(const std::optional<std::str
         *server, credentials, args, std::move(tokens));
   } else {
     ServerOptions options;
-    // The user's own process: no limits beyond the engine's.
-    options.limits.max_elements = std::numeric_limits<int>::max();
-    options.limits.max_steps = std::numeric_limits<int64_t>::max() / 4;
-    options.limits.max_frames = std::numeric_limits<int64_t>::max();
-    options.limits.max_trajectory_values = std::numeric_limits<int64_t>::max();
-    options.limits.max_sweep_items = std::numeric_limits<int>::max();
+    // The user's own process: the server's default costing limits (a
+    // 1e9-step scene is refused at once, naming the limit, rather than
+    // grinding silently), unless --no-limits. Streams and their stall
+    // timeout protect a server from other clients: none here.
+    options.limits = InProcessLimits();
     options.limits.max_streams = std::numeric_limits<int>::max() / 2;
+    options.limits.max_streams_per_peer = std::numeric_limits<int>::max() / 2;
+    options.limits.max_queued_jobs_per_peer = std::numeric_limits<int64_t>::max();
+    options.limits.max_unary_calls = std::numeric_limits<int>::max();
+    options.limits.max_unary_calls_per_peer = std::numeric_limits<int>::max();
+    options.limits.max_inflight_bytes = std::numeric_limits<int64_t>::max();
     options.limits.stall_timeout = absl::Hours(24 * 365);
     options.log = false;
     options.workers = workers > 0 ? workers : std::max(1u, std::thread::hardware_concurrency());

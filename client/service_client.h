@@ -38,8 +38,14 @@ struct RemoteSecurity {
 };
 void SetRemoteSecurity(RemoteSecurity security);
 
+// The costing limits of in-process services: the server's defaults
+// (DefaultServerLimits), or with SetInProcessLimits(false) (the command
+// line's --no-limits) none beyond the engine's.
+void SetInProcessLimits(bool on);
+ServerLimits InProcessLimits();
+
 // `server` "host:port": a channel to it. Otherwise an in-process service
-// without limits; with `jobs`, it has a job store in a fresh temporary
+// with InProcessLimits(); with `jobs`, it has a job store in a fresh temporary
 // directory (removed with the connection) and `workers` workers.
 absl::StatusOr<std::unique_ptr<Connection>> Connect(const std::optional<std::string>& server,
                                                     bool jobs, int workers);

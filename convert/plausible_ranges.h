@@ -43,6 +43,32 @@ inline constexpr PlausibleRange kStep{1e-9, 1e4, "s"};
 inline constexpr PlausibleRange kDuration{0, 1e9, "s"};
 // Adaptive steps' absolute tolerance.
 inline constexpr PlausibleRange kErrorTolerance{1e-15, 1e3, "m"};
+// Time functions (TimeFunction): the range of their values depends on
+// what they drive (a force, a displacement, a winch's speed): constants,
+// amplitudes and table values lie in that field's range, and a ramp's
+// slope in that range per second. Frequencies, phases and times:
+inline constexpr PlausibleRange kFrequency{0, 1e6, "Hz"};
+inline constexpr PlausibleRange kPhase{-1e6, 1e6, "rad"};
+inline constexpr PlausibleRange kTime{-1e9, 1e9, "s"};
+// A prescribed rotation [rad] (many turns allowed).
+inline constexpr PlausibleRange kAngle{-1e6, 1e6, "rad"};
+// Drag and added-mass coefficients (about 1 in practice).
+inline constexpr PlausibleRange kHydroCoefficient{0, 1e3, "(dimensionless)"};
+// Friction coefficients (about 0.1 to 1 in practice).
+inline constexpr PlausibleRange kFrictionCoefficient{0, 1e3, "(dimensionless)"};
+// Cable damping times (axial_time, bending_time, rayleigh_beta) and
+// Rayleigh's mass-proportional alpha.
+inline constexpr PlausibleRange kDampingTime{0, 1e4, "s"};
+inline constexpr PlausibleRange kRayleighAlpha{0, 1e6, "1/s"};
+// Contact springs: a point's [N/m] and a bed's or wheel's per area [N/m^2].
+inline constexpr PlausibleRange kStiffness{1e-6, 1e15, "N/m (N/m^2 per area)"};
+// Dampers: linear [N s/m], angular [N m s], per area [N s/m^2].
+inline constexpr PlausibleRange kDampingCoefficient{0, 1e15, "N s/m (N m s, N s/m^2)"};
+// Wave periods [s]: ripples to swells, wide.
+inline constexpr PlausibleRange kWavePeriod{1e-2, 1e4, "s"};
+// Friction's regularising speed [m/s] and length [m].
+inline constexpr PlausibleRange kFrictionSpeed{1e-12, 1e5, "m/s"};
+inline constexpr PlausibleRange kFrictionLength{1e-12, 1e5, "m"};
 // duration / step: more nominal steps than this is a unit mistake.
 inline constexpr double kMaxNominalSteps = 1e10;
 // A polyline may turn by at most this angle at a corner [degrees]; more

@@ -70,6 +70,140 @@ std::string Printable(absl::string_view message) {
   return std::string(absl::StripAsciiWhitespace(out));
 }
 
+// Length of the valid UTF-8 sequence starting at text[i] (1 to 4), or 0
+// when the byte there does not start one (RFC 3629: no overlong forms, no
+// surrogates, nothing above U+10FFFF).
+size_t Utf8SequenceLength(absl::string_view text, size_t i) {
+  const auto byte = [&](size_t k) { return static_cast<unsigned char>(text[k]); };
+  const unsigned char c = byte(i);
+  if (c < 0x80) return 1;
+  size_t n = 0;
+  unsigned char low = 0x80, high = 0xbf;  // the second byte's range
+  if (c >= 0xc2 && c <= 0xdf) {
+    n = 2;
+  } else if (c >= 0xe0 && c <= 0xef) {
+    n = 3;
+    if (c == 0xe0) low = 0xa0;
+    if (c == 0xed) high = 0x9f;
+  } else if (c >= 0xf0 && c <= 0xf4) {
+    n = 4;
+    if (c == 0xf0) low = 0x90;
+    if (c == 0xf4) high = 0x8f;
+  } else {
+    return 0;
+  }
+  if (i + n > text.size()) return 0;
+  if (byte(i + 1) < low || byte(i + 1) > high) return 0;
+  for (size_t k = 2; k < n; ++k) {
+    if (byte(i + k) < 0x80 || byte(i + k) > 0xbf) return 0;
+  }
+  return n;
+}
+
+// Offset of the first byte of `text` that is not valid UTF-8; npos when
+// all of it is.
+size_t FirstInvalidUtf8(absl::string_view text) {
+  for (size_t i = 0; i < text.size();) {
+    const size_t n = Utf8SequenceLength(text, i);
+    if (n == 0) return i;
+    i += n;
+  }
+  return absl::string_view::npos;
+}
+
+// The field path (`cables[0].name`) of the JSON value, or key, that
+// contains byte `offset` of `json`: a small scan of the nesting up to it.
+std::string JsonPathAt(absl::string_view json, size_t offset) {
+  struct Frame {
+    bool array;
+    int index = 0;
+    std::string key;
+    bool expecting_key = true;
+  };
+  std::vector<Frame> stack;
+  bool in_string = false, escaped = false, string_is_key = false;
+  std::string current;
+  for (size_t i = 0; i < offset && i < json.size(); ++i) {
+    const char c = json[i];
+    if (in_string) {
+      if (escaped) {
+        escaped = false;
+      } else if (c == '\\') {
+        escaped = true;
+      } else if (c == '"') {
+        in_string = false;
+        if (string_is_key && !stack.empty()) stack.back().key = current;
+      } else if (string_is_key) {
+        current += c;
+      }
+      continue;
+    }
+    if (c == '"') {
+      in_string = true;
+      string_is_key = !stack.empty() && !stack.back().array && stack.back().expecting_key;
+      current.clear();
+    } else if (c == '{' || c == '[') {
+      stack.push_back(Frame{c == '['});
+    } else if ((c == '}' || c == ']') && !stack.empty()) {
+      stack.pop_back();
+    } else if (c == ':' && !stack.empty()) {
+      stack.back().expecting_key = false;
+    } else if (c == ',' && !stack.empty()) {
+      if (stack.back().array) {
+        ++stack.back().index;
+      } else {
+        stack.back().expecting_key = true;
+        stack.back().key.clear();
+      }
+    }
+  }
+  if (in_string && string_is_key && !stack.empty()) stack.back().key = current;
+  std::string path;
+  for (const Frame& f : stack) {
+    if (f.array) {
+      absl::StrAppend(&path, "[", f.index, "]");
+    } else if (!f.key.empty()) {
+      absl::StrAppend(&path, path.empty() ? "" : ".", f.key);
+    }
+  }
+  return Printable(path);
+}
+
+// The first string field (at any depth) of `message` that is not valid
+// UTF-8, as InvalidArgument naming its path (`cables[0].name`).
+absl::Status CheckStringsAreUtf8(const google::protobuf::Message& message,
+                                 const std::string& path) {
+  const google::protobuf::Reflection* reflection = message.GetReflection();
+  std::vector<const FieldDescriptor*> fields;
+  reflection->ListFields(message, &fields);
+  for (const FieldDescriptor* field : fields) {
+    const std::string name = path.empty() ? field->name() : absl::StrCat(path, ".", field->name());
+    const int count = field->is_repeated() ? reflection->FieldSize(message, field) : 1;
+    for (int i = 0; i < count; ++i) {
+      const std::string item = field->is_repeated() ? absl::StrCat(name, "[", i, "]") : name;
+      if (field->cpp_type() == FieldDescriptor::CPPTYPE_MESSAGE) {
+        const google::protobuf::Message& sub =
+            field->is_repeated() ? reflection->GetRepeatedMessage(message, field, i)
+                                 : reflection->GetMessage(message, field);
+        if (absl::Status s = CheckStringsAreUtf8(sub, item); !s.ok()) return s;
+      } else if (field->type() == FieldDescriptor::TYPE_STRING) {
+        std::string scratch;
+        const std::string& value =
+            field->is_repeated()
+                ? reflection->GetRepeatedStringReference(message, field, i, &scratch)
+                : reflection->GetStringReference(message, field, &scratch);
+        if (const size_t bad = FirstInvalidUtf8(value); bad != absl::string_view::npos) {
+          return absl::InvalidArgumentError(
+              absl::StrCat(item, ": not valid UTF-8 (byte ", bad, " of the string is ",
+                           absl::StrFormat("0x%02x", static_cast<unsigned char>(value[bad])),
+                           ")"));
+        }
+      }
+    }
+  }
+  return absl::OkStatus();
+}
+
 absl::Status WithPath(const std::string& path, const absl::Status& status) {
   return absl::Status(status.code(), absl::StrCat(path, ": ", status.message()));
 }
@@ -205,6 +339,14 @@ absl::Status ParseStrictJson(absl::string_view json, absl::string_view what,
                              google::protobuf::Message* message) {
   if (absl::Status s = CheckSize(json, what); !s.ok()) return s;
   if (absl::Status s = CheckJsonNesting(json, what); !s.ok()) return s;
+  // Text that is not UTF-8, named by the field it is in (the parser would
+  // only say that some code point is not UTF-8).
+  if (const size_t bad = FirstInvalidUtf8(json); bad != absl::string_view::npos) {
+    const std::string path = JsonPathAt(json, bad);
+    return absl::InvalidArgumentError(absl::StrCat(
+        what, ": ", path.empty() ? "" : absl::StrCat(path, ": "), "not valid UTF-8 (byte ", bad,
+        " is ", absl::StrFormat("0x%02x", static_cast<unsigned char>(json[bad])), ")"));
+  }
   const google::protobuf::StringPiece text(json.data(), json.size());
   // First the syntax and the kind of every value, on a generic JSON tree.
   google::protobuf::Value tree;
@@ -226,6 +368,11 @@ absl::Status ParseStrictJson(absl::string_view json, absl::string_view what,
   if (const auto s = google::protobuf::util::JsonStringToMessage(text, message, options);
       !s.ok()) {
     return absl::InvalidArgumentError(absl::StrCat(what, ": ", Printable(s.message().as_string())));
+  }
+  // JSON escapes (\\u...) cannot make invalid UTF-8 past the parser, but
+  // the check is cheap and names the field.
+  if (absl::Status s = CheckStringsAreUtf8(*message, ""); !s.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat(what, ": ", s.message()));
   }
   return absl::OkStatus();
 }
@@ -292,6 +439,11 @@ absl::StatusOr<v1::Scene> ParseSceneTextFormat(std::string_view text) {
   if (!parser.ParseFromString(std::string(text), &scene)) {
     return absl::InvalidArgumentError(
         absl::StrCat("invalid text-format scene: ", Printable(errors.Joined())));
+  }
+  // Strings that are not UTF-8 (raw bytes, or escapes such as "\\377"):
+  // refused here naming the field, before anything serializes the scene.
+  if (absl::Status s = CheckStringsAreUtf8(scene, ""); !s.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("invalid text-format scene: ", s.message()));
   }
   return scene;
 }

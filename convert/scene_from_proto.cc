@@ -164,10 +164,14 @@ absl::Status CheckTolerance(absl::string_view path, double value) {
 // How deep TimeFunction.sum may nest.
 constexpr int kMaxTimeFunctionDepth = 8;
 
+// `range`: the range of the field the function drives (its values; its
+// ramps' slopes per second).
 absl::StatusOr<TimeFunction> ConvertTimeFunction(const std::string& path,
-                                                 const v1::TimeFunction& p, int depth = 0) {
+                                                 const v1::TimeFunction& p,
+                                                 const PlausibleRange& range, int depth = 0) {
   TimeFunction f;
-  CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(path, "constant"), p.constant()));
+  const PlausibleRange slope{range.lo, range.hi, "per s"};
+  CABLESIM_RETURN_IF_ERROR(CheckRange(Sub(path, "constant"), p.constant(), range));
   f.set_constant(p.constant());
   if (p.has_table()) {
     const std::string table = Sub(path, "table");
@@ -180,8 +184,8 @@ absl::StatusOr<TimeFunction> ConvertTimeFunction(const std::string& path,
                                   values.size(), ")"));
     }
     for (int k = 0; k < times.size(); ++k) {
-      CABLESIM_RETURN_IF_ERROR(CheckFinite(Indexed(table, "times", k), times[k]));
-      CABLESIM_RETURN_IF_ERROR(CheckFinite(Indexed(table, "values", k), values[k]));
+      CABLESIM_RETURN_IF_ERROR(CheckRange(Indexed(table, "times", k), times[k], plausible::kTime));
+      CABLESIM_RETURN_IF_ERROR(CheckRange(Indexed(table, "values", k), values[k], range));
       if (k > 0 && !(times[k] > times[k - 1])) {
         return Invalid(Sub(table, "times"),
                        absl::StrCat("times must increase (times[", k, "] = ", Num(times[k]),
@@ -192,32 +196,36 @@ absl::StatusOr<TimeFunction> ConvertTimeFunction(const std::string& path,
   }
   if (p.has_harmonic()) {
     const std::string h = Sub(path, "harmonic");
-    CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(h, "amplitude"), p.harmonic().amplitude()));
+    CABLESIM_RETURN_IF_ERROR(CheckRange(Sub(h, "amplitude"), p.harmonic().amplitude(), range));
     CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(h, "frequency"), p.harmonic().frequency()));
-    CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(h, "phase"), p.harmonic().phase()));
+    CABLESIM_RETURN_IF_ERROR(
+        CheckRange(Sub(h, "frequency"), p.harmonic().frequency(), plausible::kFrequency));
+    CABLESIM_RETURN_IF_ERROR(CheckRange(Sub(h, "phase"), p.harmonic().phase(), plausible::kPhase));
     f.add_harmonic({p.harmonic().amplitude(), p.harmonic().frequency(), p.harmonic().phase()});
   }
   if (p.has_ramp()) {
     const std::string r = Sub(path, "ramp");
-    CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(r, "slope"), p.ramp().slope()));
+    CABLESIM_RETURN_IF_ERROR(CheckRange(Sub(r, "slope"), p.ramp().slope(), slope));
     CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(r, "start"), p.ramp().start()));
+    CABLESIM_RETURN_IF_ERROR(CheckRange(Sub(r, "start"), p.ramp().start(), plausible::kDuration));
     f.add_ramp({p.ramp().slope(), p.ramp().start()});
   }
   for (int i = 0; i < p.sum_size(); ++i) {
     const std::string sub = Indexed(path, "sum", i);
     if (depth + 1 >= kMaxTimeFunctionDepth)
       return Invalid(sub, absl::StrCat("at most ", kMaxTimeFunctionDepth, " levels of sum"));
-    CABLESIM_ASSIGN_OR_RETURN(TimeFunction term, ConvertTimeFunction(sub, p.sum(i), depth + 1));
+    CABLESIM_ASSIGN_OR_RETURN(TimeFunction term, ConvertTimeFunction(sub, p.sum(i), range, depth + 1));
     f.add_term(std::move(term));
   }
   return f;
 }
 
-absl::StatusOr<TimeVector> ConvertTimeVector(const std::string& path, const v1::TimeVec3& p) {
+absl::StatusOr<TimeVector> ConvertTimeVector(const std::string& path, const v1::TimeVec3& p,
+                                             const PlausibleRange& range) {
   TimeVector v;
-  CABLESIM_ASSIGN_OR_RETURN(v[0], ConvertTimeFunction(Sub(path, "x"), p.x()));
-  CABLESIM_ASSIGN_OR_RETURN(v[1], ConvertTimeFunction(Sub(path, "y"), p.y()));
-  CABLESIM_ASSIGN_OR_RETURN(v[2], ConvertTimeFunction(Sub(path, "z"), p.z()));
+  CABLESIM_ASSIGN_OR_RETURN(v[0], ConvertTimeFunction(Sub(path, "x"), p.x(), range));
+  CABLESIM_ASSIGN_OR_RETURN(v[1], ConvertTimeFunction(Sub(path, "y"), p.y(), range));
+  CABLESIM_ASSIGN_OR_RETURN(v[2], ConvertTimeFunction(Sub(path, "z"), p.z(), range));
   return v;
 }
 
@@ -486,6 +494,8 @@ class SceneConverter {
             std::tuple{"tangential_drag", h.tangential_drag(), &cable->tangential_drag},
             std::tuple{"added_mass", h.added_mass(), &cable->added_mass}}) {
         CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(hydro_path, name), value));
+        CABLESIM_RETURN_IF_ERROR(
+            CheckRange(Sub(hydro_path, name), value, plausible::kHydroCoefficient));
         *out = value;
       }
       if (h.has_diameter()) {
@@ -498,17 +508,22 @@ class SceneConverter {
       cable->winch.enabled = true;
       CABLESIM_ASSIGN_OR_RETURN(cable->winch.speed,
                                 ConvertTimeFunction(Sub(Sub(path, "winch"), "speed"),
-                                                    c.winch().speed()));
+                                                    c.winch().speed(), plausible::kVelocity));
     }
     if (c.has_damping()) {
       const v1::CableDamping& d = c.damping();
       const std::string damping_path = Sub(path, "damping");
-      for (const auto& [name, value, out] :
-           {std::tuple{"axial_time", d.axial_time(), &cable->axial_damping_s},
-            std::tuple{"bending_time", d.bending_time(), &cable->bending_damping_s},
-            std::tuple{"rayleigh_alpha", d.rayleigh_alpha(), &cable->rayleigh_alpha_1_s},
-            std::tuple{"rayleigh_beta", d.rayleigh_beta(), &cable->rayleigh_beta_s}}) {
+      for (const auto& [name, value, out, range] :
+           {std::tuple{"axial_time", d.axial_time(), &cable->axial_damping_s,
+                       &plausible::kDampingTime},
+            std::tuple{"bending_time", d.bending_time(), &cable->bending_damping_s,
+                       &plausible::kDampingTime},
+            std::tuple{"rayleigh_alpha", d.rayleigh_alpha(), &cable->rayleigh_alpha_1_s,
+                       &plausible::kRayleighAlpha},
+            std::tuple{"rayleigh_beta", d.rayleigh_beta(), &cable->rayleigh_beta_s,
+                       &plausible::kDampingTime}}) {
         CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(damping_path, name), value));
+        CABLESIM_RETURN_IF_ERROR(CheckRange(Sub(damping_path, name), value, *range));
         *out = value;
       }
     }
@@ -578,6 +593,10 @@ class SceneConverter {
           CheckNonNegative(Sub(damping_path, "linear"), b.damping().linear()));
       CABLESIM_RETURN_IF_ERROR(
           CheckNonNegative(Sub(damping_path, "angular"), b.damping().angular()));
+      CABLESIM_RETURN_IF_ERROR(CheckRange(Sub(damping_path, "linear"), b.damping().linear(),
+                                          plausible::kDampingCoefficient));
+      CABLESIM_RETURN_IF_ERROR(CheckRange(Sub(damping_path, "angular"), b.damping().angular(),
+                                          plausible::kDampingCoefficient));
       body->linear_damping_n_s_m = b.damping().linear();
       body->angular_damping_n_m_s = b.damping().angular();
     }
@@ -602,11 +621,16 @@ class SceneConverter {
           VectorInRange(Indexed(contact_path, "points", k), c.points(k), plausible::kCoordinate));
       body->contact_points_m.push_back(point);
     }
-    CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(contact_path, "stiffness"), c.stiffness()));
+    CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange(Sub(contact_path, "stiffness"), c.stiffness(),
+                                                  plausible::kStiffness));
     body->contact_stiffness_n_m = c.stiffness();
     CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(contact_path, "damping"), c.damping()));
+    CABLESIM_RETURN_IF_ERROR(
+        CheckRange(Sub(contact_path, "damping"), c.damping(), plausible::kDampingCoefficient));
     body->contact_damping_n_s_m = c.damping();
     CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(contact_path, "friction"), c.friction()));
+    CABLESIM_RETURN_IF_ERROR(
+        CheckRange(Sub(contact_path, "friction"), c.friction(), plausible::kFrictionCoefficient));
     body->contact_friction = c.friction();
     return absl::OkStatus();
   }
@@ -639,6 +663,7 @@ class SceneConverter {
           std::tuple{"added_mass", h.added_mass(), &body->hydro_added_mass},
           std::tuple{"heave_added_mass", h.heave_added_mass(), &body->hydro_heave_added_mass}}) {
       CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(path, name), value));
+      CABLESIM_RETURN_IF_ERROR(CheckRange(Sub(path, name), value, plausible::kHydroCoefficient));
       *out = value;
     }
     body->has_hydrodynamics = true;
@@ -766,7 +791,7 @@ class SceneConverter {
     CABLESIM_RETURN_IF_ERROR(ConvertSlide(path, j, joint));
     if (j.has_motion()) {
       const std::string motion = Sub(path, "motion");
-      CABLESIM_ASSIGN_OR_RETURN(joint->motion, ConvertTimeVector(motion, j.motion()));
+      CABLESIM_ASSIGN_OR_RETURN(joint->motion, ConvertTimeVector(motion, j.motion(), plausible::kCoordinate));
       if (joint->HasMotion() && !b.IsGround()) {
         return Invalid(motion, "only a joint to ground moves (side b must be the ground)");
       }
@@ -782,7 +807,7 @@ class SceneConverter {
     }
     if (j.has_rotation()) {
       const std::string rotation = Sub(path, "rotation");
-      CABLESIM_ASSIGN_OR_RETURN(joint->rotation, ConvertTimeFunction(rotation, j.rotation()));
+      CABLESIM_ASSIGN_OR_RETURN(joint->rotation, ConvertTimeFunction(rotation, j.rotation(), plausible::kAngle));
       if (joint->HasRotation() && (!b.IsGround() || joint->type != JointType::kFixed)) {
         return Invalid(rotation,
                        "only a FIXED joint to ground turns (a PIN holds no direction; side b "
@@ -841,12 +866,12 @@ class SceneConverter {
     }
     if (l.has_varying_force()) {
       CABLESIM_ASSIGN_OR_RETURN(load->varying_force_n,
-                                ConvertTimeVector(Sub(path, "varying_force"), l.varying_force()));
+                                ConvertTimeVector(Sub(path, "varying_force"), l.varying_force(), plausible::kForce));
     }
     if (l.has_varying_torque()) {
       const std::string varying_torque = Sub(path, "varying_torque");
       CABLESIM_ASSIGN_OR_RETURN(load->varying_torque_nm,
-                                ConvertTimeVector(varying_torque, l.varying_torque()));
+                                ConvertTimeVector(varying_torque, l.varying_torque(), plausible::kTorque));
       if (load->at.cable >= 0 && !IsZero(load->varying_torque_nm))
         return Invalid(varying_torque, "allowed on bodies only");
     }
@@ -934,11 +959,12 @@ class SceneConverter {
       RegularWaveSpec out;
       CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange(Sub(path, "height"), r.height(), plausible::kSize));
       out.height_m = r.height();
-      CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange(Sub(path, "period"), r.period(), plausible::kStep));
+      CABLESIM_RETURN_IF_ERROR(
+          CheckPositiveInRange(Sub(path, "period"), r.period(), plausible::kWavePeriod));
       out.period_s = r.period();
       CABLESIM_ASSIGN_OR_RETURN(out.direction,
                                 WaveDirection(Sub(path, "direction"), r.has_direction(), r.direction()));
-      CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(path, "phase"), r.phase()));
+      CABLESIM_RETURN_IF_ERROR(CheckRange(Sub(path, "phase"), r.phase(), plausible::kPhase));
       out.phase_rad = r.phase();
       spec.regular.push_back(out);
     }
@@ -950,7 +976,7 @@ class SceneConverter {
                                                     j.significant_height(), plausible::kSize));
       out.significant_height_m = j.significant_height();
       CABLESIM_RETURN_IF_ERROR(
-          CheckPositiveInRange(Sub(path, "peak_period"), j.peak_period(), plausible::kStep));
+          CheckPositiveInRange(Sub(path, "peak_period"), j.peak_period(), plausible::kWavePeriod));
       out.peak_period_s = j.peak_period();
       if (j.peak_factor() != 0) {
         CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(path, "peak_factor"), j.peak_factor()));
@@ -987,21 +1013,30 @@ class SceneConverter {
     } else {
       return Invalid("seabed.normal", "must be given when gravity is zero");
     }
-    CABLESIM_RETURN_IF_ERROR(CheckPositive("seabed.stiffness", b.stiffness()));
+    CABLESIM_RETURN_IF_ERROR(
+        CheckPositiveInRange("seabed.stiffness", b.stiffness(), plausible::kStiffness));
     spec.stiffness_n_m2 = b.stiffness();
     CABLESIM_RETURN_IF_ERROR(CheckNonNegative("seabed.damping", b.damping()));
+    CABLESIM_RETURN_IF_ERROR(
+        CheckRange("seabed.damping", b.damping(), plausible::kDampingCoefficient));
     spec.damping_n_s_m2 = b.damping();
     CABLESIM_RETURN_IF_ERROR(CheckNonNegative("seabed.friction_axial", b.friction_axial()));
+    CABLESIM_RETURN_IF_ERROR(CheckRange("seabed.friction_axial", b.friction_axial(),
+                                        plausible::kFrictionCoefficient));
     spec.friction_axial = b.friction_axial();
     CABLESIM_RETURN_IF_ERROR(
         CheckNonNegative("seabed.friction_transverse", b.friction_transverse()));
+    CABLESIM_RETURN_IF_ERROR(CheckRange("seabed.friction_transverse", b.friction_transverse(),
+                                        plausible::kFrictionCoefficient));
     spec.friction_transverse = b.friction_transverse();
     if (b.friction_speed() != 0) {
-      CABLESIM_RETURN_IF_ERROR(CheckPositive("seabed.friction_speed", b.friction_speed()));
+      CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange("seabed.friction_speed", b.friction_speed(),
+                                                    plausible::kFrictionSpeed));
       spec.friction_speed_m_s = b.friction_speed();
     }
     if (b.friction_length() != 0) {
-      CABLESIM_RETURN_IF_ERROR(CheckPositive("seabed.friction_length", b.friction_length()));
+      CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange("seabed.friction_length", b.friction_length(),
+                                                    plausible::kFrictionLength));
       spec.friction_length_m = b.friction_length();
     }
     if (b.has_bathymetry()) CABLESIM_RETURN_IF_ERROR(ConvertBathymetry(b));
@@ -1048,7 +1083,8 @@ class SceneConverter {
         spec.cables.push_back(it->second);
       }
       if (w.has_stiffness()) {
-        CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(path, "stiffness"), w.stiffness()));
+        CABLESIM_RETURN_IF_ERROR(
+            CheckPositiveInRange(Sub(path, "stiffness"), w.stiffness(), plausible::kStiffness));
         spec.stiffness_n_m2 = w.stiffness();
       } else {
         // EA / R^2 of the stiffest cable it touches: a cable under
@@ -1062,11 +1098,16 @@ class SceneConverter {
         spec.stiffness_n_m2 = ea / (spec.radius_m * spec.radius_m);
       }
       CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(path, "damping"), w.damping()));
+      CABLESIM_RETURN_IF_ERROR(
+          CheckRange(Sub(path, "damping"), w.damping(), plausible::kDampingCoefficient));
       spec.damping_n_s_m2 = w.damping();
       CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(path, "friction"), w.friction()));
+      CABLESIM_RETURN_IF_ERROR(
+          CheckRange(Sub(path, "friction"), w.friction(), plausible::kFrictionCoefficient));
       spec.friction = w.friction();
       if (w.has_friction_speed()) {
-        CABLESIM_RETURN_IF_ERROR(CheckPositive(Sub(path, "friction_speed"), w.friction_speed()));
+        CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange(Sub(path, "friction_speed"),
+                                                      w.friction_speed(), plausible::kFrictionSpeed));
         spec.friction_speed_m_s = w.friction_speed();
       }
       scene_.sheaves.push_back(std::move(spec));
@@ -1095,8 +1136,14 @@ class SceneConverter {
         CheckRange("seabed.bathymetry.origin_x", g.origin_x(), plausible::kCoordinate));
     CABLESIM_RETURN_IF_ERROR(
         CheckRange("seabed.bathymetry.origin_y", g.origin_y(), plausible::kCoordinate));
-    if (g.nx() > 1) CABLESIM_RETURN_IF_ERROR(CheckPositive("seabed.bathymetry.dx", g.dx()));
-    if (g.ny() > 1) CABLESIM_RETURN_IF_ERROR(CheckPositive("seabed.bathymetry.dy", g.dy()));
+    if (g.nx() > 1) {
+      CABLESIM_RETURN_IF_ERROR(
+          CheckPositiveInRange("seabed.bathymetry.dx", g.dx(), plausible::kCableLength));
+    }
+    if (g.ny() > 1) {
+      CABLESIM_RETURN_IF_ERROR(
+          CheckPositiveInRange("seabed.bathymetry.dy", g.dy(), plausible::kCableLength));
+    }
     if (g.depths_size() != count)
       return Invalid("seabed.bathymetry.depths", absl::StrCat("expected nx*ny = ", count,
                                                               " values, got ", g.depths_size()));

@@ -10,6 +10,7 @@
 // (useful with port 0) is written to that file once the server serves.
 
 #include <signal.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -27,11 +28,13 @@
 #include "absl/flags/reflection.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
 #include "absl/strings/ascii.h"
 #include "cablesim/version.h"
 #include "server/cablesim_server.h"
+#include "server/listen_address.h"
 #include "server/metrics_endpoint.h"
 
 ABSL_FLAG(std::string, listen, "127.0.0.1:50051", "host:port to listen on (port 0: any free)");
@@ -73,12 +76,27 @@ ABSL_FLAG(int64_t, max_name_bytes, 256,
           "bounded by the scene format (256)");
 ABSL_FLAG(int64_t, max_coordinates, 1'000'000, "limit: coordinates of a scene's model");
 ABSL_FLAG(int, max_message_bytes, 16 << 20, "limit: gRPC message size");
+ABSL_FLAG(int, max_unary_calls, cablesim::DefaultServerLimits().max_unary_calls,
+          "limit: scene-carrying unary calls (Validate, SubmitJob, SubmitSweep) at once");
+ABSL_FLAG(int, max_unary_calls_per_peer,
+          cablesim::DefaultServerLimits().max_unary_calls_per_peer,
+          "limit: scene-carrying unary calls at once of one client (tenant or address)");
+ABSL_FLAG(int64_t, max_inflight_bytes, cablesim::DefaultServerLimits().max_inflight_bytes,
+          "limit: memory budget of the requests in flight, each counted as 20 x its size "
+          "(the parsed scene and the model built from it)");
+ABSL_FLAG(int64_t, max_work_units, cablesim::DefaultServerLimits().max_work_units,
+          "limit: a run's work, steps x (elements x Gauss points x (1 + wave components) + "
+          "contact points + sheave wraps)");
 ABSL_FLAG(double, retention_max_age_s, 0,
           "delete finished jobs and sweeps this many seconds after they finished (0: keep)");
 ABSL_FLAG(int64_t, retention_max_bytes, 0,
           "delete the oldest finished jobs and sweeps while stored results take more bytes "
           "than this (0: no limit)");
 ABSL_FLAG(double, stall_timeout_s, 30, "cancel a stream whose client reads nothing this long");
+ABSL_FLAG(std::string, check, "",
+          "check every stored row of this store (DIR, sqlite:DIR or postgresql://...) against its "
+          "checksum, list the damaged ones and exit: 0 when none is, 1 otherwise (a SQLite "
+          "store only while no server has it open)");
 ABSL_FLAG(double, shutdown_grace_s, 2,
           "on SIGTERM, wait this long for calls (and idle client connections) to end");
 
@@ -159,10 +177,34 @@ std::optional<int> ParseFlags(int argc, char** argv) {
   return std::nullopt;
 }
 
+// --check STORE: every damaged row listed; 0 when none, 1 otherwise.
+int CheckStore(const std::string& spec) {
+  cablesim::StoreOptions options;
+  options.notifications = false;
+  absl::StatusOr<std::unique_ptr<cablesim::JobStore>> store =
+      cablesim::JobStore::Open(spec, options);
+  if (!store.ok()) {
+    std::cerr << "cablesim-server: --check " << spec << ": " << store.status().message() << "\n";
+    return 1;
+  }
+  absl::StatusOr<std::vector<std::string>> damaged = (*store)->CheckRows();
+  if (!damaged.ok()) {
+    std::cerr << "cablesim-server: --check " << spec << ": " << damaged.status().message()
+              << "\n";
+    return 1;
+  }
+  for (const std::string& line : *damaged) std::cout << "damaged: " << line << "\n";
+  std::cout << (*store)->Describe() << ": " << damaged->size() << " damaged rows\n";
+  return damaged->empty() ? 0 : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (const std::optional<int> exit_code = ParseFlags(argc, argv)) return *exit_code;
+  if (const std::string check = absl::GetFlag(FLAGS_check); !check.empty()) {
+    return CheckStore(check);
+  }
   cablesim::ServerOptions options;
   options.listen = absl::GetFlag(FLAGS_listen);
   options.data_dir = absl::GetFlag(FLAGS_data_dir);
@@ -199,6 +241,10 @@ int main(int argc, char** argv) {
   limits.max_coordinates = absl::GetFlag(FLAGS_max_coordinates);
   limits.max_streams_per_peer = absl::GetFlag(FLAGS_max_streams_per_peer);
   limits.max_queued_jobs_per_peer = absl::GetFlag(FLAGS_max_queued_jobs_per_peer);
+  limits.max_unary_calls = absl::GetFlag(FLAGS_max_unary_calls);
+  limits.max_unary_calls_per_peer = absl::GetFlag(FLAGS_max_unary_calls_per_peer);
+  limits.max_inflight_bytes = absl::GetFlag(FLAGS_max_inflight_bytes);
+  limits.max_work_units = absl::GetFlag(FLAGS_max_work_units);
   if (const double age = absl::GetFlag(FLAGS_retention_max_age_s); age > 0) {
     limits.retention_max_age = absl::Seconds(age);
   } else if (age < 0) {
@@ -230,6 +276,27 @@ int main(int argc, char** argv) {
     }
   }
   if (!token_file.empty()) {
+    // The tokens are passwords: a file that others can read or change is
+    // refused (as ssh does with a private key), naming the file and its
+    // mode. Group access is only warned about: Kubernetes mounts secrets
+    // 0440 for the pod's own group (fsGroup).
+    struct stat info;
+    if (::stat(token_file.c_str(), &info) == 0) {
+      const std::string mode = absl::StrFormat("%04o", info.st_mode & 07777);
+      if ((info.st_mode & S_IRWXO) != 0) {
+        std::cerr << "cablesim-server: " << token_file << ": mode " << mode
+                  << " lets others read or change the tokens; make it readable by its owner "
+                     "only (chmod 600 "
+                  << token_file << ")\n";
+        return 1;
+      }
+      if ((info.st_mode & S_IRWXG) != 0) {
+        std::cerr << "cablesim-server: WARNING: " << token_file << ": mode " << mode
+                  << " lets its group read the tokens; fine when the group is the server's own "
+                     "(a Kubernetes secret with fsGroup), else chmod 600 "
+                  << token_file << "\n";
+      }
+    }
     std::string text;
     if (!read_file(token_file, &text)) {
       std::cerr << "cablesim-server: cannot read " << token_file << "\n";
@@ -254,17 +321,20 @@ int main(int argc, char** argv) {
     }
   }
   // Beyond loopback, only with TLS and tokens (or when told it is fine).
+  // The address is resolved once, here: the check looks at the address
+  // bound, not at how its name is spelled (127.evil.example is not local).
   {
-    std::string host = options.listen.substr(0, options.listen.rfind(':'));
-    const bool loopback = absl::StartsWith(host, "127.") || host == "localhost" ||
-                          host == "[::1]" || absl::StartsWith(options.listen, "unix:");
-    if (!loopback && (options.tls_cert_pem.empty() || options.tokens.empty()) &&
+    absl::StatusOr<cablesim::ListenAddress> listen =
+        cablesim::ResolveListenAddress(options.listen);
+    if (!listen.ok()) return UsageError(std::string(listen.status().message()));
+    if (!listen->loopback && (options.tls_cert_pem.empty() || options.tokens.empty()) &&
         !absl::GetFlag(FLAGS_insecure)) {
       return UsageError(absl::StrCat(
-          "--listen ", options.listen,
-          ": beyond loopback the server needs --tls-cert/--tls-key and --token-file "
+          "--listen ", options.listen, " (", listen->bind,
+          "): beyond loopback the server needs --tls-cert/--tls-key and --token-file "
           "(or --insecure, to accept anyone who can reach the port)"));
     }
+    options.listen = listen->bind;
   }
   // Only the tests set this (tests/server_test_util.h); no flag, so it is
   // not offered in --help, and it is announced loudly when present.

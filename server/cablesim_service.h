@@ -74,7 +74,14 @@ class CablesimServiceImpl final : public v1::CablesimService::Service {
   struct StreamWatch {
     grpc::ServerContext* context;
     std::atomic<int64_t> write_started_ns{0};  // 0: not writing
+    bool counted = false;                      // holds a max_streams slot
   };
+  // A counted stream whose write has waited this long for its client to
+  // read is "stalled": it still counts against its own client's
+  // max_streams_per_peer, but no longer against max_streams, so that
+  // streams that stop reading cannot lock other clients out of Run until
+  // the stall timeout cuts them (at most 2 x max_streams streams in all).
+  static constexpr int64_t kStalledAfterNs = 1'000'000'000;
 
  private:
   // The stored result of finished job `id` (and the job): NOT_FOUND,
@@ -108,7 +115,14 @@ class CablesimServiceImpl final : public v1::CablesimService::Service {
   bool stop_ ABSL_GUARDED_BY(mu_) = false;
   std::thread watchdog_;
 
+  // Scene-carrying unary calls in progress, in all and per client, and
+  // the memory they are estimated to hold (UnarySlot).
+  int unary_calls_ ABSL_GUARDED_BY(mu_) = 0;
+  std::map<std::string, int> peer_unary_calls_ ABSL_GUARDED_BY(mu_);
+  int64_t inflight_bytes_ ABSL_GUARDED_BY(mu_) = 0;
+
   friend class StreamSlot;
+  friend class UnarySlot;
 };
 
 }  // namespace cablesim

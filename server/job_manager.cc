@@ -266,8 +266,8 @@ void JobManager::Work() {
       absl::MutexLock claim_lock(&claim_mu_);
       absl::StatusOr<std::optional<Claim>> next = store_->ClaimNext();
       if (!next.ok()) {
-        if (log_) std::cerr << "cablesim-server: claiming a job: " << next.status() << "\n";
-      } else if (next->has_value()) {
+        LogClaimError(next.status());
+      } else if (LogClaimRecovered(), next->has_value()) {
         claim = **next;
         running->attempt = claim->attempt;
         absl::MutexLock lock(&mu_);
@@ -287,6 +287,42 @@ void JobManager::Work() {
     }
     RunOne(*claim, std::move(running));
   }
+}
+
+void JobManager::LogClaimError(const absl::Status& status) {
+  const absl::Time now = absl::Now();
+  if (claim_failing_ && now - claim_error_logged_ < kClaimErrorLogInterval) {
+    ++claim_errors_unlogged_;
+    return;
+  }
+  if (log_) {
+    std::cerr << "cablesim-server: "
+              << (absl::IsUnavailable(status)
+                      ? "the job store is unreachable (jobs wait until it answers again): "
+                      : "claiming a job: ")
+              << status;
+    if (claim_errors_unlogged_ > 0) {
+      std::cerr << " (" << claim_errors_unlogged_ << " more failed claims in the last "
+                << absl::FormatDuration(now - claim_error_logged_) << " not shown)";
+    }
+    std::cerr << "\n";
+  }
+  claim_failing_ = true;
+  claim_error_logged_ = now;
+  claim_errors_unlogged_ = 0;
+}
+
+void JobManager::LogClaimRecovered() {
+  if (!claim_failing_) return;
+  if (log_) {
+    std::cerr << "cablesim-server: the job store answers again";
+    if (claim_errors_unlogged_ > 0) {
+      std::cerr << " (" << claim_errors_unlogged_ << " failed claims not shown)";
+    }
+    std::cerr << "\n";
+  }
+  claim_failing_ = false;
+  claim_errors_unlogged_ = 0;
 }
 
 void JobManager::Heartbeats() {

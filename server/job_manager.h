@@ -120,6 +120,15 @@ class JobManager {
   // cancel looks at the store and then at running_: a cancel sees every
   // job either still QUEUED or already running here.
   absl::Mutex claim_mu_ ABSL_ACQUIRED_BEFORE(mu_);
+  // Failed claims (the store unreachable): logged once, then at most once
+  // every kClaimErrorLogInterval with a count of those not shown, and once
+  // more when the store answers again.
+  static constexpr absl::Duration kClaimErrorLogInterval = absl::Seconds(10);
+  void LogClaimError(const absl::Status& status) ABSL_EXCLUSIVE_LOCKS_REQUIRED(claim_mu_);
+  void LogClaimRecovered() ABSL_EXCLUSIVE_LOCKS_REQUIRED(claim_mu_);
+  bool claim_failing_ ABSL_GUARDED_BY(claim_mu_) = false;
+  absl::Time claim_error_logged_ ABSL_GUARDED_BY(claim_mu_);
+  int64_t claim_errors_unlogged_ ABSL_GUARDED_BY(claim_mu_) = 0;
   absl::Mutex mu_;
   std::map<std::string, std::shared_ptr<Running>> running_ ABSL_GUARDED_BY(mu_);
   uint64_t version_ ABSL_GUARDED_BY(mu_) = 0;

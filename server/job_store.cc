@@ -65,6 +65,12 @@ absl::StatusOr<std::string> NewPageTokenSecret() {
   return absl::StrCat(*a, *b);
 }
 
+absl::Status DamagedRow(absl::string_view kind, absl::string_view id) {
+  return absl::DataLossError(absl::StrCat(kind, " ", id,
+                                          ": the stored row fails its checksum (the database is "
+                                          "damaged); cablesim-server --check lists every such row"));
+}
+
 absl::StatusOr<StoredResult> CheckedResult(const std::string& id, const std::string& header,
                                            const std::string& vals, int64_t checksum,
                                            int64_t encoding) {

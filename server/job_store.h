@@ -76,6 +76,17 @@ struct StoreOptions {
   bool notifications = true;
 };
 
+// The claim order of both stores (SQL for SQLite and PostgreSQL alike,
+// over `jobs j`): first the jobs of the tenant (without a tenant: of the
+// client address) whose latest start is oldest, a tenant that never ran
+// anything first of all; then the oldest job. Serving whoever waited
+// longest since their last start is round-robin across tenants.
+inline constexpr char kFairShareOrder[] =
+    "(CASE WHEN j.tenant <> '' "
+    "THEN (SELECT COALESCE(MAX(s.started_ms), 0) FROM jobs s WHERE s.tenant = j.tenant) "
+    "ELSE (SELECT COALESCE(MAX(s.started_ms), 0) FROM jobs s "
+    "WHERE s.tenant = '' AND s.peer = j.peer) END), j.seq";
+
 class JobStore {
  public:
   // `spec`: `sqlite:DIR` or a bare DIR (SqliteJobStore), or a libpq URL
@@ -118,6 +129,9 @@ class JobStore {
   virtual absl::StatusOr<v1::Job> GetJob(const std::string& id) = 0;
   virtual absl::StatusOr<v1::Scene> GetScene(const std::string& id) = 0;
   // Newest first, at most `limit`, and with `tenant`, only that tenant's.
+  // A row whose checksum fails (CheckRows) is listed as a placeholder:
+  // a Job with only its state, JOB_STATE_UNSPECIFIED (and its key), which
+  // callers skip; GetJob and GetSweep answer DataLoss for such rows.
   // Keyset paging: each job has an order key (its internal row number,
   // larger for newer jobs, never reused); with `after_key` > 0, only jobs
   // whose key is smaller (whether or not the job of `after_key` still
@@ -136,13 +150,20 @@ class JobStore {
   virtual absl::StatusOr<bool> ReclaimSpace() { return false; }
   // The tenant that owns job or sweep `id` (by its prefix); NotFound.
   virtual absl::StatusOr<std::string> Tenant(const std::string& id) = 0;
+  // Every stored row checked against its checksum (job rows, sweep rows
+  // and results): one line per damaged row (`job j-...: ...`), empty when
+  // none is (cablesim-server --check).
+  virtual absl::StatusOr<std::vector<std::string>> CheckRows() = 0;
   // Ids of QUEUED jobs, oldest first.
   virtual absl::StatusOr<std::vector<std::string>> QueuedJobIds() = 0;
 
-  // Takes the oldest QUEUED job (shared stores: or a RUNNING one whose
+  // Takes the next QUEUED job (shared stores: or a RUNNING one whose
   // lease has expired) for this store's owner: QUEUED -> RUNNING,
   // attempts + 1. Nullopt when there is none. Two claims never get the
-  // same job (shared stores: FOR UPDATE SKIP LOCKED).
+  // same job (shared stores: FOR UPDATE SKIP LOCKED). Fair share
+  // (kFairShareOrder): round-robin across tenants (without tokens, across
+  // client addresses), oldest first within one, so that one tenant's
+  // thousand queued jobs do not hold back another's one.
   virtual absl::StatusOr<std::optional<Claim>> ClaimNext() = 0;
   // QUEUED -> RUNNING (attempts + 1); false when the job was not QUEUED.
   virtual absl::StatusOr<bool> MarkRunning(const std::string& id) = 0;
@@ -210,6 +231,9 @@ int64_t ResultChecksum(const void* header, size_t header_bytes, const void* vals
 // Job `id`'s result from its stored columns: DataLoss (never altered data)
 // unless `checksum` matches the header and values blob as stored and the
 // blob decodes by its `encoding` (result_codec.h).
+// DataLoss for a job or sweep row whose checksum fails.
+absl::Status DamagedRow(absl::string_view kind, absl::string_view id);
+
 absl::StatusOr<StoredResult> CheckedResult(const std::string& id, const std::string& header,
                                            const std::string& vals, int64_t checksum,
                                            int64_t encoding);

@@ -12,17 +12,18 @@
 // The key is hidden, since row numbers would reveal how many jobs the
 // server has made, and the token is authenticated, so that a client can
 // neither forge a key nor reuse a token for another tenant or another
-// query. With S the store's secret (JobStore::page_token_secret, 32
-// random bytes kept in the store), K_e = HMAC-SHA256(S, "cablesim page
-// token encryption"), K_m = HMAC-SHA256(S, "cablesim page token mac"):
+// query. The cipher is AES-256-GCM (an authenticated cipher, through
+// OpenSSL's EVP interface). With S the store's secret
+// (JobStore::page_token_secret, 32 random bytes kept in the store) and
+// K = HMAC-SHA256(S, "cablesim page token aes-256-gcm"):
 //
-//   n      = 8 random bytes (a fresh nonce per token)
-//   c      = key (8 bytes, big-endian) XOR HMAC-SHA256(K_e, n)[0..8)
-//   tag    = HMAC-SHA256(K_m, v || n || c || |tenant| || tenant || query)[0..16)
-//   token  = base64url(v || n || c || tag), v = 1: 44 characters
+//   n      = 12 random bytes (a fresh nonce per token)
+//   aad    = v || |tenant| (8 bytes, big-endian) || tenant || query, v = 2
+//   c, tag = AES-256-GCM(K, n, key as 8 bytes big-endian, aad), 16-byte tag
+//   token  = base64url(n || c || tag): 48 characters
 //
-// (HMAC as a pseudo-random function: the pad hides the key, the 128-bit tag
-// makes any change, or use under another tenant or query, detectable.)
+// Tokens of version 1 (an HMAC-based encrypt-then-MAC, before 0.16) are
+// refused like forged ones; a client starts again from the first page.
 // The query is what must stay the same from page to page (the state and
 // sweep filters); the page size may change.
 
@@ -51,11 +52,7 @@ class PageTokenCodec {
                                  const std::string& query) const;
 
  private:
-  std::string Tag(const std::string& body, const std::string& tenant,
-                  const std::string& query) const;
-
-  std::string encryption_key_;
-  std::string mac_key_;
+  std::string key_;  // 32 bytes
 };
 
 }  // namespace cablesim

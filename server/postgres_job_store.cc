@@ -76,15 +76,67 @@ ALTER TABLE jobs ADD COLUMN progress_time_s DOUBLE PRECISION NOT NULL DEFAULT 0;
     {3, "results compressed: how each row's vals are encoded (result_codec.h)", R"sql(
 ALTER TABLE results ADD COLUMN encoding INTEGER NOT NULL DEFAULT 0;  -- 0: raw doubles, 1: zstd
 )sql"},
+    {4, "fair share: the last start of each tenant's (or client's) jobs found by index", R"sql(
+CREATE INDEX IF NOT EXISTS jobs_by_tenant_start ON jobs(tenant, started_ms);
+CREATE INDEX IF NOT EXISTS jobs_by_tenant_peer_start ON jobs(tenant, peer, started_ms);
+)sql"},
+    {5, "row checksums of jobs and sweeps, kept by triggers (JobStore::CheckRows)", R"sql(
+ALTER TABLE jobs ADD COLUMN row_sum TEXT;
+ALTER TABLE sweeps ADD COLUMN row_sum TEXT;
+-- md5 of the served columns, in a text form no session setting changes
+-- (doubles and bytes as hex).
+CREATE FUNCTION cablesim_job_sum(j jobs) RETURNS TEXT LANGUAGE SQL IMMUTABLE AS $$
+  SELECT md5(ROW(j.seq, j.pid, j.state, j.name, encode(float8send(j.end_time_s), 'hex'),
+                 j.created_ms, j.started_ms, j.finished_ms, j.attempts, encode(j.summary, 'hex'),
+                 j.sweep_seq, j.sweep_index, j.peer, j.tenant)::text) $$;
+CREATE FUNCTION cablesim_sweep_sum(s sweeps) RETURNS TEXT LANGUAGE SQL IMMUTABLE AS $$
+  SELECT md5(ROW(s.seq, s.pid, s.name, encode(s.axes, 'hex'), s.created_ms, s.tenant)::text) $$;
+UPDATE jobs j SET row_sum = cablesim_job_sum(j);
+UPDATE sweeps s SET row_sum = cablesim_sweep_sum(s);
+-- A row already damaged keeps its checksum on update (the damage stays
+-- visible).
+CREATE FUNCTION cablesim_job_sum_trigger() RETURNS trigger LANGUAGE plpgsql AS $$
+BEGIN
+  IF TG_OP = 'INSERT' THEN
+    NEW.row_sum := cablesim_job_sum(NEW);
+  ELSIF OLD.row_sum IS NOT DISTINCT FROM cablesim_job_sum(OLD) THEN
+    NEW.row_sum := cablesim_job_sum(NEW);
+  END IF;
+  RETURN NEW;
+END $$;
+CREATE FUNCTION cablesim_sweep_sum_trigger() RETURNS trigger LANGUAGE plpgsql AS $$
+BEGIN
+  IF TG_OP = 'INSERT' THEN
+    NEW.row_sum := cablesim_sweep_sum(NEW);
+  ELSIF OLD.row_sum IS NOT DISTINCT FROM cablesim_sweep_sum(OLD) THEN
+    NEW.row_sum := cablesim_sweep_sum(NEW);
+  END IF;
+  RETURN NEW;
+END $$;
+CREATE TRIGGER jobs_row_sum BEFORE INSERT OR UPDATE OF seq, pid, state, name, end_time_s,
+  created_ms, started_ms, finished_ms, attempts, summary, sweep_seq, sweep_index, peer, tenant
+  ON jobs FOR EACH ROW EXECUTE FUNCTION cablesim_job_sum_trigger();
+CREATE TRIGGER sweeps_row_sum BEFORE INSERT OR UPDATE OF seq, pid, name, axes, created_ms, tenant
+  ON sweeps FOR EACH ROW EXECUTE FUNCTION cablesim_sweep_sum_trigger();
+)sql"},
 };
 
 // An arbitrary constant: the advisory lock under which migrations run.
 constexpr int64_t kMigrationLock = 0x63626c73696d;  // "cblsim"
 
+std::string ConnectionError(PGconn* conn) {
+  std::string text = conn != nullptr ? PQerrorMessage(conn) : "out of memory";
+  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+  return text;
+}
+
 // A query result (binary format); cleared on destruction.
 class PgResult {
  public:
-  explicit PgResult(PGresult* r) : r_(r) {}
+  // `conn`: the connection that gave `r`, for its error message when `r`
+  // is null (the connection lost or never made, or out of memory).
+  PgResult(PGresult* r, PGconn* conn)
+      : r_(r), no_result_(r == nullptr ? ConnectionError(conn) : std::string()) {}
   ~PgResult() { PQclear(r_); }
   PgResult(const PgResult&) = delete;
   PgResult& operator=(const PgResult&) = delete;
@@ -95,8 +147,13 @@ class PgResult {
   }
   absl::Status status() const {
     if (ok()) return absl::OkStatus();
-    const char* message = r_ != nullptr ? PQresultErrorMessage(r_) : "no result (out of memory?)";
-    std::string text = message != nullptr ? message : "error";
+    std::string text;
+    if (r_ == nullptr) {
+      text = absl::StrCat("the database is unreachable: ", no_result_);
+    } else {
+      const char* message = PQresultErrorMessage(r_);
+      text = message != nullptr ? message : "error";
+    }
     while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
     // Lost connection, or the database shutting down: try again later.
     const char* state = r_ != nullptr ? PQresultErrorField(r_, PG_DIAG_SQLSTATE) : nullptr;
@@ -148,6 +205,7 @@ class PgResult {
 
  private:
   PGresult* r_;
+  std::string no_result_;
 };
 
 // Query parameters: numbers and text as text, blobs as binary.
@@ -161,15 +219,17 @@ class Params {
     return Add(std::string(static_cast<const char*>(data), bytes), 1);
   }
 
-  PGresult* Run(PGconn* conn, const std::string& sql) const {
+  PgResult Run(PGconn* conn, const std::string& sql) const {
     std::vector<const char*> values;
     std::vector<int> lengths;
     for (const std::string& v : values_) {
       values.push_back(v.data());
       lengths.push_back(static_cast<int>(v.size()));
     }
-    return PQexecParams(conn, sql.c_str(), static_cast<int>(values_.size()), nullptr,
-                        values.data(), lengths.data(), formats_.data(), /*resultFormat=*/1);
+    return PgResult(PQexecParams(conn, sql.c_str(), static_cast<int>(values_.size()), nullptr,
+                                 values.data(), lengths.data(), formats_.data(),
+                                 /*resultFormat=*/1),
+                    conn);
   }
 
  private:
@@ -187,7 +247,7 @@ class Params {
 class Transaction {
  public:
   explicit Transaction(PGconn* conn) : conn_(conn) {
-    PgResult r(PQexec(conn_, "BEGIN"));
+    PgResult r(PQexec(conn_, "BEGIN"), conn_);
     begun_ = r.status();
   }
   ~Transaction() {
@@ -196,7 +256,7 @@ class Transaction {
   const absl::Status& begun() const { return begun_; }
   absl::Status Commit() {
     done_ = true;
-    PgResult r(PQexec(conn_, "COMMIT"));
+    PgResult r(PQexec(conn_, "COMMIT"), conn_);
     return r.status();
   }
 
@@ -212,7 +272,12 @@ constexpr char kJobColumns[] =
     "j.end_time_s, j.summary, COALESCE(j.sweep_seq, 0), j.sweep_index, "
     "COALESCE((SELECT octet_length(header) + octet_length(vals) FROM results "
     "WHERE job_seq = j.seq), 0)::bigint, j.pid, "
-    "COALESCE((SELECT pid FROM sweeps WHERE sweeps.seq = j.sweep_seq), ''), j.progress_time_s";
+    "COALESCE((SELECT pid FROM sweeps WHERE sweeps.seq = j.sweep_seq), ''), j.progress_time_s, "
+    "(j.row_sum IS NOT DISTINCT FROM cablesim_job_sum(j) AND (j.sweep_seq IS NULL OR "
+    "(SELECT w.row_sum IS NOT DISTINCT FROM cablesim_sweep_sum(w) FROM sweeps w "
+    "WHERE w.seq = j.sweep_seq) IS TRUE))";
+// Whether the row passed its checksum (the last of kJobColumns).
+constexpr int kJobIntactColumn = 15;
 
 v1::Job JobFromRow(const PgResult& r, int row) {
   v1::Job job;
@@ -239,12 +304,6 @@ v1::Job JobFromRow(const PgResult& r, int row) {
 std::string DescribeConnection(PGconn* conn) {
   return absl::StrCat("postgresql://", PQuser(conn), "@", PQhost(conn), ":", PQport(conn), "/",
                       PQdb(conn));
-}
-
-std::string ConnectionError(PGconn* conn) {
-  std::string text = conn != nullptr ? PQerrorMessage(conn) : "out of memory";
-  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
-  return text;
 }
 
 constexpr char kFinishedStates[] = "(3, 4, 5)";  // SUCCEEDED, FAILED, CANCELLED
@@ -308,7 +367,7 @@ void PostgresJobStore::EnsureConnected() {
 }
 
 absl::Status PostgresJobStore::Exec(const std::string& sql) {
-  PgResult r(PQexec(conn_, sql.c_str()));
+  PgResult r(PQexec(conn_, sql.c_str()), conn_);
   return r.status();
 }
 
@@ -371,7 +430,7 @@ void PostgresJobStore::Listen() {
     if (conn == nullptr || PQstatus(conn) != CONNECTION_OK) {
       PQfinish(conn);
       conn = PQconnectdb(url_.c_str());
-      PgResult r(PQexec(conn, "LISTEN cablesim"));
+      PgResult r(PQexec(conn, "LISTEN cablesim"), conn);
       if (!r.ok()) {
         // The database is away: the workers' polls carry on meanwhile.
         absl::SleepFor(absl::Milliseconds(500));
@@ -513,6 +572,7 @@ absl::StatusOr<v1::Job> PostgresJobStore::GetJob(const std::string& id) {
       conn_, absl::StrCat("SELECT ", kJobColumns, " FROM jobs j WHERE j.pid = $1")));
   if (!r.ok()) return r.status();
   if (r.rows() == 0) return absl::NotFoundError(absl::StrCat("no job \"", id, "\""));
+  if (r.Int(0, kJobIntactColumn) != 1) return DamagedRow("job", id);
   return JobFromRow(r, 0);
 }
 
@@ -561,7 +621,8 @@ absl::StatusOr<std::vector<v1::Job>> PostgresJobStore::ListJobs(v1::JobState sta
   std::vector<v1::Job> jobs;
   if (keys != nullptr) keys->clear();
   for (int i = 0; i < r.rows(); ++i) {
-    jobs.push_back(JobFromRow(r, i));
+    // A damaged row: a placeholder (JobStore::ListJobs).
+    jobs.push_back(r.Int(i, kJobIntactColumn) == 1 ? JobFromRow(r, i) : v1::Job());
     if (keys != nullptr) keys->push_back(r.Int(i, 0));
   }
   return jobs;
@@ -571,13 +632,49 @@ absl::StatusOr<std::string> PostgresJobStore::Tenant(const std::string& id) {
   const bool sweep = IsSweepId(id);
   absl::MutexLock lock(&mu_);
   EnsureConnected();
-  PgResult r(Params().Text(id).Run(conn_, sweep ? "SELECT tenant FROM sweeps WHERE pid = $1"
-                                                : "SELECT tenant FROM jobs WHERE pid = $1"));
+  PgResult r(Params().Text(id).Run(
+      conn_, sweep ? "SELECT tenant, (s.row_sum IS NOT DISTINCT FROM cablesim_sweep_sum(s)) "
+                     "FROM sweeps s WHERE pid = $1"
+                   : "SELECT tenant, (j.row_sum IS NOT DISTINCT FROM cablesim_job_sum(j)) "
+                     "FROM jobs j WHERE pid = $1"));
   if (!r.ok()) return r.status();
   if (r.rows() == 0) {
     return absl::NotFoundError(absl::StrCat("no ", sweep ? "sweep" : "job", " \"", id, "\""));
   }
+  // A damaged row's tenant cannot be trusted: DataLoss for everyone.
+  if (r.Int(0, 1) != 1) return DamagedRow(sweep ? "sweep" : "job", id);
   return r.Bytes(0, 0);
+}
+
+absl::StatusOr<std::vector<std::string>> PostgresJobStore::CheckRows() {
+  absl::MutexLock lock(&mu_);
+  EnsureConnected();
+  std::vector<std::string> damaged;
+  PgResult rows(Params().Run(
+      conn_,
+      "SELECT 'job', seq, pid FROM jobs j WHERE j.row_sum IS DISTINCT FROM cablesim_job_sum(j) "
+      "UNION ALL SELECT 'sweep', seq, pid FROM sweeps s "
+      "WHERE s.row_sum IS DISTINCT FROM cablesim_sweep_sum(s) ORDER BY 1, 2"));
+  if (!rows.ok()) return rows.status();
+  for (int i = 0; i < rows.rows(); ++i) {
+    damaged.push_back(absl::StrCat(rows.Bytes(i, 0), " ", rows.Bytes(i, 2), " (row ",
+                                   rows.Int(i, 1), "): the row fails its checksum"));
+  }
+  PgResult r(Params().Run(conn_,
+                          "SELECT r.job_seq, COALESCE(j.pid, ''), r.header, r.vals, r.checksum, "
+                          "r.encoding FROM results r LEFT JOIN jobs j ON j.seq = r.job_seq "
+                          "ORDER BY r.job_seq"));
+  if (!r.ok()) return r.status();
+  for (int i = 0; i < r.rows(); ++i) {
+    const std::string id = r.Bytes(i, 1);
+    absl::StatusOr<StoredResult> result =
+        CheckedResult(id, r.Bytes(i, 2), r.Bytes(i, 3), r.Int(i, 4), r.Int(i, 5));
+    if (!result.ok()) {
+      damaged.push_back(absl::StrCat("result of job ", id, " (row ", r.Int(i, 0),
+                                     "): ", result.status().message()));
+    }
+  }
+  return damaged;
 }
 
 absl::StatusOr<std::vector<std::string>> PostgresJobStore::QueuedJobIds() {
@@ -593,17 +690,18 @@ absl::StatusOr<std::vector<std::string>> PostgresJobStore::QueuedJobIds() {
 absl::StatusOr<std::optional<Claim>> PostgresJobStore::ClaimNext() {
   absl::MutexLock lock(&mu_);
   EnsureConnected();
-  // The oldest job no live claim holds; rows another server is claiming
-  // right now are skipped, not waited for.
+  // A job no live claim holds, round-robin across tenants (JobStore::
+  // ClaimNext); rows another server is claiming right now are skipped,
+  // not waited for.
   PgResult r(Params().Text(owner_).Int(options_.lease_ms).Run(
       conn_,
       absl::StrCat("UPDATE jobs SET state = 2, owner = $1, lease_until_ms = ", kNowMs,
                    " + $2::bigint, started_ms = ", kNowMs,
                    ", attempts = attempts + 1, cancel_requested = FALSE, progress_time_s = 0 "
-                   "WHERE seq = (SELECT seq FROM jobs WHERE state = 1 OR (state = 2 AND "
+                   "WHERE seq = (SELECT seq FROM jobs j WHERE state = 1 OR (state = 2 AND "
                    "lease_until_ms < ",
-                   kNowMs,
-                   ") ORDER BY seq LIMIT 1 FOR UPDATE SKIP LOCKED) "
+                   kNowMs, ") ORDER BY ", kFairShareOrder,
+                   " LIMIT 1 FOR UPDATE SKIP LOCKED) "
                    "RETURNING pid, attempts")));
   if (!r.ok()) return r.status();
   if (r.rows() == 0) return std::nullopt;
@@ -744,20 +842,31 @@ absl::StatusOr<v1::Sweep> PostgresJobStore::GetSweep(const std::string& id) {
   absl::MutexLock lock(&mu_);
   EnsureConnected();
   if (!IsSweepId(id)) return absl::NotFoundError(absl::StrCat("no sweep \"", id, "\""));
-  PgResult s(Params().Text(id).Run(conn_,
-                                   "SELECT name, axes, created_ms, seq FROM sweeps WHERE pid = $1"));
+  PgResult s(Params().Text(id).Run(
+      conn_,
+      "SELECT name, axes, created_ms, seq, (w.row_sum IS NOT DISTINCT FROM cablesim_sweep_sum(w)) "
+      "FROM sweeps w WHERE pid = $1"));
   if (!s.ok()) return s.status();
   if (s.rows() == 0) return absl::NotFoundError(absl::StrCat("no sweep \"", id, "\""));
+  if (s.Int(0, 4) != 1) return DamagedRow("sweep", id);
   v1::Sweep sweep;
   sweep.ParseFromString(s.Bytes(0, 1));
   sweep.set_id(id);
   sweep.set_name(s.Bytes(0, 0));
   sweep.set_created_unix_ms(s.Int(0, 2));
   PgResult r(Params().Int(s.Int(0, 3)).Run(
-      conn_, "SELECT pid, state FROM jobs WHERE sweep_seq = $1::bigint ORDER BY sweep_index"));
+      conn_,
+      "SELECT pid, state, (j.row_sum IS NOT DISTINCT FROM cablesim_job_sum(j)) FROM jobs j "
+      "WHERE sweep_seq = $1::bigint ORDER BY sweep_index"));
   if (!r.ok()) return r.status();
   int finished = 0, failed = 0;
   for (int i = 0; i < r.rows(); ++i) {
+    // A damaged item: the sweep's ids and counts cannot be served whole.
+    if (r.Int(i, 2) != 1) {
+      return absl::DataLossError(absl::StrCat("sweep ", id, ": the stored row of item ", i,
+                                              " fails its checksum (the database is damaged); "
+                                              "cablesim-server --check lists it"));
+    }
     sweep.add_job_ids(r.Bytes(i, 0));
     const auto state = static_cast<v1::JobState>(r.Int(i, 1));
     if (IsFinished(state)) ++finished;

@@ -16,6 +16,7 @@
 #include "convert/scene_field_path.h"
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
+#include "engine/elements/gauss_quadrature.h"
 #include "engine/output/run_statistics.h"
 
 namespace cablesim {
@@ -120,6 +121,48 @@ absl::StatusOr<v1::Scene> SceneOfRequest(bool has_scene, const v1::Scene& scene,
   return parsed;
 }
 
+ServerLimits DefaultServerLimits() {
+  ServerLimits limits;
+  limits.max_elements = 5000;
+  limits.max_steps = 5'000'000;
+  limits.max_frames = 200'000;
+  limits.max_trajectory_values = 32 << 20;
+  limits.max_sweep_items = 1000;
+  limits.max_streams = 64;
+  limits.max_streams_per_peer = 16;
+  limits.max_queued_jobs_per_peer = 1000;
+  limits.max_modes = 200;
+  limits.max_modal_bytes = int64_t{1} << 30;
+  limits.max_name_bytes = 256;
+  limits.max_coordinates = 1'000'000;
+  limits.max_message_bytes = 16 << 20;
+  limits.stall_timeout = absl::Seconds(30);
+  limits.max_unary_calls = 64;
+  limits.max_unary_calls_per_peer = 16;
+  limits.max_inflight_bytes = int64_t{1} << 30;
+  // What max_steps and max_elements allow a plain cable (2e11): only
+  // wave components (and contacts, wraps) beyond that are refused.
+  limits.max_work_units = limits.max_steps * limits.max_elements * GaussRule::kMaxPoints;
+  return limits;
+}
+
+int64_t WorkPerStep(const Scene& scene, int64_t elements) {
+  int64_t components = static_cast<int64_t>(scene.fluid.waves.regular.size());
+  for (const JonswapSpec& sea : scene.fluid.waves.jonswap) components += sea.components;
+  int64_t contacts = 0;
+  for (const BodySpec& body : scene.bodies) {
+    contacts += static_cast<int64_t>(body.contact_points_m.size());
+  }
+  int64_t wraps = 0;
+  for (const SheaveSpec& sheave : scene.sheaves) {
+    for (int c = 0; c < static_cast<int>(scene.cables.size()); ++c) {
+      if (sheave.Touches(c)) wraps += scene.cables[c].elements;
+    }
+  }
+  const int64_t bed = scene.seabed.enabled ? elements : 0;
+  return elements * GaussRule::kMaxPoints * (1 + components) + contacts + wraps + bed;
+}
+
 absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimits& limits,
                                         const std::function<bool()>& should_stop) {
   CheckedScene checked;
@@ -208,6 +251,19 @@ absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimi
     return absl::ResourceExhaustedError(
         absl::StrFormat("cables: %d elements asked for, the server's limit is %d (max_elements)",
                         requested_elements, limits.max_elements));
+  }
+  // The work the run will do, before anything is built: a scene within
+  // every other limit can still ask for hours of wave kinematics.
+  {
+    const int64_t per_step = WorkPerStep(checked.scene, requested_elements);
+    const double work = static_cast<double>(per_step) * static_cast<double>(checked.nominal_steps);
+    if (work > static_cast<double>(limits.max_work_units)) {
+      return absl::ResourceExhaustedError(absl::StrFormat(
+          "solver, fluid.waves: %d steps of %d work units (elements x Gauss points x (1 + wave "
+          "components), plus contact points and sheave wraps) make %.3g, the server's limit is "
+          "%d (max_work_units)",
+          checked.nominal_steps, per_step, work, limits.max_work_units));
+    }
   }
   absl::StatusOr<PreparedRun> prepared = Prepare(checked.scene, should_stop);
   if (!prepared.ok()) return prepared.status();

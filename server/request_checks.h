@@ -54,7 +54,31 @@ struct ServerLimits {
   // than max_bytes. Infinite / max: kept.
   absl::Duration retention_max_age = absl::InfiniteDuration();
   int64_t retention_max_bytes = std::numeric_limits<int64_t>::max();
+  // Unary calls that carry a scene (Validate, SubmitJob, SubmitSweep) in
+  // progress at once, in all and per client (ClientKey), and the memory
+  // they may hold together: each is estimated at kRequestMemoryFactor
+  // times its request's size (the parsed scene, the model built from it).
+  int max_unary_calls = std::numeric_limits<int>::max();
+  int max_unary_calls_per_peer = std::numeric_limits<int>::max();
+  int64_t max_inflight_bytes = std::numeric_limits<int64_t>::max();
+  // Work of a run (EstimateWork): steps x the force evaluation's units.
+  int64_t max_work_units = std::numeric_limits<int64_t>::max();
 };
+
+// The work of one force evaluation, in units of one Gauss point of one
+// element: every element's Gauss points (at most GaussRule::kMaxPoints),
+// each summing every wave component once more, plus each body contact
+// point and each element a sheave may wrap (and the seabed's elements).
+int64_t WorkPerStep(const Scene& scene, int64_t elements);
+
+// The memory a scene-carrying request holds while it is checked, per byte
+// of the request: measured at about 18 (a 7.8 MB scene held 140 MB while
+// its model was built), rounded up.
+inline constexpr int64_t kRequestMemoryFactor = 20;
+
+// The limits cablesim-server applies by default (its flags' defaults) and
+// `cablesim` applies to its in-process runs unless --no-limits.
+ServerLimits DefaultServerLimits();
 
 struct CheckedScene {
   Scene scene;

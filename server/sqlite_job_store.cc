@@ -20,6 +20,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_split.h"
 #include "server/result_codec.h"
 
 namespace cablesim {
@@ -149,12 +150,92 @@ absl::Status SqlError(sqlite3* db) {
   return absl::InternalError(absl::StrCat("sqlite: ", sqlite3_errmsg(db)));
 }
 
-// The last column: bytes of the job's stored result (0 without one).
-constexpr char kJobColumns[] =
-    "seq, state, name, created_ms, started_ms, finished_ms, attempts, end_time_s, summary, "
-    "sweep_seq, sweep_index, "
-    "(SELECT length(header) + length(vals) FROM results WHERE job_seq = jobs.seq), pid, "
-    "(SELECT pid FROM sweeps WHERE sweeps.seq = jobs.sweep_seq)";
+// Row checksums (JobStore::CheckRows): the SQL function cablesim_row_sum,
+// CRC-32 over its arguments (each as its type, its length and its bytes),
+// over these columns of every job and sweep row; triggers keep the column
+// row_sum up to date on every insert and update of them, and every read
+// that serves a row recomputes it (kJobIntact, kSweepIntact).
+constexpr char kJobSumColumns[] =
+    "seq, pid, state, name, end_time_s, created_ms, started_ms, finished_ms, attempts, "
+    "summary, sweep_seq, sweep_index, peer, tenant";
+constexpr char kSweepSumColumns[] = "seq, pid, name, axes, created_ms, tenant";
+
+// `columns` ("a, b") with each prefixed ("NEW.a, NEW.b").
+std::string Prefixed(absl::string_view prefix, absl::string_view columns) {
+  std::string out;
+  for (absl::string_view c : absl::StrSplit(columns, ", ")) {
+    absl::StrAppend(&out, out.empty() ? "" : ", ", prefix, c);
+  }
+  return out;
+}
+
+void RowSumFunction(sqlite3_context* context, int argc, sqlite3_value** argv) {
+  uLong crc = crc32(0L, Z_NULL, 0);
+  auto add = [&](const void* data, size_t n) {
+    crc = crc32(crc, static_cast<const Bytef*>(data), static_cast<uInt>(n));
+  };
+  for (int i = 0; i < argc; ++i) {
+    const unsigned char type = static_cast<unsigned char>(sqlite3_value_type(argv[i]));
+    add(&type, 1);
+    if (type == SQLITE_INTEGER) {
+      const int64_t v = sqlite3_value_int64(argv[i]);
+      add(&v, sizeof v);
+    } else if (type == SQLITE_FLOAT) {
+      const double v = sqlite3_value_double(argv[i]);
+      add(&v, sizeof v);
+    } else if (type == SQLITE_TEXT || type == SQLITE_BLOB) {
+      const void* data = type == SQLITE_TEXT
+                             ? static_cast<const void*>(sqlite3_value_text(argv[i]))
+                             : sqlite3_value_blob(argv[i]);
+      const int64_t n = sqlite3_value_bytes(argv[i]);
+      add(&n, sizeof n);
+      if (n > 0) add(data, static_cast<size_t>(n));
+    }
+  }
+  sqlite3_result_int64(context, static_cast<int64_t>(crc));
+}
+
+// 1 when the row's stored checksum matches its columns (FROM sweeps, or
+// FROM jobs; a job of a sweep also needs its sweep's row intact, whose
+// id it is served with).
+const std::string& SweepIntact() {
+  static const std::string* sql =
+      new std::string(absl::StrCat("(sweeps.row_sum IS cablesim_row_sum(",
+                                   Prefixed("sweeps.", kSweepSumColumns), "))"));
+  return *sql;
+}
+const std::string& JobIntact() {
+  static const std::string* sql = new std::string(absl::StrCat(
+      "(jobs.row_sum IS cablesim_row_sum(", Prefixed("jobs.", kJobSumColumns),
+      ") AND (jobs.sweep_seq = 0 OR (SELECT ", SweepIntact(),
+      " FROM sweeps WHERE sweeps.seq = jobs.sweep_seq) IS 1))"));
+  return *sql;
+}
+
+// The triggers that keep row_sum; an update of a row that was already
+// damaged leaves its checksum as it was (the damage stays visible).
+std::string RowSumTriggers(absl::string_view table, absl::string_view columns) {
+  const std::string fresh = absl::StrCat("UPDATE ", table, " SET row_sum = cablesim_row_sum(",
+                                         Prefixed("NEW.", columns), ") WHERE seq = NEW.seq; END;");
+  return absl::StrCat(
+      "CREATE TRIGGER IF NOT EXISTS ", table, "_row_sum_insert AFTER INSERT ON ", table,
+      " BEGIN ", fresh, " CREATE TRIGGER IF NOT EXISTS ", table, "_row_sum_update AFTER UPDATE OF ",
+      columns, " ON ", table, " WHEN OLD.row_sum IS cablesim_row_sum(", Prefixed("OLD.", columns),
+      ") BEGIN ", fresh);
+}
+
+// The last columns: bytes of the job's stored result (0 without one),
+// the id, the sweep's id, whether the row is intact.
+const std::string& JobColumns() {
+  static const std::string* sql = new std::string(absl::StrCat(
+      "seq, state, name, created_ms, started_ms, finished_ms, attempts, end_time_s, summary, "
+      "sweep_seq, sweep_index, "
+      "(SELECT length(header) + length(vals) FROM results WHERE job_seq = jobs.seq), pid, "
+      "(SELECT pid FROM sweeps WHERE sweeps.seq = jobs.sweep_seq), ",
+      JobIntact()));
+  return *sql;
+}
+constexpr int kJobIntactColumn = 14;
 
 v1::Job JobFromRow(Stmt& s) {
   v1::Job job;
@@ -228,6 +309,8 @@ absl::StatusOr<std::unique_ptr<SqliteJobStore>> SqliteJobStore::Open(const std::
   }
   std::unique_ptr<SqliteJobStore> store(new SqliteJobStore(db, lock_fd, dir));
   sqlite3_busy_timeout(db, 5000);
+  sqlite3_create_function(db, "cablesim_row_sum", -1, SQLITE_UTF8 | SQLITE_DETERMINISTIC,
+                          nullptr, RowSumFunction, nullptr, nullptr);
   if (absl::Status s = store->CheckAndMigrate(dir); !s.ok()) {
     return absl::Status(s.code(), absl::StrCat(path, ": ", s.message()));
   }
@@ -372,6 +455,34 @@ absl::Status SqliteJobStore::CheckAndMigrate(const std::string& dir) {
         !s.ok()) {
       return s;
     }
+  }
+  // Databases from before row checksums: the column, filled from the rows
+  // as they are now, and the triggers that keep it.
+  for (const auto& [table, columns] :
+       {std::pair{"jobs", kJobSumColumns}, std::pair{"sweeps", kSweepSumColumns}}) {
+    bool has = false;
+    {
+      Stmt info(db_, absl::StrCat("PRAGMA table_info(", table, ")").c_str());
+      while (info.Step() == SQLITE_ROW) has |= info.Text(1) == "row_sum";
+    }
+    if (!has) {
+      if (absl::Status s = Exec(absl::StrCat("ALTER TABLE ", table,
+                                             " ADD COLUMN row_sum INTEGER; UPDATE ", table,
+                                             " SET row_sum = cablesim_row_sum(", columns, ")")
+                                    .c_str());
+          !s.ok()) {
+        return s;
+      }
+    }
+    if (absl::Status s = Exec(RowSumTriggers(table, columns).c_str()); !s.ok()) return s;
+  }
+  // Fair share (kFairShareOrder): each tenant's, or client's, latest start
+  // by index.
+  if (absl::Status s = Exec(
+          "CREATE INDEX IF NOT EXISTS jobs_by_tenant_start ON jobs(tenant, started_ms); "
+          "CREATE INDEX IF NOT EXISTS jobs_by_tenant_peer_start ON jobs(tenant, peer, started_ms)");
+      !s.ok()) {
+    return s;
   }
   {
     std::vector<std::pair<int64_t, int64_t>> sums;
@@ -534,10 +645,13 @@ absl::StatusOr<v1::Sweep> SqliteJobStore::InsertSweep(const v1::SubmitSweepReque
 
 absl::StatusOr<v1::Job> SqliteJobStore::GetJob(const std::string& id) {
   absl::MutexLock lock(&mu_);
-  Stmt s(db_, absl::StrCat("SELECT ", kJobColumns, " FROM jobs WHERE pid = ?1").c_str());
+  Stmt s(db_, absl::StrCat("SELECT ", JobColumns(), " FROM jobs WHERE pid = ?1").c_str());
   s.Bind(1, id);
   const int rc = s.Step();
-  if (rc == SQLITE_ROW) return JobFromRow(s);
+  if (rc == SQLITE_ROW) {
+    if (s.Int(kJobIntactColumn) != 1) return DamagedRow("job", id);
+    return JobFromRow(s);
+  }
   if (rc == SQLITE_DONE) return absl::NotFoundError(absl::StrCat("no job \"", id, "\""));
   return SqlError(db_);
 }
@@ -560,7 +674,7 @@ absl::StatusOr<std::vector<v1::Job>> SqliteJobStore::ListJobs(v1::JobState state
                                                               const std::string* tenant,
                                                               std::vector<int64_t>* keys) {
   absl::MutexLock lock(&mu_);
-  Stmt s(db_, absl::StrCat("SELECT ", kJobColumns,
+  Stmt s(db_, absl::StrCat("SELECT ", JobColumns(),
                            " FROM jobs WHERE (?1 = 0 OR state = ?1) AND (?2 = 0 OR sweep_seq = ?2)"
                            " AND seq < ?4 AND (?5 = 0 OR tenant = ?6) ORDER BY seq DESC LIMIT ?3")
                   .c_str());
@@ -573,7 +687,8 @@ absl::StatusOr<std::vector<v1::Job>> SqliteJobStore::ListJobs(v1::JobState state
   if (keys != nullptr) keys->clear();
   int rc;
   while ((rc = s.Step()) == SQLITE_ROW) {
-    jobs.push_back(JobFromRow(s));
+    // A damaged row: a placeholder (JobStore::ListJobs).
+    jobs.push_back(s.Int(kJobIntactColumn) == 1 ? JobFromRow(s) : v1::Job());
     if (keys != nullptr) keys->push_back(s.Int(0));
   }
   if (rc != SQLITE_DONE) return SqlError(db_);
@@ -619,7 +734,9 @@ absl::StatusOr<std::optional<Claim>> SqliteJobStore::ClaimNext() {
   absl::MutexLock lock(&mu_);
   // One connection, one server (the flock): nothing else can claim
   // between the look and the update.
-  Stmt s(db_, "SELECT seq, pid, attempts FROM jobs WHERE state = ?1 ORDER BY seq LIMIT 1");
+  Stmt s(db_, absl::StrCat("SELECT seq, pid, attempts FROM jobs j WHERE state = ?1 ORDER BY ",
+                          kFairShareOrder, " LIMIT 1")
+                 .c_str());
   s.Bind(1, int64_t{v1::QUEUED});
   const int rc = s.Step();
   if (rc == SQLITE_DONE) return std::nullopt;
@@ -707,22 +824,33 @@ absl::StatusOr<v1::Sweep> SqliteJobStore::GetSweep(const std::string& id) {
   const int64_t seq = IsSweepId(id) ? LookUpSeq(id) : -1;
   v1::Sweep sweep;
   {
-    Stmt s(db_, "SELECT name, axes, created_ms FROM sweeps WHERE seq = ?1");
+    Stmt s(db_, absl::StrCat("SELECT name, axes, created_ms, ", SweepIntact(),
+                             " FROM sweeps WHERE seq = ?1")
+                    .c_str());
     s.Bind(1, seq);
     const int rc = s.Step();
     if (rc == SQLITE_DONE) return absl::NotFoundError(absl::StrCat("no sweep \"", id, "\""));
     if (rc != SQLITE_ROW) return SqlError(db_);
+    if (s.Int(3) != 1) return DamagedRow("sweep", id);
     sweep.ParseFromString(s.Blob(1));
     sweep.set_id(id);
     sweep.set_name(s.Text(0));
     sweep.set_created_unix_ms(s.Int(2));
   }
-  Stmt s(db_, "SELECT pid, state FROM jobs WHERE sweep_seq = ?1 ORDER BY sweep_index");
+  Stmt s(db_, absl::StrCat("SELECT pid, state, ", JobIntact(),
+                           " FROM jobs WHERE sweep_seq = ?1 ORDER BY sweep_index")
+                  .c_str());
   s.Bind(1, seq);
   int rc;
   int items = 0, finished = 0, failed = 0;
   while ((rc = s.Step()) == SQLITE_ROW) {
     ++items;
+    // A damaged item: the sweep's ids and counts cannot be served whole.
+    if (s.Int(2) != 1) {
+      return absl::DataLossError(absl::StrCat("sweep ", id, ": the stored row of item ",
+                                              items - 1, " fails its checksum (the database "
+                                              "is damaged); cablesim-server --check lists it"));
+    }
     sweep.add_job_ids(s.Text(0));
     const auto state = static_cast<v1::JobState>(s.Int(1));
     if (state == v1::SUCCEEDED || state == v1::FAILED || state == v1::CANCELLED) ++finished;
@@ -914,15 +1042,51 @@ absl::StatusOr<bool> SqliteJobStore::ReclaimSpace() {
 absl::StatusOr<std::string> SqliteJobStore::Tenant(const std::string& id) {
   const bool sweep = IsSweepId(id);
   absl::MutexLock lock(&mu_);
-  Stmt s(db_, sweep ? "SELECT tenant FROM sweeps WHERE pid = ?1"
-                    : "SELECT tenant FROM jobs WHERE pid = ?1");
+  Stmt s(db_, absl::StrCat("SELECT tenant, ", sweep ? SweepIntact() : JobIntact(), " FROM ",
+                           sweep ? "sweeps" : "jobs", " WHERE pid = ?1")
+                  .c_str());
   s.Bind(1, id);
   const int rc = s.Step();
-  if (rc == SQLITE_ROW) return s.Text(0);
+  if (rc == SQLITE_ROW) {
+    // A damaged row's tenant cannot be trusted: DataLoss for everyone.
+    if (s.Int(1) != 1) return DamagedRow(sweep ? "sweep" : "job", id);
+    return s.Text(0);
+  }
   if (rc == SQLITE_DONE) {
     return absl::NotFoundError(absl::StrCat("no ", sweep ? "sweep" : "job", " \"", id, "\""));
   }
   return SqlError(db_);
+}
+
+absl::StatusOr<std::vector<std::string>> SqliteJobStore::CheckRows() {
+  absl::MutexLock lock(&mu_);
+  std::vector<std::string> damaged;
+  for (const auto& [table, kind, intact] : {std::tuple{"jobs", "job", &JobIntact()},
+                                            std::tuple{"sweeps", "sweep", &SweepIntact()}}) {
+    Stmt s(db_, absl::StrCat("SELECT seq, pid FROM ", table, " WHERE NOT ", *intact, " ORDER BY seq")
+                    .c_str());
+    int rc;
+    while ((rc = s.Step()) == SQLITE_ROW) {
+      damaged.push_back(absl::StrCat(kind, " ", s.Text(1), " (row ", s.Int(0),
+                                     "): the row fails its checksum"));
+    }
+    if (rc != SQLITE_DONE) return SqlError(db_);
+  }
+  Stmt r(db_,
+         "SELECT job_seq, (SELECT pid FROM jobs WHERE seq = job_seq), header, vals, checksum, "
+         "encoding FROM results ORDER BY job_seq");
+  int rc;
+  while ((rc = r.Step()) == SQLITE_ROW) {
+    const std::string id = r.Text(1);
+    absl::StatusOr<StoredResult> result =
+        CheckedResult(id, r.Blob(2), r.Blob(3), r.Int(4), r.Int(5));
+    if (!result.ok()) {
+      damaged.push_back(absl::StrCat("result of job ", id, " (row ", r.Int(0),
+                                     "): ", result.status().message()));
+    }
+  }
+  if (rc != SQLITE_DONE) return SqlError(db_);
+  return damaged;
 }
 
 }  // namespace cablesim

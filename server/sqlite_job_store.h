@@ -65,6 +65,7 @@ class SqliteJobStore final : public JobStore {
                                                 std::vector<int64_t>* keys) override;
   const std::string& page_token_secret() const override { return page_token_secret_; }
   absl::StatusOr<std::string> Tenant(const std::string& id) override;
+  absl::StatusOr<std::vector<std::string>> CheckRows() override;
   absl::StatusOr<std::vector<std::string>> QueuedJobIds() override;
   absl::StatusOr<std::optional<Claim>> ClaimNext() override;
   absl::StatusOr<bool> MarkRunning(const std::string& id) override;

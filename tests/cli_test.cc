@@ -1,11 +1,13 @@
 // The command line, run in-process through RunCli.
 
 #include "client/cli.h"
+#include "client/service_client.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <chrono>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -282,6 +284,33 @@ TEST(CliTest, NumericalFailureExitsWith3AndKeepsTheCsv) {
   EXPECT_THAT(lines[1], StartsWith("0,"));
   std::remove(csv.c_str());
   std::remove(scene.c_str());
+}
+
+// The review: the in-process CLI applied no limits at all (a 1e9-step
+// scene ground silently). Now it applies the server's default limits,
+// refusing such a scene at once naming the limit, unless --no-limits.
+TEST(CliTest, InProcessRunsApplyTheServerDefaultLimitsUnlessNoLimits) {
+  std::string scene = kTinyScene;
+  scene.replace(scene.find(R"("duration": 0.02, "step": 0.005)"),
+                std::string(R"("duration": 0.02, "step": 0.005)").size(),
+                R"("duration": 1000, "step": 1e-6)");  // 1e9 steps
+  const std::string path = WriteTempFile("billion_steps.json", scene);
+  const auto start = std::chrono::steady_clock::now();
+  const CliResult run = Cli({"run", path});
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
+  EXPECT_EQ(run.code, 2) << run.err;
+  EXPECT_THAT(run.err, HasSubstr("max_steps"));
+  const CliResult validate = Cli({"validate", path});
+  EXPECT_EQ(validate.code, 2);
+  EXPECT_THAT(validate.out, HasSubstr("max_steps"));
+  const CliResult lifted = Cli({"validate", path, "--no-limits"});
+  EXPECT_EQ(lifted.code, 0) << lifted.err;
+  EXPECT_EQ(Cli({"validate", path, "--no-limits", "--server", "127.0.0.1:1"}).code, 2);
+  // The limits are the server's: its --help shows the same defaults.
+  const ServerLimits limits = DefaultServerLimits();
+  EXPECT_EQ(limits.max_steps, 5'000'000);
+  EXPECT_EQ(Cli({"validate", path}).code, 2);  // each command sets its own
+  EXPECT_EQ(InProcessLimits().max_elements, limits.max_elements);
 }
 
 }  // namespace

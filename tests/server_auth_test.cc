@@ -6,13 +6,17 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
 #include <sstream>
 #include <string>
 
+#include "absl/strings/str_format.h"
 #include "client/cli.h"
+#include "server/listen_address.h"
 #include "server_test_util.h"
 
 namespace cablesim {
@@ -39,7 +43,7 @@ grpc::Status Info(v1::CablesimService::Stub* stub, const std::string& token = ""
 TEST(ServerAuthTest, ACallWithoutAKnownTokenIsUnauthenticated) {
   const std::string dir = testing::FreshDir("auth_tokens");
   const std::string tokens = dir + "/tokens";
-  std::ofstream(tokens) << "# token tenant\n" << kToken << " alice\n";
+  testing::WritePrivateFile(tokens, absl::StrCat("# token tenant\n", kToken, " alice\n"));
   ServerProcess server(dir, {"--token-file=" + tokens});
   auto stub = server.Stub();
   grpc::Status s = Info(stub.get());
@@ -63,7 +67,7 @@ TEST(ServerAuthTest, ATenantSeesOnlyItsOwnJobsAndSweeps) {
   const std::string dir = testing::FreshDir("auth_tenants");
   const std::string tokens = dir + "/tokens";
   const std::string alice = kToken, bob = "tok-bob-0123456789ab";
-  std::ofstream(tokens) << alice << " alice\n" << bob << " bob\n";
+  testing::WritePrivateFile(tokens, absl::StrCat(alice, " alice\n", bob, " bob\n"));
   ServerProcess server(dir, {"--token-file=" + tokens, "--workers=1"});
   auto stub = server.Stub();
   auto as = [](grpc::ClientContext* context, const std::string& token) {
@@ -244,7 +248,7 @@ TEST(ServerAuthTest, TheCommandLineTakesTlsCaAndTokenFile) {
   const std::string dir = testing::FreshDir("auth_cli");
   MakeCertificates(dir);
   const std::string tokens = dir + "/tokens", mine = dir + "/my-token";
-  std::ofstream(tokens) << kToken << " alice\n";
+  testing::WritePrivateFile(tokens, absl::StrCat(kToken, " alice\n"));
   std::ofstream(mine) << "# issued to alice\n" << kToken << "\n";
   ServerProcess server(dir, {"--tls-cert=" + dir + "/server.pem",
                              "--tls-key=" + dir + "/server.key", "--token-file=" + tokens});
@@ -271,6 +275,96 @@ TEST(ServerAuthTest, BeyondLoopbackOnlyWithTlsAndTokensOrInsecure) {
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 2);
   EXPECT_THAT(ReadText(log), HasSubstr("--insecure"));
+}
+
+// The review's reproducer: --listen 127.evil.example:PORT passed a check on
+// the spelling ("starts with 127.") and bound whatever the name resolved
+// to, in plain text. Now the name is resolved first and the address it
+// resolves to decides.
+TEST(ServerAuthTest, ALoopbackLookingNameIsJudgedByTheAddressItResolvesTo) {
+  auto resolver = [](const std::string& host) -> absl::StatusOr<std::vector<std::string>> {
+    if (host == "127.evil.example") return std::vector<std::string>{"203.0.113.7"};
+    if (host == "localhost") return std::vector<std::string>{"127.0.0.1", "::1"};
+    if (host == "sixlocal") return std::vector<std::string>{"::1"};
+    if (host == "mapped") return std::vector<std::string>{"::ffff:127.0.0.2"};
+    if (host == "nothing") return std::vector<std::string>{};
+    return std::vector<std::string>{host};  // numeric
+  };
+  absl::StatusOr<ListenAddress> evil = ResolveListenAddress("127.evil.example:5000", resolver);
+  ASSERT_TRUE(evil.ok()) << evil.status();
+  EXPECT_FALSE(evil->loopback);
+  EXPECT_EQ(evil->bind, "203.0.113.7:5000");  // bound to what was checked, not re-resolved
+  absl::StatusOr<ListenAddress> local = ResolveListenAddress("localhost:0", resolver);
+  ASSERT_TRUE(local.ok());
+  EXPECT_TRUE(local->loopback);
+  EXPECT_EQ(local->bind, "127.0.0.1:0");
+  EXPECT_TRUE(ResolveListenAddress("sixlocal:7", resolver)->loopback);
+  EXPECT_EQ(ResolveListenAddress("sixlocal:7", resolver)->bind, "[::1]:7");
+  EXPECT_TRUE(ResolveListenAddress("mapped:7", resolver)->loopback);
+  EXPECT_TRUE(ResolveListenAddress("[::1]:7", resolver)->loopback);
+  EXPECT_TRUE(ResolveListenAddress("127.0.0.9:7", resolver)->loopback);
+  EXPECT_FALSE(ResolveListenAddress("0.0.0.0:7", resolver)->loopback);
+  EXPECT_FALSE(ResolveListenAddress("[::]:7", resolver)->loopback);
+  EXPECT_FALSE(ResolveListenAddress("128.0.0.1:7", resolver)->loopback);
+  EXPECT_TRUE(ResolveListenAddress("unix:/tmp/sock", resolver)->loopback);
+  EXPECT_THAT(ResolveListenAddress("nothing:7", resolver).status().message(),
+              HasSubstr("resolves to no address"));
+  EXPECT_FALSE(ResolveListenAddress("127.0.0.1:http", resolver).ok());
+  EXPECT_FALSE(ResolveListenAddress("127.0.0.1", resolver).ok());
+  // The real resolver: localhost is loopback after resolution.
+  absl::StatusOr<ListenAddress> real = ResolveListenAddress("localhost:0");
+  ASSERT_TRUE(real.ok()) << real.status();
+  EXPECT_TRUE(real->loopback);
+}
+
+// The binary refuses 127.evil.example: it either does not resolve (this
+// machine has no DNS) or resolves to something that is not loopback;
+// usage error (2) either way, before anything is bound.
+TEST(ServerAuthTest, TheServerRefusesALoopbackLookingName) {
+  const std::string dir = testing::FreshDir("auth_evil");
+  const std::string log = dir + "/refused.log";
+  const int status = std::system(
+      absl::StrCat("timeout 60 '", CABLESIM_BIN_DIR,
+                   "/cablesim-server' --listen=127.evil.example:0 --data-dir='", dir, "' 2>'",
+                   log, "'")
+          .c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 2) << ReadText(log);
+  EXPECT_THAT(ReadText(log), HasSubstr("--listen 127.evil.example:0"));
+}
+
+// A token file that others can read or change is refused, naming the
+// file and its mode (the review found a world-readable one accepted
+// silently); one its group can read starts with a warning saying why
+// (Kubernetes mounts secrets 0440 for the pod's group); a private one
+// starts quietly.
+TEST(ServerAuthTest, ATokenFileOthersCanReadIsRefused) {
+  const std::string dir = testing::FreshDir("auth_token_mode");
+  const std::string tokens = dir + "/tokens", log = dir + "/refused.log";
+  testing::WritePrivateFile(tokens, absl::StrCat(kToken, " alice\n"));
+  for (const int mode : {0644, 0604, 0606}) {
+    ASSERT_EQ(::chmod(tokens.c_str(), mode), 0);
+    const int status = std::system(
+        absl::StrCat("timeout 60 '", CABLESIM_BIN_DIR,
+                     "/cablesim-server' --listen=127.0.0.1:0 --data-dir='", dir,
+                     "' --token-file='", tokens, "' 2>'", log, "'")
+            .c_str());
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 1) << mode;
+    EXPECT_THAT(ReadText(log), HasSubstr(tokens + ": mode 0" + absl::StrFormat("%o", mode)));
+    EXPECT_THAT(ReadText(log), HasSubstr("chmod 600"));
+  }
+  ASSERT_EQ(::chmod(tokens.c_str(), 0640), 0);
+  {
+    ServerProcess server(dir, {"--token-file=" + tokens});
+    auto stub = server.Stub();
+    EXPECT_TRUE(Info(stub.get(), kToken).ok());
+    EXPECT_TRUE(server.WaitForLog("WARNING: " + tokens + ": mode 0640 lets its group read"));
+  }
+  ASSERT_EQ(::chmod(tokens.c_str(), 0600), 0);
+  ServerProcess server(dir, {"--token-file=" + tokens});
+  auto stub = server.Stub();
+  EXPECT_TRUE(Info(stub.get(), kToken).ok());
 }
 
 }  // namespace

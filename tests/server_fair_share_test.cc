@@ -97,7 +97,7 @@ TEST(ServerFairShareTest, WithTokensTheShareIsPerTenant) {
   testing::JobGate gate(dir);
   const std::string tokens = dir + "/tokens";
   const std::string alice = "tok-alice-0123456789", bob = "tok-bob-0123456789ab";
-  std::ofstream(tokens) << alice << " alice\n" << bob << " bob\n";
+  testing::WritePrivateFile(tokens, absl::StrCat(alice, " alice\n", bob, " bob\n"));
   ServerProcess server(dir,
                        {"--workers=1", "--max-queued-jobs-per-peer=1", "--token-file=" + tokens},
                        {gate.env()});

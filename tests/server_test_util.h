@@ -42,6 +42,16 @@ inline std::string FreshDir(const std::string& name) {
   return dir;
 }
 
+// Writes `text` to `path`, readable by its owner only (the server refuses
+// a token file that others can read).
+inline void WritePrivateFile(const std::string& path, const std::string& text) {
+  std::filesystem::remove(path);
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+  ASSERT_GE(fd, 0) << path;
+  ASSERT_EQ(::write(fd, text.data(), text.size()), static_cast<ssize_t>(text.size()));
+  ::close(fd);
+}
+
 // cablesim-server as a child process listening on 127.0.0.1 on a free port
 // (it binds port 0 and writes the port it got to a file). `env` adds
 // NAME=VALUE entries to the child's environment. The server's stderr goes

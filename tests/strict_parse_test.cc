@@ -126,5 +126,33 @@ TEST(StrictParseTest, LongNamesAreRefusedWithoutEchoingThem) {
               StartsWith("joints[0].a.cable: at most 256 bytes"));
 }
 
+// The review: a string that is not UTF-8 was refused without naming its
+// field in JSON ("Encountered non UTF-8 code points"), and in text format
+// passed parsing to fail later with raw libprotobuf log lines. Now both
+// name the field.
+TEST(StrictParseTest, NonUtf8StringsNameTheirField) {
+  EXPECT_EQ(ParseError("{\"cables\": [{\"name\": \"c\"}, {\"name\": \"be\xff" "am\"}]}"),
+            "invalid JSON scene: cables[1].name: not valid UTF-8 (byte 39 is 0xff)");
+  EXPECT_THAT(ParseError("{\"name\": \"\xc3\x28\"}"), HasSubstr("scene: name: not valid UTF-8"));
+  // An overlong form and a surrogate are not UTF-8 either.
+  EXPECT_THAT(ParseError("{\"name\": \"\xc0\xaf\"}"), HasSubstr(": name: not valid UTF-8"));
+  EXPECT_THAT(ParseError("{\"name\": \"\xed\xa0\x80\"}"), HasSubstr(": name: not valid UTF-8"));
+  // In a key: the path up to the byte.
+  EXPECT_THAT(ParseError("{\"cables\": [{\"na\xffme\": \"c\"}]}"),
+              HasSubstr("cables[0].na: not valid UTF-8 (byte 16 is 0xff)"));
+  // Valid multi-byte UTF-8 passes.
+  EXPECT_TRUE(ParseSceneJson("{\"name\": \"Gr\xc3\xbc\xc3\x9f" "e \xe2\x82\xac \xf0\x9f\x8c\x8a\"}").ok());
+  for (const std::string text :
+       {std::string("cables { name: \"ok\" }\ncables { name: \"be\xff" "am\" }\n"),
+        std::string("cables { name: \"ok\" }\ncables { name: \"be\\377am\" }\n")}) {
+    const absl::StatusOr<v1::Scene> scene = ParseSceneTextFormat(text);
+    ASSERT_FALSE(scene.ok()) << text;
+    EXPECT_EQ(scene.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_EQ(scene.status().message(),
+              "invalid text-format scene: cables[1].name: not valid UTF-8 (byte 2 of the "
+              "string is 0xff)");
+  }
+}
+
 }  // namespace
 }  // namespace cablesim

@@ -47,7 +47,7 @@ async function waitForPortFile(file, server) {
 async function main() {
   const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'cablesim-node-tls-'));
   makeCertificates(dir);
-  fs.writeFileSync(path.join(dir, 'tokens'), 'node-test-token-0123456789 tenant-a\n');
+  fs.writeFileSync(path.join(dir, 'tokens'), 'node-test-token-0123456789 tenant-a\n', {mode: 0o600});
   fs.writeFileSync(path.join(dir, 'client-token'), '# the client\'s token\nnode-test-token-0123456789\n');
   const portFile = path.join(dir, 'port');
   const server = childProcess.spawn(

@@ -150,6 +150,7 @@ class TlsAndTokenTest(unittest.TestCase):
             token = "tok-python-0123456789"
             with open(os.path.join(tmp, "tokens"), "w") as f:
                 f.write(token + " py\n")
+            os.chmod(os.path.join(tmp, "tokens"), 0o600)  # the server refuses others' reading
             with open(os.path.join(tmp, "my-token"), "w") as f:
                 f.write("# mine\n" + token + "\n")
             os.mkdir(os.path.join(tmp, "data"))

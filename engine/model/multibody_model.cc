@@ -307,6 +307,10 @@ double MultibodyModel::ElementForces(const VectorXd& q, VectorXd* full, SkylineL
   double* values = stiffness ? stiffness->values() : nullptr;
   for (size_t k = 0; k < elements.size(); ++k) {
     const ElementData<D>& e = elements[k];
+    if (StopNow(e.element.gauss_points())) {  // set_stop_poll
+      full->setConstant(std::numeric_limits<double>::quiet_NaN());
+      return std::numeric_limits<double>::quiet_NaN();
+    }
     fe.setZero();
     if (stiffness) ke.setZero();
     if (roundoff) re.setZero();
@@ -456,8 +460,16 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
   double size = 0;
   double* values = tangent ? tangent->values() : nullptr;
   const bool bed = seabed_ && seabed_->dissipates();
+  // Work per element for the stop poll: its Gauss points, each summing
+  // every wave component.
+  const int64_t components = wave_load_ ? wave_load_->field().components().size() : 0;
   for (size_t k = 0; k < elements.size(); ++k) {
     const ElementData<D>& e = elements[k];
+    if (StopNow(e.element.gauss_points() * (1 + components))) {  // set_stop_poll
+      if (full) full->setConstant(std::numeric_limits<double>::quiet_NaN());
+      if (power) *power = std::numeric_limits<double>::quiet_NaN();
+      return std::numeric_limits<double>::quiet_NaN();
+    }
     const uint64_t wheels = sheaves_dissipate_ ? sheave_mask_[k] : 0;
     if (!e.damped() && !bed && e.fluid_inertia == 0 && wheels == 0) continue;
     ce.setZero();

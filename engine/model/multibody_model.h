@@ -54,6 +54,7 @@
 #include "engine/forces/sheave.h"
 #include "engine/forces/wave_load.h"
 #include "engine/constraints/quadratic_form.h"
+#include "engine/scene/run_control.h"
 #include "engine/scene/scene.h"
 #include "engine/output/results.h"
 #include "engine/linear/skyline_ldlt.h"
@@ -263,6 +264,11 @@ class MultibodyModel {
   // The scene's wave load (engine/forces/wave_load.h), or null: a scene
   // without waves holds none and its elements take AddDrag's uniform current.
   const WaveLoad* wave_load() const { return wave_load_ ? &*wave_load_ : nullptr; }
+  // The run's stop poll (null: none), asked in the element loops of the
+  // forces: once it says stop, the forces still to be computed are
+  // not-a-number (the step fails at once; the run says "cancelled").
+  void set_stop_poll(StopPoll* poll) { stop_poll_ = poll; }
+  bool stop_requested() const { return stop_poll_ != nullptr && stop_poll_->stopped(); }
 
   // The fluid's loads on bodies (engine/forces/body_fluid_load.h): the
   // hydrostatic part in NetForce (scaled with gravity by the load factor,
@@ -605,6 +611,9 @@ class MultibodyModel {
   bool sheaves_dissipate_ = false;
   // Only in a scene whose fluid has waves (then it carries the current too).
   std::optional<WaveLoad> wave_load_;
+  StopPoll* stop_poll_ = nullptr;
+  // Counts `units` of work on the stop poll; true when the run should stop.
+  bool StopNow(int64_t units) const { return stop_poll_ != nullptr && stop_poll_->Poll(units); }
   // The fluid's loads on bodies that ask for them (empty in most scenes:
   // then nothing is evaluated).
   std::vector<BodyFluidLoad> body_fluid_;

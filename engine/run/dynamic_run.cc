@@ -120,6 +120,12 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     dense.BeginStep(stepper);
     external_work.Before(stepper.z(), t, stepper.lambda());
     const auto st = stepper.Step(h_try);
+    if (model->stop_requested()) {  // the step was cut short (StopPoll)
+      stepper.Restore();
+      summary->status = "cancelled";
+      summary->error = absl::StrFormat("stopped by the caller during the step from t = %.9g", t);
+      return;
+    }
     summary->newton_iterations += st.newton_iterations;
     summary->linear_iterations += st.linear_iterations;
     summary->factorizations += st.factorizations;

@@ -117,6 +117,11 @@ absl::StatusOr<RunSummary> RunPrepared(PreparedRun* prepared, FrameSink* sink,
   FrameSink* out = estimate ? &recording : sink;
   if (absl::Status s = out->OnStart(summary.info); !s.ok()) return s;
   FrameRecorder recorder(&model, out, &summary);
+  // The stop request is also asked inside a step (StopPoll): a step of a
+  // costly scene (many wave components) ends within about a millisecond
+  // of work after it.
+  StopPoll poll(control.should_stop);
+  model.set_stop_poll(&poll);
   if (settings.analysis == Analysis::kStatic) {
     RunStatic(&model, settings, control, &recorder, &summary);
   } else if (settings.analysis == Analysis::kModal) {
@@ -135,6 +140,13 @@ absl::StatusOr<RunSummary> RunPrepared(PreparedRun* prepared, FrameSink* sink,
         summary.error_estimate_method = "none: the run did not finish";
       }
     }
+  }
+  model.set_stop_poll(nullptr);
+  // A step (or load increment, or the initial solve) cut short by the
+  // stop request failed for that reason alone.
+  if (poll.stopped() && summary.status != "cancelled") {
+    summary.status = "cancelled";
+    summary.error = "stopped by the caller during a step";
   }
   if (statistics != nullptr) {
     summary.has_statistics = true;
