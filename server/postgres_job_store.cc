@@ -11,12 +11,26 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_replace.h"
 #include "absl/strings/str_format.h"
 #include "absl/time/clock.h"
 #include "server/result_codec.h"
 
 namespace cablesim {
 namespace {
+
+// SQL with the job states named: {QUEUED}, {RUNNING}, {SUCCEEDED},
+// {FAILED} and {CANCELLED} become the numbers of the contract's JobState
+// (service.proto), which is what the jobs table stores, so no query spells
+// a state as a bare integer.
+std::string NamedStates(absl::string_view sql) {
+  return absl::StrReplaceAll(
+      sql, {{"{QUEUED}", absl::StrCat(static_cast<int>(v1::QUEUED))},
+            {"{RUNNING}", absl::StrCat(static_cast<int>(v1::RUNNING))},
+            {"{SUCCEEDED}", absl::StrCat(static_cast<int>(v1::SUCCEEDED))},
+            {"{FAILED}", absl::StrCat(static_cast<int>(v1::FAILED))},
+            {"{CANCELLED}", absl::StrCat(static_cast<int>(v1::CANCELLED))}});
+}
 
 // The database's clock in Unix milliseconds: leases are compared with one
 // clock, whichever server looks.
@@ -454,9 +468,9 @@ void PostgresJobStore::Listen() {
 absl::StatusOr<int> PostgresJobStore::RequeueRunning() {
   absl::MutexLock lock(&mu_);
   EnsureConnected();
-  PgResult r(Params().Run(conn_, absl::StrCat("UPDATE jobs SET state = 1, owner = '' WHERE "
-                                              "state = 2 AND lease_until_ms < ",
-                                              kNowMs)));
+  PgResult r(Params().Run(conn_, NamedStates(absl::StrCat("UPDATE jobs SET state = {QUEUED}, owner = '' WHERE "
+                                                          "state = {RUNNING} AND lease_until_ms < ",
+                                                          kNowMs))));
   if (!r.ok()) return r.status();
   return static_cast<int>(r.changed());
 }
@@ -468,7 +482,7 @@ absl::Status PostgresJobStore::CheckPeerRoom(const std::string& peer, int64_t ad
   PgResult lock(Params().Text(peer).Run(conn_, "SELECT pg_advisory_xact_lock(hashtext($1))"));
   if (!lock.ok()) return lock.status();
   PgResult c(Params().Text(peer).Run(
-      conn_, "SELECT COUNT(*) FROM jobs WHERE peer = $1 AND state IN (1, 2)"));
+      conn_, NamedStates("SELECT COUNT(*) FROM jobs WHERE peer = $1 AND state IN ({QUEUED}, {RUNNING})")));
   if (!c.ok()) return c.status();
   const int64_t unfinished = c.Int(0, 0);
   if (unfinished + adding > max_unfinished) {
@@ -680,7 +694,7 @@ absl::StatusOr<std::vector<std::string>> PostgresJobStore::CheckRows() {
 absl::StatusOr<std::vector<std::string>> PostgresJobStore::QueuedJobIds() {
   absl::MutexLock lock(&mu_);
   EnsureConnected();
-  PgResult r(Params().Run(conn_, "SELECT pid FROM jobs WHERE state = 1 ORDER BY seq"));
+  PgResult r(Params().Run(conn_, NamedStates("SELECT pid FROM jobs WHERE state = {QUEUED} ORDER BY seq")));
   if (!r.ok()) return r.status();
   std::vector<std::string> ids;
   for (int i = 0; i < r.rows(); ++i) ids.push_back(r.Bytes(i, 0));
@@ -695,14 +709,14 @@ absl::StatusOr<std::optional<Claim>> PostgresJobStore::ClaimNext() {
   // not waited for.
   PgResult r(Params().Text(owner_).Int(options_.lease_ms).Run(
       conn_,
-      absl::StrCat("UPDATE jobs SET state = 2, owner = $1, lease_until_ms = ", kNowMs,
+      NamedStates(absl::StrCat("UPDATE jobs SET state = {RUNNING}, owner = $1, lease_until_ms = ", kNowMs,
                    " + $2::bigint, started_ms = ", kNowMs,
                    ", attempts = attempts + 1, cancel_requested = FALSE, progress_time_s = 0 "
-                   "WHERE seq = (SELECT seq FROM jobs j WHERE state = 1 OR (state = 2 AND "
+                   "WHERE seq = (SELECT seq FROM jobs j WHERE state = {QUEUED} OR (state = {RUNNING} AND "
                    "lease_until_ms < ",
                    kNowMs, ") ORDER BY ", kFairShareOrder,
                    " LIMIT 1 FOR UPDATE SKIP LOCKED) "
-                   "RETURNING pid, attempts")));
+                   "RETURNING pid, attempts"))));
   if (!r.ok()) return r.status();
   if (r.rows() == 0) return std::nullopt;
   Notify();
@@ -713,10 +727,10 @@ absl::StatusOr<bool> PostgresJobStore::MarkRunning(const std::string& id) {
   absl::MutexLock lock(&mu_);
   EnsureConnected();
   PgResult r(Params().Text(owner_).Int(options_.lease_ms).Text(id).Run(
-      conn_, absl::StrCat("UPDATE jobs SET state = 2, owner = $1, lease_until_ms = ", kNowMs,
+      conn_, NamedStates(absl::StrCat("UPDATE jobs SET state = {RUNNING}, owner = $1, lease_until_ms = ", kNowMs,
                           " + $2::bigint, started_ms = ", kNowMs,
                           ", attempts = attempts + 1, cancel_requested = FALSE "
-                          "WHERE pid = $3 AND state = 1 RETURNING seq")));
+                          "WHERE pid = $3 AND state = {QUEUED} RETURNING seq"))));
   if (!r.ok()) return r.status();
   return r.rows() == 1;
 }
@@ -726,8 +740,8 @@ absl::Status PostgresJobStore::Requeue(const std::string& id, int attempt) {
   EnsureConnected();
   PgResult r(Params().Text(id).Text(owner_).Int(attempt).Run(
       conn_,
-      "UPDATE jobs SET state = 1, owner = '', lease_until_ms = 0 WHERE pid = $1 AND state = 2 "
-      "AND owner = $2 AND ($3::int = 0 OR attempts = $3::int)"));
+      NamedStates("UPDATE jobs SET state = {QUEUED}, owner = '', lease_until_ms = 0 WHERE pid = $1 "
+                  "AND state = {RUNNING} AND owner = $2 AND ($3::int = 0 OR attempts = $3::int)")));
   if (!r.ok()) return r.status();
   Notify();
   return absl::OkStatus();
@@ -738,10 +752,10 @@ absl::StatusOr<bool> PostgresJobStore::CancelQueued(const std::string& id) {
   EnsureConnected();
   // A job whose server died (lease expired) is as good as queued.
   PgResult r(Params().Text(id).Run(
-      conn_, absl::StrCat("UPDATE jobs SET state = 5, finished_ms = ", kNowMs,
-                          ", owner = '' WHERE pid = $1 AND (state = 1 OR (state = 2 AND "
+      conn_, NamedStates(absl::StrCat("UPDATE jobs SET state = {CANCELLED}, finished_ms = ", kNowMs,
+                          ", owner = '' WHERE pid = $1 AND (state = {QUEUED} OR (state = {RUNNING} AND "
                           "lease_until_ms < ",
-                          kNowMs, ")) RETURNING seq")));
+                          kNowMs, ")) RETURNING seq"))));
   if (!r.ok()) return r.status();
   if (r.rows() == 1) Notify();
   return r.rows() == 1;
@@ -751,7 +765,7 @@ absl::Status PostgresJobStore::RequestCancel(const std::string& id) {
   absl::MutexLock lock(&mu_);
   EnsureConnected();
   PgResult r(Params().Text(id).Run(
-      conn_, "UPDATE jobs SET cancel_requested = TRUE WHERE pid = $1 AND state = 2"));
+      conn_, NamedStates("UPDATE jobs SET cancel_requested = TRUE WHERE pid = $1 AND state = {RUNNING}")));
   if (!r.ok()) return r.status();
   Notify();
   return absl::OkStatus();
@@ -770,10 +784,10 @@ absl::StatusOr<HeartbeatReply> PostgresJobStore::Heartbeat(
                    .Text(job.id)
                    .Text(owner_)
                    .Int(job.attempt)
-                   .Run(conn_, absl::StrCat("UPDATE jobs SET lease_until_ms = ", kNowMs,
+                   .Run(conn_, NamedStates(absl::StrCat("UPDATE jobs SET lease_until_ms = ", kNowMs,
                                             " + $1::bigint, progress_time_s = $2::float8 "
-                                            "WHERE pid = $3 AND state = 2 AND owner = $4 AND "
-                                            "attempts = $5::int RETURNING cancel_requested")));
+                                            "WHERE pid = $3 AND state = {RUNNING} AND owner = $4 AND "
+                                            "attempts = $5::int RETURNING cancel_requested"))));
     if (!r.ok()) return r.status();
     if (r.rows() == 0) {
       reply.lost.push_back(job.id);
@@ -802,11 +816,11 @@ absl::StatusOr<bool> PostgresJobStore::Finish(const std::string& id, v1::JobStat
                  .Text(id)
                  .Text(owner_)
                  .Int(attempt)
-                 .Run(conn_, absl::StrCat("UPDATE jobs SET state = $1::int, finished_ms = ",
+                 .Run(conn_, NamedStates(absl::StrCat("UPDATE jobs SET state = $1::int, finished_ms = ",
                                           kNowMs,
                                           ", summary = $2, lease_until_ms = 0 WHERE pid = $3 AND "
-                                          "state = 2 AND owner = $4 AND ($5::int = 0 OR "
-                                          "attempts = $5::int) RETURNING seq")));
+                                          "state = {RUNNING} AND owner = $4 AND ($5::int = 0 OR "
+                                          "attempts = $5::int) RETURNING seq"))));
   if (!u.ok()) return (u.status());
   if (u.rows() != 1) return false;
   PgResult r(Params()
