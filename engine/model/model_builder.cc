@@ -780,46 +780,9 @@ void ModelBuilder::BuildElements() {
                        j.components, j.seed);
     model_.wave_load_.emplace(std::move(field), fluid.current_m_s);
   }
-  // The fluid's loads on bodies that ask for them (SceneFromProto requires
-  // a fluid and gravity with them).
-  for (int b = 0; b < static_cast<int>(scene_.bodies.size()); ++b) {
-    const BodySpec& body = scene_.bodies[b];
-    if (!body.has_hydrodynamics || !(fluid.density_kg_m3 > 0) || !(g > 0)) continue;
-    BodyFluidLoad::Params p;
-    p.density_kg_m3 = fluid.density_kg_m3;
-    p.g_m_s2 = g;
-    p.up = -scene_.gravity_m_s2 / g;
-    p.still_level_m = fluid.still_water_level_m;
-    p.diameter_m = body.hydro_diameter_m;
-    p.height_m = body.hydro_height_m;
-    p.drag = body.hydro_drag;
-    p.heave_drag = body.hydro_heave_drag;
-    p.added_mass = body.hydro_added_mass;
-    p.heave_added_mass = body.hydro_heave_added_mass;
-    p.current_m_s = fluid.current_m_s;
-    const BodyFluidLoad& load = model_.body_fluid_.emplace_back(p, BodyCoord(b), model_.dim_);
-    MultibodyModel::BodyData& data = model_.bodies_[b];
-    data.added_mass = load.AddedMass(q0_);
-    data.has_added_mass = !data.added_mass.isZero(0);
-    if (load.dynamic(model_.wave_load_.has_value())) model_.has_damping_ = true;
-  }
   if (scene_.seabed.enabled) {
     model_.seabed_.emplace(scene_.seabed);
     if (model_.seabed_->dissipates()) model_.has_damping_ = true;
-    // Bodies with contact points (SceneFromProto refuses them without a
-    // seabed).
-    for (int b = 0; b < static_cast<int>(scene_.bodies.size()); ++b) {
-      const BodySpec& body = scene_.bodies[b];
-      if (body.contact_points_m.empty()) continue;
-      MultibodyModel::BodyContact contact;
-      contact.coord = BodyCoord(b);
-      contact.points = body.contact_points_m;
-      contact.k = body.contact_stiffness_n_m;
-      contact.c = body.contact_damping_n_s_m;
-      contact.mu = body.contact_friction;
-      if (contact.c != 0 || contact.mu != 0) model_.has_damping_ = true;
-      model_.body_contacts_.push_back(std::move(contact));
-    }
   }
   if (model_.dim_ == 2) {
     BuildElementsOf<2>(&model_.elements2_);
@@ -845,39 +808,51 @@ void ModelBuilder::BuildSheaves() {
   }
 }
 
-absl::Status ModelBuilder::Sliders() {
+absl::Status ModelBuilder::Contributors() {
   MultibodyModel& m = model_;
-  for (int ji = 0; ji < static_cast<int>(scene_.joints.size()); ++ji) {
-    const JointSpec& joint = scene_.joints[ji];
-    if (joint.type != JointType::kSlide) continue;
-    const Attachment& on_cable = joint.a.cable >= 0 ? joint.a : joint.b;
-    const Attachment& on_body = joint.a.body >= 0 ? joint.a : joint.b;
-    const int cable = on_cable.cable;
-    const CableSpec& spec = scene_.cables[cable];
-    std::vector<SlidingJoint::Segment> segments;
-    double s0 = 0;
-    for (int k = m.cable_element_begin_[cable]; k < m.cable_element_begin_[cable + 1]; ++k) {
-      const int first = m.dim_ == 2 ? m.elements2_[k].first_coord : m.elements3_[k].first_coord;
-      const double l =
-          m.dim_ == 2 ? m.elements2_[k].element.length() : m.elements3_[k].element.length();
-      segments.push_back({first, s0, l});
-      s0 += l;
+  std::vector<int> body_coord(scene_.bodies.size());
+  for (size_t b = 0; b < body_coord.size(); ++b) body_coord[b] = BodyCoord(static_cast<int>(b));
+  auto add = [&m](std::unique_ptr<ForceContributor> c) {
+    if (c->dissipates()) m.has_damping_ = true;
+    m.contributors_.push_back(std::move(c));
+  };
+  // The list's order is the order of summation.
+  if (auto contact = MakeBodySeabedContact(scene_, body_coord, m.dim_)) {
+    m.body_contact_ = contact.get();
+    add(std::move(contact));
+  }
+  if (auto fluid = MakeBodyFluidForces(scene_, body_coord, m.dim_, m.wave_load_.has_value())) {
+    // The added mass joins the body's mass matrix and kinetic energy.
+    for (const BodyFluidLoad& load : fluid->loads()) {
+      for (size_t b = 0; b < body_coord.size(); ++b) {
+        if (body_coord[b] != load.coord()) continue;
+        MultibodyModel::BodyData& data = m.bodies_[b];
+        data.added_mass = load.AddedMass(q0_);
+        data.has_added_mass = !data.added_mass.isZero(0);
+      }
     }
-    // Default stiffness: the axial stiffness EA / l_e of one element.
-    double k = joint.slide.stiffness_n_m;
-    if (k == 0) k = spec.youngs_modulus_pa * spec.area_m2 * spec.elements / spec.length_m;
-    SlidingJoint slider(m.dim_, std::move(segments), BodyCoord(on_body.body), m.body_stride_,
-                        on_body.point_body_m, k, joint.slide.friction,
-                        joint.slide.stick_velocity_m_s, on_cable.s_m);
-    const double gap = slider.Gap(q0_);
-    if (gap > 1e-6) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "joints[%d]: the body point is %.6g m from the cable at t = 0 (a sliding joint starts "
-          "on its cable)",
-          ji, gap));
+    m.body_fluid_ = fluid.get();
+    add(std::move(fluid));
+  }
+  bool slides = false;
+  for (const JointSpec& joint : scene_.joints) slides = slides || joint.type == JointType::kSlide;
+  if (slides) {
+    std::vector<std::vector<SlidingJoint::Segment>> segments(scene_.cables.size());
+    for (size_t cable = 0; cable < segments.size(); ++cable) {
+      double s0 = 0;
+      for (int k = m.cable_element_begin_[cable]; k < m.cable_element_begin_[cable + 1]; ++k) {
+        const int first = m.dim_ == 2 ? m.elements2_[k].first_coord : m.elements3_[k].first_coord;
+        const double l =
+            m.dim_ == 2 ? m.elements2_[k].element.length() : m.elements3_[k].element.length();
+        segments[cable].push_back({first, s0, l});
+        s0 += l;
+      }
     }
-    if (slider.has_friction()) m.has_damping_ = true;
-    m.sliders_.push_back(std::move(slider));
+    absl::StatusOr<std::unique_ptr<SlidingJoints>> sliders =
+        MakeSlidingJoints(scene_, segments, body_coord, m.dim_, m.body_stride_, q0_);
+    if (!sliders.ok()) return sliders.status();
+    m.sliders_ = sliders->get();
+    add(std::move(*sliders));
   }
   return absl::OkStatus();
 }
@@ -1143,7 +1118,7 @@ void ModelBuilder::EnvelopeAndMass() {
       const double diag = k < D ? b.mass : b.jbar((k - D) / D);
       m.mass_.values()[m.mass_.Slot(j, j)] += m.s_(b.coord + k) * m.s_(b.coord + k) * diag;
     }
-    if (b.has_added_mass) m.ScatterBodyBlock(b.coord, b.added_mass, 1.0, &m.mass_);
+    if (b.has_added_mass) m.Map().ScatterBlock(b.coord, b.added_mass, 1.0, &m.mass_);
   }
 }
 
@@ -1223,7 +1198,7 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene,
   if (builder.Stopped()) return stopped;
   builder.BuildElements();
   if (builder.Stopped()) return stopped;
-  if (absl::Status s = builder.Sliders(); !s.ok()) return s;
+  if (absl::Status s = builder.Contributors(); !s.ok()) return s;
   builder.Winches();
   builder.ConstantForces();
   builder.Probes();

@@ -175,11 +175,13 @@ class ModelBuilder {
   // elements: a sheave touches every element of the cables it lists).
   void BuildSheaves();
 
-  // The sliding joints (SlidingJoint, a penalty force; no rows), each
-  // over its cable's elements, with its stiffness (default EA / l_e of
-  // its cable, l_e = length / elements). Fails when a slider's body point
-  // is more than 1e-6 m from its cable at t = 0 (names the joint).
-  absl::Status Sliders();
+  // The force contributors the scene uses (engine/forces/force_contributor.h),
+  // each built by the Make... next to its class, in the order the model
+  // sums them: body seabed contact, body fluid loads (whose added mass joins
+  // the bodies' mass here), sliding joints (MakeSlidingJoints fails when a
+  // slider's body point is more than 1e-6 m from its cable at t = 0, naming
+  // the joint). A contributor that dissipates turns on the damping pass.
+  absl::Status Contributors();
 
   // The winches' data (MultibodyModel::WinchData): their cables' element
   // ranges; the model then needs its damping pass (the convective terms).

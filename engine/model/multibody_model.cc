@@ -97,40 +97,19 @@ void MultibodyModel::RowGradient(const Row& row, const VectorXd& q, double* grad
 
 void MultibodyModel::ScatterSlider(const SlidingJoint::Local& local, VectorXd* full,
                                    VectorXd* roundoff, double scale, SkylineLdlt* a) const {
-  constexpr double kEps = std::numeric_limits<double>::epsilon();
-  for (int k = 0; k < local.n; ++k) {
-    (*full)(local.coord[k]) += local.force(k);
-    if (roundoff)
-      (*roundoff)(local.coord[k]) += kEps * std::abs(local.force(k)) + local.rounding;
-  }
-  if (a == nullptr) return;
-  double* values = a->values();
-  // Lower triangle on z: pairs with j_a > j_b once, with j_a == j_b all
-  // (the symmetric local matrix then sums both transposes).
-  for (int i = 0; i < local.n; ++i) {
-    const int ji = j_[local.coord[i]];
-    if (ji < 0) continue;
-    for (int k = 0; k < local.n; ++k) {
-      const int jk = j_[local.coord[k]];
-      if (jk < 0 || jk > ji) continue;
-      values[a->Slot(ji, jk)] +=
-          scale * s_(local.coord[i]) * s_(local.coord[k]) * local.matrix(i, k);
-    }
-  }
+  ForceOutput out{full, roundoff, a, scale, Map()};
+  AddLocalTerms(local, &out);
 }
 
-void MultibodyModel::ScatterBodyBlock(int coord, const Eigen::Matrix3d& m, double scale,
-                                      SkylineLdlt* a) const {
-  double* values = a->values();
-  for (int i = 0; i < dim_; ++i) {
-    const int ji = j_[coord + i];
-    if (ji < 0) continue;
-    for (int k = 0; k < dim_; ++k) {
-      const int jk = j_[coord + k];
-      if (jk < 0 || jk > ji) continue;
-      values[a->Slot(ji, jk)] += scale * s_(coord + i) * s_(coord + k) * m(i, k);
-    }
-  }
+const std::vector<BodyFluidLoad>& MultibodyModel::body_fluid_loads() const {
+  static const std::vector<BodyFluidLoad> kNone;
+  return body_fluid_ ? body_fluid_->loads() : kNone;
+}
+
+const ForceContributor* MultibodyModel::FindContributor(std::string_view name) const {
+  for (const auto& c : contributors_)
+    if (c->name() == name) return c.get();
+  return nullptr;
 }
 
 VectorXd MultibodyModel::Reduce(const VectorXd& full) const {
@@ -368,12 +347,10 @@ double MultibodyModel::NetForce(const VectorXd& q, double load_factor, VectorXd*
       }
     }
   }
-  // Bodies' hydrostatic buoyancy (BodyFluidLoad), scaled as gravity.
-  for (const BodyFluidLoad& b : body_fluid_) {
-    Eigen::Matrix3d k = Eigen::Matrix3d::Zero();
-    b.AddHydrostatic(q, load_factor, &full, stiffness ? &k : nullptr);
-    if (stiffness) ScatterBodyBlock(b.coord(), k, stiffness_scale, stiffness);
-  }
+  // Contributors' applied loads (body buoyancy, ...), scaled as gravity.
+  const ForceState state = StateAt(q, nullptr, load_factor);
+  ForceOutput out{&full, nullptr, stiffness, stiffness_scale, Map()};
+  for (const auto& c : contributors_) c->AddAppliedLoad(state, &out);
   // The size of the applied terms counts only coordinates that move: a
   // heavy body welded to ground must not loosen the tolerance elsewhere.
   double size = 0;
@@ -390,23 +367,11 @@ double MultibodyModel::NetForce(const VectorXd& q, double load_factor, VectorXd*
                                                      full_roundoff)
                                   : ElementForces<3>(q, &full, stiffness, stiffness_scale,
                                                      full_roundoff));
-  if (!body_contacts_.empty()) {
-    double contact_size = 0;
-    if (dim_ == 2) {
-      BodyContactTerms<2>(ContactTerm::kPotential, q, nullptr, &full, stiffness, stiffness_scale,
-                          full_roundoff, &contact_size);
-    } else {
-      BodyContactTerms<3>(ContactTerm::kPotential, q, nullptr, &full, stiffness, stiffness_scale,
-                          full_roundoff, &contact_size);
-    }
-    size = std::max(size, contact_size);
-  }
-  for (const SlidingJoint& slider : sliders_) {
-    SlidingJoint::Local local;
-    slider.Penalty(q, &local, stiffness != nullptr);
-    ScatterSlider(local, &full, full_roundoff, stiffness_scale, stiffness);
-    size = std::max(size, local.force.lpNorm<Eigen::Infinity>());
-  }
+  // Contributors' conservative forces (contact, penalties).
+  out.roundoff = full_roundoff;
+  out.size = 0;
+  for (const auto& c : contributors_) c->AddConservative(state, &out);
+  size = std::max(size, out.size);
   f->setZero();
   for (int i = 0; i < n; ++i)
     if (j_[i] >= 0) (*f)(j_[i]) += s_(i) * full(i);
@@ -534,36 +499,12 @@ double MultibodyModel::DampingForce(const VectorXd& q, const VectorXd& qdot, Vec
         tangent->values()[tangent->Slot(j_[i], j_[i])] += tangent_scale * s_(i) * s_(i) * c;
     }
   }
-  if (!body_contacts_.empty()) {
-    double contact_size = 0;
-    if (dim_ == 2) {
-      BodyContactTerms<2>(ContactTerm::kDissipation, q, &qdot, &full, tangent, tangent_scale,
-                          nullptr, &contact_size);
-    } else {
-      BodyContactTerms<3>(ContactTerm::kDissipation, q, &qdot, &full, tangent, tangent_scale,
-                          nullptr, &contact_size);
-    }
-    size = std::max(size, contact_size);
-  }
-  // The fluid's drag, inertia and wave buoyancy on bodies (BodyFluidLoad).
-  const WaveField* waves = wave_field();
-  for (const BodyFluidLoad& b : body_fluid_) {
-    if (!b.dynamic(waves != nullptr)) continue;
-    Eigen::Matrix3d c;
-    const Vector3d force = b.DynamicForce(q, qdot, time_, waves, tangent ? &c : nullptr);
-    for (int d = 0; d < dim_; ++d) {
-      full(b.coord() + d) += force(d);
-      if (full_roundoff) (*full_roundoff)(b.coord() + d) += kSumRounding * std::abs(force(d));
-    }
-    size = std::max(size, force.lpNorm<Eigen::Infinity>());
-    if (tangent) ScatterBodyBlock(b.coord(), c, tangent_scale, tangent);
-  }
-  for (const SlidingJoint& slider : sliders_) {
-    if (!slider.has_friction()) continue;
-    SlidingJoint::Local local;
-    slider.Friction(q, qdot, &local, tangent != nullptr);
-    ScatterSlider(local, &full, full_roundoff, tangent_scale, tangent);
-    size = std::max(size, local.force.lpNorm<Eigen::Infinity>());
+  // Contributors' velocity-dependent forces.
+  if (!contributors_.empty()) {
+    const ForceState state = StateAt(q, &qdot, 1.0);
+    ForceOutput out{&full, full_roundoff, tangent, tangent_scale, Map()};
+    for (const auto& c : contributors_) c->AddDissipative(state, &out);
+    size = std::max(size, out.size);
   }
   if (!winches_.empty()) {
     size = std::max(size, dim_ == 2 ? WinchForces<2>(q, qdot, &full, tangent, tangent_scale,
@@ -592,18 +533,9 @@ double MultibodyModel::DampingPower(const VectorXd& q, const VectorXd& qdot) con
   for (const BodyData& b : bodies_)
     for (int k = 0; k < body_stride_; ++k)
       power += BodyDampingCoefficient(b, k) * qdot(b.coord + k) * qdot(b.coord + k);
-  for (const SlidingJoint& slider : sliders_)
-    if (slider.has_friction()) power += slider.Friction(q, qdot, nullptr, false);
-  if (!body_contacts_.empty())
-    power += dim_ == 2 ? BodyContactTerms<2>(ContactTerm::kDissipation, q, &qdot, nullptr,
-                                             nullptr, 0, nullptr, nullptr)
-                       : BodyContactTerms<3>(ContactTerm::kDissipation, q, &qdot, nullptr,
-                                             nullptr, 0, nullptr, nullptr);
-  const WaveField* waves = wave_field();
-  for (const BodyFluidLoad& b : body_fluid_) {
-    if (!b.dynamic(waves != nullptr)) continue;
-    const Vector3d force = b.DynamicForce(q, qdot, time_, waves, nullptr);
-    for (int d = 0; d < dim_; ++d) power -= force(d) * qdot(b.coord() + d);
+  if (!contributors_.empty()) {
+    const ForceState state = StateAt(q, &qdot, 1.0);
+    for (const auto& c : contributors_) c->AddDissipatedPower(state, &power);
   }
   // A winch cable's damping (not its convective inertia, which dissipates
   // nothing).
@@ -616,78 +548,11 @@ double MultibodyModel::DampingPower(const VectorXd& q, const VectorXd& qdot) con
   return power;
 }
 
-template <int D>
-double MultibodyModel::BodyContactTerms(ContactTerm term, const VectorXd& q,
-                                        const VectorXd* other, VectorXd* full, SkylineLdlt* a,
-                                        double scale, VectorXd* roundoff, double* size) const {
-  constexpr int S = D == 2 ? 4 : 12;  // the body's natural coordinates
-  constexpr double kEps = std::numeric_limits<double>::epsilon();
-  using Point = Eigen::Matrix<double, D, 1>;
-  using Block = Eigen::Matrix<double, D, D>;
-  using Local = Eigen::Matrix<double, S, 1>;
-  const Seabed& bed = *seabed_;
-  const double bed_size = std::abs(bed.Height(Vector3d::Zero()));
-  double result = 0;
-  for (const BodyContact& c : body_contacts_) {
-    if (term == ContactTerm::kDissipation && c.c == 0 && c.mu == 0) continue;
-    if (term == ContactTerm::kStaticFriction && c.mu == 0) continue;
-    const Local qb = q.segment<S>(c.coord);
-    Local force = Local::Zero(), bound = Local::Zero();
-    Eigen::Matrix<double, S, S> matrix = Eigen::Matrix<double, S, S>::Zero();
-    for (const Vector3d& p : c.points) {
-      // r = B q_b: planar r_c + p_x u + p_y perp(u), spatial r_c + sum p_k e_k.
-      Eigen::Matrix<double, D, S> b = Eigen::Matrix<double, D, S>::Zero();
-      b.template leftCols<D>().setIdentity();
-      if constexpr (D == 2) {
-        b(0, 2) = b(1, 3) = p.x();
-        b(0, 3) = -p.y();
-        b(1, 2) = p.y();
-      } else {
-        for (int k = 0; k < 3; ++k) b.template block<3, 3>(0, 3 + 3 * k) = p(k) * Block::Identity();
-      }
-      const Point r = b * qb;
-      Point f = Point::Zero();
-      Block h = Block::Zero();
-      if (term == ContactTerm::kPotential) {
-        result += bed.PointPotential<D>(r, c.k, &f, a ? &h : nullptr);
-        f = -f;  // the force is minus the energy's gradient
-        if (roundoff && f.squaredNorm() > 0)
-          bound += (kEps * c.k * (bed_size + (b.cwiseAbs() * qb.cwiseAbs()).sum())) *
-                   (b.cwiseAbs().transpose() * Point::Ones());
-      } else if (term == ContactTerm::kDissipation) {
-        const Point v = b * other->segment<S>(c.coord);
-        result += bed.PointDissipation<D>(r, v, c.k, c.c, c.mu, &f, a ? &h : nullptr);
-      } else {
-        const Point r0 = b * other->segment<S>(c.coord);
-        bed.PointStaticFriction<D>(r, r0, c.k, c.mu, &f, a ? &h : nullptr);
-      }
-      force.noalias() += b.transpose() * f;
-      if (a) matrix.noalias() += b.transpose() * h * b;
-    }
-    if (size) *size = std::max(*size, force.template lpNorm<Eigen::Infinity>());
-    if (full) full->segment<S>(c.coord) += force;
-    if (roundoff) roundoff->segment<S>(c.coord) += bound + kEps * force.cwiseAbs();
-    if (!a) continue;
-    double* values = a->values();
-    // Lower triangle on z (as ScatterSlider).
-    for (int i = 0; i < S; ++i) {
-      const int ji = j_[c.coord + i];
-      if (ji < 0) continue;
-      for (int k = 0; k < S; ++k) {
-        const int jk = j_[c.coord + k];
-        if (jk < 0 || jk > ji) continue;
-        values[a->Slot(ji, jk)] += scale * s_(c.coord + i) * s_(c.coord + k) * matrix(i, k);
-      }
-    }
-  }
-  return result;
-}
-
 bool MultibodyModel::has_static_friction() const {
   if (!seabed_) return false;
   if (seabed_->has_friction() && (!elements2_.empty() || !elements3_.empty())) return true;
-  for (const BodyContact& c : body_contacts_)
-    if (c.mu != 0) return true;
+  for (const auto& c : contributors_)
+    if (c->has_static_friction()) return true;
   return false;
 }
 
@@ -716,13 +581,11 @@ void MultibodyModel::StaticFriction(const VectorXd& q, const VectorXd& q_start, 
   };
   if (dim_ == 2) {
     cables(elements2_, std::integral_constant<int, 2>());
-    BodyContactTerms<2>(ContactTerm::kStaticFriction, q, &q_start, &full, matrix, scale,
-                                  nullptr, nullptr);
   } else {
     cables(elements3_, std::integral_constant<int, 3>());
-    BodyContactTerms<3>(ContactTerm::kStaticFriction, q, &q_start, &full, matrix, scale,
-                                  nullptr, nullptr);
   }
+  ForceOutput out{&full, nullptr, matrix, scale, Map()};
+  for (const auto& c : contributors_) c->AddStaticFriction(q, q_start, &out);
   if (f) {
     const int n = coordinates();
     for (int i = 0; i < n; ++i)
@@ -1088,24 +951,26 @@ EnergySample MultibodyModel::Energy(const VectorXd& q, const VectorXd& qdot, dou
   // Torques, time-varying loads, moving supports: their work so far
   // (AccumulateExternalWork).
   en.potential -= external_work_;
-  // Sliding joints: their penalty energy (counted with the loads' part).
-  double slider_energy = 0;
-  for (const SlidingJoint& slider : sliders_) slider_energy += slider.Penalty(q, nullptr, false);
-  en.potential += slider_energy;
-  if (!body_contacts_.empty())
-    en.contact += dim_ == 2 ? BodyContactTerms<2>(ContactTerm::kPotential, q, nullptr, nullptr,
-                                                  nullptr, 0, nullptr, nullptr)
-                            : BodyContactTerms<3>(ContactTerm::kPotential, q, nullptr, nullptr,
-                                                  nullptr, 0, nullptr, nullptr);
-  // Bodies' hydrostatic buoyancy: its potential, with the loads.
-  double buoyancy_energy = 0;
-  for (const BodyFluidLoad& b : body_fluid_) buoyancy_energy += b.HydrostaticEnergy(q, load_factor);
-  en.potential += buoyancy_energy;
+  // Contributors' stored energies, each in its bucket (the loads' part or
+  // contact).
+  double loads_energy = 0;
+  if (!contributors_.empty()) {
+    const ForceState state = StateAt(q, &qdot, load_factor);
+    for (const auto& c : contributors_) {
+      const double u = c->StoredEnergy(state);
+      if (c->bucket() == EnergyBucket::kContact) {
+        en.contact += u;
+      } else {
+        en.potential += u;
+        loads_energy += u;
+      }
+    }
+  }
   en.total = en.kinetic + en.potential + en.axial + en.bending + en.contact;
   if (parts != nullptr) {
     // The element gravity above is at load factor 1 (statics scales it).
     for (PartEnergy& part : parts->cables) part.gravity *= load_factor;
-    parts->loads = slider_energy + buoyancy_energy - external_work_;
+    parts->loads = loads_energy - external_work_;
     if (load_force_.size() > 0) parts->loads -= load_factor * load_force_.dot(q);
   }
   return en;

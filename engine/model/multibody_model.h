@@ -40,8 +40,10 @@
 
 #include <array>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
@@ -49,6 +51,8 @@
 #include "absl/status/statusor.h"
 #include "engine/elements/ancf_cable_element.h"
 #include "engine/forces/body_fluid_load.h"
+#include "engine/forces/body_seabed_contact.h"
+#include "engine/forces/force_contributor.h"
 #include "engine/forces/seabed.h"
 #include "engine/forces/sheave.h"
 #include "engine/forces/wave_load.h"
@@ -264,7 +268,7 @@ class MultibodyModel {
   // hydrostatic part in NetForce (scaled with gravity by the load factor,
   // its energy in the loads' part), the drag, inertia and wave buoyancy in
   // DampingForce (their work in the damping power).
-  const std::vector<BodyFluidLoad>& body_fluid_loads() const { return body_fluid_; }
+  const std::vector<BodyFluidLoad>& body_fluid_loads() const;
 
   // The scene's seabed (engine/forces/seabed.h), or null: a scene without
   // one holds no seabed object, and its force loops only test this.
@@ -272,7 +276,7 @@ class MultibodyModel {
 
   // Bodies with seabed contact points (BodySpec::contact_points_m): their
   // count. A scene without any holds none and its loops only test this.
-  int body_contacts() const { return static_cast<int>(body_contacts_.size()); }
+  int body_contacts() const { return body_contact_ ? body_contact_->count() : 0; }
 
   // STATIC analyses only: the seabed's static friction (Seabed::
   // AddStaticFriction, on cables and body contact points) at full q,
@@ -315,8 +319,16 @@ class MultibodyModel {
   // Sliding joints (SlidingJoint, a penalty force): their number, and
   // where each slider is now, its arc length on its cable [m] as of the
   // last evaluation.
-  int sliders() const { return static_cast<int>(sliders_.size()); }
-  double SliderArcLength(int i) const { return sliders_[i].s(); }
+  int sliders() const { return sliders_ ? sliders_->count() : 0; }
+  double SliderArcLength(int i) const { return sliders_->slider(i).s(); }
+
+  // The force contributors the scene uses (engine/forces/force_contributor.h),
+  // in the order the model sums them.
+  const std::vector<std::unique_ptr<ForceContributor>>& contributors() const {
+    return contributors_;
+  }
+  // The contributor called `name`, or null.
+  const ForceContributor* FindContributor(std::string_view name) const;
 
   // Winches (WinchSpec, docs/model.md "Winches"): an axially moving mesh
   // on each winch cable, whose N elements all have the length L(t) / N, so
@@ -376,26 +388,6 @@ class MultibodyModel {
     bool has_added_mass = false;
     Eigen::Matrix3d added_mass = Eigen::Matrix3d::Zero();
   };
-  // A body's seabed contact points (BodySpec): body frame [m], spring k
-  // [N/m], damper c [N s/m], friction mu [-] per point.
-  struct BodyContact {
-    int coord = 0;  // full index of the body's r_c
-    std::vector<Eigen::Vector3d> points;
-    double k = 0, c = 0, mu = 0;
-  };
-  enum class ContactTerm { kPotential, kDissipation, kStaticFriction };
-  // The body contact points' terms: kPotential (at q: returns U, adds the
-  // force -dU/dq to `full` and its Hessian to `a`), kDissipation (`other`
-  // the rate: returns the power, adds the force and its velocity tangent),
-  // kStaticFriction (`other` the start: returns 0). Each
-  // point r = B q_b is linear in its body's coordinates q_b, so the
-  // generalized force is B^T f and the matrix B^T H B, within the body's
-  // own block of the envelope. `size` (when not null) gets the largest
-  // force entry; `roundoff` a bound of the rounding (kPotential).
-  template <int D>
-  double BodyContactTerms(ContactTerm term, const Eigen::VectorXd& q,
-                          const Eigen::VectorXd* other, Eigen::VectorXd* full, SkylineLdlt* a,
-                          double scale, Eigen::VectorXd* roundoff, double* size) const;
   // A torque load on a body [N m]: torque = base + varying(t).
   struct TorqueLoad {
     int body = 0;
@@ -510,9 +502,13 @@ class MultibodyModel {
                            double scale) const;
   void ScatterSlider(const SlidingJoint::Local& local, Eigen::VectorXd* full, Eigen::VectorXd* roundoff,
                      double scale, SkylineLdlt* a) const;
-  // Adds scale times the D x D block m on body coordinates from full index
-  // `coord` (its centre of mass), mapped onto z, to `a`.
-  void ScatterBodyBlock(int coord, const Eigen::Matrix3d& m, double scale, SkylineLdlt* a) const;
+  // The coordinate map (q = c + S z) for contributors' scatters.
+  CoordinateMap Map() const { return CoordinateMap{j_.data(), s_.data(), dim_}; }
+  // The state contributors are evaluated at (time_ and the wave field).
+  ForceState StateAt(const Eigen::VectorXd& q, const Eigen::VectorXd* qdot,
+                     double load_factor) const {
+    return ForceState{&q, qdot, load_factor, time_, wave_field()};
+  }
   const WaveField* wave_field() const { return wave_load_ ? &wave_load_->field() : nullptr; }
   void ProjectInitialVelocity();
   // SetTime's share for the winches: lengths, elements, mass, gravity and
@@ -591,7 +587,6 @@ class MultibodyModel {
   bool has_damping_ = false;
   Eigen::Vector3d current_ = Eigen::Vector3d::Zero();  // the fluid's [m/s]
   std::optional<Seabed> seabed_;  // only in a scene with a seabed
-  std::vector<BodyContact> body_contacts_;  // only bodies with contact points
   // Scratch (full size) for StaticFriction (sized on first use).
   Eigen::VectorXd scratch_static_;
   // Sheaves, and per element the bit set of those that touch its cable
@@ -601,9 +596,12 @@ class MultibodyModel {
   bool sheaves_dissipate_ = false;
   // Only in a scene whose fluid has waves (then it carries the current too).
   std::optional<WaveLoad> wave_load_;
-  // The fluid's loads on bodies that ask for them (empty in most scenes:
-  // then nothing is evaluated).
-  std::vector<BodyFluidLoad> body_fluid_;
+  // The force contributors the scene uses (none in most scenes), summed in
+  // this order; and typed views of some of them for the accessors above.
+  std::vector<std::unique_ptr<ForceContributor>> contributors_;
+  const BodyFluidForces* body_fluid_ = nullptr;
+  const BodySeabedContact* body_contact_ = nullptr;
+  const SlidingJoints* sliders_ = nullptr;
 
   std::vector<Row> rows_;
   std::vector<int> row_coord_;
@@ -651,8 +649,6 @@ class MultibodyModel {
   std::vector<VaryingForce> varying_forces_;
   // Work done by torques, time-varying loads and moving supports so far [J].
   double external_work_ = 0;
-  // Sliding joints (empty in most scenes: then nothing is evaluated).
-  std::vector<SlidingJoint> sliders_;
   // Winches (empty in most scenes: then nothing is evaluated).
   std::vector<WinchData> winches_;
   // Per winch element (winch by winch, along each cable): the convective

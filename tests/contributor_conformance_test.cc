@@ -1,0 +1,388 @@
+// Every force contributor (engine/forces/force_contributor.h) against its
+// own contract, by central differences, in one place. A new contributor is
+// tested by adding one line to kCases below: a label, the contributor's
+// name(), and a small scene that uses it in a state where it acts.
+//
+// Each case builds the scene's model, takes the contributor from it, and
+// evaluates it on the full coordinates with the identity map (every
+// coordinate its own unknown, s = 1), so the matrices come out whole:
+//
+//  1. stiffness: K = -dF/dq of the conservative force F (applied load plus
+//     conservative part), against the central difference of F;
+//  2. energy: F = -dU/dq of the stored energy U (at a load factor of 0.7,
+//     so that force and energy must scale alike);
+//  3. damping: C = -df_d/dqdot of the dissipative force f_d, against the
+//     central difference of f_d in qdot (the contract leaves the
+//     q-derivative of f_d out);
+//  4. power: the dissipated power equals -f_d . qdot;
+//  5. rounding: every force entry's rounding bound covers at least the
+//     rounding of the entry itself, eps |f_i| (the floor the model sums);
+//  6. static friction (when the contributor has any): its matrix is the
+//     derivative of minus its force;
+// and a scene without any force feature builds no contributor at all (the
+// zero-cost rule).
+//
+// Tolerances. A central difference with step h has truncation error
+// h^2 |f'''| / 6 and rounding error ~ eps |f| / h (each evaluation is
+// known to a few eps times the size of its terms). With h = 1e-6 (the
+// coordinates are metres or unit directions, the velocities m/s, all of
+// order 0.01 to 100) the rounding part is ~ 2e-10 |f| and the truncation
+// part ~ 1e-12 |f'''|; every law here is smooth at the chosen states
+// (contacts engaged millimetres deep, the buoy piercing the level by a
+// metre, the friction's tanh at v / v_s of order one), where |f'''| is at
+// most |K| / (0.01 m)^2 for K the matrix scale. So an error bound of 1e-6
+// times the scale of the compared quantity (its largest entry, plus the
+// energy / 1 m for the energy check) leaves a margin of 100 or more above
+// both, while a wrong or missing term (a factor 2, a dropped coupling, a
+// sign) shows as an error of order the scale itself. The power is an
+// identity up to the rounding of sums of a few dozen products: 1e-12
+// times the sum of |f_i qdot_i|.
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <ostream>
+#include <numeric>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Eigenvalues>
+#include <gtest/gtest.h>
+
+#include "absl/strings/str_format.h"
+#include "engine/forces/force_contributor.h"
+#include "engine/forces/wave_load.h"
+#include "engine/model/multibody_model.h"
+#include "tests/test_util.h"
+
+namespace cablesim {
+namespace {
+
+using Eigen::VectorXd;
+using testing::SampleScene;
+using testing::SceneFromJson;
+
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+constexpr double kStep = 1e-6;       // central-difference step (see above)
+constexpr double kRelative = 1e-6;   // difference against derivative
+constexpr double kPowerRel = 1e-12;  // power against -f . qdot
+constexpr double kLoadFactor = 0.7;
+constexpr double kTime = 12;  // past the waves' ramp
+
+// A 1000 kg block whose four contact points are sunk 2 mm into the bed,
+// with damping and friction (tests/seabed_body_test.cc has its physics).
+std::string ContactBlock(const char* model, double friction = 0.5) {
+  return absl::StrFormat(R"({
+    "model": "%s", "gravity": {"y": -9.81},
+    "bodies": [{"name": "block", "mass": 1000, "inertia": {"x": 100, "y": 120, "z": 110},
+                "position": {"y": 0.498},
+                "seabed_contact": {"points": [{"x": -0.6, "y": -0.5, "z": -0.4},
+                                              {"x": 0.6, "y": -0.5, "z": -0.4},
+                                              {"x": -0.6, "y": -0.5, "z": 0.4},
+                                              {"x": 0.6, "y": -0.5, "z": 0.4}],
+                                   "stiffness": 1e7, "damping": 2e4, "friction": %.17g}}],
+    "seabed": {"stiffness": 1e6},
+    "solver": {"duration": 1}})",
+                         model, friction);
+}
+
+// A buoy (d = 2 m, H = 4 m) whose centre is 0.5 m above the still level,
+// with drag and added mass, in still water or in waves.
+std::string Buoy(const char* model, bool waves) {
+  const char* up = std::string(model) == "PLANAR" ? "y" : "z";
+  return absl::StrFormat(R"({
+    "model": "%s", "gravity": {"%s": -9.81},
+    "fluid": {"density": 1025, "water_depth": 50, "current": {"x": 0.3} %s},
+    "bodies": [{"name": "buoy", "mass": 4000, "inertia": {"x": 4000, "y": 6000, "z": 6000},
+                "position": {"%s": 0.5},
+                "hydrodynamics": {"diameter": 2, "height": 4, "drag_coefficient": 1.2,
+                                  "heave_drag_coefficient": 0.8, "added_mass": 1,
+                                  "heave_added_mass": 0.5}}],
+    "solver": {"duration": 1}})",
+                         model, up,
+                         waves ? R"(, "waves": {"regular": [{"height": 2, "period": 8}],
+                                                "ramp_time": 5})"
+                               : "",
+                         up);
+}
+
+// How a contributor's matrix relates to its force: the exact derivative,
+// or (where its header says so) a symmetric positive semi-definite matrix
+// that leaves a non-symmetric term out (the seabed's Coulomb friction:
+// forces/seabed.h, "its velocity tangent ... leaves out the rank-one
+// term"), which the test checks for symmetry and definiteness instead.
+enum Tangent { kExact, kSymmetricBound };
+
+struct Case {
+  const char* label;
+  const char* contributor;
+  std::function<Scene()> scene;
+  Tangent damping = kExact;         // C against -df_d/dqdot
+  Tangent static_friction = kExact;  // against -dq_s/dq
+  // The velocities' scale [m/s]: of the order of the friction's
+  // regularisation speed v_s, where the tanh is curved (far above it the
+  // friction force is flat in the velocity and the check weak).
+  double speed = 0.1;
+};
+
+void PrintTo(const Case& c, std::ostream* os) { *os << c.label; }
+
+// One line per contributor (and per variant worth checking).
+const Case kCases[] = {
+    {"BodySeabedContactDamperPlanar", "body_seabed_contact",
+     [] { return SceneFromJson(ContactBlock("PLANAR", 0)); }},
+    {"BodySeabedContactPlanar", "body_seabed_contact",
+     [] { return SceneFromJson(ContactBlock("PLANAR")); }, kSymmetricBound, kSymmetricBound},
+    {"BodySeabedContactSpatial", "body_seabed_contact",
+     [] { return SceneFromJson(ContactBlock("SPATIAL")); }, kSymmetricBound, kSymmetricBound},
+    {"BodyFluidPlanar", "body_fluid", [] { return SceneFromJson(Buoy("PLANAR", false)); }},
+    {"BodyFluidSpatialInWaves", "body_fluid", [] { return SceneFromJson(Buoy("SPATIAL", true)); }},
+    {"SlidingJointsZipLine", "sliding_joints", [] { return SampleScene("zip-line.json"); },
+     kExact, kExact, 1e-3},
+};
+
+// A symmetric bound: m = m^T and no eigenvalue below -1e-12 of its
+// largest (rounding of the sums that built it).
+void ExpectSymmetricPositiveSemiDefinite(const Eigen::MatrixXd& m) {
+  const double scale = m.lpNorm<Eigen::Infinity>();
+  EXPECT_LE((m - m.transpose()).lpNorm<Eigen::Infinity>(), 1e-12 * scale);
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (m + m.transpose()));
+  EXPECT_GE(eig.eigenvalues().minCoeff(), -1e-12 * scale);
+}
+
+// A contributor evaluated on full coordinates through the identity map,
+// with matrices over all coordinates.
+class Harness {
+ public:
+  Harness(const MultibodyModel& model, const ForceContributor& c)
+      : n_(model.coordinates()), dim_(model.dimension()), c_(c), j_(n_), s_(VectorXd::Ones(n_)) {
+    std::iota(j_.begin(), j_.end(), 0);
+    matrix_.SetPattern(std::vector<int>(n_, 0));
+    waves_ = model.wave_load() ? &model.wave_load()->field() : nullptr;
+  }
+  int n() const { return n_; }
+
+  ForceOutput Output(VectorXd* f, VectorXd* roundoff, bool matrix) {
+    f->setZero(n_);
+    if (roundoff) roundoff->setZero(n_);
+    matrix_.SetZero();
+    return ForceOutput{f, roundoff, matrix ? &matrix_ : nullptr, 1.0,
+                       CoordinateMap{j_.data(), s_.data(), dim_}};
+  }
+  ForceState State(const VectorXd& q, const VectorXd* qdot, double load_factor) const {
+    return ForceState{&q, qdot, load_factor, kTime, waves_};
+  }
+  // F = applied load + conservative part; K into `k` when not null.
+  VectorXd Conservative(const VectorXd& q, double lf, Eigen::MatrixXd* k = nullptr,
+                        VectorXd* roundoff = nullptr) {
+    VectorXd f;
+    ForceOutput out = Output(&f, nullptr, k != nullptr);
+    const ForceState s = State(q, nullptr, lf);
+    c_.AddAppliedLoad(s, &out);
+    out.roundoff = roundoff;
+    if (roundoff) roundoff->setZero(n_);
+    c_.AddConservative(s, &out);
+    if (k) *k = Dense();
+    return f;
+  }
+  VectorXd Dissipative(const VectorXd& q, const VectorXd& qdot, Eigen::MatrixXd* c = nullptr,
+                       VectorXd* roundoff = nullptr) {
+    VectorXd f;
+    ForceOutput out = Output(&f, roundoff, c != nullptr);
+    c_.AddDissipative(State(q, &qdot, 1.0), &out);
+    if (c) *c = Dense();
+    return f;
+  }
+  double Energy(const VectorXd& q, double lf) const { return c_.StoredEnergy(State(q, nullptr, lf)); }
+  double Power(const VectorXd& q, const VectorXd& qdot) const {
+    double p = 0;
+    c_.AddDissipatedPower(State(q, &qdot, 1.0), &p);
+    return p;
+  }
+  VectorXd StaticFriction(const VectorXd& q, const VectorXd& q0, Eigen::MatrixXd* m = nullptr) {
+    VectorXd f;
+    ForceOutput out = Output(&f, nullptr, m != nullptr);
+    c_.AddStaticFriction(q, q0, &out);
+    if (m) *m = Dense();
+    return f;
+  }
+
+ private:
+  Eigen::MatrixXd Dense() const {
+    Eigen::MatrixXd m(n_, n_);
+    for (int i = 0; i < n_; ++i)
+      for (int k = 0; k < n_; ++k) m(i, k) = matrix_.values()[matrix_.Slot(i, k)];
+    return m;
+  }
+  int n_, dim_;
+  const ForceContributor& c_;
+  std::vector<int> j_;
+  VectorXd s_;
+  SkylineLdlt matrix_;
+  const WaveField* waves_ = nullptr;
+};
+
+// The matrix `m` against minus the central difference of `eval` along each
+// coordinate; returns the largest error over the scale.
+double DerivativeError(const std::function<VectorXd(const VectorXd&)>& eval, const VectorXd& x,
+                       const Eigen::MatrixXd& m, double scale, double step = kStep) {
+  double worst = 0;
+  for (int i = 0; i < x.size(); ++i) {
+    VectorXd xp = x, xm = x;
+    xp(i) += step;
+    xm(i) -= step;
+    const VectorXd column = -(eval(xp) - eval(xm)) / (2 * step);
+    worst = std::max(worst, (column - m.col(i)).lpNorm<Eigen::Infinity>() / scale);
+  }
+  return worst;
+}
+
+class ContributorConformanceTest : public ::testing::TestWithParam<Case> {
+ protected:
+  void SetUp() override {
+    auto model = MultibodyModel::Build(GetParam().scene());
+    ASSERT_TRUE(model.ok()) << model.status();
+    model_.emplace(std::move(*model));
+    contributor_ = model_->FindContributor(GetParam().contributor);
+    ASSERT_NE(contributor_, nullptr) << GetParam().contributor;
+    EXPECT_EQ(contributor_->name(), GetParam().contributor);
+    // A state off the scene's layout (every coordinate moved by up to 0.4
+    // mm, deterministically) and a velocity of order the case's speed.
+    q_.resize(model_->coordinates());
+    model_->ToFull(model_->initial_z(), &q_);
+    qdot_.resize(q_.size());
+    for (int i = 0; i < q_.size(); ++i) {
+      q_(i) += 4e-4 * std::sin(1.7 * i + 0.3);
+      qdot_(i) = GetParam().speed * std::cos(2.3 * i + 0.1);
+    }
+  }
+  std::optional<MultibodyModel> model_;
+  const ForceContributor* contributor_ = nullptr;
+  VectorXd q_, qdot_;
+};
+
+TEST_P(ContributorConformanceTest, StiffnessIsMinusTheForceDerivative) {
+  Harness h(*model_, *contributor_);
+  Eigen::MatrixXd k;
+  const VectorXd f = h.Conservative(q_, kLoadFactor, &k);
+  const double scale = std::max(k.lpNorm<Eigen::Infinity>(), f.lpNorm<Eigen::Infinity>());
+  if (scale == 0) GTEST_SKIP() << "no conservative force";
+  const double error = DerivativeError(
+      [&](const VectorXd& x) { return h.Conservative(x, kLoadFactor); }, q_, k, scale);
+  EXPECT_LE(error, kRelative) << "scale " << scale;
+}
+
+TEST_P(ContributorConformanceTest, ForceIsMinusTheEnergyGradient) {
+  Harness h(*model_, *contributor_);
+  const VectorXd f = h.Conservative(q_, kLoadFactor);
+  const double u = h.Energy(q_, kLoadFactor);
+  const double scale = f.lpNorm<Eigen::Infinity>() + std::abs(u) / 1.0;
+  if (scale == 0) GTEST_SKIP() << "no stored energy";
+  double worst = 0;
+  for (int i = 0; i < q_.size(); ++i) {
+    VectorXd qp = q_, qm = q_;
+    qp(i) += kStep;
+    qm(i) -= kStep;
+    const double grad = (h.Energy(qp, kLoadFactor) - h.Energy(qm, kLoadFactor)) / (2 * kStep);
+    worst = std::max(worst, std::abs(f(i) + grad) / scale);
+  }
+  EXPECT_LE(worst, kRelative) << "scale " << scale;
+}
+
+TEST_P(ContributorConformanceTest, DampingIsMinusTheVelocityDerivative) {
+  Harness h(*model_, *contributor_);
+  Eigen::MatrixXd c;
+  const VectorXd f = h.Dissipative(q_, qdot_, &c);
+  const double scale = std::max(c.lpNorm<Eigen::Infinity>(), f.lpNorm<Eigen::Infinity>());
+  if (scale == 0) GTEST_SKIP() << "no dissipative force";
+  EXPECT_TRUE(contributor_->dissipates());
+  if (GetParam().damping == kSymmetricBound) return ExpectSymmetricPositiveSemiDefinite(c);
+  // The step scales with the speed (1e-6 at 0.1 m/s): for a friction law
+  // f(v / v_s) with v ~ v_s, the third derivative is ~ f / v_s^3, so the
+  // step must be small against v_s too (see the file's comment).
+  const double error = DerivativeError(
+      [&](const VectorXd& v) { return h.Dissipative(q_, v); }, qdot_, c, scale,
+      1e-5 * GetParam().speed);
+  EXPECT_LE(error, kRelative) << "scale " << scale;
+}
+
+TEST_P(ContributorConformanceTest, DissipatedPowerIsMinusForceTimesVelocity) {
+  Harness h(*model_, *contributor_);
+  const VectorXd f = h.Dissipative(q_, qdot_);
+  const double power = h.Power(q_, qdot_);
+  const double bound = kPowerRel * f.cwiseProduct(qdot_).cwiseAbs().sum();
+  EXPECT_NEAR(power, -f.dot(qdot_), bound);
+  if (!contributor_->dissipates()) {
+    EXPECT_EQ(f.lpNorm<Eigen::Infinity>(), 0);
+  }
+}
+
+TEST_P(ContributorConformanceTest, RoundingBoundCoversEveryForceEntry) {
+  Harness h(*model_, *contributor_);
+  VectorXd roundoff;
+  const VectorXd f = h.Conservative(q_, kLoadFactor, nullptr, &roundoff);
+  VectorXd f_only;
+  {
+    // The applied load's rounding is the model's (eps |sum|); the
+    // conservative part's is the contributor's.
+    Harness a(*model_, *contributor_);
+    VectorXd applied;
+    ForceOutput out = a.Output(&applied, nullptr, false);
+    contributor_->AddAppliedLoad(a.State(q_, nullptr, kLoadFactor), &out);
+    f_only = f - applied;
+  }
+  for (int i = 0; i < f.size(); ++i) EXPECT_GE(roundoff(i), kEps * std::abs(f_only(i))) << i;
+}
+
+TEST_P(ContributorConformanceTest, StaticFrictionMatrixIsMinusItsDerivative) {
+  if (!contributor_->has_static_friction()) GTEST_SKIP() << "no static friction";
+  Harness h(*model_, *contributor_);
+  // Displaced 0.1 mm from where the analysis started (inside the
+  // friction's elastic range).
+  VectorXd q0 = q_;
+  for (int i = 0; i < q0.size(); ++i) q0(i) -= 1e-4 * std::cos(0.9 * i);
+  Eigen::MatrixXd m;
+  const VectorXd f = h.StaticFriction(q_, q0, &m);
+  const double scale = std::max(m.lpNorm<Eigen::Infinity>(), f.lpNorm<Eigen::Infinity>());
+  ASSERT_GT(scale, 0);
+  if (GetParam().static_friction == kSymmetricBound) return ExpectSymmetricPositiveSemiDefinite(m);
+  const double error = DerivativeError(
+      [&](const VectorXd& x) { return h.StaticFriction(x, q0); }, q_, m, scale);
+  EXPECT_LE(error, kRelative) << "scale " << scale;
+}
+
+INSTANTIATE_TEST_SUITE_P(Contributors, ContributorConformanceTest, ::testing::ValuesIn(kCases),
+                         [](const ::testing::TestParamInfo<Case>& info) {
+                           return std::string(info.param.label);
+                         });
+
+// A scene without any force feature builds no contributor: nothing is
+// evaluated or allocated for features it does not use.
+TEST(ContributorConformance, ASceneWithoutFeaturesBuildsNoContributor) {
+  auto model = MultibodyModel::Build(SampleScene("falling-pendulum.json"));
+  ASSERT_TRUE(model.ok()) << model.status();
+  EXPECT_TRUE(model->contributors().empty());
+}
+
+// Every contributor a sample scene builds has a case above.
+TEST(ContributorConformance, EveryContributorOfTheSampleScenesHasACase) {
+  const char* samples[] = {"zip-line.json", "mooring-three-line-buoy.json",
+                           "mooring-line-in-waves.json", "atwood-machine.json",
+                           "crane-winch.json", "damped-cantilever.json", "towed-cable.json"};
+  for (const char* file : samples) {
+    auto model = MultibodyModel::Build(SampleScene(file));
+    ASSERT_TRUE(model.ok()) << file << ": " << model.status();
+    for (const auto& c : model->contributors()) {
+      bool found = false;
+      for (const Case& k : kCases) {
+        if (c->name() == k.contributor) found = true;
+      }
+      EXPECT_TRUE(found) << file << ": " << c->name() << " has no conformance case";
+    }
+  }
+}
+
+}  // namespace
+}  // namespace cablesim
