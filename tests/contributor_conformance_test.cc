@@ -49,6 +49,7 @@
 #include <vector>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include "absl/strings/str_format.h"
@@ -113,7 +114,9 @@ std::string Buoy(const char* model, bool waves) {
 // that leaves a non-symmetric term out (the seabed's Coulomb friction:
 // forces/seabed.h, "its velocity tangent ... leaves out the rank-one
 // term"), which the test checks for symmetry and definiteness instead.
-enum Tangent { kExact, kSymmetricBound };
+// Or the symmetric part of the derivative, where the header says the
+// skew-symmetric part is left out (torques: forces/applied_loads.h).
+enum Tangent { kExact, kSymmetricBound, kSymmetricPart };
 
 struct Case {
   const char* label;
@@ -125,12 +128,37 @@ struct Case {
   // regularisation speed v_s, where the tanh is curved (far above it the
   // friction force is flat in the velocity and the check weak).
   double speed = 0.1;
+  // Whether the conservative force is minus the gradient of the stored
+  // energy (not for torques and time-varying loads, whose work is summed
+  // per step instead: StepWorkAndEnergyBalanceTheForce checks it).
+  bool potential = true;
+  Tangent stiffness = kExact;  // K against -dF/dq
 };
 
 void PrintTo(const Case& c, std::ostream* os) { *os << c.label; }
 
+// A body with a constant force and torque and time-varying ones at a
+// point off its centre.
+std::string LoadedBody(const char* model) {
+  return absl::StrFormat(R"({
+    "model": "%s",
+    "bodies": [{"name": "wheel", "mass": 2, "inertia": {"x": 0.25, "y": 0.3, "z": 0.5}}],
+    "loads": [{"at": {"body": "wheel", "point": {"x": 0.5, "y": 0.2}},
+               "force": {"x": 1, "y": -2}, "torque": %s,
+               "varying_force": {"y": {"harmonic": {"amplitude": 3, "frequency": 0.1}}},
+               "varying_torque": {"z": {"harmonic": {"amplitude": 2, "frequency": 0.1}}}}],
+    "solver": {"duration": 1}})",
+                         model,
+                         std::string(model) == "PLANAR" ? R"({"z": 1})"
+                                                        : R"({"x": 0.3, "y": -0.2, "z": 1})");
+}
+
 // One line per contributor (and per variant worth checking).
 const Case kCases[] = {
+    {"AppliedLoadsPlanar", "applied_loads", [] { return SceneFromJson(LoadedBody("PLANAR")); },
+     kExact, kExact, 0.1, false, kSymmetricPart},
+    {"AppliedLoadsSpatial", "applied_loads", [] { return SceneFromJson(LoadedBody("SPATIAL")); },
+     kExact, kExact, 0.1, false, kSymmetricPart},
     {"BodySeabedContactDamperPlanar", "body_seabed_contact",
      [] { return SceneFromJson(ContactBlock("PLANAR", 0)); }},
     {"BodySeabedContactPlanar", "body_seabed_contact",
@@ -245,6 +273,7 @@ class ContributorConformanceTest : public ::testing::TestWithParam<Case> {
     auto model = MultibodyModel::Build(GetParam().scene());
     ASSERT_TRUE(model.ok()) << model.status();
     model_.emplace(std::move(*model));
+    model_->SetTime(kTime);
     contributor_ = model_->FindContributor(GetParam().contributor);
     ASSERT_NE(contributor_, nullptr) << GetParam().contributor;
     EXPECT_EQ(contributor_->name(), GetParam().contributor);
@@ -252,6 +281,7 @@ class ContributorConformanceTest : public ::testing::TestWithParam<Case> {
     // mm, deterministically) and a velocity of order the case's speed.
     q_.resize(model_->coordinates());
     model_->ToFull(model_->initial_z(), &q_);
+    layout_ = q_;
     qdot_.resize(q_.size());
     for (int i = 0; i < q_.size(); ++i) {
       q_(i) += 4e-4 * std::sin(1.7 * i + 0.3);
@@ -260,7 +290,7 @@ class ContributorConformanceTest : public ::testing::TestWithParam<Case> {
   }
   std::optional<MultibodyModel> model_;
   const ForceContributor* contributor_ = nullptr;
-  VectorXd q_, qdot_;
+  VectorXd q_, qdot_, layout_;
 };
 
 TEST_P(ContributorConformanceTest, StiffnessIsMinusTheForceDerivative) {
@@ -269,12 +299,59 @@ TEST_P(ContributorConformanceTest, StiffnessIsMinusTheForceDerivative) {
   const VectorXd f = h.Conservative(q_, kLoadFactor, &k);
   const double scale = std::max(k.lpNorm<Eigen::Infinity>(), f.lpNorm<Eigen::Infinity>());
   if (scale == 0) GTEST_SKIP() << "no conservative force";
+  if (GetParam().stiffness == kSymmetricPart) {
+    Eigen::MatrixXd fd(q_.size(), q_.size());
+    for (int i = 0; i < q_.size(); ++i) {
+      VectorXd qp = q_, qm = q_;
+      qp(i) += kStep;
+      qm(i) -= kStep;
+      fd.col(i) = -(h.Conservative(qp, kLoadFactor) - h.Conservative(qm, kLoadFactor)) /
+                  (2 * kStep);
+    }
+    const Eigen::MatrixXd sym = 0.5 * (fd + fd.transpose());
+    EXPECT_LE((sym - k).lpNorm<Eigen::Infinity>() / scale, kRelative) << "scale " << scale;
+    return;
+  }
   const double error = DerivativeError(
       [&](const VectorXd& x) { return h.Conservative(x, kLoadFactor); }, q_, k, scale);
   EXPECT_LE(error, kRelative) << "scale " << scale;
 }
 
+// Along a rigid rotation of the whole layout by an angle theta about an
+// axis through the origin (every D-vector of q turned: positions, slopes,
+// body axes, which stay orthonormal), the work the contributor's force
+// does equals the work external agents report (StepWork) minus the rise of
+// its stored energy: W(-h, h) - (U(h) - U(-h)) = F(0) . (q(h) - q(-h)) to
+// O(h^3) (central). Scale: sum |F_i dq_i| plus |U|.
+TEST_P(ContributorConformanceTest, StepWorkAndEnergyBalanceTheForce) {
+  Harness h(*model_, *contributor_);
+  const int dim = model_->dimension();
+  const Eigen::Vector3d axis =
+      dim == 2 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d(0.3, 0.5, 0.8).normalized();
+  auto turned = [&](double theta) {
+    const Eigen::Matrix3d r = Eigen::AngleAxisd(theta, axis).toRotationMatrix();
+    VectorXd q = layout_;
+    for (int i = 0; i + dim <= q.size(); i += dim) {
+      Eigen::Vector3d x = Eigen::Vector3d::Zero();
+      x.head(dim) = layout_.segment(i, dim);
+      q.segment(i, dim) = (r * x).head(dim);
+    }
+    return q;
+  };
+  const VectorXd q_minus = turned(-kStep), q_plus = turned(kStep);
+  const VectorXd f = h.Conservative(layout_, kLoadFactor);
+  double work = 0;
+  contributor_->AddStepWork(StepEnds{&q_minus, &q_plus, kTime, kTime, kLoadFactor}, &work);
+  const double rise = h.Energy(q_plus, kLoadFactor) - h.Energy(q_minus, kLoadFactor);
+  const VectorXd dq = q_plus - q_minus;
+  const double scale =
+      f.cwiseProduct(dq).cwiseAbs().sum() + std::abs(h.Energy(layout_, kLoadFactor)) * kStep;
+  if (scale == 0) GTEST_SKIP() << "no force along the rotation";
+  EXPECT_LE(std::abs(work - rise - f.dot(dq)), kRelative * scale) << "scale " << scale;
+}
+
 TEST_P(ContributorConformanceTest, ForceIsMinusTheEnergyGradient) {
+  if (!GetParam().potential) GTEST_SKIP() << "not a potential's force (its work is per step)";
   Harness h(*model_, *contributor_);
   const VectorXd f = h.Conservative(q_, kLoadFactor);
   const double u = h.Energy(q_, kLoadFactor);

@@ -32,7 +32,7 @@
 //  - AddDissipatedPower: -f_d . qdot [W] of the dissipative part (the
 //    model's energy.damped integrates it); equals -f . qdot of
 //    AddDissipative.
-//  - StepWork: work done over a step by external agents that have no
+//  - AddStepWork: work done over a step by external agents that have no
 //    potential (torques, time-varying loads) [J].
 //  - AddStaticFriction: its share of static friction (STATIC analyses).
 //  - SetTime: time-dependent data at time t.
@@ -124,6 +124,8 @@ class ForceContributor {
   virtual std::string_view name() const = 0;
   virtual EnergyBucket bucket() const { return EnergyBucket::kLoads; }
 
+  // Whether SetTime changes anything (the model's is_time_dependent()).
+  virtual bool time_dependent() const { return false; }
   virtual void SetTime(double t) { (void)t; }
 
   virtual void AddAppliedLoad(const ForceState& s, ForceOutput* out) const {
@@ -148,9 +150,11 @@ class ForceContributor {
     (void)s;
     (void)power;
   }
-  virtual double StepWork(const StepEnds& e) const {
+  // Adds the work external agents did through it over a step [J] (a
+  // running sum, as the power's).
+  virtual void AddStepWork(const StepEnds& e, double* work) const {
     (void)e;
-    return 0;
+    (void)work;
   }
   // Whether AddDissipative adds anything (the model's has_damping()).
   virtual bool dissipates() const { return false; }

@@ -817,6 +817,17 @@ absl::Status ModelBuilder::Contributors() {
     m.contributors_.push_back(std::move(c));
   };
   // The list's order is the order of summation.
+  std::vector<std::array<std::vector<AppliedLoads::Term>, 3>> points(scene_.loads.size());
+  for (size_t l = 0; l < points.size(); ++l) {
+    if (IsZero(scene_.loads[l].varying_force_n)) continue;
+    const LinearVector point = PointOf(scene_.loads[l].at);
+    for (int d = 0; d < m.dim_; ++d)
+      for (const auto& [i, c] : point[d].terms) points[l][d].push_back({i, c});
+  }
+  if (auto loads = MakeAppliedLoads(scene_, points, body_coord, m.dim_)) {
+    m.has_step_work_ = true;
+    add(std::move(loads));
+  }
   if (auto contact = MakeBodySeabedContact(scene_, body_coord, m.dim_)) {
     m.body_contact_ = contact.get();
     add(std::move(contact));
@@ -918,22 +929,6 @@ void ModelBuilder::ConstantForces() {
   for (const LoadSpec& load : scene_.loads) {
     const LinearVector point = PointOf(load.at);
     add_point_force(point, load.force_n);
-    if (!IsZero(load.varying_force_n)) {
-      MultibodyModel::VaryingForce v;
-      for (int d = 0; d < D; ++d)
-        for (const auto& [i, c] : point[d].terms) v.point[d].push_back({i, c});
-      v.force = load.varying_force_n;
-      m.varying_forces_.push_back(std::move(v));
-    }
-    const bool varying_torque = !IsZero(load.varying_torque_nm);
-    if (load.at.body >= 0 && (load.torque_nm.norm() > 0 || varying_torque)) {
-      MultibodyModel::TorqueLoad t;
-      t.body = load.at.body;
-      t.torque = t.base = load.torque_nm;
-      t.varying = load.varying_torque_nm;
-      t.is_varying = varying_torque;
-      m.torques_.push_back(std::move(t));
-    }
   }
 }
 
@@ -1155,10 +1150,9 @@ void ModelBuilder::ConstraintPattern() {
 MultibodyModel ModelBuilder::Finish() {
   model_.scratch_full_ = VectorXd::Zero(q0_.size());
   model_.scratch_roundoff_ = VectorXd::Zero(q0_.size());
-  model_.time_dependent_ = !model_.moving_rows_.empty() || !model_.varying_forces_.empty() ||
-                          !model_.turning_rows_.empty();
-  for (const MultibodyModel::TorqueLoad& t : model_.torques_)
-    if (t.is_varying) model_.time_dependent_ = true;
+  model_.time_dependent_ = !model_.moving_rows_.empty() || !model_.turning_rows_.empty();
+  for (const auto& c : model_.contributors_)
+    if (c->time_dependent()) model_.time_dependent_ = true;
   if (!model_.winches_.empty()) {
     model_.time_dependent_ = true;
     if (model_.dim_ == 2) {

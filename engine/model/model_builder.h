@@ -177,7 +177,8 @@ class ModelBuilder {
 
   // The force contributors the scene uses (engine/forces/force_contributor.h),
   // each built by the Make... next to its class, in the order the model
-  // sums them: body seabed contact, body fluid loads (whose added mass joins
+  // sums them: applied loads (time-varying forces, torques), body seabed
+  // contact, body fluid loads (whose added mass joins
   // the bodies' mass here), sliding joints (MakeSlidingJoints fails when a
   // slider's body point is more than 1e-6 m from its cable at t = 0, naming
   // the joint). A contributor that dissipates turns on the damping pass.
@@ -189,9 +190,8 @@ class ModelBuilder {
 
   // The constant generalized force [N, or N m per unit slope]: element and
   // body gravity and each load's force at its point (the loads' also
-  // apart, for the energy per part); the torques on bodies, kept apart
-  // (their work is summed step by step), and the time-varying forces with
-  // their points (evaluated by SetTime).
+  // apart, for the energy per part). Torques and time-varying forces are
+  // the applied-loads contributor's (Contributors).
   void ConstantForces();
 
   // Each probe's point as a linear form of q (position [m] = const + sum

@@ -323,31 +323,8 @@ double MultibodyModel::NetForce(const VectorXd& q, double load_factor, VectorXd*
   constexpr double kEps = std::numeric_limits<double>::epsilon();
   VectorXd& full = scratch_full_;
   full = load_factor * constant_force_;
-  // A torque T on a body: its virtual work T . dphi, with de_k = dphi x e_k,
-  // is done by the generalized forces (1/2) T x e_k on the axes (spatial),
-  // and T_z perp(u) on u (planar), on the unit, orthogonal axes the
-  // constraints keep. Their derivative is skew-symmetric, so the symmetric
-  // Newton matrix leaves it out (Newton then converges linearly, at a rate
-  // of order h^2 |T| / J, instead of quadratically).
-  // Time-varying forces at points (their value at time_, SetTime).
-  for (const VaryingForce& l : varying_forces_) {
-    for (int d = 0; d < dim_; ++d)
-      for (const ProbeTerm& t : l.point[d]) full(t.coord) += load_factor * t.coeff * l.value(d);
-  }
-  for (const TorqueLoad& t : torques_) {
-    const int c = bodies_[t.body].coord;
-    if (dim_ == 2) {
-      const double tz = load_factor * t.torque.z();
-      full(c + 2) -= tz * q(c + 3);
-      full(c + 3) += tz * q(c + 2);
-    } else {
-      for (int k = 0; k < 3; ++k) {
-        const Vector3d e = q.segment<3>(c + 3 + 3 * k);
-        full.segment<3>(c + 3 + 3 * k) += 0.5 * load_factor * t.torque.cross(e);
-      }
-    }
-  }
-  // Contributors' applied loads (body buoyancy, ...), scaled as gravity.
+  // Contributors' applied loads (time-varying loads, torques, body
+  // buoyancy), scaled as gravity.
   const ForceState state = StateAt(q, nullptr, load_factor);
   ForceOutput out{&full, nullptr, stiffness, stiffness_scale, Map()};
   for (const auto& c : contributors_) c->AddAppliedLoad(state, &out);
@@ -669,9 +646,7 @@ void MultibodyModel::SetTime(double t) {
     for (int k = row.lin_begin; k < row.lin_end; ++k)
       lin_value_[k] = r.n(row_coord_[row.coord_begin + lin_local_[k]] - r.coord);
   }
-  for (VaryingForce& l : varying_forces_) l.value = Evaluate(l.force, t);
-  for (TorqueLoad& tl : torques_)
-    if (tl.is_varying) tl.torque = tl.base + Evaluate(tl.varying, t);
+  for (const auto& c : contributors_) c->SetTime(t);
   if (!winches_.empty()) {
     if (dim_ == 2) {
       UpdateWinches<2>();
@@ -980,11 +955,10 @@ void MultibodyModel::AccumulateExternalWork(const VectorXd& q_before, const Vect
                                             double t_before, double t_after,
                                             const VectorXd& lambda_before,
                                             const VectorXd& lambda_after, double load_factor) {
-  for (const VaryingForce& l : varying_forces_) {
-    const Vector3d mean = 0.5 * (Evaluate(l.force, t_before) + Evaluate(l.force, t_after));
-    for (int d = 0; d < dim_; ++d)
-      for (const ProbeTerm& t : l.point[d])
-        external_work_ += load_factor * mean(d) * t.coeff * (q_after(t.coord) - q_before(t.coord));
+  // Contributors' work (torques, time-varying loads).
+  if (has_step_work_) {
+    const StepEnds ends{&q_before, &q_after, t_before, t_after, load_factor};
+    for (const auto& c : contributors_) c->AddStepWork(ends, &external_work_);
   }
   for (const MovingRow& m : moving_rows_) {
     const double lambda = 0.5 * (lambda_before(m.row) + lambda_after(m.row));
@@ -995,30 +969,6 @@ void MultibodyModel::AccumulateExternalWork(const VectorXd& q_before, const Vect
     const Vector3d dn = r.Normal(t_after) - r.Normal(t_before);
     external_work_ += lambda * 0.5 *
                       (DotAt(dn, q_before, r.coord, dim_) + DotAt(dn, q_after, r.coord, dim_));
-  }
-  for (const TorqueLoad& tl : torques_) {
-    const Vector3d torque =
-        tl.is_varying
-            ? Vector3d(tl.base + 0.5 * (Evaluate(tl.varying, t_before) +
-                                        Evaluate(tl.varying, t_after)))
-            : tl.torque;
-    const int c = bodies_[tl.body].coord;
-    if (dim_ == 2) {
-      // Exact for a constant torque: T_z times the angle turned.
-      const Eigen::Vector2d u0 = q_before.segment<2>(c + 2), u1 = q_after.segment<2>(c + 2);
-      external_work_ += load_factor * torque.z() *
-                      std::atan2(u0.x() * u1.y() - u0.y() * u1.x(), u0.dot(u1));
-    } else {
-      // T . phi with phi the rotation vector of the step (exact when the
-      // rotation axis is fixed over the step, second order otherwise).
-      Eigen::Matrix3d before, after;
-      for (int k = 0; k < 3; ++k) {
-        before.col(k) = q_before.segment<3>(c + 3 + 3 * k);
-        after.col(k) = q_after.segment<3>(c + 3 + 3 * k);
-      }
-      const Eigen::AngleAxisd delta(Eigen::Matrix3d(after * before.transpose()));
-      external_work_ += load_factor * torque.dot(delta.angle() * delta.axis());
-    }
   }
 }
 

@@ -50,6 +50,7 @@
 
 #include "absl/status/statusor.h"
 #include "engine/elements/ancf_cable_element.h"
+#include "engine/forces/applied_loads.h"
 #include "engine/forces/body_fluid_load.h"
 #include "engine/forces/body_seabed_contact.h"
 #include "engine/forces/force_contributor.h"
@@ -237,8 +238,7 @@ class MultibodyModel {
   //    (second order; the moving support's formula is its case Phi_t =
   //    -d').
   bool has_external_work() const {
-    return !torques_.empty() || !varying_forces_.empty() || !moving_rows_.empty() ||
-           !turning_rows_.empty();
+    return has_step_work_ || !moving_rows_.empty() || !turning_rows_.empty();
   }
   void AccumulateExternalWork(const Eigen::VectorXd& q_before, const Eigen::VectorXd& q_after,
                               double t_before, double t_after,
@@ -388,25 +388,10 @@ class MultibodyModel {
     bool has_added_mass = false;
     Eigen::Matrix3d added_mass = Eigen::Matrix3d::Zero();
   };
-  // A torque load on a body [N m]: torque = base + varying(t).
-  struct TorqueLoad {
-    int body = 0;
-    Eigen::Vector3d torque = Eigen::Vector3d::Zero();
-    Eigen::Vector3d base = Eigen::Vector3d::Zero();
-    TimeVector varying;
-    bool is_varying = false;
-  };
   // A flat linear form sum coeff * q[coord].
   struct ProbeTerm {
     int coord = 0;
     double coeff = 0;
-  };
-  // A time-varying force at a point: per component d, the point's linear
-  // form (the generalized force is F_d coeff on q[coord]).
-  struct VaryingForce {
-    std::array<std::vector<ProbeTerm>, 3> point;
-    TimeVector force;
-    Eigen::Vector3d value = Eigen::Vector3d::Zero();  // force(time_)
   };
   // A constraint row of a moving support: c = c0 - motion(t).
   struct MovingRow {
@@ -569,7 +554,6 @@ class MultibodyModel {
   std::vector<ElementData<2>> elements2_;
   std::vector<ElementData<3>> elements3_;
   std::vector<BodyData> bodies_;
-  std::vector<TorqueLoad> torques_;
   Eigen::VectorXd constant_force_;  // full: gravity and point loads
   // Full: the point loads alone (empty without any), for EnergyParts::loads.
   Eigen::VectorXd load_force_;
@@ -602,6 +586,7 @@ class MultibodyModel {
   const BodyFluidForces* body_fluid_ = nullptr;
   const BodySeabedContact* body_contact_ = nullptr;
   const SlidingJoints* sliders_ = nullptr;
+  bool has_step_work_ = false;  // a contributor whose work is summed per step
 
   std::vector<Row> rows_;
   std::vector<int> row_coord_;
@@ -646,7 +631,6 @@ class MultibodyModel {
   bool time_dependent_ = false;
   std::vector<MovingRow> moving_rows_;
   std::vector<TurningRow> turning_rows_;
-  std::vector<VaryingForce> varying_forces_;
   // Work done by torques, time-varying loads and moving supports so far [J].
   double external_work_ = 0;
   // Winches (empty in most scenes: then nothing is evaluated).
