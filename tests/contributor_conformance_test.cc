@@ -153,8 +153,20 @@ std::string LoadedBody(const char* model) {
                                                         : R"({"x": 0.3, "y": -0.2, "z": 1})");
 }
 
+// A body with linear and angular damping.
+std::string DampedBody(const char* model) {
+  return absl::StrFormat(R"({
+    "model": "%s",
+    "bodies": [{"name": "b", "mass": 2, "inertia": {"x": 0.25, "y": 0.3, "z": 0.5},
+                "damping": {"linear": 3, "angular": 0.7}}],
+    "solver": {"duration": 1}})",
+                         model);
+}
+
 // One line per contributor (and per variant worth checking).
 const Case kCases[] = {
+    {"BodyDampingPlanar", "body_damping", [] { return SceneFromJson(DampedBody("PLANAR")); }},
+    {"BodyDampingSpatial", "body_damping", [] { return SceneFromJson(DampedBody("SPATIAL")); }},
     {"AppliedLoadsPlanar", "applied_loads", [] { return SceneFromJson(LoadedBody("PLANAR")); },
      kExact, kExact, 0.1, false, kSymmetricPart},
     {"AppliedLoadsSpatial", "applied_loads", [] { return SceneFromJson(LoadedBody("SPATIAL")); },

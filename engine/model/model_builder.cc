@@ -263,9 +263,6 @@ absl::Status ModelBuilder::InitialCoordinates() {
     MultibodyModel::BodyData data;
     data.coord = i;
     data.mass = body.mass_kg;
-    data.linear_damping = body.linear_damping_n_s_m;
-    data.angular_damping = body.angular_damping_n_m_s;
-    if (data.linear_damping != 0 || data.angular_damping != 0) model_.has_damping_ = true;
     const Vector3d& inertia = body.inertia_kg_m2;
     if (D == 2) {
       q0_.segment<2>(i + 2) = frame0_[b].col(0).head<2>();
@@ -828,6 +825,7 @@ absl::Status ModelBuilder::Contributors() {
     m.has_step_work_ = true;
     add(std::move(loads));
   }
+  if (auto damping = MakeBodyDamping(scene_, body_coord, m.dim_)) add(std::move(damping));
   if (auto contact = MakeBodySeabedContact(scene_, body_coord, m.dim_)) {
     m.body_contact_ = contact.get();
     add(std::move(contact));

@@ -177,8 +177,8 @@ class ModelBuilder {
 
   // The force contributors the scene uses (engine/forces/force_contributor.h),
   // each built by the Make... next to its class, in the order the model
-  // sums them: applied loads (time-varying forces, torques), body seabed
-  // contact, body fluid loads (whose added mass joins
+  // sums them: applied loads (time-varying forces, torques), body damping,
+  // body seabed contact, body fluid loads (whose added mass joins
   // the bodies' mass here), sliding joints (MakeSlidingJoints fails when a
   // slider's body point is more than 1e-6 m from its cable at t = 0, naming
   // the joint). A contributor that dissipates turns on the damping pass.

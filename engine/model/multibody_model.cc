@@ -443,12 +443,6 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
   return size;
 }
 
-double MultibodyModel::BodyDampingCoefficient(const BodyData& b, int k) const {
-  if (k < dim_) return b.linear_damping;
-  // Planar: the torque -c omega on u is -c udot; spatial: -(c / 2) edot_k.
-  return dim_ == 2 ? b.angular_damping : 0.5 * b.angular_damping;
-}
-
 double MultibodyModel::DampingForce(const VectorXd& q, const VectorXd& qdot, VectorXd* f,
                                     SkylineLdlt* tangent, double tangent_scale,
                                     VectorXd* roundoff) {
@@ -465,17 +459,6 @@ double MultibodyModel::DampingForce(const VectorXd& q, const VectorXd& qdot, Vec
                                               full_roundoff, nullptr)
                           : ElementDamping<3>(q, qdot, &full, tangent, tangent_scale,
                                               full_roundoff, nullptr);
-  for (const BodyData& b : bodies_) {
-    for (int k = 0; k < body_stride_; ++k) {
-      const double c = BodyDampingCoefficient(b, k);
-      if (c == 0) continue;
-      const int i = b.coord + k;
-      full(i) -= c * qdot(i);
-      size = std::max(size, std::abs(c * qdot(i)));
-      if (tangent && j_[i] >= 0)
-        tangent->values()[tangent->Slot(j_[i], j_[i])] += tangent_scale * s_(i) * s_(i) * c;
-    }
-  }
   // Contributors' velocity-dependent forces.
   if (!contributors_.empty()) {
     const ForceState state = StateAt(q, &qdot, 1.0);
@@ -507,9 +490,6 @@ double MultibodyModel::DampingPower(const VectorXd& q, const VectorXd& qdot) con
   } else {
     ElementDamping<3>(q, qdot, nullptr, nullptr, 0, nullptr, &power);
   }
-  for (const BodyData& b : bodies_)
-    for (int k = 0; k < body_stride_; ++k)
-      power += BodyDampingCoefficient(b, k) * qdot(b.coord + k) * qdot(b.coord + k);
   if (!contributors_.empty()) {
     const ForceState state = StateAt(q, &qdot, 1.0);
     for (const auto& c : contributors_) c->AddDissipatedPower(state, &power);

@@ -51,6 +51,7 @@
 #include "absl/status/statusor.h"
 #include "engine/elements/ancf_cable_element.h"
 #include "engine/forces/applied_loads.h"
+#include "engine/forces/body_damping.h"
 #include "engine/forces/body_fluid_load.h"
 #include "engine/forces/body_seabed_contact.h"
 #include "engine/forces/force_contributor.h"
@@ -381,8 +382,6 @@ class MultibodyModel {
     int coord = 0;  // full index of r_c
     double mass = 0;
     Eigen::Vector3d jbar = Eigen::Vector3d::Zero();  // per axis [kg m^2]
-    double linear_damping = 0;   // [N s/m]
-    double angular_damping = 0;  // [N m s/rad]
     // The fluid's added mass on r_c (BodyFluidLoad::AddedMass) [kg], in the
     // mass matrix and the kinetic energy; only with has_added_mass.
     bool has_added_mass = false;
@@ -455,8 +454,6 @@ class MultibodyModel {
   double ElementDamping(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
                         Eigen::VectorXd* full, SkylineLdlt* tangent, double tangent_scale,
                         Eigen::VectorXd* roundoff, double* power) const;
-  // Per body coordinate the damping coefficient c_i of its force -c_i qdot_i.
-  double BodyDampingCoefficient(const BodyData& b, int k) const;
   template <int D>
   void ElementEnergy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, EnergySample* en,
                      EnergyParts* parts) const;
