@@ -52,7 +52,9 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "engine/constraints/constraint.h"
 #include "engine/forces/force_contributor.h"
 #include "engine/forces/wave_load.h"
 #include "engine/model/multibody_model.h"
@@ -472,6 +474,201 @@ TEST(ContributorConformance, EveryContributorOfTheSampleScenesHasACase) {
     }
   }
 }
+
+
+// ---- Constraint families (engine/constraints/constraint.h) ----
+//
+// Each case's model is checked family by family and as a whole, on the
+// unknowns z (q = c + S z), at t = 0.7 s (supports moving and turning):
+//
+//  1. Jacobian: each family's dPhi/dz against the central difference of
+//     its residual (step 1e-6; the rows are at most quadratic, so the
+//     difference is exact up to rounding eps |q| / h ~ 2e-10 for the
+//     metre-sized scenes here: bound 1e-6 of max(1, |J|)).
+//  2. Hessian: sum_i lambda_i d^2 Phi_i / dz^2 against the central
+//     difference of J(z)^T lambda (same step and bound).
+//  3. Time: along z(t) = z0 + v (t - t0) (no acceleration), dPhi/dt = J v
+//     + Phi_t (central first difference, step 1e-6 s: truncation h^2
+//     Phi''' / 6 ~ 1e-11, rounding ~ 2e-10; bound 1e-6 of max(1, |dPhi/dt|))
+//     and d^2 Phi/dt^2 = -gamma (central second difference, step 1e-3 s:
+//     truncation h^2 Phi'''' / 12 ~ 1e-5 for the harmonic laws here, of
+//     frequency 0.5 Hz on unit lengths, rounding 4 eps |q| / h^2 ~ 1e-9;
+//     bound 1e-4 of max(1, |gamma|)).
+//  4. Work: a family's step work over [t - h, t + h] at fixed q and
+//     multipliers is lambda . Phi_t times 2 h (the work of a rheonomic row
+//     is int lambda Phi_t dt), to the same bounds as 3.
+// A new family is covered by the scenes below once one of them uses it.
+
+struct ConstraintCase {
+  const char* label;
+  std::function<Scene()> scene;
+};
+
+void PrintTo(const ConstraintCase& c, std::ostream* os) { *os << c.label; }
+
+std::string TurningJson() {
+  return R"("rotation": {"ramp": {"slope": 1}, "sum": [{"harmonic": {"amplitude": 0.3,
+             "frequency": 0.5}}]}, "rotation_axis": {"x": 0.3, "y": 0.4, "z": 1})";
+}
+
+const ConstraintCase kConstraintCases[] = {
+    {"TurningBodySpatial",
+     [] {
+       return SceneFromJson(absl::StrCat(R"({"gravity": {"y": -9.81},
+         "bodies": [{"name": "b", "mass": 2, "inertia": {"x": 0.1, "y": 0.15, "z": 0.2},
+                     "position": {"x": -0.5}}],
+         "joints": [{"type": "FIXED", "a": {"body": "b", "point": {"x": 0.5}}, )",
+                                         TurningJson(), R"(}], "solver": {"duration": 1}})"));
+     }},
+    {"TurningClampedRod",
+     [] {
+       return SceneFromJson(absl::StrCat(R"({
+         "cables": [{"name": "rod", "points": [{"x": 0}, {"x": 1}], "density": 7850,
+                     "youngs_modulus": 2e11, "diameter": 0.02, "elements": 4}],
+         "joints": [{"type": "FIXED", "a": {"cable": "rod", "s": 0}, )",
+                                         TurningJson(), R"(}], "solver": {"duration": 1}})"));
+     }},
+    {"MovingSupportCraneTrolley", [] { return SampleScene("crane-trolley-hoist.json"); }},
+    {"BodyOnCableEndCylinder", [] { return SampleScene("cable-with-end-cylinder.json"); }},
+    {"PinnedCylindersPaper", [] { return SampleScene("paper/cylinders-3.json"); }},
+};
+
+class ConstraintConformanceTest : public ::testing::TestWithParam<ConstraintCase> {
+ protected:
+  static constexpr double kT0 = 0.7;
+  void SetUp() override {
+    auto model = MultibodyModel::Build(GetParam().scene());
+    ASSERT_TRUE(model.ok()) << model.status();
+    model_.emplace(std::move(*model));
+    ASSERT_GT(model_->multipliers(), 0);
+    ASSERT_FALSE(model_->constraint_families().empty());
+    model_->SetTime(kT0);
+    z_ = model_->initial_z();
+    v_.resize(z_.size());
+    for (int j = 0; j < z_.size(); ++j) {
+      z_(j) += 1e-3 * std::sin(1.3 * j + 0.2);
+      v_(j) = 0.3 * std::cos(1.1 * j + 0.4);
+    }
+    lambda_.resize(model_->multipliers());
+    for (int i = 0; i < lambda_.size(); ++i) lambda_(i) = 10 * std::sin(0.7 * i + 1);
+  }
+  VectorXd Full(const VectorXd& z) const {
+    VectorXd q(model_->coordinates());
+    model_->ToFull(z, &q);
+    return q;
+  }
+  // The family's residual and (dense) Jacobian on z at z.
+  VectorXd Residual(const ConstraintFamily& f, const VectorXd& z,
+                    Eigen::MatrixXd* jac = nullptr) const {
+    VectorXd phi = VectorXd::Zero(model_->multipliers());
+    SparseRows pattern = model_->jacobian_pattern();
+    std::fill(pattern.value.begin(), pattern.value.end(), 0.0);
+    f.Residual(Full(z), model_->Map(), &phi, jac ? &pattern : nullptr);
+    if (jac) {
+      jac->setZero(phi.size(), z.size());
+      for (int r = 0; r < phi.size(); ++r)
+        for (int k = pattern.row_start[r]; k < pattern.row_start[r + 1]; ++k)
+          (*jac)(r, pattern.col[k]) += pattern.value[k];
+    }
+    return phi;
+  }
+  // All families' residual at time t and unknowns z.
+  VectorXd Phi(double t, const VectorXd& z) {
+    model_->SetTime(t);
+    VectorXd phi(model_->multipliers());
+    model_->Constraints(Full(z), &phi, nullptr);
+    return phi;
+  }
+  std::optional<MultibodyModel> model_;
+  VectorXd z_, v_, lambda_;
+};
+
+TEST_P(ConstraintConformanceTest, JacobianIsTheResidualsDerivative) {
+  for (const ConstraintFamily* f : model_->constraint_families()) {
+    Eigen::MatrixXd jac;
+    Residual(*f, z_, &jac);
+    const double scale = std::max(1.0, jac.lpNorm<Eigen::Infinity>());
+    double worst = 0;
+    for (int j = 0; j < z_.size(); ++j) {
+      VectorXd zp = z_, zm = z_;
+      zp(j) += kStep;
+      zm(j) -= kStep;
+      const VectorXd column = (Residual(*f, zp) - Residual(*f, zm)) / (2 * kStep);
+      worst = std::max(worst, (column - jac.col(j)).lpNorm<Eigen::Infinity>() / scale);
+    }
+    EXPECT_LE(worst, kRelative) << f->name();
+  }
+}
+
+TEST_P(ConstraintConformanceTest, HessianIsTheJacobiansDerivative) {
+  for (const ConstraintFamily* f : model_->constraint_families()) {
+    SkylineLdlt a = model_->mass();
+    a.SetZero();
+    f->AddHessian(lambda_, 1.0, &a);
+    const double scale = std::max(1.0, lambda_.lpNorm<Eigen::Infinity>());
+    double worst = 0;
+    for (int j = 0; j < z_.size(); ++j) {
+      VectorXd zp = z_, zm = z_;
+      zp(j) += kStep;
+      zm(j) -= kStep;
+      Eigen::MatrixXd jp, jm;
+      Residual(*f, zp, &jp);
+      Residual(*f, zm, &jm);
+      const VectorXd column = (jp - jm).transpose() * lambda_ / (2 * kStep);
+      for (int i = 0; i < z_.size(); ++i) {
+        const int slot = a.Slot(i, j);
+        const double h = slot >= 0 ? a.values()[slot] : 0.0;
+        worst = std::max(worst, std::abs(column(i) - h) / scale);
+      }
+    }
+    EXPECT_LE(worst, kRelative) << f->name();
+  }
+}
+
+TEST_P(ConstraintConformanceTest, RateAndGammaAreTheResidualsTimeDerivatives) {
+  const VectorXd q = Full(z_);
+  VectorXd qdot(model_->coordinates());
+  model_->RateToFull(v_, &qdot);
+  model_->SetTime(kT0);
+  VectorXd rate = VectorXd::Zero(model_->multipliers()), gamma(model_->multipliers());
+  for (const ConstraintFamily* f : model_->constraint_families()) f->AddRate(q, &rate);
+  model_->ConstraintGamma(q, qdot, &gamma);
+  VectorXd phi(model_->multipliers());
+  SparseRows jac = model_->jacobian_pattern();
+  model_->Constraints(q, &phi, &jac);
+  VectorXd jv(phi.size());
+  jac.Multiply(v_.data(), jv.data());
+  const VectorXd dphi = jv + rate;
+  auto path = [&](double dt) { return Phi(kT0 + dt, z_ + dt * v_); };
+  const double h1 = kStep, h2 = 1e-3;
+  const VectorXd first = (path(h1) - path(-h1)) / (2 * h1);
+  const VectorXd second = (path(h2) - 2 * path(0) + path(-h2)) / (h2 * h2);
+  EXPECT_LE((first - dphi).lpNorm<Eigen::Infinity>(),
+            kRelative * std::max(1.0, dphi.lpNorm<Eigen::Infinity>()));
+  EXPECT_LE((second + gamma).lpNorm<Eigen::Infinity>(),
+            1e-4 * std::max(1.0, gamma.lpNorm<Eigen::Infinity>()));
+}
+
+TEST_P(ConstraintConformanceTest, StepWorkIsTheMultipliersWorkOnTheRate) {
+  const VectorXd q = Full(z_);
+  for (const ConstraintFamily* f : model_->constraint_families()) {
+    model_->SetTime(kT0);
+    VectorXd rate = VectorXd::Zero(model_->multipliers());
+    f->AddRate(q, &rate);
+    double work = 0;
+    f->AddStepWork(ConstraintStep{&q, &q, kT0 - kStep, kT0 + kStep, &lambda_, &lambda_}, &work);
+    const double expected = lambda_.dot(rate) * 2 * kStep;
+    EXPECT_LE(std::abs(work - expected),
+              kRelative * std::max(1.0, lambda_.cwiseProduct(rate).cwiseAbs().sum()) * 2 * kStep)
+        << f->name();
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Constraints, ConstraintConformanceTest,
+                         ::testing::ValuesIn(kConstraintCases),
+                         [](const ::testing::TestParamInfo<ConstraintCase>& info) {
+                           return std::string(info.param.label);
+                         });
 
 }  // namespace
 }  // namespace cablesim

@@ -634,6 +634,8 @@ void ModelBuilder::KeepMovableRows() {
   // bilinear, so a row with a zero reduced gradient there is one that the
   // elimination has made constant, e.g. a clamped node welded to a body
   // welded to ground).
+  std::vector<PrescribedMotion::MovingRow> moving_rows;
+  std::vector<PrescribedMotion::TurningRow> turning_rows;
   for (const PendingRow& r : pending_) {
     VectorXd grad = VectorXd::Zero(m.dofs_);
     for (const auto& [i, v] : r.f.linear)
@@ -643,25 +645,29 @@ void ModelBuilder::KeepMovableRows() {
       if (m.j_[ij.second] >= 0) grad(m.j_[ij.second]) += v * m.s_(ij.second) * q0_(ij.first);
     }
     if (grad.lpNorm<Eigen::Infinity>() <= 1e-12) continue;
-    m.AddRow(r.f, r.kind, r.joint, r.body);
+    m.joint_rows_->AddRow(r.f, r.kind, r.joint, r.body);
     if (r.motion_axis >= 0) {
-      MultibodyModel::MovingRow moving;
-      moving.row = static_cast<int>(m.rows_.size()) - 1;
+      PrescribedMotion::MovingRow moving;
+      moving.row = m.joint_rows_->size() - 1;
       moving.joint = r.joint;
       moving.axis = r.motion_axis;
       moving.c0 = r.f.c;
       moving.motion = scene_.joints[r.joint].motion[r.motion_axis];
-      m.moving_rows_.push_back(moving);
+      moving_rows.push_back(moving);
     }
     if (r.turn_coord >= 0) {
-      MultibodyModel::TurningRow turning;
-      turning.row = static_cast<int>(m.rows_.size()) - 1;
+      PrescribedMotion::TurningRow turning;
+      turning.row = m.joint_rows_->size() - 1;
       turning.coord = r.turn_coord;
       turning.n0 = r.turn_n0;
       turning.axis = scene_.joints[r.joint].rotation_axis;
       turning.angle = scene_.joints[r.joint].rotation;
-      m.turning_rows_.push_back(turning);
+      turning_rows.push_back(turning);
     }
+  }
+  if (!moving_rows.empty() || !turning_rows.empty()) {
+    m.motion_ = std::make_unique<PrescribedMotion>(m.joint_rows_.get(), std::move(moving_rows),
+                                                   std::move(turning_rows), m.dim_);
   }
 }
 
@@ -670,8 +676,8 @@ absl::Status ModelBuilder::CheckIntegratorFits() const {
     return absl::OkStatus();
   const std::string name(IntegratorName(scene_.solver.integrator));
   const MultibodyModel& m = model_;
-  if (!m.rows_.empty()) {
-    const MultibodyModel::Row& r = m.rows_.front();
+  if (m.joint_rows_->size() > 0) {
+    const JointRows::Row& r = m.joint_rows_->row(0);
     const std::string what = r.joint >= 0
                                  ? absl::StrFormat("joints[%d] is kept as constraint rows", r.joint)
                                  : absl::StrFormat("bodies[%d] has its axes' constraint rows", r.body);
@@ -696,7 +702,8 @@ absl::Status ModelBuilder::CheckMovingRows() const {
   std::vector<int> kept(scene_.joints.size(), 0), wanted(scene_.joints.size(), 0);
   for (const PendingRow& r : pending_)
     if (r.motion_axis >= 0) ++wanted[r.joint];
-  for (const MultibodyModel::MovingRow& m : model_.moving_rows_) ++kept[m.joint];
+  if (model_.motion_)
+    for (const PrescribedMotion::MovingRow& m : model_.motion_->moving()) ++kept[m.joint];
   for (size_t j = 0; j < kept.size(); ++j) {
     if (kept[j] != wanted[j]) {
       return absl::InvalidArgumentError(absl::StrFormat(
@@ -960,7 +967,8 @@ void ModelBuilder::Probes() {
   for (size_t p = 0; p < scene_.probes.size(); ++p) {
     const Attachment& at = scene_.probes[p].at;
     bool found = false;
-    for (const MultibodyModel::MovingRow& row : m.moving_rows_) {
+    if (!m.motion_) break;
+    for (const PrescribedMotion::MovingRow& row : m.motion_->moving()) {
       const JointSpec& joint = scene_.joints[row.joint];
       const Attachment& held = joint.a.IsGround() ? joint.b : joint.a;
       const bool same = at.cable >= 0 ? held.cable == at.cable && mesh_.Node(held) == mesh_.Node(at)
@@ -1060,8 +1068,9 @@ void ModelBuilder::EnvelopeAndMass() {
     for (int k = 0; k < bs; ++k) idx[k] = b.coord + k;
     couple(idx.data(), bs);
   }
-  for (const Row& row : m.rows_) {
-    couple(&m.row_coord_[row.coord_begin], row.coord_end - row.coord_begin);
+  for (int i = 0; i < m.joint_rows_->size(); ++i) {
+    const JointRows::Row& row = m.joint_rows_->row(i);
+    couple(m.joint_rows_->coords(row), m.joint_rows_->coord_count(row));
   }
 
   // The first `count` coordinates of a body coupled with every element of
@@ -1117,38 +1126,20 @@ void ModelBuilder::EnvelopeAndMass() {
 
 void ModelBuilder::ConstraintPattern() {
   MultibodyModel& m = model_;
-  m.jac_pattern_.cols = m.dofs_;
-  for (const Row& row : m.rows_) {
-    for (int k = row.coord_begin; k < row.coord_end; ++k) {
-      if (m.j_[m.row_coord_[k]] < 0) continue;
-      m.jac_pattern_.col.push_back(m.j_[m.row_coord_[k]]);
-      m.jac_pattern_.value.push_back(0);
-    }
-    m.jac_pattern_.row_start.push_back(static_cast<int>(m.jac_pattern_.col.size()));
-  }
-  m.mono_row_.assign(m.mono_a_.size(), -1);
-  m.mono_col_.assign(m.mono_a_.size(), -1);
-  m.mono_factor_.assign(m.mono_a_.size(), 0.0);
-  for (const Row& row : m.rows_) {
-    const int* coord = &m.row_coord_[row.coord_begin];
-    for (int k = row.mono_begin; k < row.mono_end; ++k) {
-      const int a = coord[m.mono_a_[k]], b = coord[m.mono_b_[k]];
-      const int ja = m.j_[a], jb = m.j_[b];
-      if (ja < 0 || jb < 0) continue;
-      // w q_a q_b has Hessian entries (a, b) and (b, a) equal to w; on z
-      // they land on (ja, jb) and (jb, ja): stored once off the diagonal,
-      // twice (2 w) on it.
-      m.mono_row_[k] = std::max(ja, jb);
-      m.mono_col_[k] = std::min(ja, jb);
-      m.mono_factor_[k] = m.mono_w_[k] * m.s_(a) * m.s_(b) * (ja == jb ? 2 : 1);
-    }
-  }
+  m.joint_rows_->SetupPattern(m.Map(), m.dofs_, &m.jac_pattern_);
+  // The families the scene uses, in the order they are summed: the rows
+  // first (they write their values), then the supports' time law.
+  if (m.joint_rows_->size() > 0) m.families_.push_back(m.joint_rows_.get());
+  if (m.motion_) m.families_.push_back(m.motion_.get());
+  m.families_view_.assign(m.families_.begin(), m.families_.end());
 }
 
 MultibodyModel ModelBuilder::Finish() {
   model_.scratch_full_ = VectorXd::Zero(q0_.size());
   model_.scratch_roundoff_ = VectorXd::Zero(q0_.size());
-  model_.time_dependent_ = !model_.moving_rows_.empty() || !model_.turning_rows_.empty();
+  model_.time_dependent_ = false;
+  for (const ConstraintFamily* f : model_.families_)
+    if (f->time_dependent()) model_.time_dependent_ = true;
   for (const auto& c : model_.contributors_)
     if (c->time_dependent()) model_.time_dependent_ = true;
   if (!model_.winches_.empty()) {

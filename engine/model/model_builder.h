@@ -57,7 +57,7 @@ class ModelBuilder {
   // A constraint row before the rows no unknown can change are dropped.
   struct PendingRow {
     QuadraticForm f;
-    MultibodyModel::Row::Kind kind;
+    JointRows::Row::Kind kind;
     int joint;  // scene joint, or -1 for a body's own axis constraint
     int body;   // the body of an axis constraint, or -1
     // A moving support's position row: the component of the joint's
@@ -226,7 +226,7 @@ class ModelBuilder {
   int UnknownOf(int i) const { return model_.j_[i]; }
 
  private:
-  using Row = MultibodyModel::Row;
+  using Row = JointRows::Row;
 
   // Full index of a node's position, of a body's centre of mass.
   int NodeCoord(int node) const { return model_.node_stride_ * node; }

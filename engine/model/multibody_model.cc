@@ -23,77 +23,7 @@ namespace {
 using Eigen::Vector3d;
 using Eigen::VectorXd;
 
-// n . x with x the first D entries of v from index i (a plain loop: GCC
-// 12 warns falsely about head(D) of a fixed-size vector).
-double DotAt(const Vector3d& n, const VectorXd& v, int i, int D) {
-  double sum = 0;
-  for (int d = 0; d < D; ++d) sum += n(d) * v(i + d);
-  return sum;
-}
-
 }  // namespace
-
-void MultibodyModel::AddRow(const QuadraticForm& f, Row::Kind kind, int joint, int body) {
-  Row row;
-  row.kind = kind;
-  row.joint = joint;
-  row.body = body;
-  row.c = f.c;
-  std::vector<int> coords;
-  for (const auto& [i, v] : f.linear)
-    if (v != 0) coords.push_back(i);
-  for (const auto& [ij, v] : f.quadratic) {
-    if (v == 0) continue;
-    coords.push_back(ij.first);
-    coords.push_back(ij.second);
-  }
-  std::sort(coords.begin(), coords.end());
-  coords.erase(std::unique(coords.begin(), coords.end()), coords.end());
-  // The widest row, two welded spatial bodies, touches 24 coordinates.
-  assert(static_cast<int>(coords.size()) <= kMaxRowCoords);
-  auto local = [&](int i) {
-    return static_cast<int>(std::lower_bound(coords.begin(), coords.end(), i) - coords.begin());
-  };
-  row.coord_begin = static_cast<int>(row_coord_.size());
-  row_coord_.insert(row_coord_.end(), coords.begin(), coords.end());
-  row.coord_end = static_cast<int>(row_coord_.size());
-  row.lin_begin = static_cast<int>(lin_local_.size());
-  for (const auto& [i, v] : f.linear) {
-    if (v == 0) continue;
-    lin_local_.push_back(local(i));
-    lin_value_.push_back(v);
-  }
-  row.lin_end = static_cast<int>(lin_local_.size());
-  row.mono_begin = static_cast<int>(mono_a_.size());
-  for (const auto& [ij, v] : f.quadratic) {
-    if (v == 0) continue;
-    mono_a_.push_back(local(ij.first));
-    mono_b_.push_back(local(ij.second));
-    mono_w_.push_back(v);
-  }
-  row.mono_end = static_cast<int>(mono_a_.size());
-  rows_.push_back(row);
-}
-
-double MultibodyModel::RowValue(const Row& row, const VectorXd& q) const {
-  const int* coord = &row_coord_[row.coord_begin];
-  double acc = row.c;
-  for (int k = row.lin_begin; k < row.lin_end; ++k) acc += lin_value_[k] * q(coord[lin_local_[k]]);
-  for (int k = row.mono_begin; k < row.mono_end; ++k)
-    acc += mono_w_[k] * q(coord[mono_a_[k]]) * q(coord[mono_b_[k]]);
-  return acc;
-}
-
-void MultibodyModel::RowGradient(const Row& row, const VectorXd& q, double* grad) const {
-  const int* coord = &row_coord_[row.coord_begin];
-  const int n = row.coord_end - row.coord_begin;
-  for (int k = 0; k < n; ++k) grad[k] = 0;
-  for (int k = row.lin_begin; k < row.lin_end; ++k) grad[lin_local_[k]] += lin_value_[k];
-  for (int k = row.mono_begin; k < row.mono_end; ++k) {
-    grad[mono_a_[k]] += mono_w_[k] * q(coord[mono_b_[k]]);
-    grad[mono_b_[k]] += mono_w_[k] * q(coord[mono_a_[k]]);
-  }
-}
 
 void MultibodyModel::ScatterSlider(const SlidingJoint::Local& local, VectorXd* full,
                                    VectorXd* roundoff, double scale, SkylineLdlt* a) const {
@@ -174,10 +104,8 @@ void MultibodyModel::ProjectInitialVelocity() {
   Constraints(q0, &phi, &jac);
   VectorXd jv(nrows);
   jac.Multiply(v0_.data(), jv.data());
-  // Moving supports: Phi_z v + Phi_t = 0 with Phi_t = -motion'(t).
-  for (const MovingRow& m : moving_rows_) jv(m.row) -= m.rate;
-  for (const TurningRow& r : turning_rows_)
-    jv(r.row) += DotAt(r.rate, q0, r.coord, dim_);
+  // Moving and turning supports: Phi_z v + Phi_t = 0.
+  for (const ConstraintFamily* f : families_) f->AddRate(q0, &jv);
   if (jv.lpNorm<Eigen::Infinity>() <= 1e-14 * (1 + v0_.lpNorm<Eigen::Infinity>())) return;
   SkylineLdlt mass = mass_;
   if (!mass.Factor()) return;
@@ -551,81 +479,27 @@ void MultibodyModel::StaticFriction(const VectorXd& q, const VectorXd& q_start, 
 }
 
 void MultibodyModel::Constraints(const VectorXd& q, VectorXd* phi, SparseRows* jac) const {
-  int slot = 0;
-  double grad[kMaxRowCoords];
-  for (size_t i = 0; i < rows_.size(); ++i) {
-    const Row& row = rows_[i];
-    (*phi)(i) = RowValue(row, q);
-    if (!jac) continue;
-    RowGradient(row, q, grad);
-    for (int k = row.coord_begin; k < row.coord_end; ++k) {
-      const int coord = row_coord_[k];
-      if (j_[coord] < 0) continue;
-      jac->value[slot++] = grad[k - row.coord_begin] * s_(coord);
-    }
-  }
+  const CoordinateMap map = Map();
+  for (const ConstraintFamily* f : families_) f->Residual(q, map, phi, jac);
 }
 
 void MultibodyModel::AddConstraintHessian(const VectorXd& q, const VectorXd& lambda, double scale,
                                           SkylineLdlt* a) const {
   // The Hessians are constant; `q` is kept for the interface.
   (void)q;
-  double* values = a->values();
-  for (size_t i = 0; i < rows_.size(); ++i) {
-    const Row& row = rows_[i];
-    const double f = scale * lambda(i);
-    // Slots are looked up in `a` (any pattern containing envelope()).
-    for (int k = row.mono_begin; k < row.mono_end; ++k)
-      if (mono_row_[k] >= 0) values[a->Slot(mono_row_[k], mono_col_[k])] += f * mono_factor_[k];
-  }
+  for (const ConstraintFamily* f : families_) f->AddHessian(lambda, scale, a);
 }
 
 void MultibodyModel::ConstraintGamma(const VectorXd& q, const VectorXd& qdot,
                                      VectorXd* gamma) const {
-  for (size_t i = 0; i < rows_.size(); ++i) {
-    const Row& row = rows_[i];
-    const int* coord = &row_coord_[row.coord_begin];
-    double acc = 0;
-    for (int k = row.mono_begin; k < row.mono_end; ++k)
-      acc += mono_w_[k] * qdot(coord[mono_a_[k]]) * qdot(coord[mono_b_[k]]);
-    (*gamma)(i) = -2 * acc;
-  }
-  for (const MovingRow& m : moving_rows_) (*gamma)(m.row) += m.accel;
-  for (const TurningRow& r : turning_rows_) {
-    (*gamma)(r.row) -=
-        2 * DotAt(r.rate, qdot, r.coord, dim_) + DotAt(r.accel, q, r.coord, dim_);
-  }
-}
-
-Vector3d MultibodyModel::TurningRow::Normal(double t, Vector3d* rate_out,
-                                            Vector3d* accel_out) const {
-  const TimeFunction::Value v = angle.Evaluate(t);
-  const double c = std::cos(v.f), s = std::sin(v.f);
-  const Vector3d n = c * n0 + s * axis.cross(n0) + (1 - c) * axis.dot(n0) * axis;
-  if (rate_out != nullptr) {
-    const Vector3d an = axis.cross(n);
-    *rate_out = v.df * an;
-    *accel_out = v.ddf * an + v.df * v.df * axis.cross(an);
-  }
-  return n;
+  gamma->setZero();
+  for (const ConstraintFamily* f : families_) f->AddGamma(q, qdot, gamma);
 }
 
 void MultibodyModel::SetTime(double t) {
   time_ = t;
   if (!time_dependent_) return;
-  for (MovingRow& m : moving_rows_) {
-    const TimeFunction::Value v = m.motion.Evaluate(t);
-    rows_[m.row].c = m.c0 - v.f;
-    m.rate = v.df;
-    m.accel = v.ddf;
-  }
-  for (TurningRow& r : turning_rows_) {
-    r.n = r.Normal(t, &r.rate, &r.accel);
-    // Every coordinate of x has a slot in the row (AddTurningRows).
-    const Row& row = rows_[r.row];
-    for (int k = row.lin_begin; k < row.lin_end; ++k)
-      lin_value_[k] = r.n(row_coord_[row.coord_begin + lin_local_[k]] - r.coord);
-  }
+  for (ConstraintFamily* f : families_) f->SetTime(t);
   for (const auto& c : contributors_) c->SetTime(t);
   if (!winches_.empty()) {
     if (dim_ == 2) {
@@ -940,16 +814,9 @@ void MultibodyModel::AccumulateExternalWork(const VectorXd& q_before, const Vect
     const StepEnds ends{&q_before, &q_after, t_before, t_after, load_factor};
     for (const auto& c : contributors_) c->AddStepWork(ends, &external_work_);
   }
-  for (const MovingRow& m : moving_rows_) {
-    const double lambda = 0.5 * (lambda_before(m.row) + lambda_after(m.row));
-    external_work_ -= lambda * (m.motion(t_after) - m.motion(t_before));
-  }
-  for (const TurningRow& r : turning_rows_) {
-    const double lambda = 0.5 * (lambda_before(r.row) + lambda_after(r.row));
-    const Vector3d dn = r.Normal(t_after) - r.Normal(t_before);
-    external_work_ += lambda * 0.5 *
-                      (DotAt(dn, q_before, r.coord, dim_) + DotAt(dn, q_after, r.coord, dim_));
-  }
+  // Rheonomic rows' work (moving and turning supports).
+  const ConstraintStep step{&q_before, &q_after, t_before, t_after, &lambda_before, &lambda_after};
+  for (const ConstraintFamily* f : families_) f->AddStepWork(step, &external_work_);
 }
 
 template <int D>

@@ -58,6 +58,9 @@
 #include "engine/forces/seabed.h"
 #include "engine/forces/sheave.h"
 #include "engine/forces/wave_load.h"
+#include "engine/constraints/constraint.h"
+#include "engine/constraints/joint_rows.h"
+#include "engine/constraints/prescribed_motion.h"
 #include "engine/constraints/quadratic_form.h"
 #include "engine/scene/scene.h"
 #include "engine/output/results.h"
@@ -85,7 +88,7 @@ class MultibodyModel {
   int dimension() const { return dim_; }
   int coordinates() const { return static_cast<int>(c_.size()); }
   int dofs() const { return dofs_; }
-  int multipliers() const { return static_cast<int>(rows_.size()); }
+  int multipliers() const { return joint_rows_->size(); }
   int elements() const { return static_cast<int>(elements2_.size() + elements3_.size()); }
   // Nodes of the mesh; a node split where a cable without bending
   // stiffness kinks (ModelBuilder::MeshCables) counts once.
@@ -239,7 +242,7 @@ class MultibodyModel {
   //    (second order; the moving support's formula is its case Phi_t =
   //    -d').
   bool has_external_work() const {
-    return has_step_work_ || !moving_rows_.empty() || !turning_rows_.empty();
+    return has_step_work_ || motion_ != nullptr;
   }
   void AccumulateExternalWork(const Eigen::VectorXd& q_before, const Eigen::VectorXd& q_after,
                               double t_before, double t_after,
@@ -352,7 +355,15 @@ class MultibodyModel {
 
   // Which joint a constraint row belongs to (for messages), or -1 for a
   // body's own axis constraints.
-  int RowJoint(int row) const { return rows_[row].joint; }
+  int RowJoint(int row) const { return joint_rows_->row(row).joint; }
+
+  // The map q = c + S z as contributors and constraint families see it.
+  CoordinateMap Map() const { return CoordinateMap{j_.data(), s_.data(), dim_}; }
+
+  // The constraint families the scene uses (engine/constraints/constraint.h).
+  const std::vector<const ConstraintFamily*>& constraint_families() const {
+    return families_view_;
+  }
 
  private:
   // Build's steps fill in the members below.
@@ -392,32 +403,6 @@ class MultibodyModel {
     int coord = 0;
     double coeff = 0;
   };
-  // A constraint row of a moving support: c = c0 - motion(t).
-  struct MovingRow {
-    int row = 0;
-    int joint = 0, axis = 0;  // scene joint and component of its motion
-    double c0 = 0;
-    TimeFunction motion;
-    double rate = 0, accel = 0;  // motion' and motion'' at time_
-  };
-  // A direction row of a turning support: n(t) . x = 0, x the D
-  // coordinates from full index `coord` (a clamped slope or a body axis),
-  // n(t) = R(angle(t)) n0 with R the rotation about the unit `axis`.
-  // SetTime writes n(t) into the row's linear coefficients, so Constraints
-  // and the Jacobian need nothing else; Phi_t = n' . x and Phi_tt = n'' . x
-  // enter the initial velocity and ConstraintGamma.
-  struct TurningRow {
-    int row = 0;
-    int coord = 0;
-    Eigen::Vector3d n0 = Eigen::Vector3d::Zero(), axis = Eigen::Vector3d::UnitZ();
-    TimeFunction angle;
-    Eigen::Vector3d n = Eigen::Vector3d::Zero(), rate = Eigen::Vector3d::Zero(),
-                    accel = Eigen::Vector3d::Zero();  // n, n', n'' at time_
-    // n at time t (Rodrigues' formula); with `rate` and `accel` not null,
-    // also n' = angle' a x n and n'' = angle'' a x n + angle'^2 a x (a x n).
-    Eigen::Vector3d Normal(double t, Eigen::Vector3d* rate = nullptr,
-                           Eigen::Vector3d* accel = nullptr) const;
-  };
   // A winch (WinchSpec) on a cable.
   struct WinchData {
     int cable = 0;
@@ -431,19 +416,6 @@ class MultibodyModel {
     // damping is then 0.
     double axial_damping_s = 0, alpha_1_s = 0;
   };
-  // Constraint rows as flat quadratic forms over local coordinate lists:
-  // phi = c + sum lin_val * q[coord[lin_local]] + sum w q[coord[a]] q[coord[b]].
-  struct Row {
-    int joint = -1;  // scene joint, or -1 for a body's own axis constraint
-    int body = -1;   // the body of an axis constraint
-    enum Kind { kPosition, kDirection, kSlope, kAxes } kind = kPosition;
-    double c = 0;
-    int coord_begin = 0, coord_end = 0;  // into row_coord_
-    int lin_begin = 0, lin_end = 0;      // into lin_local_, lin_value_
-    int mono_begin = 0, mono_end = 0;    // into mono_a_, mono_b_, mono_w_
-  };
-  static constexpr int kMaxRowCoords = 48;
-
   template <int D>
   double ElementForces(const Eigen::VectorXd& q, Eigen::VectorXd* full, SkylineLdlt* stiffness,
                        double stiffness_scale, Eigen::VectorXd* roundoff) const;
@@ -463,10 +435,6 @@ class MultibodyModel {
   template <int D>
   Eigen::Vector3d ElementAngularMomentum(const Eigen::VectorXd& q,
                                          const Eigen::VectorXd& qdot) const;
-  double RowValue(const Row& row, const Eigen::VectorXd& q) const;
-  // Local gradient of a row: grad[k] for coordinate row_coord_[begin + k].
-  void RowGradient(const Row& row, const Eigen::VectorXd& q, double* grad) const;
-  void AddRow(const QuadraticForm& f, Row::Kind kind, int joint, int body);
   // Adds a slider's local force to the full vector `full` (and its rounding
   // to `roundoff`) and scale times its matrix, mapped onto z, to `a`.
   // A wheel carried by a body (Sheave::body() >= 0) on the element whose
@@ -484,8 +452,6 @@ class MultibodyModel {
                            double scale) const;
   void ScatterSlider(const SlidingJoint::Local& local, Eigen::VectorXd* full, Eigen::VectorXd* roundoff,
                      double scale, SkylineLdlt* a) const;
-  // The coordinate map (q = c + S z) for contributors' scatters.
-  CoordinateMap Map() const { return CoordinateMap{j_.data(), s_.data(), dim_}; }
   // The state contributors are evaluated at (time_ and the wave field).
   ForceState StateAt(const Eigen::VectorXd& q, const Eigen::VectorXd* qdot,
                      double load_factor) const {
@@ -585,16 +551,13 @@ class MultibodyModel {
   const SlidingJoints* sliders_ = nullptr;
   bool has_step_work_ = false;  // a contributor whose work is summed per step
 
-  std::vector<Row> rows_;
-  std::vector<int> row_coord_;
-  std::vector<int> lin_local_;
-  std::vector<double> lin_value_;
-  std::vector<int> mono_a_, mono_b_;
-  std::vector<double> mono_w_;
-  // Per monomial: the (row >= col) entry of its Hessian on z (or -1) and
-  // its factor.
-  std::vector<int> mono_row_, mono_col_;
-  std::vector<double> mono_factor_;
+  // The constraint families: the joints' rows (always, possibly none) and
+  // the supports' time law (only with moving or turning supports); the
+  // families the scene uses, in the order they are summed.
+  std::unique_ptr<JointRows> joint_rows_ = std::make_unique<JointRows>();
+  std::unique_ptr<PrescribedMotion> motion_;
+  std::vector<ConstraintFamily*> families_;
+  std::vector<const ConstraintFamily*> families_view_;
 
   // Probes: per probe and component d < 3, a linear form over q (as flat
   // term lists); velocity and acceleration use the same coefficients.
@@ -626,8 +589,6 @@ class MultibodyModel {
   // Time dependence.
   double time_ = 0;
   bool time_dependent_ = false;
-  std::vector<MovingRow> moving_rows_;
-  std::vector<TurningRow> turning_rows_;
   // Work done by torques, time-varying loads and moving supports so far [J].
   double external_work_ = 0;
   // Winches (empty in most scenes: then nothing is evaluated).

@@ -1,4 +1,4 @@
-#include "engine/forces/force_contributor.h"
+#include "engine/linear/coordinate_map.h"
 
 namespace cablesim {
 
