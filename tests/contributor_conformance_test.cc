@@ -56,6 +56,7 @@
 #include "absl/strings/str_format.h"
 #include "engine/constraints/constraint.h"
 #include "engine/forces/force_contributor.h"
+#include "engine/forces/seabed.h"
 #include "engine/forces/wave_load.h"
 #include "engine/model/multibody_model.h"
 #include "tests/test_util.h"
@@ -475,6 +476,132 @@ TEST(ContributorConformance, EveryContributorOfTheSampleScenesHasACase) {
   }
 }
 
+
+// ---- Element terms (ElementTerm, engine/forces/force_contributor.h) ----
+//
+// Each term of a case's model on one element (4 elements' length 2 m, a
+// cubic 2 mm into the seabed at one end and 5 mm at the other, moving at
+// 0.1 m/s): the gradient against the central difference of the energy,
+// the Hessian against that of the gradient, the damping tangent against
+// that of the dissipative force in the rates (or, for Coulomb friction, a
+// symmetric positive semi-definite bound, as forces/seabed.h says), the
+// power against -f . edot. Tolerances as for the contributors above.
+
+struct ElementCase {
+  const char* label;
+  const char* term;
+  std::function<Scene()> scene;
+  Tangent damping = kExact;
+};
+
+void PrintTo(const ElementCase& c, std::ostream* os) { *os << c.label; }
+
+std::string SeabedChain(const char* model, const char* bed) {
+  return absl::StrFormat(R"({
+    "model": "%s", "gravity": {"y": -9.81},
+    "cables": [{"name": "c", "points": [{"x": 0, "y": -20}, {"x": 8, "y": -20}], "density": 7850,
+                "youngs_modulus": 2e11, "diameter": 0.05, "elements": 4}],
+    "seabed": {"depth": 20, %s},
+    "solver": {"duration": 1}})",
+                         model, bed);
+}
+
+const ElementCase kElementCases[] = {
+    {"CableSeabedDamperPlanar", "cable_seabed",
+     [] { return SceneFromJson(SeabedChain("PLANAR", R"("stiffness": 3e5, "damping": 1e4)")); }},
+    {"CableSeabedFrictionSpatial", "cable_seabed",
+     [] {
+       return SceneFromJson(SeabedChain(
+           "SPATIAL",
+           R"("stiffness": 3e5, "damping": 1e4, "friction_axial": 0.5, "friction_transverse": 1)"));
+     },
+     kSymmetricBound},
+};
+
+class ElementTermConformanceTest : public ::testing::TestWithParam<ElementCase> {
+ protected:
+  void SetUp() override {
+    auto model = MultibodyModel::Build(GetParam().scene());
+    ASSERT_TRUE(model.ok()) << model.status();
+    model_.emplace(std::move(*model));
+    for (const auto& t : model_->element_terms())
+      if (t->name() == GetParam().term) term_ = t.get();
+    ASSERT_NE(term_, nullptr) << GetParam().term;
+  }
+  template <int D>
+  void Check() {
+    using C = ElementCoords<D>;
+    using M = ElementMatrix<D>;
+    const Seabed& bed = *model_->seabed();
+    // Places the element's nodes below the bed by the given depths (the
+    // bed's normal from its height function).
+    Eigen::Vector3d n = Eigen::Vector3d::Zero();
+    for (int d = 0; d < D; ++d)
+      n(d) = bed.Height(Eigen::Vector3d::Unit(d)) - bed.Height(Eigen::Vector3d::Zero());
+    const double h0 = bed.Height(Eigen::Vector3d::Zero());
+    const double length = 2;
+    C e, edot;
+    const Eigen::Vector3d x = Eigen::Vector3d::UnitX(), r0 = -(h0 + 0.002) * n,
+                          r1 = 2 * x - (h0 + 0.005) * n;
+    e << r0.head<D>(), (x - 0.0015 * n).head<D>(), r1.head<D>(), (x - 0.0015 * n).head<D>();
+    for (int i = 0; i < 4 * D; ++i) edot(i) = 0.1 * std::cos(1.9 * i + 0.3);
+    C g = C::Zero();
+    M k = M::Zero();
+    const double u = term_->AddPotential(e, length, &g, &k, nullptr);
+    ASSERT_GT(u, 0) << "the element is not in the bed";
+    EXPECT_NEAR(term_->Energy(e, length), u, 1e-14 * u);
+    double gerr = 0, kerr = 0;
+    for (int i = 0; i < 4 * D; ++i) {
+      C ep = e, em = e;
+      ep(i) += kStep;
+      em(i) -= kStep;
+      gerr = std::max(gerr, std::abs((term_->Energy(ep, length) - term_->Energy(em, length)) /
+                                         (2 * kStep) - g(i)));
+      C gp = C::Zero(), gm = C::Zero();
+      term_->AddPotential(ep, length, &gp, nullptr, nullptr);
+      term_->AddPotential(em, length, &gm, nullptr, nullptr);
+      kerr = std::max(kerr, ((gp - gm) / (2 * kStep) - k.col(i)).template lpNorm<Eigen::Infinity>());
+    }
+    EXPECT_LE(gerr, kRelative * (g.template lpNorm<Eigen::Infinity>() + u));
+    EXPECT_LE(kerr, kRelative * k.template lpNorm<Eigen::Infinity>());
+    if (!term_->dissipates()) return;
+    C f = C::Zero();
+    M c = M::Zero();
+    const double power = term_->AddDissipation(e, edot, length, &f, &c);
+    EXPECT_NEAR(power, -f.dot(edot), kPowerRel * f.cwiseProduct(edot).cwiseAbs().sum());
+    if (GetParam().damping == kSymmetricBound) {
+      ExpectSymmetricPositiveSemiDefinite(Eigen::MatrixXd(c));
+      return;
+    }
+    double cerr = 0;
+    for (int i = 0; i < 4 * D; ++i) {
+      C vp = edot, vm = edot;
+      vp(i) += kStep;
+      vm(i) -= kStep;
+      C fp = C::Zero(), fm = C::Zero();
+      term_->AddDissipation(e, vp, length, &fp, nullptr);
+      term_->AddDissipation(e, vm, length, &fm, nullptr);
+      cerr = std::max(cerr, (-(fp - fm) / (2 * kStep) - c.col(i)).template lpNorm<Eigen::Infinity>());
+    }
+    EXPECT_LE(cerr, kRelative * c.template lpNorm<Eigen::Infinity>());
+  }
+  std::optional<MultibodyModel> model_;
+  const ElementTerm* term_ = nullptr;
+};
+
+TEST_P(ElementTermConformanceTest, MatchesItsFiniteDifferences) {
+  if (model_->dimension() == 2) {
+    Check<2>();
+  } else {
+    Check<3>();
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(ElementTerms, ElementTermConformanceTest,
+                         ::testing::ValuesIn(kElementCases),
+                         [](const ::testing::TestParamInfo<ElementCase>& info) {
+                           return std::string(info.param.label);
+                         });
 
 // ---- Constraint families (engine/constraints/constraint.h) ----
 //

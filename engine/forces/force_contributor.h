@@ -148,6 +148,80 @@ class ForceContributor {
   }
 };
 
+// A force on cable elements, evaluated element by element inside the
+// model's one element loop (so that each element's terms are summed and
+// scattered once, with the elastic force's): per element of undeformed
+// length `length` at coordinates e (AncfCableElement<D> layout). Each
+// method comes in the two fixed sizes (planar, spatial); a term overrides
+// the ones it has. The model holds the terms the scene uses.
+template <int D>
+using ElementCoords = Eigen::Matrix<double, 4 * D, 1>;
+template <int D>
+using ElementMatrix = Eigen::Matrix<double, 4 * D, 4 * D>;
+
+class ElementTerm {
+ public:
+  virtual ~ElementTerm() = default;
+  virtual std::string_view name() const = 0;
+  virtual EnergyBucket bucket() const { return EnergyBucket::kContact; }
+
+  // Adds dU/de to `gradient` (minus the force, as the elastic force's
+  // gradient), d^2U/de^2 to `hessian` and the gradient's rounding bound to
+  // `roundoff` (either may be null); returns U [J].
+  virtual double AddPotential(const ElementCoords<2>& e, double length,
+                              ElementCoords<2>* gradient, ElementMatrix<2>* hessian,
+                              ElementCoords<2>* roundoff) const {
+    (void)e, (void)length, (void)gradient, (void)hessian, (void)roundoff;
+    return 0;
+  }
+  virtual double AddPotential(const ElementCoords<3>& e, double length,
+                              ElementCoords<3>* gradient, ElementMatrix<3>* hessian,
+                              ElementCoords<3>* roundoff) const {
+    (void)e, (void)length, (void)gradient, (void)hessian, (void)roundoff;
+    return 0;
+  }
+  // U [J] alone.
+  virtual double Energy(const ElementCoords<2>& e, double length) const {
+    (void)e, (void)length;
+    return 0;
+  }
+  virtual double Energy(const ElementCoords<3>& e, double length) const {
+    (void)e, (void)length;
+    return 0;
+  }
+
+  // Whether AddDissipation adds anything.
+  virtual bool dissipates() const { return false; }
+  // Adds the velocity-dependent force to `force` and its velocity tangent
+  // -df/d(edot) to `c`; returns the power dissipated [W].
+  virtual double AddDissipation(const ElementCoords<2>& e, const ElementCoords<2>& edot,
+                                double length, ElementCoords<2>* force,
+                                ElementMatrix<2>* c) const {
+    (void)e, (void)edot, (void)length, (void)force, (void)c;
+    return 0;
+  }
+  virtual double AddDissipation(const ElementCoords<3>& e, const ElementCoords<3>& edot,
+                                double length, ElementCoords<3>* force,
+                                ElementMatrix<3>* c) const {
+    (void)e, (void)edot, (void)length, (void)force, (void)c;
+    return 0;
+  }
+
+  virtual bool has_static_friction() const { return false; }
+  // STATIC analyses: adds the static friction force (e0 where the analysis
+  // started) to `force` and its matrix to `matrix` (may be null).
+  virtual void AddStaticFriction(const ElementCoords<2>& e, const ElementCoords<2>& e0,
+                                 double length, ElementCoords<2>* force,
+                                 ElementMatrix<2>* matrix) const {
+    (void)e, (void)e0, (void)length, (void)force, (void)matrix;
+  }
+  virtual void AddStaticFriction(const ElementCoords<3>& e, const ElementCoords<3>& e0,
+                                 double length, ElementCoords<3>* force,
+                                 ElementMatrix<3>* matrix) const {
+    (void)e, (void)e0, (void)length, (void)force, (void)matrix;
+  }
+};
+
 }  // namespace cablesim
 
 #endif  // CABLESIM_ENGINE_FORCES_FORCE_CONTRIBUTOR_H_

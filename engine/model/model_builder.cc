@@ -498,9 +498,13 @@ void ModelBuilder::BuildElements() {
                        j.components, j.seed);
     model_.wave_load_.emplace(std::move(field), fluid.current_m_s);
   }
-  if (scene_.seabed.enabled) {
-    model_.seabed_.emplace(scene_.seabed);
-    if (model_.seabed_->dissipates()) model_.has_damping_ = true;
+  if (auto bed = MakeCableSeabed(scene_)) {
+    model_.cable_seabed_ = bed.get();
+    model_.element_terms_.push_back(std::move(bed));
+  }
+  for (const auto& t : model_.element_terms_) {
+    if (t->dissipates()) model_.element_terms_dissipate_ = model_.has_damping_ = true;
+    if (t->bucket() == EnergyBucket::kContact) model_.has_element_contact_ = true;
   }
   if (model_.dim_ == 2) {
     BuildElementsOf<2>(&model_.elements2_);

@@ -41,7 +41,8 @@ void MultibodyModel::ElementEnergy(const VectorXd& q, const VectorXd& qdot, Ener
     en->kinetic += kinetic;
     en->axial += se.axial;
     en->bending += se.bending;
-    if (seabed_) en->contact += seabed_->Energy<D>(qe, e.element.length());
+    for (const auto& t : element_terms_)
+      en->contact += t->Energy(ElementCoords<D>(qe), e.element.length());
     if (!sheaves_.empty()) {
       for (uint64_t bits = sheave_mask_[k]; bits != 0; bits &= bits - 1) {
         const Sheave& wheel = sheaves_[std::countr_zero(bits)];

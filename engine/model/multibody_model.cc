@@ -219,10 +219,11 @@ double MultibodyModel::ElementForces(const VectorXd& q, VectorXd* full, SkylineL
     if (roundoff) re.setZero();
     e.element.ElasticForce(q.segment<kN>(e.first_coord), &fe, stiffness ? &ke : nullptr,
                            roundoff ? &re : nullptr);
-    // The seabed's force, like the elastic one, is the gradient of an energy.
-    if (seabed_)
-      seabed_->AddPotential<D>(q.segment<kN>(e.first_coord), e.element.length(), &fe,
-                               stiffness ? &ke : nullptr, roundoff ? &re : nullptr);
+    // Element terms' forces (the seabed's), like the elastic one, are
+    // gradients of energies.
+    for (const auto& t : element_terms_)
+      t->AddPotential(q.segment<kN>(e.first_coord), e.element.length(), &fe,
+                      stiffness ? &ke : nullptr, roundoff ? &re : nullptr);
     if (!sheaves_.empty()) {
       for (uint64_t bits = sheave_mask_[k]; bits != 0; bits &= bits - 1) {
         const Sheave& wheel = sheaves_[std::countr_zero(bits)];
@@ -325,7 +326,7 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
   typename AncfCableElement<D>::Coords fe;
   double size = 0;
   double* values = tangent ? tangent->values() : nullptr;
-  const bool bed = seabed_ && seabed_->dissipates();
+  const bool bed = element_terms_dissipate_;
   for (size_t k = 0; k < elements.size(); ++k) {
     const ElementData<D>& e = elements[k];
     const uint64_t wheels = sheaves_dissipate_ ? sheave_mask_[k] : 0;
@@ -347,8 +348,11 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
       e.element.AddDrag(q.segment<kN>(e.first_coord), ve, current_.head<D>(), e.drag_n, e.drag_t,
                         &fe, &ce);
     }
-    if (bed)
-      seabed_->AddDissipation<D>(q.segment<kN>(e.first_coord), ve, e.element.length(), &fe, &ce);
+    if (bed) {
+      for (const auto& t : element_terms_)
+        if (t->dissipates())
+          t->AddDissipation(q.segment<kN>(e.first_coord), ve, e.element.length(), &fe, &ce);
+    }
     for (uint64_t bits = wheels; bits != 0; bits &= bits - 1) {
       const Sheave& wheel = sheaves_[std::countr_zero(bits)];
       if (wheel.body() >= 0) {
@@ -434,8 +438,10 @@ double MultibodyModel::DampingPower(const VectorXd& q, const VectorXd& qdot) con
 }
 
 bool MultibodyModel::has_static_friction() const {
-  if (!seabed_) return false;
-  if (seabed_->has_friction() && (!elements2_.empty() || !elements3_.empty())) return true;
+  if (!elements2_.empty() || !elements3_.empty()) {
+    for (const auto& t : element_terms_)
+      if (t->has_static_friction()) return true;
+  }
   for (const auto& c : contributors_)
     if (c->has_static_friction()) return true;
   return false;
@@ -448,7 +454,10 @@ void MultibodyModel::StaticFriction(const VectorXd& q, const VectorXd& q_start, 
   full.setZero(c_.size());
   auto cables = [&](const auto& elements, auto dim) {
     constexpr int D = decltype(dim)::value, kN = 4 * D, kN2 = kN * kN;
-    if (!seabed_->has_friction()) return;
+    const ElementTerm* term = nullptr;
+    for (const auto& t : element_terms_)
+      if (t->has_static_friction()) term = t.get();
+    if (term == nullptr) return;
     typename AncfCableElement<D>::Coords fe;
     typename AncfCableElement<D>::Matrix me;
     double* values = matrix ? matrix->values() : nullptr;
@@ -456,7 +465,7 @@ void MultibodyModel::StaticFriction(const VectorXd& q, const VectorXd& q_start, 
       const ElementData<D>& e = elements[k];
       fe.setZero();
       if (matrix) me.setZero();
-      seabed_->AddStaticFriction<D>(q.segment<kN>(e.first_coord),
+      term->AddStaticFriction(q.segment<kN>(e.first_coord),
                                               q_start.segment<kN>(e.first_coord),
                                               e.element.length(), &fe, matrix ? &me : nullptr);
       full.segment<kN>(e.first_coord) += fe;

@@ -276,7 +276,7 @@ class MultibodyModel {
 
   // The scene's seabed (engine/forces/seabed.h), or null: a scene without
   // one holds no seabed object, and its force loops only test this.
-  const Seabed* seabed() const { return seabed_ ? &*seabed_ : nullptr; }
+  const Seabed* seabed() const { return cable_seabed_ ? &cable_seabed_->bed() : nullptr; }
 
   // Bodies with seabed contact points (BodySpec::contact_points_m): their
   // count. A scene without any holds none and its loops only test this.
@@ -293,7 +293,7 @@ class MultibodyModel {
   void StaticFriction(const Eigen::VectorXd& q, const Eigen::VectorXd& q_start,
                         Eigen::VectorXd* f, SkylineLdlt* matrix, double scale);
   // Whether frames carry energy.contact (a seabed or sheaves).
-  bool has_contact() const { return seabed_.has_value() || !sheaves_.empty(); }
+  bool has_contact() const { return has_element_contact_ || !sheaves_.empty(); }
 
   // The scene's sheaves (engine/forces/sheave.h), none in most scenes.
   const std::vector<Sheave>& sheaves() const { return sheaves_; }
@@ -330,6 +330,10 @@ class MultibodyModel {
   // in the order the model sums them.
   const std::vector<std::unique_ptr<ForceContributor>>& contributors() const {
     return contributors_;
+  }
+  // The per-element force terms the scene uses (ElementTerm).
+  const std::vector<std::unique_ptr<ElementTerm>>& element_terms() const {
+    return element_terms_;
   }
   // The contributor called `name`, or null.
   const ForceContributor* FindContributor(std::string_view name) const;
@@ -533,7 +537,12 @@ class MultibodyModel {
   double energy_roundoff_ = 0;
   bool has_damping_ = false;
   Eigen::Vector3d current_ = Eigen::Vector3d::Zero();  // the fluid's [m/s]
-  std::optional<Seabed> seabed_;  // only in a scene with a seabed
+  // The per-element force terms the scene uses (ElementTerm; none in
+  // most scenes), summed in this order inside the element loops; whether
+  // any dissipates or stores contact energy; the cable seabed's typed view.
+  std::vector<std::unique_ptr<ElementTerm>> element_terms_;
+  bool element_terms_dissipate_ = false, has_element_contact_ = false;
+  const CableSeabed* cable_seabed_ = nullptr;
   // Scratch (full size) for StaticFriction (sized on first use).
   Eigen::VectorXd scratch_static_;
   // Sheaves, and per element the bit set of those that touch its cable
