@@ -685,8 +685,8 @@ void ModelBuilder::Probes() {
   for (size_t p = 0; p < scene_.probes.size(); ++p) {
     const Attachment& at = scene_.probes[p].at;
     bool found = false;
-    if (!m.motion_) break;
-    for (const PrescribedMotion::MovingRow& row : m.motion_->moving()) {
+    const std::vector<PrescribedMotion::MovingRow> none;
+    for (const PrescribedMotion::MovingRow& row : m.motion_ ? m.motion_->moving() : none) {
       const JointSpec& joint = scene_.joints[row.joint];
       const Attachment& held = joint.a.IsGround() ? joint.b : joint.a;
       const bool same = at.cable >= 0 ? held.cable == at.cable && mesh_.Node(held) == mesh_.Node(at)
