@@ -66,6 +66,18 @@ inline LinearVector Add(const LinearVector& a, const LinearVector& b, double sb 
   return r;
 }
 
+// The constant vector v.
+inline LinearVector Constant(const Eigen::Vector3d& v) {
+  return {LinearForm::Constant(v.x()), LinearForm::Constant(v.y()), LinearForm::Constant(v.z())};
+}
+
+// sum s_k v_k.
+inline LinearVector Combination(const std::vector<std::pair<double, LinearVector>>& terms) {
+  LinearVector r;
+  for (const auto& [s, v] : terms) r = Add(r, v, s);
+  return r;
+}
+
 struct QuadraticForm {
   double c = 0;
   std::map<int, double> linear;

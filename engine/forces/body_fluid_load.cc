@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <utility>
+
+#include "engine/linear/rounding.h"
 
 namespace cablesim {
 
@@ -108,6 +111,81 @@ Vector3d BodyFluidLoad::DynamicForce(const VectorXd& q, const VectorXd& qdot, do
   }
   if (dim_ == 2) force.z() = 0;
   return force;
+}
+
+void BodyFluidForces::AddAppliedLoad(const ForceState& s, ForceOutput* out) const {
+  for (const BodyFluidLoad& b : loads_) {
+    Matrix3d k = Matrix3d::Zero();
+    b.AddHydrostatic(*s.q, s.load_factor, out->full, out->matrix ? &k : nullptr);
+    if (out->matrix) out->map.ScatterBlock(b.coord(), k, out->scale, out->matrix);
+  }
+}
+
+void BodyFluidForces::AddDissipative(const ForceState& s, ForceOutput* out) const {
+  const bool waves = s.waves != nullptr;
+  const int dim = out->map.dim;
+  for (const BodyFluidLoad& b : loads_) {
+    if (!b.dynamic(waves)) continue;
+    Matrix3d c;
+    const Vector3d force = b.DynamicForce(*s.q, *s.qdot, s.time, s.waves,
+                                          out->matrix ? &c : nullptr);
+    for (int d = 0; d < dim; ++d) {
+      (*out->full)(b.coord() + d) += force(d);
+      if (out->roundoff) (*out->roundoff)(b.coord() + d) += kSumRounding * std::abs(force(d));
+    }
+    out->size = std::max(out->size, force.lpNorm<Eigen::Infinity>());
+    if (out->matrix) out->map.ScatterBlock(b.coord(), c, out->scale, out->matrix);
+  }
+}
+
+double BodyFluidForces::StoredEnergy(const ForceState& s) const {
+  double energy = 0;
+  for (const BodyFluidLoad& b : loads_) energy += b.HydrostaticEnergy(*s.q, s.load_factor);
+  return energy;
+}
+
+void BodyFluidForces::AddDissipatedPower(const ForceState& s, double* power) const {
+  for (const BodyFluidLoad& b : loads_) {
+    if (!b.dynamic(s.waves != nullptr)) continue;
+    const Vector3d force = b.DynamicForce(*s.q, *s.qdot, s.time, s.waves, nullptr);
+    for (int d = 0; d < b.dim(); ++d) *power -= force(d) * (*s.qdot)(b.coord() + d);
+  }
+}
+
+bool BodyFluidForces::dynamic(bool has_waves) const {
+  for (const BodyFluidLoad& b : loads_)
+    if (b.dynamic(has_waves)) return true;
+  return false;
+}
+
+std::unique_ptr<BodyFluidForces> MakeBodyFluidForces(const Scene& scene,
+                                                     const std::vector<int>& body_coord, int dim,
+                                                     bool has_waves) {
+  // SceneFromProto requires a fluid and gravity with body hydrodynamics.
+  const FluidSpec& fluid = scene.fluid;
+  const double g = scene.gravity_m_s2.norm();
+  std::vector<BodyFluidLoad> loads;
+  for (size_t b = 0; b < scene.bodies.size(); ++b) {
+    const BodySpec& body = scene.bodies[b];
+    if (!body.has_hydrodynamics || !(fluid.density_kg_m3 > 0) || !(g > 0)) continue;
+    BodyFluidLoad::Params p;
+    p.density_kg_m3 = fluid.density_kg_m3;
+    p.g_m_s2 = g;
+    p.up = -scene.gravity_m_s2 / g;
+    p.still_level_m = fluid.still_water_level_m;
+    p.diameter_m = body.hydro_diameter_m;
+    p.height_m = body.hydro_height_m;
+    p.drag = body.hydro_drag;
+    p.heave_drag = body.hydro_heave_drag;
+    p.added_mass = body.hydro_added_mass;
+    p.heave_added_mass = body.hydro_heave_added_mass;
+    p.current_m_s = fluid.current_m_s;
+    loads.emplace_back(p, body_coord[b], dim);
+  }
+  if (loads.empty()) return nullptr;
+  auto forces = std::make_unique<BodyFluidForces>(std::move(loads));
+  forces->set_dissipates(forces->dynamic(has_waves));
+  return forces;
 }
 
 }  // namespace cablesim

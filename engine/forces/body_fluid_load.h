@@ -72,9 +72,15 @@
 //
 // Units SI. Allocates nothing.
 
+#include <memory>
+#include <string_view>
+#include <vector>
+
 #include <Eigen/Core>
 
+#include "engine/forces/force_contributor.h"
 #include "engine/forces/waves.h"
+#include "engine/scene/scene.h"
 
 namespace cablesim {
 
@@ -95,6 +101,7 @@ class BodyFluidLoad {
   BodyFluidLoad(const Params& p, int coord, int dim);
 
   int coord() const { return coord_; }
+  int dim() const { return dim_; }
   double waterplane_area() const { return area_; }
 
   // The submerged length s(z) [m] at the centre's height z above a level.
@@ -127,6 +134,39 @@ class BodyFluidLoad {
   double area_ = 0;
   Eigen::Vector3d up_ = Eigen::Vector3d::UnitZ();  // zero beyond dim
 };
+
+// Every fluid-loaded body of a scene as one ForceContributor: F_s as an
+// applied load (scaled with gravity by the load factor; U_s in the loads'
+// energy), F_d + F_i + F_w as the dissipative part (its power in the
+// damping power).
+class BodyFluidForces : public ForceContributor {
+ public:
+  explicit BodyFluidForces(std::vector<BodyFluidLoad> loads) : loads_(std::move(loads)) {}
+
+  const std::vector<BodyFluidLoad>& loads() const { return loads_; }
+
+  std::string_view name() const override { return "body_fluid"; }
+  void AddAppliedLoad(const ForceState& s, ForceOutput* out) const override;
+  void AddDissipative(const ForceState& s, ForceOutput* out) const override;
+  double StoredEnergy(const ForceState& s) const override;
+  void AddDissipatedPower(const ForceState& s, double* power) const override;
+  // Whether any body's DynamicForce can be nonzero (`has_waves`: the scene
+  // has waves).
+  bool dynamic(bool has_waves) const;
+  bool dissipates() const override { return dissipates_; }
+  void set_dissipates(bool d) { dissipates_ = d; }
+
+ private:
+  std::vector<BodyFluidLoad> loads_;
+  bool dissipates_ = false;
+};
+
+// The contributor for the scene's bodies with hydrodynamics (in a fluid,
+// under gravity), or null when none has any. `body_coord[b]`: body b's
+// first full coordinate; `has_waves`: the model built a wave field.
+std::unique_ptr<BodyFluidForces> MakeBodyFluidForces(const Scene& scene,
+                                                     const std::vector<int>& body_coord, int dim,
+                                                     bool has_waves);
 
 }  // namespace cablesim
 

@@ -534,4 +534,48 @@ CABLESIM_SEABED_INSTANTIATE(2)
 CABLESIM_SEABED_INSTANTIATE(3)
 #undef CABLESIM_SEABED_INSTANTIATE
 
+double CableSeabed::AddPotential(const ElementCoords<2>& e, double length,
+                                 ElementCoords<2>* gradient, ElementMatrix<2>* hessian,
+                                 ElementCoords<2>* roundoff) const {
+  return bed_.AddPotential<2>(e, length, gradient, hessian, roundoff);
+}
+
+double CableSeabed::AddPotential(const ElementCoords<3>& e, double length,
+                                 ElementCoords<3>* gradient, ElementMatrix<3>* hessian,
+                                 ElementCoords<3>* roundoff) const {
+  return bed_.AddPotential<3>(e, length, gradient, hessian, roundoff);
+}
+
+double CableSeabed::Energy(const ElementCoords<2>& e, double length) const {
+  return bed_.Energy<2>(e, length);
+}
+
+double CableSeabed::Energy(const ElementCoords<3>& e, double length) const {
+  return bed_.Energy<3>(e, length);
+}
+
+double CableSeabed::AddDissipation(const ElementCoords<2>& e, const ElementCoords<2>& edot,
+                                   double length, ElementCoords<2>* force,
+                                   ElementMatrix<2>* c) const {
+  return bed_.AddDissipation<2>(e, edot, length, force, c);
+}
+
+double CableSeabed::AddDissipation(const ElementCoords<3>& e, const ElementCoords<3>& edot,
+                                   double length, ElementCoords<3>* force,
+                                   ElementMatrix<3>* c) const {
+  return bed_.AddDissipation<3>(e, edot, length, force, c);
+}
+
+void CableSeabed::AddStaticFriction(const ElementCoords<2>& e, const ElementCoords<2>& e0,
+                                    double length, ElementCoords<2>* force,
+                                    ElementMatrix<2>* matrix) const {
+  bed_.AddStaticFriction<2>(e, e0, length, force, matrix);
+}
+
+void CableSeabed::AddStaticFriction(const ElementCoords<3>& e, const ElementCoords<3>& e0,
+                                    double length, ElementCoords<3>* force,
+                                    ElementMatrix<3>* matrix) const {
+  bed_.AddStaticFriction<3>(e, e0, length, force, matrix);
+}
+
 }  // namespace cablesim

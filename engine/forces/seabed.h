@@ -131,9 +131,13 @@
 // Units SI. Used by MultibodyModel only when the scene has a seabed; the
 // plane's loops only test whether a grid is present.
 
+#include <memory>
 #include <optional>
+#include <string_view>
 
 #include <Eigen/Core>
+
+#include "engine/forces/force_contributor.h"
 
 #include "engine/forces/bathymetry_grid.h"
 #include "engine/scene/scene.h"
@@ -266,6 +270,41 @@ class Seabed {
   double k_ = 0, c_ = 0, mu_a_ = 0, mu_t_ = 0, v_s_ = 1e-3, u_s_ = 1e-5;
   std::optional<BathymetryGrid> grid_;  // only with a bathymetry grid
 };
+
+// The seabed under the scene's cables as an ElementTerm: the bed's energy
+// and force (energy.contact), its damping and friction, its static friction.
+class CableSeabed : public ElementTerm {
+ public:
+  explicit CableSeabed(const SeabedSpec& spec) : bed_(spec) {}
+  const Seabed& bed() const { return bed_; }
+
+  std::string_view name() const override { return "cable_seabed"; }
+  double AddPotential(const ElementCoords<2>& e, double length, ElementCoords<2>* gradient,
+                      ElementMatrix<2>* hessian, ElementCoords<2>* roundoff) const override;
+  double AddPotential(const ElementCoords<3>& e, double length, ElementCoords<3>* gradient,
+                      ElementMatrix<3>* hessian, ElementCoords<3>* roundoff) const override;
+  double Energy(const ElementCoords<2>& e, double length) const override;
+  double Energy(const ElementCoords<3>& e, double length) const override;
+  bool dissipates() const override { return bed_.dissipates(); }
+  double AddDissipation(const ElementCoords<2>& e, const ElementCoords<2>& edot, double length,
+                        ElementCoords<2>* force, ElementMatrix<2>* c) const override;
+  double AddDissipation(const ElementCoords<3>& e, const ElementCoords<3>& edot, double length,
+                        ElementCoords<3>* force, ElementMatrix<3>* c) const override;
+  bool has_static_friction() const override { return bed_.has_friction(); }
+  void AddStaticFriction(const ElementCoords<2>& e, const ElementCoords<2>& e0, double length,
+                         ElementCoords<2>* force, ElementMatrix<2>* matrix) const override;
+  void AddStaticFriction(const ElementCoords<3>& e, const ElementCoords<3>& e0, double length,
+                         ElementCoords<3>* force, ElementMatrix<3>* matrix) const override;
+
+ private:
+  Seabed bed_;
+};
+
+// The term for the scene's seabed under its cables, or null without one.
+inline std::unique_ptr<CableSeabed> MakeCableSeabed(const Scene& scene) {
+  if (!scene.seabed.enabled) return nullptr;
+  return std::make_unique<CableSeabed>(scene.seabed);
+}
 
 }  // namespace cablesim
 

@@ -5,6 +5,9 @@
 #include <limits>
 #include <utility>
 
+#include "absl/status/status.h"
+#include "absl/strings/str_format.h"
+
 namespace cablesim {
 namespace {
 constexpr double kEps = std::numeric_limits<double>::epsilon();
@@ -179,6 +182,83 @@ double SlidingJoint::Gap(const VectorXd& q) const {
   Shape sh;
   ShapeAt(s_, &sh);
   return (Interpolate(q, sh, sh.n) - Point(q)).norm();
+}
+
+void AddLocalTerms(const SlidingJoint::Local& local, ForceOutput* out) {
+  for (int k = 0; k < local.n; ++k) {
+    (*out->full)(local.coord[k]) += local.force(k);
+    if (out->roundoff)
+      (*out->roundoff)(local.coord[k]) += kEps * std::abs(local.force(k)) + local.rounding;
+  }
+  if (out->matrix)
+    out->map.Scatter(local.coord.data(), local.n, local.matrix.data(),
+                     static_cast<int>(local.matrix.rows()), out->scale, out->matrix);
+}
+
+void SlidingJoints::AddConservative(const ForceState& s, ForceOutput* out) const {
+  for (const SlidingJoint& slider : sliders_) {
+    SlidingJoint::Local local;
+    slider.Penalty(*s.q, &local, out->matrix != nullptr);
+    AddLocalTerms(local, out);
+    out->size = std::max(out->size, local.force.lpNorm<Eigen::Infinity>());
+  }
+}
+
+void SlidingJoints::AddDissipative(const ForceState& s, ForceOutput* out) const {
+  for (const SlidingJoint& slider : sliders_) {
+    if (!slider.has_friction()) continue;
+    SlidingJoint::Local local;
+    slider.Friction(*s.q, *s.qdot, &local, out->matrix != nullptr);
+    AddLocalTerms(local, out);
+    out->size = std::max(out->size, local.force.lpNorm<Eigen::Infinity>());
+  }
+}
+
+double SlidingJoints::StoredEnergy(const ForceState& s) const {
+  double energy = 0;
+  for (const SlidingJoint& slider : sliders_) energy += slider.Penalty(*s.q, nullptr, false);
+  return energy;
+}
+
+void SlidingJoints::AddDissipatedPower(const ForceState& s, double* power) const {
+  for (const SlidingJoint& slider : sliders_)
+    if (slider.has_friction()) *power += slider.Friction(*s.q, *s.qdot, nullptr, false);
+}
+
+bool SlidingJoints::dissipates() const {
+  for (const SlidingJoint& slider : sliders_)
+    if (slider.has_friction()) return true;
+  return false;
+}
+
+absl::StatusOr<std::unique_ptr<SlidingJoints>> MakeSlidingJoints(
+    const Scene& scene, const std::vector<std::vector<SlidingJoint::Segment>>& segments,
+    const std::vector<int>& body_coord, int dim, int body_stride, const VectorXd& q0) {
+  std::vector<SlidingJoint> sliders;
+  for (int ji = 0; ji < static_cast<int>(scene.joints.size()); ++ji) {
+    const JointSpec& joint = scene.joints[ji];
+    if (joint.type != JointType::kSlide) continue;
+    const Attachment& on_cable = joint.a.cable >= 0 ? joint.a : joint.b;
+    const Attachment& on_body = joint.a.body >= 0 ? joint.a : joint.b;
+    const int cable = on_cable.cable;
+    const CableSpec& spec = scene.cables[cable];
+    // Default stiffness: the axial stiffness EA / l_e of one element.
+    double k = joint.slide.stiffness_n_m;
+    if (k == 0) k = spec.youngs_modulus_pa * spec.area_m2 * spec.elements / spec.length_m;
+    SlidingJoint slider(dim, segments[cable], body_coord[on_body.body], body_stride,
+                        on_body.point_body_m, k, joint.slide.friction,
+                        joint.slide.stick_velocity_m_s, on_cable.s_m);
+    const double gap = slider.Gap(q0);
+    if (gap > 1e-6) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "joints[%d]: the body point is %.6g m from the cable at t = 0 (a sliding joint starts "
+          "on its cable)",
+          ji, gap));
+    }
+    sliders.push_back(std::move(slider));
+  }
+  if (sliders.empty()) return nullptr;
+  return std::make_unique<SlidingJoints>(std::move(sliders));
 }
 
 }  // namespace cablesim

@@ -52,9 +52,15 @@
 // dissipates mu N tanh(v_t / v_s) v_t >= 0 [W].
 
 #include <array>
+#include <memory>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
+
+#include "absl/status/statusor.h"
+#include "engine/forces/force_contributor.h"
+#include "engine/scene/scene.h"
 
 namespace cablesim {
 
@@ -133,6 +139,39 @@ class SlidingJoint {
   mutable double s_;
   mutable int seg_ = 0;
 };
+
+// Every sliding joint of a scene as one ForceContributor: the penalty as
+// the conservative part (its energy with the loads'), friction as the
+// dissipative part.
+class SlidingJoints : public ForceContributor {
+ public:
+  explicit SlidingJoints(std::vector<SlidingJoint> sliders) : sliders_(std::move(sliders)) {}
+
+  int count() const { return static_cast<int>(sliders_.size()); }
+  const SlidingJoint& slider(int i) const { return sliders_[i]; }
+
+  std::string_view name() const override { return "sliding_joints"; }
+  void AddConservative(const ForceState& s, ForceOutput* out) const override;
+  void AddDissipative(const ForceState& s, ForceOutput* out) const override;
+  double StoredEnergy(const ForceState& s) const override;
+  void AddDissipatedPower(const ForceState& s, double* power) const override;
+  bool dissipates() const override;
+
+ private:
+  std::vector<SlidingJoint> sliders_;
+};
+
+// Adds a slider's local terms (force, its rounding, scale times its
+// matrix when out->matrix) to `out`, and raises out->size.
+void AddLocalTerms(const SlidingJoint::Local& local, ForceOutput* out);
+
+// The contributor for the scene's SLIDE joints, or null without any.
+// `segments[c]`: cable c's elements in order; `body_coord[b]`: body b's
+// first full coordinate; `q0` the full configuration at t = 0, where each
+// body point must lie on its cable (InvalidArgument naming the joint).
+absl::StatusOr<std::unique_ptr<SlidingJoints>> MakeSlidingJoints(
+    const Scene& scene, const std::vector<std::vector<SlidingJoint::Segment>>& segments,
+    const std::vector<int>& body_coord, int dim, int body_stride, const Eigen::VectorXd& q0);
 
 }  // namespace cablesim
 

@@ -38,16 +38,6 @@ Eigen::Matrix3d BodyFrame(const Vector3d& axis) {
   return r;
 }
 
-LinearVector Constant(const Vector3d& v) {
-  return {LinearForm::Constant(v.x()), LinearForm::Constant(v.y()), LinearForm::Constant(v.z())};
-}
-
-LinearVector Combination(const std::vector<std::pair<double, LinearVector>>& terms) {
-  LinearVector r;
-  for (const auto& [s, v] : terms) r = Add(r, v, s);
-  return r;
-}
-
 }  // namespace
 
 int ModelBuilder::Mesh::Node(const Attachment& at) const {
@@ -264,9 +254,6 @@ absl::Status ModelBuilder::InitialCoordinates() {
     MultibodyModel::BodyData data;
     data.coord = i;
     data.mass = body.mass_kg;
-    data.linear_damping = body.linear_damping_n_s_m;
-    data.angular_damping = body.angular_damping_n_m_s;
-    if (data.linear_damping != 0 || data.angular_damping != 0) model_.has_damping_ = true;
     const Vector3d& inertia = body.inertia_kg_m2;
     if (D == 2) {
       q0_.segment<2>(i + 2) = frame0_[b].col(0).head<2>();
@@ -343,219 +330,6 @@ Vector3d ModelBuilder::AtStart(const LinearVector& v) const {
   return Vector3d(v[0].Evaluate(q0_), v[1].Evaluate(q0_), v[2].Evaluate(q0_));
 }
 
-absl::Status ModelBuilder::Joints() {
-  const int D = model_.dim_, bs = model_.body_stride_;
-  const int num_nodes = model_.num_nodes_;
-  elimination_.grounded.assign(q0_.size(), false);
-  elimination_.clamp_dir.assign(num_nodes, Vector3d::Zero());
-  elimination_.clamped.assign(num_nodes, false);
-  std::vector<bool>& grounded = elimination_.grounded;
-  pending_.clear();
-  for (int ji = 0; ji < static_cast<int>(scene_.joints.size()); ++ji) {
-    const JointSpec& joint = scene_.joints[ji];
-    if (joint.type == JointType::kSlide) {
-      // A force (Sliders), not rows: one side a body, the other a cable.
-      if (!((joint.a.body >= 0 && joint.b.cable >= 0) ||
-            (joint.b.body >= 0 && joint.a.cable >= 0))) {
-        return absl::InvalidArgumentError(absl::StrCat(
-            "joints[", ji, "].type: SLIDE joins a body (one side) to a cable (the other)"));
-      }
-      continue;
-    }
-    Attachment a = joint.a, b = joint.b;
-    if (a.IsGround()) std::swap(a, b);
-    if (a.IsGround()) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("joints[", ji, "].a: a joint needs a cable or a body on one side"));
-    }
-    const bool fixed = joint.type == JointType::kFixed;
-    if (b.IsGround() && (joint.HasMotion() || joint.HasRotation())) {
-      // A moving support: its point stays as rows (below); FIXED keeps the
-      // orientation by elimination, as a fixed support does, or, when the
-      // support turns, by rows whose normals turn with it.
-      if (joint.HasRotation()) {
-        AddTurningRows(ji, a);
-      } else if (fixed && a.cable >= 0) {
-        const int node = mesh_.Node(a);
-        elimination_.clamped[node] = true;
-        elimination_.clamp_dir[node] = AtStart(NodeSlope(node)).normalized();
-      } else if (fixed) {
-        const int i = BodyCoord(a.body);
-        for (int k = D; k < bs; ++k) grounded[i + k] = true;
-      }
-      const LinearVector pa = PointOf(a);
-      const Vector3d p0 = AtStart(pa);
-      for (int d = 0; d < D; ++d) {
-        LinearForm diff = pa[d];
-        diff.c -= p0(d);
-        PendingRow row{QuadraticForm::FromLinear(diff), Row::kPosition, ji, -1};
-        row.motion_axis = d;
-        pending_.push_back(row);
-      }
-      continue;
-    }
-    if (b.IsGround()) {
-      if (a.cable >= 0) {
-        const int node = mesh_.Node(a);
-        for (int d = 0; d < D; ++d) grounded[NodeCoord(node) + d] = true;
-        if (fixed) {
-          elimination_.clamped[node] = true;
-          elimination_.clamp_dir[node] = AtStart(NodeSlope(node)).normalized();
-        }
-        continue;
-      }
-      const int i = BodyCoord(a.body);
-      if (fixed) {
-        for (int k = 0; k < bs; ++k) grounded[i + k] = true;
-        continue;
-      }
-      if (a.point_body_m.norm() == 0) {
-        for (int d = 0; d < D; ++d) grounded[i + d] = true;
-        continue;
-      }
-    }
-    // Points coincide: D rows.
-    const LinearVector pa = PointOf(a);
-    const LinearVector pb = b.IsGround() ? Constant(AtStart(pa)) : PointOf(b);
-    for (int d = 0; d < D; ++d) {
-      LinearForm diff = pa[d];
-      diff += pb[d].Scaled(-1);
-      pending_.push_back({QuadraticForm::FromLinear(diff), Row::kPosition, ji, -1});
-    }
-    if (!fixed || b.IsGround()) continue;
-    if (absl::Status s = AddOrientationRows(ji, a, b); !s.ok()) return s;
-  }
-  // Each body's axes stay unit and orthogonal.
-  for (int b = 0; b < static_cast<int>(scene_.bodies.size()); ++b) {
-    const auto e = BodyAxes(b);
-    const int axes = D == 2 ? 1 : 3;
-    for (int k = 0; k < axes; ++k) {
-      QuadraticForm f = Dot(e[k], e[k], D);
-      f.c -= 1;
-      pending_.push_back({f, Row::kAxes, -1, b});
-    }
-    for (int k = 0; k < axes; ++k)
-      for (int l = k + 1; l < axes; ++l)
-        pending_.push_back({Dot(e[k], e[l], D), Row::kAxes, -1, b});
-  }
-  return absl::OkStatus();
-}
-
-void ModelBuilder::AddTurningRows(int ji, Attachment a) {
-  const int D = model_.dim_;
-  // One row n . x = 0 per pair (x, n) of a held direction x and a normal
-  // n of its initial direction: a clamped slope r_x keeps n . r_x = 0 for
-  // the D - 1 normals of d0 (its length, the stretch, stays free); a body
-  // keeps u . v0 = 0 (planar) or u . v0 = u . w0 = v . w0 = 0 (spatial),
-  // which with its unit and orthogonality rows fix its axes to R(t) e0.
-  auto add = [&](int coord, const Vector3d& n0) {
-    LinearForm f;
-    for (int d = 0; d < D; ++d) f.terms[coord + d] = 1;  // placeholders
-    PendingRow row{QuadraticForm::FromLinear(f), Row::kDirection, ji, -1};
-    row.turn_coord = coord;
-    row.turn_n0 = n0;
-    pending_.push_back(row);
-  };
-  auto at_start = [&](int coord) {
-    Vector3d x = Vector3d::Zero();
-    x.head(D) = q0_.segment(coord, D);
-    return x;
-  };
-  if (a.cable >= 0) {
-    const int slope = NodeCoord(mesh_.Node(a)) + D;
-    const Vector3d d0 = at_start(slope).normalized();
-    if (D == 2) {
-      add(slope, Vector3d(-d0.y(), d0.x(), 0));
-    } else {
-      const Vector3d n1 = d0.unitOrthogonal();
-      add(slope, n1);
-      add(slope, d0.cross(n1));
-    }
-    return;
-  }
-  const int c = BodyCoord(a.body);
-  if (D == 2) {
-    add(c + 2, Vector3d(-q0_(c + 3), q0_(c + 2), 0));
-  } else {
-    add(c + 3, at_start(c + 6));
-    add(c + 3, at_start(c + 9));
-    add(c + 6, at_start(c + 9));
-  }
-}
-
-absl::Status ModelBuilder::AddOrientationRows(int ji, Attachment a, Attachment b) {
-  const int D = model_.dim_;
-  if (a.cable < 0 && b.cable >= 0) std::swap(a, b);  // a node first
-  if (a.cable >= 0 && b.cable >= 0) {
-    // Two cables welded end to end: the slopes stay equal, r_x,b = c r_x,a
-    // with c = |r_x,b| / |r_x,a| at t = 0 (1 for a cable split at the
-    // joint): D linear rows, of full rank in every configuration. (Rows
-    // (r_x,a x r_x,b) . m with fixed m lose rank once the tangent turns
-    // onto m.) The stretch on both sides is thereby tied; that is exact for
-    // a uniform cable without a point load at the joint.
-    const LinearVector ta = NodeSlope(mesh_.Node(a)), tb = NodeSlope(mesh_.Node(b));
-    const Vector3d t0a = AtStart(ta), t0b = AtStart(tb);
-    const double sine = t0a.cross(t0b).norm() / (t0a.norm() * t0b.norm());
-    if (!(sine <= 1e-6) || t0a.dot(t0b) <= 0) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "joints[%d]: FIXED between two cables needs their tangents parallel and in the same "
-          "sense at t = 0 (sine of the angle between them: %.6g)",
-          ji, sine));
-    }
-    const double ratio = t0b.norm() / t0a.norm();
-    for (int d = 0; d < D; ++d) {
-      LinearForm diff = tb[d];
-      diff += ta[d].Scaled(-ratio);
-      pending_.push_back({QuadraticForm::FromLinear(diff), Row::kSlope, ji, -1});
-    }
-  } else if (a.cable >= 0) {
-    // A cable tangent along the body's x axis: t . e2 = 0 (and t . e3 = 0).
-    const LinearVector t = NodeSlope(mesh_.Node(a));
-    pending_.push_back({Dot(t, BodyAxis(b.body, 1), D), Row::kDirection, ji, -1});
-    if (D == 3) pending_.push_back({Dot(t, BodyAxis(b.body, 2), D), Row::kDirection, ji, -1});
-  } else {
-    // Two bodies welded: with B0 = A0 R0 at t = 0, b's axes must stay
-    // A R0: e2_b . u_hat = 0, e3_b . u_hat = 0, e3_b . v_hat = 0 where
-    // u_hat, v_hat are A R0 e_x, A R0 e_y (planar: the first only).
-    const Eigen::Matrix3d r0 = frame0_[a.body].transpose() * frame0_[b.body];
-    const auto ea = BodyAxes(a.body);
-    const LinearVector u_hat =
-        Combination({{r0(0, 0), ea[0]}, {r0(1, 0), ea[1]}, {r0(2, 0), ea[2]}});
-    const LinearVector v_hat =
-        Combination({{r0(0, 1), ea[0]}, {r0(1, 1), ea[1]}, {r0(2, 1), ea[2]}});
-    pending_.push_back({Dot(BodyAxis(b.body, 1), u_hat, D), Row::kDirection, ji, -1});
-    if (D == 3) {
-      pending_.push_back({Dot(BodyAxis(b.body, 2), u_hat, D), Row::kDirection, ji, -1});
-      pending_.push_back({Dot(BodyAxis(b.body, 2), v_hat, D), Row::kDirection, ji, -1});
-    }
-  }
-  return absl::OkStatus();
-}
-
-absl::Status ModelBuilder::CheckJointsAtStart() const {
-  std::vector<double> gap2(scene_.joints.size(), 0.0);
-  for (const PendingRow& r : pending_) {
-    const double v = r.f.Evaluate(q0_);
-    if (r.kind == Row::kPosition) gap2[r.joint] += v * v;
-    // (A turning support's rows hold at t = 0 by construction; f holds
-    // placeholders until SetTime writes n(0).)
-    if (r.kind == Row::kDirection && r.turn_coord < 0 && std::abs(v) > 1e-6) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "joints[%d]: FIXED needs the cable tangent parallel to the other side's axis at "
-          "t = 0 (sine of the angle between them: %.6g)",
-          r.joint, v));
-    }
-  }
-  for (size_t j = 0; j < gap2.size(); ++j) {
-    if (std::sqrt(gap2[j]) > 1e-6) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "joints[%d]: its two points are %.6g m apart at t = 0 (they must coincide)",
-          static_cast<int>(j), std::sqrt(gap2[j])));
-    }
-  }
-  return absl::OkStatus();
-}
-
 void ModelBuilder::OrderUnknowns() {
   MultibodyModel& m = model_;
   const int D = m.dim_, bs = m.body_stride_, ncoord = static_cast<int>(q0_.size());
@@ -628,54 +402,13 @@ void ModelBuilder::OrderUnknowns() {
   m.v0_ = m.Reduce(qd0);
 }
 
-void ModelBuilder::KeepMovableRows() {
-  MultibodyModel& m = model_;
-  // A row that no unknown can change (both sides held by ground, say a
-  // pinned node and a body pinned at its centre of mass, or the axes of a
-  // welded body) is satisfied by construction, as far as
-  // CheckJointsAtStart allows, and could never be corrected.
-  // The test is the row's gradient on z at t = 0 (the rows are linear or
-  // bilinear, so a row with a zero reduced gradient there is one that the
-  // elimination has made constant, e.g. a clamped node welded to a body
-  // welded to ground).
-  for (const PendingRow& r : pending_) {
-    VectorXd grad = VectorXd::Zero(m.dofs_);
-    for (const auto& [i, v] : r.f.linear)
-      if (m.j_[i] >= 0) grad(m.j_[i]) += v * m.s_(i);
-    for (const auto& [ij, v] : r.f.quadratic) {
-      if (m.j_[ij.first] >= 0) grad(m.j_[ij.first]) += v * m.s_(ij.first) * q0_(ij.second);
-      if (m.j_[ij.second] >= 0) grad(m.j_[ij.second]) += v * m.s_(ij.second) * q0_(ij.first);
-    }
-    if (grad.lpNorm<Eigen::Infinity>() <= 1e-12) continue;
-    m.AddRow(r.f, r.kind, r.joint, r.body);
-    if (r.motion_axis >= 0) {
-      MultibodyModel::MovingRow moving;
-      moving.row = static_cast<int>(m.rows_.size()) - 1;
-      moving.joint = r.joint;
-      moving.axis = r.motion_axis;
-      moving.c0 = r.f.c;
-      moving.motion = scene_.joints[r.joint].motion[r.motion_axis];
-      m.moving_rows_.push_back(moving);
-    }
-    if (r.turn_coord >= 0) {
-      MultibodyModel::TurningRow turning;
-      turning.row = static_cast<int>(m.rows_.size()) - 1;
-      turning.coord = r.turn_coord;
-      turning.n0 = r.turn_n0;
-      turning.axis = scene_.joints[r.joint].rotation_axis;
-      turning.angle = scene_.joints[r.joint].rotation;
-      m.turning_rows_.push_back(turning);
-    }
-  }
-}
-
 absl::Status ModelBuilder::CheckIntegratorFits() const {
   if (!TraitsOf(scene_.solver.integrator).is_explicit || scene_.solver.analysis != Analysis::kDynamic)
     return absl::OkStatus();
   const std::string name(IntegratorName(scene_.solver.integrator));
   const MultibodyModel& m = model_;
-  if (!m.rows_.empty()) {
-    const MultibodyModel::Row& r = m.rows_.front();
+  if (m.joint_rows_->size() > 0) {
+    const JointRows::Row& r = m.joint_rows_->row(0);
     const std::string what = r.joint >= 0
                                  ? absl::StrFormat("joints[%d] is kept as constraint rows", r.joint)
                                  : absl::StrFormat("bodies[%d] has its axes' constraint rows", r.body);
@@ -691,21 +424,6 @@ absl::Status ModelBuilder::CheckIntegratorFits() const {
           "solver.integrator: %s does not take winches (cables[%d].winch): it "
           "factors the mass matrix once; use HHT, GENERALIZED_ALPHA or IMPLICIT_EULER",
           name, c));
-    }
-  }
-  return absl::OkStatus();
-}
-
-absl::Status ModelBuilder::CheckMovingRows() const {
-  std::vector<int> kept(scene_.joints.size(), 0), wanted(scene_.joints.size(), 0);
-  for (const PendingRow& r : pending_)
-    if (r.motion_axis >= 0) ++wanted[r.joint];
-  for (const MultibodyModel::MovingRow& m : model_.moving_rows_) ++kept[m.joint];
-  for (size_t j = 0; j < kept.size(); ++j) {
-    if (kept[j] != wanted[j]) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "joints[%d].motion: the point it moves is also held by a fixed joint to ground",
-          static_cast<int>(j)));
     }
   }
   return absl::OkStatus();
@@ -781,46 +499,13 @@ void ModelBuilder::BuildElements() {
                        j.components, j.seed);
     model_.wave_load_.emplace(std::move(field), fluid.current_m_s);
   }
-  // The fluid's loads on bodies that ask for them (SceneFromProto requires
-  // a fluid and gravity with them).
-  for (int b = 0; b < static_cast<int>(scene_.bodies.size()); ++b) {
-    const BodySpec& body = scene_.bodies[b];
-    if (!body.has_hydrodynamics || !(fluid.density_kg_m3 > 0) || !(g > 0)) continue;
-    BodyFluidLoad::Params p;
-    p.density_kg_m3 = fluid.density_kg_m3;
-    p.g_m_s2 = g;
-    p.up = -scene_.gravity_m_s2 / g;
-    p.still_level_m = fluid.still_water_level_m;
-    p.diameter_m = body.hydro_diameter_m;
-    p.height_m = body.hydro_height_m;
-    p.drag = body.hydro_drag;
-    p.heave_drag = body.hydro_heave_drag;
-    p.added_mass = body.hydro_added_mass;
-    p.heave_added_mass = body.hydro_heave_added_mass;
-    p.current_m_s = fluid.current_m_s;
-    const BodyFluidLoad& load = model_.body_fluid_.emplace_back(p, BodyCoord(b), model_.dim_);
-    MultibodyModel::BodyData& data = model_.bodies_[b];
-    data.added_mass = load.AddedMass(q0_);
-    data.has_added_mass = !data.added_mass.isZero(0);
-    if (load.dynamic(model_.wave_load_.has_value())) model_.has_damping_ = true;
+  if (auto bed = MakeCableSeabed(scene_)) {
+    model_.cable_seabed_ = bed.get();
+    model_.element_terms_.push_back(std::move(bed));
   }
-  if (scene_.seabed.enabled) {
-    model_.seabed_.emplace(scene_.seabed);
-    if (model_.seabed_->dissipates()) model_.has_damping_ = true;
-    // Bodies with contact points (SceneFromProto refuses them without a
-    // seabed).
-    for (int b = 0; b < static_cast<int>(scene_.bodies.size()); ++b) {
-      const BodySpec& body = scene_.bodies[b];
-      if (body.contact_points_m.empty()) continue;
-      MultibodyModel::BodyContact contact;
-      contact.coord = BodyCoord(b);
-      contact.points = body.contact_points_m;
-      contact.k = body.contact_stiffness_n_m;
-      contact.c = body.contact_damping_n_s_m;
-      contact.mu = body.contact_friction;
-      if (contact.c != 0 || contact.mu != 0) model_.has_damping_ = true;
-      model_.body_contacts_.push_back(std::move(contact));
-    }
+  for (const auto& t : model_.element_terms_) {
+    if (t->dissipates()) model_.element_terms_dissipate_ = model_.has_damping_ = true;
+    if (t->bucket() == EnergyBucket::kContact) model_.has_element_contact_ = true;
   }
   if (model_.dim_ == 2) {
     BuildElementsOf<2>(&model_.elements2_);
@@ -846,39 +531,63 @@ void ModelBuilder::BuildSheaves() {
   }
 }
 
-absl::Status ModelBuilder::Sliders() {
+absl::Status ModelBuilder::Contributors() {
   MultibodyModel& m = model_;
-  for (int ji = 0; ji < static_cast<int>(scene_.joints.size()); ++ji) {
-    const JointSpec& joint = scene_.joints[ji];
-    if (joint.type != JointType::kSlide) continue;
-    const Attachment& on_cable = joint.a.cable >= 0 ? joint.a : joint.b;
-    const Attachment& on_body = joint.a.body >= 0 ? joint.a : joint.b;
-    const int cable = on_cable.cable;
-    const CableSpec& spec = scene_.cables[cable];
-    std::vector<SlidingJoint::Segment> segments;
-    double s0 = 0;
-    for (int k = m.cable_element_begin_[cable]; k < m.cable_element_begin_[cable + 1]; ++k) {
-      const int first = m.dim_ == 2 ? m.elements2_[k].first_coord : m.elements3_[k].first_coord;
-      const double l =
-          m.dim_ == 2 ? m.elements2_[k].element.length() : m.elements3_[k].element.length();
-      segments.push_back({first, s0, l});
-      s0 += l;
+  std::vector<int> body_coord(scene_.bodies.size());
+  for (size_t b = 0; b < body_coord.size(); ++b) body_coord[b] = BodyCoord(static_cast<int>(b));
+  auto add = [&m](std::unique_ptr<ForceContributor> c) {
+    if (c->dissipates()) m.has_damping_ = true;
+    m.contributors_.push_back(std::move(c));
+  };
+  // The list's order is the order of summation.
+  std::vector<std::array<std::vector<AppliedLoads::Term>, 3>> points(scene_.loads.size());
+  for (size_t l = 0; l < points.size(); ++l) {
+    if (IsZero(scene_.loads[l].varying_force_n)) continue;
+    const LinearVector point = PointOf(scene_.loads[l].at);
+    for (int d = 0; d < m.dim_; ++d)
+      for (const auto& [i, c] : point[d].terms) points[l][d].push_back({i, c});
+  }
+  if (auto loads = MakeAppliedLoads(scene_, points, body_coord, m.dim_)) {
+    m.has_step_work_ = true;
+    add(std::move(loads));
+  }
+  if (auto damping = MakeBodyDamping(scene_, body_coord, m.dim_)) add(std::move(damping));
+  if (auto contact = MakeBodySeabedContact(scene_, body_coord, m.dim_)) {
+    m.body_contact_ = contact.get();
+    add(std::move(contact));
+  }
+  if (auto fluid = MakeBodyFluidForces(scene_, body_coord, m.dim_, m.wave_load_.has_value())) {
+    // The added mass joins the body's mass matrix and kinetic energy.
+    for (const BodyFluidLoad& load : fluid->loads()) {
+      for (size_t b = 0; b < body_coord.size(); ++b) {
+        if (body_coord[b] != load.coord()) continue;
+        MultibodyModel::BodyData& data = m.bodies_[b];
+        data.added_mass = load.AddedMass(q0_);
+        data.has_added_mass = !data.added_mass.isZero(0);
+      }
     }
-    // Default stiffness: the axial stiffness EA / l_e of one element.
-    double k = joint.slide.stiffness_n_m;
-    if (k == 0) k = spec.youngs_modulus_pa * spec.area_m2 * spec.elements / spec.length_m;
-    SlidingJoint slider(m.dim_, std::move(segments), BodyCoord(on_body.body), m.body_stride_,
-                        on_body.point_body_m, k, joint.slide.friction,
-                        joint.slide.stick_velocity_m_s, on_cable.s_m);
-    const double gap = slider.Gap(q0_);
-    if (gap > 1e-6) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "joints[%d]: the body point is %.6g m from the cable at t = 0 (a sliding joint starts "
-          "on its cable)",
-          ji, gap));
+    m.body_fluid_ = fluid.get();
+    add(std::move(fluid));
+  }
+  bool slides = false;
+  for (const JointSpec& joint : scene_.joints) slides = slides || joint.type == JointType::kSlide;
+  if (slides) {
+    std::vector<std::vector<SlidingJoint::Segment>> segments(scene_.cables.size());
+    for (size_t cable = 0; cable < segments.size(); ++cable) {
+      double s0 = 0;
+      for (int k = m.cable_element_begin_[cable]; k < m.cable_element_begin_[cable + 1]; ++k) {
+        const int first = m.dim_ == 2 ? m.elements2_[k].first_coord : m.elements3_[k].first_coord;
+        const double l =
+            m.dim_ == 2 ? m.elements2_[k].element.length() : m.elements3_[k].element.length();
+        segments[cable].push_back({first, s0, l});
+        s0 += l;
+      }
     }
-    if (slider.has_friction()) m.has_damping_ = true;
-    m.sliders_.push_back(std::move(slider));
+    absl::StatusOr<std::unique_ptr<SlidingJoints>> sliders =
+        MakeSlidingJoints(scene_, segments, body_coord, m.dim_, m.body_stride_, q0_);
+    if (!sliders.ok()) return sliders.status();
+    m.sliders_ = sliders->get();
+    add(std::move(*sliders));
   }
   return absl::OkStatus();
 }
@@ -944,22 +653,6 @@ void ModelBuilder::ConstantForces() {
   for (const LoadSpec& load : scene_.loads) {
     const LinearVector point = PointOf(load.at);
     add_point_force(point, load.force_n);
-    if (!IsZero(load.varying_force_n)) {
-      MultibodyModel::VaryingForce v;
-      for (int d = 0; d < D; ++d)
-        for (const auto& [i, c] : point[d].terms) v.point[d].push_back({i, c});
-      v.force = load.varying_force_n;
-      m.varying_forces_.push_back(std::move(v));
-    }
-    const bool varying_torque = !IsZero(load.varying_torque_nm);
-    if (load.at.body >= 0 && (load.torque_nm.norm() > 0 || varying_torque)) {
-      MultibodyModel::TorqueLoad t;
-      t.body = load.at.body;
-      t.torque = t.base = load.torque_nm;
-      t.varying = load.varying_torque_nm;
-      t.is_varying = varying_torque;
-      m.torques_.push_back(std::move(t));
-    }
   }
 }
 
@@ -993,7 +686,8 @@ void ModelBuilder::Probes() {
   for (size_t p = 0; p < scene_.probes.size(); ++p) {
     const Attachment& at = scene_.probes[p].at;
     bool found = false;
-    for (const MultibodyModel::MovingRow& row : m.moving_rows_) {
+    const std::vector<PrescribedMotion::MovingRow> none;
+    for (const PrescribedMotion::MovingRow& row : m.motion_ ? m.motion_->moving() : none) {
       const JointSpec& joint = scene_.joints[row.joint];
       const Attachment& held = joint.a.IsGround() ? joint.b : joint.a;
       const bool same = at.cable >= 0 ? held.cable == at.cable && mesh_.Node(held) == mesh_.Node(at)
@@ -1036,155 +730,14 @@ void ModelBuilder::WinchBases(const std::vector<MultibodyModel::ElementData<D>>&
   }
 }
 
-template <int D>
-void ModelBuilder::SetupElementSlots(const std::vector<MultibodyModel::ElementData<D>>& elements) {
-  MultibodyModel& m = model_;
-  constexpr int kN = 4 * D, kN2 = kN * kN;
-  m.element_slots_.resize(kN2 * elements.size());
-  m.element_factors_.resize(kN2 * elements.size());
-  for (size_t k = 0; k < elements.size(); ++k) {
-    if (k % 65536 == 0 && Stopped()) return;
-    const MultibodyModel::ElementData<D>& e = elements[k];
-    for (int a = 0; a < kN; ++a) {
-      for (int b = 0; b < kN; ++b) {
-        const int ia = e.first_coord + a, ib = e.first_coord + b;
-        const int ja = m.j_[ia], jb = m.j_[ib];
-        // A(ja, jb) with ja > jb is stored once; the diagonal takes every
-        // (a, b) with ja == jb (both orders of a != b), as the sum requires.
-        const int slot = (ja >= 0 && jb >= 0 && ja >= jb) ? m.mass_.Slot(ja, jb) : -1;
-        m.element_slots_[kN2 * k + kN * a + b] = slot;
-        m.element_factors_[kN2 * k + kN * a + b] = slot < 0 ? 0 : m.s_(ia) * m.s_(ib);
-      }
-    }
-    const auto me = e.element.MassMatrix(e.mass_per_length);
-    for (int t = 0; t < kN2; ++t) {
-      const int slot = m.element_slots_[kN2 * k + t];
-      if (slot >= 0)
-        m.mass_.values()[slot] += m.element_factors_[kN2 * k + t] * me(t / kN, t % kN);
-    }
-  }
-}
-
-void ModelBuilder::EnvelopeAndMass() {
-  MultibodyModel& m = model_;
-  const int D = m.dim_, bs = m.body_stride_;
-  m.envelope_.resize(m.dofs_);
-  for (int j = 0; j < m.dofs_; ++j) m.envelope_[j] = j;
-  auto couple = [&](const int* idx, int n) {
-    int lo = std::numeric_limits<int>::max();
-    for (int k = 0; k < n; ++k)
-      if (m.j_[idx[k]] >= 0) lo = std::min(lo, m.j_[idx[k]]);
-    for (int k = 0; k < n; ++k)
-      if (m.j_[idx[k]] >= 0) m.envelope_[m.j_[idx[k]]] = std::min(m.envelope_[m.j_[idx[k]]], lo);
-  };
-  {
-    std::vector<int> idx(4 * D);
-    for (const auto& e : m.elements2_) {
-      for (int k = 0; k < 8; ++k) idx[k] = e.first_coord + k;
-      couple(idx.data(), 8);
-    }
-    for (const auto& e : m.elements3_) {
-      for (int k = 0; k < 12; ++k) idx[k] = e.first_coord + k;
-      couple(idx.data(), 12);
-    }
-  }
-  for (const MultibodyModel::BodyData& b : m.bodies_) {
-    std::vector<int> idx(bs);
-    for (int k = 0; k < bs; ++k) idx[k] = b.coord + k;
-    couple(idx.data(), bs);
-  }
-  for (const Row& row : m.rows_) {
-    couple(&m.row_coord_[row.coord_begin], row.coord_end - row.coord_begin);
-  }
-
-  // The first `count` coordinates of a body coupled with every element of
-  // a cable (a slider, a wheel the body carries).
-  auto couple_body_with_cable = [&](int body, int count, int cable) {
-    int cable_lo = std::numeric_limits<int>::max(), body_lo = cable_lo;
-    const int first = NodeCoord(mesh_.first_node[cable]);
-    const int last = NodeCoord(mesh_.first_node[cable + 1]);
-    for (int i = first; i < last; ++i)
-      if (m.j_[i] >= 0) cable_lo = std::min(cable_lo, m.j_[i]);
-    for (int k = 0; k < count; ++k)
-      if (m.j_[BodyCoord(body) + k] >= 0) body_lo = std::min(body_lo, m.j_[BodyCoord(body) + k]);
-    for (int k = 0; k < count; ++k) {
-      const int j = m.j_[BodyCoord(body) + k];
-      if (j >= 0) m.envelope_[j] = std::min(m.envelope_[j], cable_lo);
-    }
-    for (int i = first; i < last; ++i) {
-      const int j = m.j_[i];
-      if (j >= 0 && j > body_lo) m.envelope_[j] = std::min(m.envelope_[j], body_lo);
-    }
-  };
-  // A slider couples its body with every element of its cable.
-  for (const JointSpec& joint : scene_.joints) {
-    if (joint.type != JointType::kSlide) continue;
-    const int cable = joint.a.cable >= 0 ? joint.a.cable : joint.b.cable;
-    const int body = joint.a.body >= 0 ? joint.a.body : joint.b.body;
-    couple_body_with_cable(body, bs, cable);
-  }
-  // A wheel on a body couples the body's centre with the cables it touches.
-  for (const SheaveSpec& wheel : scene_.sheaves) {
-    if (wheel.body < 0) continue;
-    for (int cable = 0; cable < static_cast<int>(scene_.cables.size()); ++cable)
-      if (wheel.Touches(cable)) couple_body_with_cable(wheel.body, D, cable);
-  }
-
-  // The reduced mass matrix, with the element scatter tables.
-  m.mass_.SetPattern(m.envelope_);
-  if (D == 2) {
-    SetupElementSlots(m.elements2_);
-  } else {
-    SetupElementSlots(m.elements3_);
-  }
-  for (const MultibodyModel::BodyData& b : m.bodies_) {
-    for (int k = 0; k < bs; ++k) {
-      const int j = m.j_[b.coord + k];
-      if (j < 0) continue;
-      const double diag = k < D ? b.mass : b.jbar((k - D) / D);
-      m.mass_.values()[m.mass_.Slot(j, j)] += m.s_(b.coord + k) * m.s_(b.coord + k) * diag;
-    }
-    if (b.has_added_mass) m.ScatterBodyBlock(b.coord, b.added_mass, 1.0, &m.mass_);
-  }
-}
-
-void ModelBuilder::ConstraintPattern() {
-  MultibodyModel& m = model_;
-  m.jac_pattern_.cols = m.dofs_;
-  for (const Row& row : m.rows_) {
-    for (int k = row.coord_begin; k < row.coord_end; ++k) {
-      if (m.j_[m.row_coord_[k]] < 0) continue;
-      m.jac_pattern_.col.push_back(m.j_[m.row_coord_[k]]);
-      m.jac_pattern_.value.push_back(0);
-    }
-    m.jac_pattern_.row_start.push_back(static_cast<int>(m.jac_pattern_.col.size()));
-  }
-  m.mono_row_.assign(m.mono_a_.size(), -1);
-  m.mono_col_.assign(m.mono_a_.size(), -1);
-  m.mono_factor_.assign(m.mono_a_.size(), 0.0);
-  for (const Row& row : m.rows_) {
-    const int* coord = &m.row_coord_[row.coord_begin];
-    for (int k = row.mono_begin; k < row.mono_end; ++k) {
-      const int a = coord[m.mono_a_[k]], b = coord[m.mono_b_[k]];
-      const int ja = m.j_[a], jb = m.j_[b];
-      if (ja < 0 || jb < 0) continue;
-      // w q_a q_b has Hessian entries (a, b) and (b, a) equal to w; on z
-      // they land on (ja, jb) and (jb, ja): stored once off the diagonal,
-      // twice (2 w) on it.
-      m.mono_row_[k] = std::max(ja, jb);
-      m.mono_col_[k] = std::min(ja, jb);
-      m.mono_factor_[k] = m.mono_w_[k] * m.s_(a) * m.s_(b) * (ja == jb ? 2 : 1);
-    }
-  }
-}
-
 MultibodyModel ModelBuilder::Finish() {
   model_.scratch_full_ = VectorXd::Zero(q0_.size());
   model_.scratch_roundoff_ = VectorXd::Zero(q0_.size());
-  model_.time_dependent_ = !model_.moving_rows_.empty() || !model_.varying_forces_.empty() ||
-                          !model_.turning_rows_.empty();
-  for (const MultibodyModel::TorqueLoad& t : model_.torques_)
-    if (t.is_varying) model_.time_dependent_ = true;
+  model_.time_dependent_ = false;
+  for (const ConstraintFamily* f : model_.families_)
+    if (f->time_dependent()) model_.time_dependent_ = true;
+  for (const auto& c : model_.contributors_)
+    if (c->time_dependent()) model_.time_dependent_ = true;
   if (!model_.winches_.empty()) {
     model_.time_dependent_ = true;
     if (model_.dim_ == 2) {
@@ -1231,7 +784,7 @@ absl::StatusOr<MultibodyModel> MultibodyModel::Build(const Scene& scene,
   if (builder.Stopped()) return stopped;
   builder.BuildElements();
   if (builder.Stopped()) return stopped;
-  if (absl::Status s = builder.Sliders(); !s.ok()) return s;
+  if (absl::Status s = builder.Contributors(); !s.ok()) return s;
   builder.Winches();
   builder.ConstantForces();
   builder.Probes();

@@ -57,7 +57,7 @@ class ModelBuilder {
   // A constraint row before the rows no unknown can change are dropped.
   struct PendingRow {
     QuadraticForm f;
-    MultibodyModel::Row::Kind kind;
+    JointRows::Row::Kind kind;
     int joint;  // scene joint, or -1 for a body's own axis constraint
     int body;   // the body of an axis constraint, or -1
     // A moving support's position row: the component of the joint's
@@ -175,11 +175,14 @@ class ModelBuilder {
   // elements: a sheave touches every element of the cables it lists).
   void BuildSheaves();
 
-  // The sliding joints (SlidingJoint, a penalty force; no rows), each
-  // over its cable's elements, with its stiffness (default EA / l_e of
-  // its cable, l_e = length / elements). Fails when a slider's body point
-  // is more than 1e-6 m from its cable at t = 0 (names the joint).
-  absl::Status Sliders();
+  // The force contributors the scene uses (engine/forces/force_contributor.h),
+  // each built by the Make... next to its class, in the order the model
+  // sums them: applied loads (time-varying forces, torques), body damping,
+  // body seabed contact, body fluid loads (whose added mass joins
+  // the bodies' mass here), sliding joints (MakeSlidingJoints fails when a
+  // slider's body point is more than 1e-6 m from its cable at t = 0, naming
+  // the joint). A contributor that dissipates turns on the damping pass.
+  absl::Status Contributors();
 
   // The winches' data (MultibodyModel::WinchData): their cables' element
   // ranges; the model then needs its damping pass (the convective terms).
@@ -187,9 +190,8 @@ class ModelBuilder {
 
   // The constant generalized force [N, or N m per unit slope]: element and
   // body gravity and each load's force at its point (the loads' also
-  // apart, for the energy per part); the torques on bodies, kept apart
-  // (their work is summed step by step), and the time-varying forces with
-  // their points (evaluated by SetTime).
+  // apart, for the energy per part). Torques and time-varying forces are
+  // the applied-loads contributor's (Contributors).
   void ConstantForces();
 
   // Each probe's point as a linear form of q (position [m] = const + sum
@@ -224,7 +226,7 @@ class ModelBuilder {
   int UnknownOf(int i) const { return model_.j_[i]; }
 
  private:
-  using Row = MultibodyModel::Row;
+  using Row = JointRows::Row;
 
   // Full index of a node's position, of a body's centre of mass.
   int NodeCoord(int node) const { return model_.node_stride_ * node; }

@@ -23,114 +23,23 @@ namespace {
 using Eigen::Vector3d;
 using Eigen::VectorXd;
 
-// n . x with x the first D entries of v from index i (a plain loop: GCC
-// 12 warns falsely about head(D) of a fixed-size vector).
-double DotAt(const Vector3d& n, const VectorXd& v, int i, int D) {
-  double sum = 0;
-  for (int d = 0; d < D; ++d) sum += n(d) * v(i + d);
-  return sum;
-}
-
 }  // namespace
-
-void MultibodyModel::AddRow(const QuadraticForm& f, Row::Kind kind, int joint, int body) {
-  Row row;
-  row.kind = kind;
-  row.joint = joint;
-  row.body = body;
-  row.c = f.c;
-  std::vector<int> coords;
-  for (const auto& [i, v] : f.linear)
-    if (v != 0) coords.push_back(i);
-  for (const auto& [ij, v] : f.quadratic) {
-    if (v == 0) continue;
-    coords.push_back(ij.first);
-    coords.push_back(ij.second);
-  }
-  std::sort(coords.begin(), coords.end());
-  coords.erase(std::unique(coords.begin(), coords.end()), coords.end());
-  // The widest row, two welded spatial bodies, touches 24 coordinates.
-  assert(static_cast<int>(coords.size()) <= kMaxRowCoords);
-  auto local = [&](int i) {
-    return static_cast<int>(std::lower_bound(coords.begin(), coords.end(), i) - coords.begin());
-  };
-  row.coord_begin = static_cast<int>(row_coord_.size());
-  row_coord_.insert(row_coord_.end(), coords.begin(), coords.end());
-  row.coord_end = static_cast<int>(row_coord_.size());
-  row.lin_begin = static_cast<int>(lin_local_.size());
-  for (const auto& [i, v] : f.linear) {
-    if (v == 0) continue;
-    lin_local_.push_back(local(i));
-    lin_value_.push_back(v);
-  }
-  row.lin_end = static_cast<int>(lin_local_.size());
-  row.mono_begin = static_cast<int>(mono_a_.size());
-  for (const auto& [ij, v] : f.quadratic) {
-    if (v == 0) continue;
-    mono_a_.push_back(local(ij.first));
-    mono_b_.push_back(local(ij.second));
-    mono_w_.push_back(v);
-  }
-  row.mono_end = static_cast<int>(mono_a_.size());
-  rows_.push_back(row);
-}
-
-double MultibodyModel::RowValue(const Row& row, const VectorXd& q) const {
-  const int* coord = &row_coord_[row.coord_begin];
-  double acc = row.c;
-  for (int k = row.lin_begin; k < row.lin_end; ++k) acc += lin_value_[k] * q(coord[lin_local_[k]]);
-  for (int k = row.mono_begin; k < row.mono_end; ++k)
-    acc += mono_w_[k] * q(coord[mono_a_[k]]) * q(coord[mono_b_[k]]);
-  return acc;
-}
-
-void MultibodyModel::RowGradient(const Row& row, const VectorXd& q, double* grad) const {
-  const int* coord = &row_coord_[row.coord_begin];
-  const int n = row.coord_end - row.coord_begin;
-  for (int k = 0; k < n; ++k) grad[k] = 0;
-  for (int k = row.lin_begin; k < row.lin_end; ++k) grad[lin_local_[k]] += lin_value_[k];
-  for (int k = row.mono_begin; k < row.mono_end; ++k) {
-    grad[mono_a_[k]] += mono_w_[k] * q(coord[mono_b_[k]]);
-    grad[mono_b_[k]] += mono_w_[k] * q(coord[mono_a_[k]]);
-  }
-}
 
 void MultibodyModel::ScatterSlider(const SlidingJoint::Local& local, VectorXd* full,
                                    VectorXd* roundoff, double scale, SkylineLdlt* a) const {
-  constexpr double kEps = std::numeric_limits<double>::epsilon();
-  for (int k = 0; k < local.n; ++k) {
-    (*full)(local.coord[k]) += local.force(k);
-    if (roundoff)
-      (*roundoff)(local.coord[k]) += kEps * std::abs(local.force(k)) + local.rounding;
-  }
-  if (a == nullptr) return;
-  double* values = a->values();
-  // Lower triangle on z: pairs with j_a > j_b once, with j_a == j_b all
-  // (the symmetric local matrix then sums both transposes).
-  for (int i = 0; i < local.n; ++i) {
-    const int ji = j_[local.coord[i]];
-    if (ji < 0) continue;
-    for (int k = 0; k < local.n; ++k) {
-      const int jk = j_[local.coord[k]];
-      if (jk < 0 || jk > ji) continue;
-      values[a->Slot(ji, jk)] +=
-          scale * s_(local.coord[i]) * s_(local.coord[k]) * local.matrix(i, k);
-    }
-  }
+  ForceOutput out{full, roundoff, a, scale, Map()};
+  AddLocalTerms(local, &out);
 }
 
-void MultibodyModel::ScatterBodyBlock(int coord, const Eigen::Matrix3d& m, double scale,
-                                      SkylineLdlt* a) const {
-  double* values = a->values();
-  for (int i = 0; i < dim_; ++i) {
-    const int ji = j_[coord + i];
-    if (ji < 0) continue;
-    for (int k = 0; k < dim_; ++k) {
-      const int jk = j_[coord + k];
-      if (jk < 0 || jk > ji) continue;
-      values[a->Slot(ji, jk)] += scale * s_(coord + i) * s_(coord + k) * m(i, k);
-    }
-  }
+const std::vector<BodyFluidLoad>& MultibodyModel::body_fluid_loads() const {
+  static const std::vector<BodyFluidLoad> kNone;
+  return body_fluid_ ? body_fluid_->loads() : kNone;
+}
+
+const ForceContributor* MultibodyModel::FindContributor(std::string_view name) const {
+  for (const auto& c : contributors_)
+    if (c->name() == name) return c.get();
+  return nullptr;
 }
 
 VectorXd MultibodyModel::Reduce(const VectorXd& full) const {
@@ -195,10 +104,8 @@ void MultibodyModel::ProjectInitialVelocity() {
   Constraints(q0, &phi, &jac);
   VectorXd jv(nrows);
   jac.Multiply(v0_.data(), jv.data());
-  // Moving supports: Phi_z v + Phi_t = 0 with Phi_t = -motion'(t).
-  for (const MovingRow& m : moving_rows_) jv(m.row) -= m.rate;
-  for (const TurningRow& r : turning_rows_)
-    jv(r.row) += DotAt(r.rate, q0, r.coord, dim_);
+  // Moving and turning supports: Phi_z v + Phi_t = 0.
+  for (const ConstraintFamily* f : families_) f->AddRate(q0, &jv);
   if (jv.lpNorm<Eigen::Infinity>() <= 1e-14 * (1 + v0_.lpNorm<Eigen::Infinity>())) return;
   SkylineLdlt mass = mass_;
   if (!mass.Factor()) return;
@@ -316,10 +223,11 @@ double MultibodyModel::ElementForces(const VectorXd& q, VectorXd* full, SkylineL
     if (roundoff) re.setZero();
     e.element.ElasticForce(q.segment<kN>(e.first_coord), &fe, stiffness ? &ke : nullptr,
                            roundoff ? &re : nullptr);
-    // The seabed's force, like the elastic one, is the gradient of an energy.
-    if (seabed_)
-      seabed_->AddPotential<D>(q.segment<kN>(e.first_coord), e.element.length(), &fe,
-                               stiffness ? &ke : nullptr, roundoff ? &re : nullptr);
+    // Element terms' forces (the seabed's), like the elastic one, are
+    // gradients of energies.
+    for (const auto& t : element_terms_)
+      t->AddPotential(q.segment<kN>(e.first_coord), e.element.length(), &fe,
+                      stiffness ? &ke : nullptr, roundoff ? &re : nullptr);
     if (!sheaves_.empty()) {
       for (uint64_t bits = sheave_mask_[k]; bits != 0; bits &= bits - 1) {
         const Sheave& wheel = sheaves_[std::countr_zero(bits)];
@@ -348,36 +256,11 @@ double MultibodyModel::NetForce(const VectorXd& q, double load_factor, VectorXd*
   constexpr double kEps = std::numeric_limits<double>::epsilon();
   VectorXd& full = scratch_full_;
   full = load_factor * constant_force_;
-  // A torque T on a body: its virtual work T . dphi, with de_k = dphi x e_k,
-  // is done by the generalized forces (1/2) T x e_k on the axes (spatial),
-  // and T_z perp(u) on u (planar), on the unit, orthogonal axes the
-  // constraints keep. Their derivative is skew-symmetric, so the symmetric
-  // Newton matrix leaves it out (Newton then converges linearly, at a rate
-  // of order h^2 |T| / J, instead of quadratically).
-  // Time-varying forces at points (their value at time_, SetTime).
-  for (const VaryingForce& l : varying_forces_) {
-    for (int d = 0; d < dim_; ++d)
-      for (const ProbeTerm& t : l.point[d]) full(t.coord) += load_factor * t.coeff * l.value(d);
-  }
-  for (const TorqueLoad& t : torques_) {
-    const int c = bodies_[t.body].coord;
-    if (dim_ == 2) {
-      const double tz = load_factor * t.torque.z();
-      full(c + 2) -= tz * q(c + 3);
-      full(c + 3) += tz * q(c + 2);
-    } else {
-      for (int k = 0; k < 3; ++k) {
-        const Vector3d e = q.segment<3>(c + 3 + 3 * k);
-        full.segment<3>(c + 3 + 3 * k) += 0.5 * load_factor * t.torque.cross(e);
-      }
-    }
-  }
-  // Bodies' hydrostatic buoyancy (BodyFluidLoad), scaled as gravity.
-  for (const BodyFluidLoad& b : body_fluid_) {
-    Eigen::Matrix3d k = Eigen::Matrix3d::Zero();
-    b.AddHydrostatic(q, load_factor, &full, stiffness ? &k : nullptr);
-    if (stiffness) ScatterBodyBlock(b.coord(), k, stiffness_scale, stiffness);
-  }
+  // Contributors' applied loads (time-varying loads, torques, body
+  // buoyancy), scaled as gravity.
+  const ForceState state = StateAt(q, nullptr, load_factor);
+  ForceOutput out{&full, nullptr, stiffness, stiffness_scale, Map()};
+  for (const auto& c : contributors_) c->AddAppliedLoad(state, &out);
   // The size of the applied terms counts only coordinates that move: a
   // heavy body welded to ground must not loosen the tolerance elsewhere.
   double size = 0;
@@ -394,23 +277,11 @@ double MultibodyModel::NetForce(const VectorXd& q, double load_factor, VectorXd*
                                                      full_roundoff)
                                   : ElementForces<3>(q, &full, stiffness, stiffness_scale,
                                                      full_roundoff));
-  if (!body_contacts_.empty()) {
-    double contact_size = 0;
-    if (dim_ == 2) {
-      BodyContactTerms<2>(ContactTerm::kPotential, q, nullptr, &full, stiffness, stiffness_scale,
-                          full_roundoff, &contact_size);
-    } else {
-      BodyContactTerms<3>(ContactTerm::kPotential, q, nullptr, &full, stiffness, stiffness_scale,
-                          full_roundoff, &contact_size);
-    }
-    size = std::max(size, contact_size);
-  }
-  for (const SlidingJoint& slider : sliders_) {
-    SlidingJoint::Local local;
-    slider.Penalty(q, &local, stiffness != nullptr);
-    ScatterSlider(local, &full, full_roundoff, stiffness_scale, stiffness);
-    size = std::max(size, local.force.lpNorm<Eigen::Infinity>());
-  }
+  // Contributors' conservative forces (contact, penalties).
+  out.roundoff = full_roundoff;
+  out.size = 0;
+  for (const auto& c : contributors_) c->AddConservative(state, &out);
+  size = std::max(size, out.size);
   f->setZero();
   for (int i = 0; i < n; ++i)
     if (j_[i] >= 0) (*f)(j_[i]) += s_(i) * full(i);
@@ -459,7 +330,7 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
   typename AncfCableElement<D>::Coords fe;
   double size = 0;
   double* values = tangent ? tangent->values() : nullptr;
-  const bool bed = seabed_ && seabed_->dissipates();
+  const bool bed = element_terms_dissipate_;
   // Work per element for the stop poll: its Gauss points, each summing
   // every wave component.
   const int64_t components = wave_load_ ? wave_load_->field().components().size() : 0;
@@ -489,8 +360,11 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
       e.element.AddDrag(q.segment<kN>(e.first_coord), ve, current_.head<D>(), e.drag_n, e.drag_t,
                         &fe, &ce);
     }
-    if (bed)
-      seabed_->AddDissipation<D>(q.segment<kN>(e.first_coord), ve, e.element.length(), &fe, &ce);
+    if (bed) {
+      for (const auto& t : element_terms_)
+        if (t->dissipates())
+          t->AddDissipation(q.segment<kN>(e.first_coord), ve, e.element.length(), &fe, &ce);
+    }
     for (uint64_t bits = wheels; bits != 0; bits &= bits - 1) {
       const Sheave& wheel = sheaves_[std::countr_zero(bits)];
       if (wheel.body() >= 0) {
@@ -513,12 +387,6 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
   return size;
 }
 
-double MultibodyModel::BodyDampingCoefficient(const BodyData& b, int k) const {
-  if (k < dim_) return b.linear_damping;
-  // Planar: the torque -c omega on u is -c udot; spatial: -(c / 2) edot_k.
-  return dim_ == 2 ? b.angular_damping : 0.5 * b.angular_damping;
-}
-
 double MultibodyModel::DampingForce(const VectorXd& q, const VectorXd& qdot, VectorXd* f,
                                     SkylineLdlt* tangent, double tangent_scale,
                                     VectorXd* roundoff) {
@@ -535,47 +403,12 @@ double MultibodyModel::DampingForce(const VectorXd& q, const VectorXd& qdot, Vec
                                               full_roundoff, nullptr)
                           : ElementDamping<3>(q, qdot, &full, tangent, tangent_scale,
                                               full_roundoff, nullptr);
-  for (const BodyData& b : bodies_) {
-    for (int k = 0; k < body_stride_; ++k) {
-      const double c = BodyDampingCoefficient(b, k);
-      if (c == 0) continue;
-      const int i = b.coord + k;
-      full(i) -= c * qdot(i);
-      size = std::max(size, std::abs(c * qdot(i)));
-      if (tangent && j_[i] >= 0)
-        tangent->values()[tangent->Slot(j_[i], j_[i])] += tangent_scale * s_(i) * s_(i) * c;
-    }
-  }
-  if (!body_contacts_.empty()) {
-    double contact_size = 0;
-    if (dim_ == 2) {
-      BodyContactTerms<2>(ContactTerm::kDissipation, q, &qdot, &full, tangent, tangent_scale,
-                          nullptr, &contact_size);
-    } else {
-      BodyContactTerms<3>(ContactTerm::kDissipation, q, &qdot, &full, tangent, tangent_scale,
-                          nullptr, &contact_size);
-    }
-    size = std::max(size, contact_size);
-  }
-  // The fluid's drag, inertia and wave buoyancy on bodies (BodyFluidLoad).
-  const WaveField* waves = wave_field();
-  for (const BodyFluidLoad& b : body_fluid_) {
-    if (!b.dynamic(waves != nullptr)) continue;
-    Eigen::Matrix3d c;
-    const Vector3d force = b.DynamicForce(q, qdot, time_, waves, tangent ? &c : nullptr);
-    for (int d = 0; d < dim_; ++d) {
-      full(b.coord() + d) += force(d);
-      if (full_roundoff) (*full_roundoff)(b.coord() + d) += kSumRounding * std::abs(force(d));
-    }
-    size = std::max(size, force.lpNorm<Eigen::Infinity>());
-    if (tangent) ScatterBodyBlock(b.coord(), c, tangent_scale, tangent);
-  }
-  for (const SlidingJoint& slider : sliders_) {
-    if (!slider.has_friction()) continue;
-    SlidingJoint::Local local;
-    slider.Friction(q, qdot, &local, tangent != nullptr);
-    ScatterSlider(local, &full, full_roundoff, tangent_scale, tangent);
-    size = std::max(size, local.force.lpNorm<Eigen::Infinity>());
+  // Contributors' velocity-dependent forces.
+  if (!contributors_.empty()) {
+    const ForceState state = StateAt(q, &qdot, 1.0);
+    ForceOutput out{&full, full_roundoff, tangent, tangent_scale, Map()};
+    for (const auto& c : contributors_) c->AddDissipative(state, &out);
+    size = std::max(size, out.size);
   }
   if (!winches_.empty()) {
     size = std::max(size, dim_ == 2 ? WinchForces<2>(q, qdot, &full, tangent, tangent_scale,
@@ -601,21 +434,9 @@ double MultibodyModel::DampingPower(const VectorXd& q, const VectorXd& qdot) con
   } else {
     ElementDamping<3>(q, qdot, nullptr, nullptr, 0, nullptr, &power);
   }
-  for (const BodyData& b : bodies_)
-    for (int k = 0; k < body_stride_; ++k)
-      power += BodyDampingCoefficient(b, k) * qdot(b.coord + k) * qdot(b.coord + k);
-  for (const SlidingJoint& slider : sliders_)
-    if (slider.has_friction()) power += slider.Friction(q, qdot, nullptr, false);
-  if (!body_contacts_.empty())
-    power += dim_ == 2 ? BodyContactTerms<2>(ContactTerm::kDissipation, q, &qdot, nullptr,
-                                             nullptr, 0, nullptr, nullptr)
-                       : BodyContactTerms<3>(ContactTerm::kDissipation, q, &qdot, nullptr,
-                                             nullptr, 0, nullptr, nullptr);
-  const WaveField* waves = wave_field();
-  for (const BodyFluidLoad& b : body_fluid_) {
-    if (!b.dynamic(waves != nullptr)) continue;
-    const Vector3d force = b.DynamicForce(q, qdot, time_, waves, nullptr);
-    for (int d = 0; d < dim_; ++d) power -= force(d) * qdot(b.coord() + d);
+  if (!contributors_.empty()) {
+    const ForceState state = StateAt(q, &qdot, 1.0);
+    for (const auto& c : contributors_) c->AddDissipatedPower(state, &power);
   }
   // A winch cable's damping (not its convective inertia, which dissipates
   // nothing).
@@ -628,78 +449,13 @@ double MultibodyModel::DampingPower(const VectorXd& q, const VectorXd& qdot) con
   return power;
 }
 
-template <int D>
-double MultibodyModel::BodyContactTerms(ContactTerm term, const VectorXd& q,
-                                        const VectorXd* other, VectorXd* full, SkylineLdlt* a,
-                                        double scale, VectorXd* roundoff, double* size) const {
-  constexpr int S = D == 2 ? 4 : 12;  // the body's natural coordinates
-  constexpr double kEps = std::numeric_limits<double>::epsilon();
-  using Point = Eigen::Matrix<double, D, 1>;
-  using Block = Eigen::Matrix<double, D, D>;
-  using Local = Eigen::Matrix<double, S, 1>;
-  const Seabed& bed = *seabed_;
-  const double bed_size = std::abs(bed.Height(Vector3d::Zero()));
-  double result = 0;
-  for (const BodyContact& c : body_contacts_) {
-    if (term == ContactTerm::kDissipation && c.c == 0 && c.mu == 0) continue;
-    if (term == ContactTerm::kStaticFriction && c.mu == 0) continue;
-    const Local qb = q.segment<S>(c.coord);
-    Local force = Local::Zero(), bound = Local::Zero();
-    Eigen::Matrix<double, S, S> matrix = Eigen::Matrix<double, S, S>::Zero();
-    for (const Vector3d& p : c.points) {
-      // r = B q_b: planar r_c + p_x u + p_y perp(u), spatial r_c + sum p_k e_k.
-      Eigen::Matrix<double, D, S> b = Eigen::Matrix<double, D, S>::Zero();
-      b.template leftCols<D>().setIdentity();
-      if constexpr (D == 2) {
-        b(0, 2) = b(1, 3) = p.x();
-        b(0, 3) = -p.y();
-        b(1, 2) = p.y();
-      } else {
-        for (int k = 0; k < 3; ++k) b.template block<3, 3>(0, 3 + 3 * k) = p(k) * Block::Identity();
-      }
-      const Point r = b * qb;
-      Point f = Point::Zero();
-      Block h = Block::Zero();
-      if (term == ContactTerm::kPotential) {
-        result += bed.PointPotential<D>(r, c.k, &f, a ? &h : nullptr);
-        f = -f;  // the force is minus the energy's gradient
-        if (roundoff && f.squaredNorm() > 0)
-          bound += (kEps * c.k * (bed_size + (b.cwiseAbs() * qb.cwiseAbs()).sum())) *
-                   (b.cwiseAbs().transpose() * Point::Ones());
-      } else if (term == ContactTerm::kDissipation) {
-        const Point v = b * other->segment<S>(c.coord);
-        result += bed.PointDissipation<D>(r, v, c.k, c.c, c.mu, &f, a ? &h : nullptr);
-      } else {
-        const Point r0 = b * other->segment<S>(c.coord);
-        bed.PointStaticFriction<D>(r, r0, c.k, c.mu, &f, a ? &h : nullptr);
-      }
-      force.noalias() += b.transpose() * f;
-      if (a) matrix.noalias() += b.transpose() * h * b;
-    }
-    if (size) *size = std::max(*size, force.template lpNorm<Eigen::Infinity>());
-    if (full) full->segment<S>(c.coord) += force;
-    if (roundoff) roundoff->segment<S>(c.coord) += bound + kEps * force.cwiseAbs();
-    if (!a) continue;
-    double* values = a->values();
-    // Lower triangle on z (as ScatterSlider).
-    for (int i = 0; i < S; ++i) {
-      const int ji = j_[c.coord + i];
-      if (ji < 0) continue;
-      for (int k = 0; k < S; ++k) {
-        const int jk = j_[c.coord + k];
-        if (jk < 0 || jk > ji) continue;
-        values[a->Slot(ji, jk)] += scale * s_(c.coord + i) * s_(c.coord + k) * matrix(i, k);
-      }
-    }
-  }
-  return result;
-}
-
 bool MultibodyModel::has_static_friction() const {
-  if (!seabed_) return false;
-  if (seabed_->has_friction() && (!elements2_.empty() || !elements3_.empty())) return true;
-  for (const BodyContact& c : body_contacts_)
-    if (c.mu != 0) return true;
+  if (!elements2_.empty() || !elements3_.empty()) {
+    for (const auto& t : element_terms_)
+      if (t->has_static_friction()) return true;
+  }
+  for (const auto& c : contributors_)
+    if (c->has_static_friction()) return true;
   return false;
 }
 
@@ -710,7 +466,10 @@ void MultibodyModel::StaticFriction(const VectorXd& q, const VectorXd& q_start, 
   full.setZero(c_.size());
   auto cables = [&](const auto& elements, auto dim) {
     constexpr int D = decltype(dim)::value, kN = 4 * D, kN2 = kN * kN;
-    if (!seabed_->has_friction()) return;
+    const ElementTerm* term = nullptr;
+    for (const auto& t : element_terms_)
+      if (t->has_static_friction()) term = t.get();
+    if (term == nullptr) return;
     typename AncfCableElement<D>::Coords fe;
     typename AncfCableElement<D>::Matrix me;
     double* values = matrix ? matrix->values() : nullptr;
@@ -718,7 +477,7 @@ void MultibodyModel::StaticFriction(const VectorXd& q, const VectorXd& q_start, 
       const ElementData<D>& e = elements[k];
       fe.setZero();
       if (matrix) me.setZero();
-      seabed_->AddStaticFriction<D>(q.segment<kN>(e.first_coord),
+      term->AddStaticFriction(q.segment<kN>(e.first_coord),
                                               q_start.segment<kN>(e.first_coord),
                                               e.element.length(), &fe, matrix ? &me : nullptr);
       full.segment<kN>(e.first_coord) += fe;
@@ -728,13 +487,11 @@ void MultibodyModel::StaticFriction(const VectorXd& q, const VectorXd& q_start, 
   };
   if (dim_ == 2) {
     cables(elements2_, std::integral_constant<int, 2>());
-    BodyContactTerms<2>(ContactTerm::kStaticFriction, q, &q_start, &full, matrix, scale,
-                                  nullptr, nullptr);
   } else {
     cables(elements3_, std::integral_constant<int, 3>());
-    BodyContactTerms<3>(ContactTerm::kStaticFriction, q, &q_start, &full, matrix, scale,
-                                  nullptr, nullptr);
   }
+  ForceOutput out{&full, nullptr, matrix, scale, Map()};
+  for (const auto& c : contributors_) c->AddStaticFriction(q, q_start, &out);
   if (f) {
     const int n = coordinates();
     for (int i = 0; i < n; ++i)
@@ -743,84 +500,28 @@ void MultibodyModel::StaticFriction(const VectorXd& q, const VectorXd& q_start, 
 }
 
 void MultibodyModel::Constraints(const VectorXd& q, VectorXd* phi, SparseRows* jac) const {
-  int slot = 0;
-  double grad[kMaxRowCoords];
-  for (size_t i = 0; i < rows_.size(); ++i) {
-    const Row& row = rows_[i];
-    (*phi)(i) = RowValue(row, q);
-    if (!jac) continue;
-    RowGradient(row, q, grad);
-    for (int k = row.coord_begin; k < row.coord_end; ++k) {
-      const int coord = row_coord_[k];
-      if (j_[coord] < 0) continue;
-      jac->value[slot++] = grad[k - row.coord_begin] * s_(coord);
-    }
-  }
+  const CoordinateMap map = Map();
+  for (const ConstraintFamily* f : families_) f->Residual(q, map, phi, jac);
 }
 
 void MultibodyModel::AddConstraintHessian(const VectorXd& q, const VectorXd& lambda, double scale,
                                           SkylineLdlt* a) const {
   // The Hessians are constant; `q` is kept for the interface.
   (void)q;
-  double* values = a->values();
-  for (size_t i = 0; i < rows_.size(); ++i) {
-    const Row& row = rows_[i];
-    const double f = scale * lambda(i);
-    // Slots are looked up in `a` (any pattern containing envelope()).
-    for (int k = row.mono_begin; k < row.mono_end; ++k)
-      if (mono_row_[k] >= 0) values[a->Slot(mono_row_[k], mono_col_[k])] += f * mono_factor_[k];
-  }
+  for (const ConstraintFamily* f : families_) f->AddHessian(lambda, scale, a);
 }
 
 void MultibodyModel::ConstraintGamma(const VectorXd& q, const VectorXd& qdot,
                                      VectorXd* gamma) const {
-  for (size_t i = 0; i < rows_.size(); ++i) {
-    const Row& row = rows_[i];
-    const int* coord = &row_coord_[row.coord_begin];
-    double acc = 0;
-    for (int k = row.mono_begin; k < row.mono_end; ++k)
-      acc += mono_w_[k] * qdot(coord[mono_a_[k]]) * qdot(coord[mono_b_[k]]);
-    (*gamma)(i) = -2 * acc;
-  }
-  for (const MovingRow& m : moving_rows_) (*gamma)(m.row) += m.accel;
-  for (const TurningRow& r : turning_rows_) {
-    (*gamma)(r.row) -=
-        2 * DotAt(r.rate, qdot, r.coord, dim_) + DotAt(r.accel, q, r.coord, dim_);
-  }
-}
-
-Vector3d MultibodyModel::TurningRow::Normal(double t, Vector3d* rate_out,
-                                            Vector3d* accel_out) const {
-  const TimeFunction::Value v = angle.Evaluate(t);
-  const double c = std::cos(v.f), s = std::sin(v.f);
-  const Vector3d n = c * n0 + s * axis.cross(n0) + (1 - c) * axis.dot(n0) * axis;
-  if (rate_out != nullptr) {
-    const Vector3d an = axis.cross(n);
-    *rate_out = v.df * an;
-    *accel_out = v.ddf * an + v.df * v.df * axis.cross(an);
-  }
-  return n;
+  gamma->setZero();
+  for (const ConstraintFamily* f : families_) f->AddGamma(q, qdot, gamma);
 }
 
 void MultibodyModel::SetTime(double t) {
   time_ = t;
   if (!time_dependent_) return;
-  for (MovingRow& m : moving_rows_) {
-    const TimeFunction::Value v = m.motion.Evaluate(t);
-    rows_[m.row].c = m.c0 - v.f;
-    m.rate = v.df;
-    m.accel = v.ddf;
-  }
-  for (TurningRow& r : turning_rows_) {
-    r.n = r.Normal(t, &r.rate, &r.accel);
-    // Every coordinate of x has a slot in the row (AddTurningRows).
-    const Row& row = rows_[r.row];
-    for (int k = row.lin_begin; k < row.lin_end; ++k)
-      lin_value_[k] = r.n(row_coord_[row.coord_begin + lin_local_[k]] - r.coord);
-  }
-  for (VaryingForce& l : varying_forces_) l.value = Evaluate(l.force, t);
-  for (TorqueLoad& tl : torques_)
-    if (tl.is_varying) tl.torque = tl.base + Evaluate(tl.varying, t);
+  for (ConstraintFamily* f : families_) f->SetTime(t);
+  for (const auto& c : contributors_) c->SetTime(t);
   if (!winches_.empty()) {
     if (dim_ == 2) {
       UpdateWinches<2>();
@@ -830,465 +531,18 @@ void MultibodyModel::SetTime(double t) {
   }
 }
 
-template <int D>
-void MultibodyModel::UpdateWinches() {
-  constexpr int kN = 4 * D, kN2 = kN * kN;
-  std::vector<ElementData<D>>* elements_ptr;
-  if constexpr (D == 2) {
-    elements_ptr = &elements2_;
-  } else {
-    elements_ptr = &elements3_;
-  }
-  std::vector<ElementData<D>>& elements = *elements_ptr;
-  std::copy(mass_base_.begin(), mass_base_.end(), mass_.values());
-  constant_force_ = constant_force_base_;
-  const Eigen::Matrix<double, D, 1> g = gravity_.head<D>();
-  size_t slot = 0;
-  for (WinchData& w : winches_) {
-    const TimeFunction::Value v = w.speed.Evaluate(time_);
-    w.length = w.length0 + w.speed.Integral(time_);
-    w.rate = v.f;
-    w.accel = v.df;
-    const int n = w.element_end - w.element_begin;
-    const double l = w.length / n, ldot = w.rate / n, lddot = w.accel / n;
-    for (int k = 0; k < n; ++k, ++slot) {
-      const int index = w.element_begin + k;
-      ElementData<D>& e = elements[index];
-      e.element.set_length(l);
-      const auto me = e.element.MassMatrix(w.mass_per_length);
-      for (int a = 0; a < 4; ++a)
-        for (int b = 0; b < 4; ++b) e.mbar(a, b) = me(D * a, D * b);
-      e.gravity = e.element.GravityForce(w.mass_per_length, g);
-      constant_force_.segment<kN>(e.first_coord) += e.gravity;
-      ScatterElementMatrix<kN2>(index, me.data(), 1.0, mass_.values());
-      const WinchElementInertia in = ComputeWinchElementInertia(w.mass_per_length, l, k);
-      WinchConvectiveCoefficients(in, ldot, lddot, &winch_cv_[slot], &winch_ce_[slot]);
-      winch_mdot_[slot] = ldot * in.m_l;
-      winch_g_[slot] = in.g;
-      winch_h_[slot] = in.h;
-    }
-  }
-}
-
-template <int D>
-double MultibodyModel::WinchDamping(const WinchData& w, int index, const VectorXd& q,
-                                   const VectorXd& qdot,
-                                   typename AncfCableElement<D>::Coords* fe,
-                                   typename AncfCableElement<D>::Matrix* ce) const {
-  constexpr int kN = 4 * D;
-  if (w.alpha_1_s == 0 && w.axial_damping_s == 0) return 0;
-  const ElementData<D>& e = Elements<D>()[index];
-  const auto qe = q.segment<kN>(e.first_coord);
-  const auto ve = qdot.segment<kN>(e.first_coord);
-  const int n = w.element_end - w.element_begin, k = index - w.element_begin;
-  const double l = w.length / n, ldot = w.rate / n;
-  double power = 0;
-  if (w.alpha_1_s != 0) {
-    // -alpha int mu S^T v dx with the material velocity v = S edot + ldot W e.
-    const Eigen::Matrix4d& g = winch_g_[winch_slot_[index]];
-    for (int a = 0; a < 4; ++a) {
-      for (int d = 0; d < D; ++d) {
-        double p = 0;
-        for (int b = 0; b < 4; ++b) p += e.mbar(a, b) * ve(D * b + d) + ldot * g(a, b) * qe(D * b + d);
-        if (fe) (*fe)(D * a + d) -= w.alpha_1_s * p;
-        power += w.alpha_1_s * p * ve(D * a + d);
-        if (ce)
-          for (int b = 0; b < 4; ++b) (*ce)(D * a + d, D * b + d) += w.alpha_1_s * e.mbar(a, b);
-      }
-    }
-    // The power is alpha int mu |v|^2 = 2 alpha T: add ldot e^T G^T edot +
-    // ldot^2 e^T H e to the edot . (M edot + ldot G e) summed above.
-    const Eigen::Matrix4d& h = winch_h_[winch_slot_[index]];
-    for (int d = 0; d < D; ++d) {
-      for (int a = 0; a < 4; ++a) {
-        for (int b = 0; b < 4; ++b) {
-          power += w.alpha_1_s * ldot * qe(D * a + d) *
-                   (g(b, a) * ve(D * b + d) + ldot * h(a, b) * qe(D * b + d));
-        }
-      }
-    }
-  }
-  if (w.axial_damping_s != 0) {
-    // Kelvin-Voigt on the material strain rate u . d(r_s)/dt|_s.
-    static const GaussRule rule = MakeGaussRule(AncfCableElement<D>::kDefaultGaussPoints);
-    const double c = w.ea * w.axial_damping_s;
-    for (int gp = 0; gp < rule.n; ++gp) {
-      double d1[4], wd[4];
-      HermiteShapeD1(rule.xi[gp], l, d1);
-      WinchSlopeRateShape(rule.xi[gp], l, k, wd);
-      Eigen::Matrix<double, D, 1> u = Eigen::Matrix<double, D, 1>::Zero(), udot = u;
-      for (int a = 0; a < 4; ++a) {
-        u += d1[a] * qe.template segment<D>(D * a);
-        udot += d1[a] * ve.template segment<D>(D * a) + ldot * wd[a] * qe.template segment<D>(D * a);
-      }
-      const double wl = rule.weight[gp] * l, rate = u.dot(udot);
-      power += wl * c * rate * rate;
-      if (fe)
-        for (int a = 0; a < 4; ++a) fe->template segment<D>(D * a) -= (wl * c * rate * d1[a]) * u;
-      if (ce) {
-        const Eigen::Matrix<double, D, D> uu = u * u.transpose();
-        for (int a = 0; a < 4; ++a)
-          for (int b = 0; b < 4; ++b)
-            ce->template block<D, D>(D * a, D * b) += (wl * c * d1[a] * d1[b]) * uu;
-      }
-    }
-  }
-  return power;
-}
-
-template <int D>
-double MultibodyModel::WinchForces(const VectorXd& q, const VectorXd& qdot, VectorXd* full,
-                                   SkylineLdlt* tangent, double tangent_scale,
-                                   VectorXd* roundoff) const {
-  constexpr int kN = 4 * D, kN2 = kN * kN;
-  const auto& elements = Elements<D>();
-  typename AncfCableElement<D>::Coords fe;
-  typename AncfCableElement<D>::Matrix ce;
-  double size = 0;
-  for (const WinchData& w : winches_) {
-    for (int index = w.element_begin; index < w.element_end; ++index) {
-      const int slot = winch_slot_[index];
-      const ElementData<D>& e = elements[index];
-      const auto qe = q.segment<kN>(e.first_coord);
-      const auto ve = qdot.segment<kN>(e.first_coord);
-      const Eigen::Matrix4d& cv = winch_cv_[slot];
-      const Eigen::Matrix4d& cx = winch_ce_[slot];
-      // The convective force -cv edot - ce e; Newton takes Mdot (the
-      // symmetric part of cv).
-      fe.setZero();
-      ce.setZero();
-      for (int a = 0; a < 4; ++a) {
-        for (int d = 0; d < D; ++d) {
-          double f = 0, abs_sum = 0;
-          for (int b = 0; b < 4; ++b) {
-            const double tv = cv(a, b) * ve(D * b + d), te = cx(a, b) * qe(D * b + d);
-            f -= tv + te;
-            abs_sum += std::abs(tv) + std::abs(te);
-            ce(D * a + d, D * b + d) = winch_mdot_[slot](a, b);
-          }
-          fe(D * a + d) = f;
-          if (roundoff) (*roundoff)(e.first_coord + D * a + d) += kSumRounding * abs_sum;
-        }
-      }
-      WinchDamping<D>(w, index, q, qdot, &fe, tangent ? &ce : nullptr);
-      full->segment<kN>(e.first_coord) += fe;
-      size = std::max(size, fe.template lpNorm<Eigen::Infinity>());
-      if (roundoff)
-        roundoff->segment<kN>(e.first_coord).noalias() += kSumRounding * fe.cwiseAbs();
-      if (!tangent) continue;
-      const int* slots = &element_slots_[kN2 * index];
-      const double* factors = &element_factors_[kN2 * index];
-      for (int t = 0; t < kN2; ++t)
-        if (slots[t] >= 0) tangent->values()[slots[t]] += tangent_scale * factors[t] * ce(t / kN, t % kN);
-    }
-  }
-  return size;
-}
-
-double MultibodyModel::CableMass(int cable) const {
-  double mass = 0;
-  auto sum = [&](const auto& elements) {
-    for (int k = cable_element_begin_[cable]; k < cable_element_begin_[cable + 1]; ++k) {
-      const Eigen::Matrix4d& m = elements[k].mbar;
-      mass += m(0, 0) + m(0, 2) + m(2, 0) + m(2, 2);
-    }
-  };
-  if (dim_ == 2) {
-    sum(elements2_);
-  } else {
-    sum(elements3_);
-  }
-  return mass;
-}
-
-template <int D>
-Eigen::Vector3d MultibodyModel::WinchTension(const VectorXd& q, int w) const {
-  const ElementData<D>& e = Elements<D>()[winches_[w].element_end - 1];
-  const Eigen::Matrix<double, D, 1> u =
-      e.element.Slope(q.segment<4 * D>(e.first_coord), 1.0);
-  Eigen::Vector3d f = Eigen::Vector3d::Zero();
-  f.head<D>() = winches_[w].ea * 0.5 * (u.squaredNorm() - 1) * u;
-  return f;
-}
-
-template <int D>
-void MultibodyModel::ElementEnergy(const VectorXd& q, const VectorXd& qdot, EnergySample* en,
-                                   EnergyParts* parts) const {
-  constexpr int kN = 4 * D;
-  const auto& elements = Elements<D>();
-  // The totals are summed element by element, the parts apart (so the
-  // parts' sums check the totals, and the totals are those of a run
-  // without parts, bit for bit).
-  size_t cable = 0;
-  for (size_t k = 0; k < elements.size(); ++k) {
-    const ElementData<D>& e = elements[k];
-    const auto qe = q.segment<kN>(e.first_coord);
-    const auto ve = qdot.segment<kN>(e.first_coord);
-    // T = 1/2 ve^T (mbar (x) I_D) ve, from the element's 4 x 4 scalar mass
-    // matrix (not its full mass matrix, rebuilt by quadrature each call).
-    double kinetic = 0;
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
-        kinetic += e.mbar(a, b) * ve.template segment<D>(D * a).dot(ve.template segment<D>(D * b));
-    kinetic *= 0.5;
-    const auto se = e.element.StrainEnergy(qe);
-    en->kinetic += kinetic;
-    en->axial += se.axial;
-    en->bending += se.bending;
-    if (seabed_) en->contact += seabed_->Energy<D>(qe, e.element.length());
-    if (!sheaves_.empty()) {
-      for (uint64_t bits = sheave_mask_[k]; bits != 0; bits &= bits - 1) {
-        const Sheave& wheel = sheaves_[std::countr_zero(bits)];
-        if (wheel.body() >= 0) {
-          Eigen::Matrix<double, 5 * D, 1> x;
-          x << qe, q.segment<D>(bodies_[wheel.body()].coord);
-          en->contact += wheel.AddPotentialOnBody<D>(x, e.element.length(), nullptr, nullptr);
-        } else {
-          en->contact += wheel.Energy<D>(qe, e.element.length());
-        }
-      }
-    }
-    if (parts == nullptr) continue;
-    while (static_cast<int>(k) >= cable_element_begin_[cable + 1]) ++cable;
-    PartEnergy* part = &parts->cables[cable];
-    part->kinetic += kinetic;
-    part->axial += se.axial;
-    part->bending += se.bending;
-    // Element gravity is exactly -Q_g . e (MODEL.md section 2).
-    part->gravity -= e.gravity.dot(qe);
-  }
-}
-
-EnergySample MultibodyModel::Energy(const VectorXd& q, const VectorXd& qdot, double load_factor,
-                                    EnergyParts* parts) const {
-  EnergySample en;
-  if (parts != nullptr) {
-    parts->cables.assign(cable_names_.size(), PartEnergy());
-    parts->bodies.assign(bodies_.size(), PartEnergy());
-  }
-  if (dim_ == 2) {
-    ElementEnergy<2>(q, qdot, &en, parts);
-  } else {
-    ElementEnergy<3>(q, qdot, &en, parts);
-  }
-  const int D = dim_;
-  for (size_t i = 0; i < bodies_.size(); ++i) {
-    const BodyData& b = bodies_[i];
-    double translation = 0.5 * b.mass * qdot.segment(b.coord, D).squaredNorm();
-    if (b.has_added_mass) {
-      for (int i = 0; i < D; ++i)
-        for (int k = 0; k < D; ++k)
-          translation += 0.5 * b.added_mass(i, k) * qdot(b.coord + i) * qdot(b.coord + k);
-    }
-    en.kinetic += translation;
-    double kinetic = translation;
-    const int axes = D == 2 ? 1 : 3;
-    for (int k = 0; k < axes; ++k) {
-      const double rotation = 0.5 * b.jbar(k) * qdot.segment(b.coord + D + D * k, D).squaredNorm();
-      en.kinetic += rotation;
-      kinetic += rotation;
-    }
-    if (parts != nullptr) {
-      PartEnergy& part = parts->bodies[i];
-      part.kinetic = kinetic;
-      part.gravity = -load_factor * b.mass * gravity_.head(D).dot(q.segment(b.coord, D));
-    }
-  }
-  // Gravity and point loads are constant forces on q: V = -F . q. Element
-  // gravity is exactly -Q_g . e (MODEL.md section 2).
-  en.potential = -load_factor * constant_force_.dot(q);
-  // Torques, time-varying loads, moving supports: their work so far
-  // (AccumulateExternalWork).
-  en.potential -= external_work_;
-  // Sliding joints: their penalty energy (counted with the loads' part).
-  double slider_energy = 0;
-  for (const SlidingJoint& slider : sliders_) slider_energy += slider.Penalty(q, nullptr, false);
-  en.potential += slider_energy;
-  if (!body_contacts_.empty())
-    en.contact += dim_ == 2 ? BodyContactTerms<2>(ContactTerm::kPotential, q, nullptr, nullptr,
-                                                  nullptr, 0, nullptr, nullptr)
-                            : BodyContactTerms<3>(ContactTerm::kPotential, q, nullptr, nullptr,
-                                                  nullptr, 0, nullptr, nullptr);
-  // Bodies' hydrostatic buoyancy: its potential, with the loads.
-  double buoyancy_energy = 0;
-  for (const BodyFluidLoad& b : body_fluid_) buoyancy_energy += b.HydrostaticEnergy(q, load_factor);
-  en.potential += buoyancy_energy;
-  en.total = en.kinetic + en.potential + en.axial + en.bending + en.contact;
-  if (parts != nullptr) {
-    // The element gravity above is at load factor 1 (statics scales it).
-    for (PartEnergy& part : parts->cables) part.gravity *= load_factor;
-    parts->loads = slider_energy + buoyancy_energy - external_work_;
-    if (load_force_.size() > 0) parts->loads -= load_factor * load_force_.dot(q);
-  }
-  return en;
-}
-
 void MultibodyModel::AccumulateExternalWork(const VectorXd& q_before, const VectorXd& q_after,
                                             double t_before, double t_after,
                                             const VectorXd& lambda_before,
                                             const VectorXd& lambda_after, double load_factor) {
-  for (const VaryingForce& l : varying_forces_) {
-    const Vector3d mean = 0.5 * (Evaluate(l.force, t_before) + Evaluate(l.force, t_after));
-    for (int d = 0; d < dim_; ++d)
-      for (const ProbeTerm& t : l.point[d])
-        external_work_ += load_factor * mean(d) * t.coeff * (q_after(t.coord) - q_before(t.coord));
+  // Contributors' work (torques, time-varying loads).
+  if (has_step_work_) {
+    const StepEnds ends{&q_before, &q_after, t_before, t_after, load_factor};
+    for (const auto& c : contributors_) c->AddStepWork(ends, &external_work_);
   }
-  for (const MovingRow& m : moving_rows_) {
-    const double lambda = 0.5 * (lambda_before(m.row) + lambda_after(m.row));
-    external_work_ -= lambda * (m.motion(t_after) - m.motion(t_before));
-  }
-  for (const TurningRow& r : turning_rows_) {
-    const double lambda = 0.5 * (lambda_before(r.row) + lambda_after(r.row));
-    const Vector3d dn = r.Normal(t_after) - r.Normal(t_before);
-    external_work_ += lambda * 0.5 *
-                      (DotAt(dn, q_before, r.coord, dim_) + DotAt(dn, q_after, r.coord, dim_));
-  }
-  for (const TorqueLoad& tl : torques_) {
-    const Vector3d torque =
-        tl.is_varying
-            ? Vector3d(tl.base + 0.5 * (Evaluate(tl.varying, t_before) +
-                                        Evaluate(tl.varying, t_after)))
-            : tl.torque;
-    const int c = bodies_[tl.body].coord;
-    if (dim_ == 2) {
-      // Exact for a constant torque: T_z times the angle turned.
-      const Eigen::Vector2d u0 = q_before.segment<2>(c + 2), u1 = q_after.segment<2>(c + 2);
-      external_work_ += load_factor * torque.z() *
-                      std::atan2(u0.x() * u1.y() - u0.y() * u1.x(), u0.dot(u1));
-    } else {
-      // T . phi with phi the rotation vector of the step (exact when the
-      // rotation axis is fixed over the step, second order otherwise).
-      Eigen::Matrix3d before, after;
-      for (int k = 0; k < 3; ++k) {
-        before.col(k) = q_before.segment<3>(c + 3 + 3 * k);
-        after.col(k) = q_after.segment<3>(c + 3 + 3 * k);
-      }
-      const Eigen::AngleAxisd delta(Eigen::Matrix3d(after * before.transpose()));
-      external_work_ += load_factor * torque.dot(delta.angle() * delta.axis());
-    }
-  }
-}
-
-template <int D>
-Eigen::Vector3d MultibodyModel::ElementAngularMomentum(const VectorXd& q,
-                                                      const VectorXd& qdot) const {
-  Vector3d l = Vector3d::Zero();
-  for (const ElementData<D>& e : Elements<D>()) {
-    for (int a = 0; a < 4; ++a) {
-      Vector3d ra = Vector3d::Zero();
-      ra.head<D>() = q.segment<D>(e.first_coord + D * a);
-      for (int b = 0; b < 4; ++b) {
-        Vector3d vb = Vector3d::Zero();
-        vb.head<D>() = qdot.segment<D>(e.first_coord + D * b);
-        l += e.mbar(a, b) * ra.cross(vb);
-      }
-    }
-  }
-  return l;
-}
-
-Eigen::Vector3d MultibodyModel::AngularMomentum(const VectorXd& q, const VectorXd& qdot) const {
-  Vector3d l = dim_ == 2 ? ElementAngularMomentum<2>(q, qdot) : ElementAngularMomentum<3>(q, qdot);
-  const int D = dim_;
-  auto vec = [D](const VectorXd& x, int i) {
-    Vector3d v = Vector3d::Zero();
-    v.head(D) = x.segment(i, D);
-    return v;
-  };
-  for (const BodyData& b : bodies_) {
-    l += b.mass * vec(q, b.coord).cross(vec(qdot, b.coord));
-    if (D == 2) {
-      // Both axes u and perp(u) carry Jb_x + Jb_y = I_z: I_z u x udot.
-      l += b.jbar(0) * vec(q, b.coord + 2).cross(vec(qdot, b.coord + 2));
-    } else {
-      for (int k = 0; k < 3; ++k)
-        l += b.jbar(k) * vec(q, b.coord + 3 + 3 * k).cross(vec(qdot, b.coord + 3 + 3 * k));
-    }
-  }
-  return l;
-}
-
-template <int D>
-Eigen::Vector3d MultibodyModel::CablePositionOf(const VectorXd& q, int cable, double s,
-                                                Vector3d* slope) const {
-  constexpr int kN = 4 * D;
-  const auto& elements = Elements<D>();
-  Vector3d r = Vector3d::Zero();
-  const int begin = cable_element_begin_[cable], end = cable_element_begin_[cable + 1];
-  double start = 0;
-  for (int k = begin; k < end; ++k) {
-    const ElementData<D>& e = elements[k];
-    const double l = e.element.length();
-    if (s <= start + l || k + 1 == end) {
-      const double xi = std::clamp((s - start) / l, 0.0, 1.0);
-      r.head<D>() = e.element.Position(q.segment<kN>(e.first_coord), xi);
-      if (slope) {
-        slope->setZero();
-        slope->head<D>() = e.element.Slope(q.segment<kN>(e.first_coord), xi);
-      }
-      return r;
-    }
-    start += l;
-  }
-  return r;
-}
-
-Eigen::Vector3d MultibodyModel::CablePosition(const VectorXd& q, int cable, double s,
-                                              Vector3d* slope) const {
-  return dim_ == 2 ? CablePositionOf<2>(q, cable, s, slope)
-                   : CablePositionOf<3>(q, cable, s, slope);
-}
-
-void MultibodyModel::NodePositions(const VectorXd& q, std::vector<Vector3d>* out) const {
-  out->resize(shape_coord_.size());
-  for (size_t k = 0; k < shape_coord_.size(); ++k) {
-    Vector3d& r = (*out)[k];
-    r.setZero();
-    r.head(dim_) = q.segment(shape_coord_[k], dim_);
-  }
-}
-
-void MultibodyModel::Probes(const VectorXd& q, const VectorXd& qdot, const VectorXd& qddot,
-                            std::vector<ProbeSample>* out) const {
-  out->resize(probe_names_.size());
-  for (size_t p = 0; p < probe_names_.size(); ++p) {
-    ProbeSample& s = (*out)[p];
-    for (int d = 0; d < 3; ++d) {
-      const int r = 3 * static_cast<int>(p) + d;
-      double x = probe_const_[r], v = 0, a = 0;
-      for (int k = probe_term_begin_[r]; k < probe_term_begin_[r + 1]; ++k) {
-        const ProbeTerm& t = probe_terms_[k];
-        x += t.coeff * q(t.coord);
-        v += t.coeff * qdot(t.coord);
-        a += t.coeff * qddot(t.coord);
-      }
-      s.position_m(d) = x;
-      s.velocity_m_s(d) = v;
-      s.acceleration_m_s2(d) = a;
-    }
-  }
-}
-
-}  // namespace cablesim
-
-namespace cablesim {
-
-void MultibodyModel::ProbeForces(const VectorXd& q, const VectorXd& lambda,
-                                 std::vector<Eigen::Vector3d>* out) const {
-  out->resize(force_probes_.size());
-  for (size_t k = 0; k < force_probes_.size(); ++k) {
-    Eigen::Vector3d& force = (*out)[k];
-    force.setZero();
-    if (!probe_winch_.empty() && probe_winch_[force_probes_[k]] >= 0) {
-      const int w = probe_winch_[force_probes_[k]];
-      force = dim_ == 2 ? WinchTension<2>(q, w) : WinchTension<3>(q, w);
-      continue;
-    }
-    for (int d = 0; d < 3; ++d) {
-      const int row = probe_force_rows_[force_probes_[k]][d];
-      if (row >= 0) force(d) = -lambda(row);
-    }
-  }
+  // Rheonomic rows' work (moving and turning supports).
+  const ConstraintStep step{&q_before, &q_after, t_before, t_after, &lambda_before, &lambda_after};
+  for (const ConstraintFamily* f : families_) f->AddStepWork(step, &external_work_);
 }
 
 }  // namespace cablesim

@@ -41,18 +41,27 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "absl/status/statusor.h"
 #include "engine/elements/ancf_cable_element.h"
+#include "engine/forces/applied_loads.h"
+#include "engine/forces/body_damping.h"
 #include "engine/forces/body_fluid_load.h"
+#include "engine/forces/body_seabed_contact.h"
+#include "engine/forces/force_contributor.h"
 #include "engine/forces/seabed.h"
 #include "engine/forces/sheave.h"
 #include "engine/forces/wave_load.h"
+#include "engine/constraints/constraint.h"
+#include "engine/constraints/joint_rows.h"
+#include "engine/constraints/prescribed_motion.h"
 #include "engine/constraints/quadratic_form.h"
 #include "engine/scene/run_control.h"
 #include "engine/scene/scene.h"
@@ -84,7 +93,7 @@ class MultibodyModel {
   int dimension() const { return dim_; }
   int coordinates() const { return static_cast<int>(c_.size()); }
   int dofs() const { return dofs_; }
-  int multipliers() const { return static_cast<int>(rows_.size()); }
+  int multipliers() const { return joint_rows_->size(); }
   int elements() const { return static_cast<int>(elements2_.size() + elements3_.size()); }
   // Nodes of the mesh; a node split where a cable without bending
   // stiffness kinks (ModelBuilder::MeshCables) counts once.
@@ -238,8 +247,7 @@ class MultibodyModel {
   //    (second order; the moving support's formula is its case Phi_t =
   //    -d').
   bool has_external_work() const {
-    return !torques_.empty() || !varying_forces_.empty() || !moving_rows_.empty() ||
-           !turning_rows_.empty();
+    return has_step_work_ || motion_ != nullptr;
   }
   void AccumulateExternalWork(const Eigen::VectorXd& q_before, const Eigen::VectorXd& q_after,
                               double t_before, double t_after,
@@ -274,15 +282,15 @@ class MultibodyModel {
   // hydrostatic part in NetForce (scaled with gravity by the load factor,
   // its energy in the loads' part), the drag, inertia and wave buoyancy in
   // DampingForce (their work in the damping power).
-  const std::vector<BodyFluidLoad>& body_fluid_loads() const { return body_fluid_; }
+  const std::vector<BodyFluidLoad>& body_fluid_loads() const;
 
   // The scene's seabed (engine/forces/seabed.h), or null: a scene without
   // one holds no seabed object, and its force loops only test this.
-  const Seabed* seabed() const { return seabed_ ? &*seabed_ : nullptr; }
+  const Seabed* seabed() const { return cable_seabed_ ? &cable_seabed_->bed() : nullptr; }
 
   // Bodies with seabed contact points (BodySpec::contact_points_m): their
   // count. A scene without any holds none and its loops only test this.
-  int body_contacts() const { return static_cast<int>(body_contacts_.size()); }
+  int body_contacts() const { return body_contact_ ? body_contact_->count() : 0; }
 
   // STATIC analyses only: the seabed's static friction (Seabed::
   // AddStaticFriction, on cables and body contact points) at full q,
@@ -295,7 +303,7 @@ class MultibodyModel {
   void StaticFriction(const Eigen::VectorXd& q, const Eigen::VectorXd& q_start,
                         Eigen::VectorXd* f, SkylineLdlt* matrix, double scale);
   // Whether frames carry energy.contact (a seabed or sheaves).
-  bool has_contact() const { return seabed_.has_value() || !sheaves_.empty(); }
+  bool has_contact() const { return has_element_contact_ || !sheaves_.empty(); }
 
   // The scene's sheaves (engine/forces/sheave.h), none in most scenes.
   const std::vector<Sheave>& sheaves() const { return sheaves_; }
@@ -325,8 +333,20 @@ class MultibodyModel {
   // Sliding joints (SlidingJoint, a penalty force): their number, and
   // where each slider is now, its arc length on its cable [m] as of the
   // last evaluation.
-  int sliders() const { return static_cast<int>(sliders_.size()); }
-  double SliderArcLength(int i) const { return sliders_[i].s(); }
+  int sliders() const { return sliders_ ? sliders_->count() : 0; }
+  double SliderArcLength(int i) const { return sliders_->slider(i).s(); }
+
+  // The force contributors the scene uses (engine/forces/force_contributor.h),
+  // in the order the model sums them.
+  const std::vector<std::unique_ptr<ForceContributor>>& contributors() const {
+    return contributors_;
+  }
+  // The per-element force terms the scene uses (ElementTerm).
+  const std::vector<std::unique_ptr<ElementTerm>>& element_terms() const {
+    return element_terms_;
+  }
+  // The contributor called `name`, or null.
+  const ForceContributor* FindContributor(std::string_view name) const;
 
   // Winches (WinchSpec, docs/model.md "Winches"): an axially moving mesh
   // on each winch cable, whose N elements all have the length L(t) / N, so
@@ -349,7 +369,15 @@ class MultibodyModel {
 
   // Which joint a constraint row belongs to (for messages), or -1 for a
   // body's own axis constraints.
-  int RowJoint(int row) const { return rows_[row].joint; }
+  int RowJoint(int row) const { return joint_rows_->row(row).joint; }
+
+  // The map q = c + S z as contributors and constraint families see it.
+  CoordinateMap Map() const { return CoordinateMap{j_.data(), s_.data(), dim_}; }
+
+  // The constraint families the scene uses (engine/constraints/constraint.h).
+  const std::vector<const ConstraintFamily*>& constraint_families() const {
+    return families_view_;
+  }
 
  private:
   // Build's steps fill in the members below.
@@ -379,78 +407,15 @@ class MultibodyModel {
     int coord = 0;  // full index of r_c
     double mass = 0;
     Eigen::Vector3d jbar = Eigen::Vector3d::Zero();  // per axis [kg m^2]
-    double linear_damping = 0;   // [N s/m]
-    double angular_damping = 0;  // [N m s/rad]
     // The fluid's added mass on r_c (BodyFluidLoad::AddedMass) [kg], in the
     // mass matrix and the kinetic energy; only with has_added_mass.
     bool has_added_mass = false;
     Eigen::Matrix3d added_mass = Eigen::Matrix3d::Zero();
   };
-  // A body's seabed contact points (BodySpec): body frame [m], spring k
-  // [N/m], damper c [N s/m], friction mu [-] per point.
-  struct BodyContact {
-    int coord = 0;  // full index of the body's r_c
-    std::vector<Eigen::Vector3d> points;
-    double k = 0, c = 0, mu = 0;
-  };
-  enum class ContactTerm { kPotential, kDissipation, kStaticFriction };
-  // The body contact points' terms: kPotential (at q: returns U, adds the
-  // force -dU/dq to `full` and its Hessian to `a`), kDissipation (`other`
-  // the rate: returns the power, adds the force and its velocity tangent),
-  // kStaticFriction (`other` the start: returns 0). Each
-  // point r = B q_b is linear in its body's coordinates q_b, so the
-  // generalized force is B^T f and the matrix B^T H B, within the body's
-  // own block of the envelope. `size` (when not null) gets the largest
-  // force entry; `roundoff` a bound of the rounding (kPotential).
-  template <int D>
-  double BodyContactTerms(ContactTerm term, const Eigen::VectorXd& q,
-                          const Eigen::VectorXd* other, Eigen::VectorXd* full, SkylineLdlt* a,
-                          double scale, Eigen::VectorXd* roundoff, double* size) const;
-  // A torque load on a body [N m]: torque = base + varying(t).
-  struct TorqueLoad {
-    int body = 0;
-    Eigen::Vector3d torque = Eigen::Vector3d::Zero();
-    Eigen::Vector3d base = Eigen::Vector3d::Zero();
-    TimeVector varying;
-    bool is_varying = false;
-  };
   // A flat linear form sum coeff * q[coord].
   struct ProbeTerm {
     int coord = 0;
     double coeff = 0;
-  };
-  // A time-varying force at a point: per component d, the point's linear
-  // form (the generalized force is F_d coeff on q[coord]).
-  struct VaryingForce {
-    std::array<std::vector<ProbeTerm>, 3> point;
-    TimeVector force;
-    Eigen::Vector3d value = Eigen::Vector3d::Zero();  // force(time_)
-  };
-  // A constraint row of a moving support: c = c0 - motion(t).
-  struct MovingRow {
-    int row = 0;
-    int joint = 0, axis = 0;  // scene joint and component of its motion
-    double c0 = 0;
-    TimeFunction motion;
-    double rate = 0, accel = 0;  // motion' and motion'' at time_
-  };
-  // A direction row of a turning support: n(t) . x = 0, x the D
-  // coordinates from full index `coord` (a clamped slope or a body axis),
-  // n(t) = R(angle(t)) n0 with R the rotation about the unit `axis`.
-  // SetTime writes n(t) into the row's linear coefficients, so Constraints
-  // and the Jacobian need nothing else; Phi_t = n' . x and Phi_tt = n'' . x
-  // enter the initial velocity and ConstraintGamma.
-  struct TurningRow {
-    int row = 0;
-    int coord = 0;
-    Eigen::Vector3d n0 = Eigen::Vector3d::Zero(), axis = Eigen::Vector3d::UnitZ();
-    TimeFunction angle;
-    Eigen::Vector3d n = Eigen::Vector3d::Zero(), rate = Eigen::Vector3d::Zero(),
-                    accel = Eigen::Vector3d::Zero();  // n, n', n'' at time_
-    // n at time t (Rodrigues' formula); with `rate` and `accel` not null,
-    // also n' = angle' a x n and n'' = angle'' a x n + angle'^2 a x (a x n).
-    Eigen::Vector3d Normal(double t, Eigen::Vector3d* rate = nullptr,
-                           Eigen::Vector3d* accel = nullptr) const;
   };
   // A winch (WinchSpec) on a cable.
   struct WinchData {
@@ -465,19 +430,6 @@ class MultibodyModel {
     // damping is then 0.
     double axial_damping_s = 0, alpha_1_s = 0;
   };
-  // Constraint rows as flat quadratic forms over local coordinate lists:
-  // phi = c + sum lin_val * q[coord[lin_local]] + sum w q[coord[a]] q[coord[b]].
-  struct Row {
-    int joint = -1;  // scene joint, or -1 for a body's own axis constraint
-    int body = -1;   // the body of an axis constraint
-    enum Kind { kPosition, kDirection, kSlope, kAxes } kind = kPosition;
-    double c = 0;
-    int coord_begin = 0, coord_end = 0;  // into row_coord_
-    int lin_begin = 0, lin_end = 0;      // into lin_local_, lin_value_
-    int mono_begin = 0, mono_end = 0;    // into mono_a_, mono_b_, mono_w_
-  };
-  static constexpr int kMaxRowCoords = 48;
-
   template <int D>
   double ElementForces(const Eigen::VectorXd& q, Eigen::VectorXd* full, SkylineLdlt* stiffness,
                        double stiffness_scale, Eigen::VectorXd* roundoff) const;
@@ -488,8 +440,6 @@ class MultibodyModel {
   double ElementDamping(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
                         Eigen::VectorXd* full, SkylineLdlt* tangent, double tangent_scale,
                         Eigen::VectorXd* roundoff, double* power) const;
-  // Per body coordinate the damping coefficient c_i of its force -c_i qdot_i.
-  double BodyDampingCoefficient(const BodyData& b, int k) const;
   template <int D>
   void ElementEnergy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, EnergySample* en,
                      EnergyParts* parts) const;
@@ -499,10 +449,6 @@ class MultibodyModel {
   template <int D>
   Eigen::Vector3d ElementAngularMomentum(const Eigen::VectorXd& q,
                                          const Eigen::VectorXd& qdot) const;
-  double RowValue(const Row& row, const Eigen::VectorXd& q) const;
-  // Local gradient of a row: grad[k] for coordinate row_coord_[begin + k].
-  void RowGradient(const Row& row, const Eigen::VectorXd& q, double* grad) const;
-  void AddRow(const QuadraticForm& f, Row::Kind kind, int joint, int body);
   // Adds a slider's local force to the full vector `full` (and its rounding
   // to `roundoff`) and scale times its matrix, mapped onto z, to `a`.
   // A wheel carried by a body (Sheave::body() >= 0) on the element whose
@@ -520,9 +466,11 @@ class MultibodyModel {
                            double scale) const;
   void ScatterSlider(const SlidingJoint::Local& local, Eigen::VectorXd* full, Eigen::VectorXd* roundoff,
                      double scale, SkylineLdlt* a) const;
-  // Adds scale times the D x D block m on body coordinates from full index
-  // `coord` (its centre of mass), mapped onto z, to `a`.
-  void ScatterBodyBlock(int coord, const Eigen::Matrix3d& m, double scale, SkylineLdlt* a) const;
+  // The state contributors are evaluated at (time_ and the wave field).
+  ForceState StateAt(const Eigen::VectorXd& q, const Eigen::VectorXd* qdot,
+                     double load_factor) const {
+    return ForceState{&q, qdot, load_factor, time_, wave_field()};
+  }
   const WaveField* wave_field() const { return wave_load_ ? &wave_load_->field() : nullptr; }
   void ProjectInitialVelocity();
   // SetTime's share for the winches: lengths, elements, mass, gravity and
@@ -583,7 +531,6 @@ class MultibodyModel {
   std::vector<ElementData<2>> elements2_;
   std::vector<ElementData<3>> elements3_;
   std::vector<BodyData> bodies_;
-  std::vector<TorqueLoad> torques_;
   Eigen::VectorXd constant_force_;  // full: gravity and point loads
   // Full: the point loads alone (empty without any), for EnergyParts::loads.
   Eigen::VectorXd load_force_;
@@ -600,8 +547,12 @@ class MultibodyModel {
   double energy_roundoff_ = 0;
   bool has_damping_ = false;
   Eigen::Vector3d current_ = Eigen::Vector3d::Zero();  // the fluid's [m/s]
-  std::optional<Seabed> seabed_;  // only in a scene with a seabed
-  std::vector<BodyContact> body_contacts_;  // only bodies with contact points
+  // The per-element force terms the scene uses (ElementTerm; none in
+  // most scenes), summed in this order inside the element loops; whether
+  // any dissipates or stores contact energy; the cable seabed's typed view.
+  std::vector<std::unique_ptr<ElementTerm>> element_terms_;
+  bool element_terms_dissipate_ = false, has_element_contact_ = false;
+  const CableSeabed* cable_seabed_ = nullptr;
   // Scratch (full size) for StaticFriction (sized on first use).
   Eigen::VectorXd scratch_static_;
   // Sheaves, and per element the bit set of those that touch its cable
@@ -614,20 +565,21 @@ class MultibodyModel {
   StopPoll* stop_poll_ = nullptr;
   // Counts `units` of work on the stop poll; true when the run should stop.
   bool StopNow(int64_t units) const { return stop_poll_ != nullptr && stop_poll_->Poll(units); }
-  // The fluid's loads on bodies that ask for them (empty in most scenes:
-  // then nothing is evaluated).
-  std::vector<BodyFluidLoad> body_fluid_;
+  // The force contributors the scene uses (none in most scenes), summed in
+  // this order; and typed views of some of them for the accessors above.
+  std::vector<std::unique_ptr<ForceContributor>> contributors_;
+  const BodyFluidForces* body_fluid_ = nullptr;
+  const BodySeabedContact* body_contact_ = nullptr;
+  const SlidingJoints* sliders_ = nullptr;
+  bool has_step_work_ = false;  // a contributor whose work is summed per step
 
-  std::vector<Row> rows_;
-  std::vector<int> row_coord_;
-  std::vector<int> lin_local_;
-  std::vector<double> lin_value_;
-  std::vector<int> mono_a_, mono_b_;
-  std::vector<double> mono_w_;
-  // Per monomial: the (row >= col) entry of its Hessian on z (or -1) and
-  // its factor.
-  std::vector<int> mono_row_, mono_col_;
-  std::vector<double> mono_factor_;
+  // The constraint families: the joints' rows (always, possibly none) and
+  // the supports' time law (only with moving or turning supports); the
+  // families the scene uses, in the order they are summed.
+  std::unique_ptr<JointRows> joint_rows_ = std::make_unique<JointRows>();
+  std::unique_ptr<PrescribedMotion> motion_;
+  std::vector<ConstraintFamily*> families_;
+  std::vector<const ConstraintFamily*> families_view_;
 
   // Probes: per probe and component d < 3, a linear form over q (as flat
   // term lists); velocity and acceleration use the same coefficients.
@@ -659,13 +611,8 @@ class MultibodyModel {
   // Time dependence.
   double time_ = 0;
   bool time_dependent_ = false;
-  std::vector<MovingRow> moving_rows_;
-  std::vector<TurningRow> turning_rows_;
-  std::vector<VaryingForce> varying_forces_;
   // Work done by torques, time-varying loads and moving supports so far [J].
   double external_work_ = 0;
-  // Sliding joints (empty in most scenes: then nothing is evaluated).
-  std::vector<SlidingJoint> sliders_;
   // Winches (empty in most scenes: then nothing is evaluated).
   std::vector<WinchData> winches_;
   // Per winch element (winch by winch, along each cable): the convective

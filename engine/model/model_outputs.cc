@@ -1,0 +1,253 @@
+// MultibodyModel's reports on a state (multibody_model.h): energy (in
+// total and per part), angular momentum, cable positions, node positions,
+// probes and the forces force probes report.
+
+#include "engine/model/multibody_model.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Dense>
+#include <Eigen/Geometry>
+
+#include <bit>
+
+namespace cablesim {
+
+using Eigen::Vector3d;
+using Eigen::VectorXd;
+
+template <int D>
+void MultibodyModel::ElementEnergy(const VectorXd& q, const VectorXd& qdot, EnergySample* en,
+                                   EnergyParts* parts) const {
+  constexpr int kN = 4 * D;
+  const auto& elements = Elements<D>();
+  // The totals are summed element by element, the parts apart (so the
+  // parts' sums check the totals, and the totals are those of a run
+  // without parts, bit for bit).
+  size_t cable = 0;
+  for (size_t k = 0; k < elements.size(); ++k) {
+    const ElementData<D>& e = elements[k];
+    const auto qe = q.segment<kN>(e.first_coord);
+    const auto ve = qdot.segment<kN>(e.first_coord);
+    // T = 1/2 ve^T (mbar (x) I_D) ve, from the element's 4 x 4 scalar mass
+    // matrix (not its full mass matrix, rebuilt by quadrature each call).
+    double kinetic = 0;
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b)
+        kinetic += e.mbar(a, b) * ve.template segment<D>(D * a).dot(ve.template segment<D>(D * b));
+    kinetic *= 0.5;
+    const auto se = e.element.StrainEnergy(qe);
+    en->kinetic += kinetic;
+    en->axial += se.axial;
+    en->bending += se.bending;
+    for (const auto& t : element_terms_)
+      en->contact += t->Energy(ElementCoords<D>(qe), e.element.length());
+    if (!sheaves_.empty()) {
+      for (uint64_t bits = sheave_mask_[k]; bits != 0; bits &= bits - 1) {
+        const Sheave& wheel = sheaves_[std::countr_zero(bits)];
+        if (wheel.body() >= 0) {
+          Eigen::Matrix<double, 5 * D, 1> x;
+          x << qe, q.segment<D>(bodies_[wheel.body()].coord);
+          en->contact += wheel.AddPotentialOnBody<D>(x, e.element.length(), nullptr, nullptr);
+        } else {
+          en->contact += wheel.Energy<D>(qe, e.element.length());
+        }
+      }
+    }
+    if (parts == nullptr) continue;
+    while (static_cast<int>(k) >= cable_element_begin_[cable + 1]) ++cable;
+    PartEnergy* part = &parts->cables[cable];
+    part->kinetic += kinetic;
+    part->axial += se.axial;
+    part->bending += se.bending;
+    // Element gravity is exactly -Q_g . e (MODEL.md section 2).
+    part->gravity -= e.gravity.dot(qe);
+  }
+}
+
+EnergySample MultibodyModel::Energy(const VectorXd& q, const VectorXd& qdot, double load_factor,
+                                    EnergyParts* parts) const {
+  EnergySample en;
+  if (parts != nullptr) {
+    parts->cables.assign(cable_names_.size(), PartEnergy());
+    parts->bodies.assign(bodies_.size(), PartEnergy());
+  }
+  if (dim_ == 2) {
+    ElementEnergy<2>(q, qdot, &en, parts);
+  } else {
+    ElementEnergy<3>(q, qdot, &en, parts);
+  }
+  const int D = dim_;
+  for (size_t i = 0; i < bodies_.size(); ++i) {
+    const BodyData& b = bodies_[i];
+    double translation = 0.5 * b.mass * qdot.segment(b.coord, D).squaredNorm();
+    if (b.has_added_mass) {
+      for (int i = 0; i < D; ++i)
+        for (int k = 0; k < D; ++k)
+          translation += 0.5 * b.added_mass(i, k) * qdot(b.coord + i) * qdot(b.coord + k);
+    }
+    en.kinetic += translation;
+    double kinetic = translation;
+    const int axes = D == 2 ? 1 : 3;
+    for (int k = 0; k < axes; ++k) {
+      const double rotation = 0.5 * b.jbar(k) * qdot.segment(b.coord + D + D * k, D).squaredNorm();
+      en.kinetic += rotation;
+      kinetic += rotation;
+    }
+    if (parts != nullptr) {
+      PartEnergy& part = parts->bodies[i];
+      part.kinetic = kinetic;
+      part.gravity = -load_factor * b.mass * gravity_.head(D).dot(q.segment(b.coord, D));
+    }
+  }
+  // Gravity and point loads are constant forces on q: V = -F . q. Element
+  // gravity is exactly -Q_g . e (MODEL.md section 2).
+  en.potential = -load_factor * constant_force_.dot(q);
+  // Torques, time-varying loads, moving supports: their work so far
+  // (AccumulateExternalWork).
+  en.potential -= external_work_;
+  // Contributors' stored energies, each in its bucket (the loads' part or
+  // contact).
+  double loads_energy = 0;
+  if (!contributors_.empty()) {
+    const ForceState state = StateAt(q, &qdot, load_factor);
+    for (const auto& c : contributors_) {
+      const double u = c->StoredEnergy(state);
+      if (c->bucket() == EnergyBucket::kContact) {
+        en.contact += u;
+      } else {
+        en.potential += u;
+        loads_energy += u;
+      }
+    }
+  }
+  en.total = en.kinetic + en.potential + en.axial + en.bending + en.contact;
+  if (parts != nullptr) {
+    // The element gravity above is at load factor 1 (statics scales it).
+    for (PartEnergy& part : parts->cables) part.gravity *= load_factor;
+    parts->loads = loads_energy - external_work_;
+    if (load_force_.size() > 0) parts->loads -= load_factor * load_force_.dot(q);
+  }
+  return en;
+}
+
+template <int D>
+Eigen::Vector3d MultibodyModel::ElementAngularMomentum(const VectorXd& q,
+                                                      const VectorXd& qdot) const {
+  Vector3d l = Vector3d::Zero();
+  for (const ElementData<D>& e : Elements<D>()) {
+    for (int a = 0; a < 4; ++a) {
+      Vector3d ra = Vector3d::Zero();
+      ra.head<D>() = q.segment<D>(e.first_coord + D * a);
+      for (int b = 0; b < 4; ++b) {
+        Vector3d vb = Vector3d::Zero();
+        vb.head<D>() = qdot.segment<D>(e.first_coord + D * b);
+        l += e.mbar(a, b) * ra.cross(vb);
+      }
+    }
+  }
+  return l;
+}
+
+Eigen::Vector3d MultibodyModel::AngularMomentum(const VectorXd& q, const VectorXd& qdot) const {
+  Vector3d l = dim_ == 2 ? ElementAngularMomentum<2>(q, qdot) : ElementAngularMomentum<3>(q, qdot);
+  const int D = dim_;
+  auto vec = [D](const VectorXd& x, int i) {
+    Vector3d v = Vector3d::Zero();
+    v.head(D) = x.segment(i, D);
+    return v;
+  };
+  for (const BodyData& b : bodies_) {
+    l += b.mass * vec(q, b.coord).cross(vec(qdot, b.coord));
+    if (D == 2) {
+      // Both axes u and perp(u) carry Jb_x + Jb_y = I_z: I_z u x udot.
+      l += b.jbar(0) * vec(q, b.coord + 2).cross(vec(qdot, b.coord + 2));
+    } else {
+      for (int k = 0; k < 3; ++k)
+        l += b.jbar(k) * vec(q, b.coord + 3 + 3 * k).cross(vec(qdot, b.coord + 3 + 3 * k));
+    }
+  }
+  return l;
+}
+
+template <int D>
+Eigen::Vector3d MultibodyModel::CablePositionOf(const VectorXd& q, int cable, double s,
+                                                Vector3d* slope) const {
+  constexpr int kN = 4 * D;
+  const auto& elements = Elements<D>();
+  Vector3d r = Vector3d::Zero();
+  const int begin = cable_element_begin_[cable], end = cable_element_begin_[cable + 1];
+  double start = 0;
+  for (int k = begin; k < end; ++k) {
+    const ElementData<D>& e = elements[k];
+    const double l = e.element.length();
+    if (s <= start + l || k + 1 == end) {
+      const double xi = std::clamp((s - start) / l, 0.0, 1.0);
+      r.head<D>() = e.element.Position(q.segment<kN>(e.first_coord), xi);
+      if (slope) {
+        slope->setZero();
+        slope->head<D>() = e.element.Slope(q.segment<kN>(e.first_coord), xi);
+      }
+      return r;
+    }
+    start += l;
+  }
+  return r;
+}
+
+Eigen::Vector3d MultibodyModel::CablePosition(const VectorXd& q, int cable, double s,
+                                              Vector3d* slope) const {
+  return dim_ == 2 ? CablePositionOf<2>(q, cable, s, slope)
+                   : CablePositionOf<3>(q, cable, s, slope);
+}
+
+void MultibodyModel::NodePositions(const VectorXd& q, std::vector<Vector3d>* out) const {
+  out->resize(shape_coord_.size());
+  for (size_t k = 0; k < shape_coord_.size(); ++k) {
+    Vector3d& r = (*out)[k];
+    r.setZero();
+    r.head(dim_) = q.segment(shape_coord_[k], dim_);
+  }
+}
+
+void MultibodyModel::Probes(const VectorXd& q, const VectorXd& qdot, const VectorXd& qddot,
+                            std::vector<ProbeSample>* out) const {
+  out->resize(probe_names_.size());
+  for (size_t p = 0; p < probe_names_.size(); ++p) {
+    ProbeSample& s = (*out)[p];
+    for (int d = 0; d < 3; ++d) {
+      const int r = 3 * static_cast<int>(p) + d;
+      double x = probe_const_[r], v = 0, a = 0;
+      for (int k = probe_term_begin_[r]; k < probe_term_begin_[r + 1]; ++k) {
+        const ProbeTerm& t = probe_terms_[k];
+        x += t.coeff * q(t.coord);
+        v += t.coeff * qdot(t.coord);
+        a += t.coeff * qddot(t.coord);
+      }
+      s.position_m(d) = x;
+      s.velocity_m_s(d) = v;
+      s.acceleration_m_s2(d) = a;
+    }
+  }
+}
+
+void MultibodyModel::ProbeForces(const VectorXd& q, const VectorXd& lambda,
+                                 std::vector<Eigen::Vector3d>* out) const {
+  out->resize(force_probes_.size());
+  for (size_t k = 0; k < force_probes_.size(); ++k) {
+    Eigen::Vector3d& force = (*out)[k];
+    force.setZero();
+    if (!probe_winch_.empty() && probe_winch_[force_probes_[k]] >= 0) {
+      const int w = probe_winch_[force_probes_[k]];
+      force = dim_ == 2 ? WinchTension<2>(q, w) : WinchTension<3>(q, w);
+      continue;
+    }
+    for (int d = 0; d < 3; ++d) {
+      const int row = probe_force_rows_[force_probes_[k]][d];
+      if (row >= 0) force(d) = -lambda(row);
+    }
+  }
+}
+
+}  // namespace cablesim
