@@ -213,20 +213,35 @@ int Run(const std::string& path, const std::optional<std::string>& csv_path,
   std::optional<v1::Scene> proto = ReadScene(path, err, &error);
   if (!proto.has_value()) return kExitBadInput;
   const std::optional<std::string> shape_path = ShapePath(shape_flag, csv_path, &*proto);
-  std::unique_ptr<Connection> c = ConnectOrReport(server, false, 0, err);
+  // Without --server: the service in this process, called directly (the
+  // same service code, no gRPC start-up; see RunInProcess).
+  std::unique_ptr<Connection> c;
+  if (server.has_value()) {
+    c = ConnectOrReport(server, false, 0, err);
+  } else if (absl::StatusOr<std::unique_ptr<Connection>> local = ConnectInProcessDirect();
+             local.ok()) {
+    c = std::move(*local);
+  } else {
+    err << "cablesim: " << local.status().message() << "\n";
+  }
   if (c == nullptr) return kExitIoError;
 
   LazyCsvSink sink(csv_path, shape_path);
   Progress progress(&err, Progress::IsTerminal(err), "run");
-  grpc::ClientContext context;
   v1::RunRequest request;
   *request.mutable_scene() = *proto;
   request.set_frames_per_batch(256);
-  std::unique_ptr<grpc::ClientReader<v1::RunEvent>> reader = c->stub->Run(&context, request);
-  const absl::StatusOr<RunSummary> summary =
-      ReadRunStream(&context, reader.get(), &sink, [&](double t, double end) {
-        progress.Update(end > 0 ? t / end : 0, absl::StrFormat("t = %.4g s", t));
-      });
+  const auto on_frame_time = [&](double t, double end) {
+    progress.Update(end > 0 ? t / end : 0, absl::StrFormat("t = %.4g s", t));
+  };
+  absl::StatusOr<RunSummary> summary;
+  if (server.has_value()) {
+    grpc::ClientContext context;
+    std::unique_ptr<grpc::ClientReader<v1::RunEvent>> reader = c->stub->Run(&context, request);
+    summary = ReadRunStream(&context, reader.get(), &sink, on_frame_time);
+  } else {
+    summary = RunInProcess(c.get(), request, &sink, on_frame_time);
+  }
   progress.Done();
   const absl::Status csv_status = sink.Finish();
   // A failed CSV write stops the run, whatever the service then reports.

@@ -113,7 +113,7 @@ bool Finished(v1::JobState s) {
 
 // Writes `event`, recording the wait for the watchdog.
 template <typename Message>
-bool TimedWrite(grpc::ServerWriter<Message>* writer, const Message& event,
+bool TimedWrite(grpc::ServerWriterInterface<Message>* writer, const Message& event,
                 CablesimServiceImpl::StreamWatch* watch) {
   watch->write_started_ns = NowNs();
   const bool ok = writer->Write(event);
@@ -125,7 +125,8 @@ bool TimedWrite(grpc::ServerWriter<Message>* writer, const Message& event,
 // summary).
 class StreamingSink : public FrameSink {
  public:
-  StreamingSink(grpc::ServerWriter<v1::RunEvent>* writer, CablesimServiceImpl::StreamWatch* watch,
+  StreamingSink(grpc::ServerWriterInterface<v1::RunEvent>* writer,
+                CablesimServiceImpl::StreamWatch* watch,
                 int batch, std::string scene_name, double end_time_s)
       : writer_(writer),
         watch_(watch),
@@ -166,7 +167,7 @@ class StreamingSink : public FrameSink {
     gone_ = true;
     return absl::CancelledError("the client went away");
   }
-  grpc::ServerWriter<v1::RunEvent>* writer_;
+  grpc::ServerWriterInterface<v1::RunEvent>* writer_;
   CablesimServiceImpl::StreamWatch* watch_;
   const int batch_;
   const std::string scene_name_;
@@ -353,6 +354,12 @@ grpc::Status CablesimServiceImpl::Validate(grpc::ServerContext* context,
 
 grpc::Status CablesimServiceImpl::Run(grpc::ServerContext* context, const v1::RunRequest* request,
                                       grpc::ServerWriter<v1::RunEvent>* writer) {
+  return RunTo(context, request, writer);
+}
+
+grpc::Status CablesimServiceImpl::RunTo(grpc::ServerContext* context,
+                                        const v1::RunRequest* request,
+                                        grpc::ServerWriterInterface<v1::RunEvent>* writer) {
   std::string tenant;
   if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   StreamSlot slot(this, context, /*counted=*/true, ClientKey(context, tenant));
