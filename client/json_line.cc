@@ -47,6 +47,17 @@ JsonLine& JsonLine::Add(std::string_view key, const std::vector<double>& values)
   return *this;
 }
 
+JsonLine& JsonLine::Add(std::string_view key, const std::vector<std::string>& values) {
+  std::string array = "[";
+  for (size_t i = 0; i < values.size(); ++i) {
+    if (i > 0) array += ",";
+    array += Quote(values[i]);
+  }
+  array += "]";
+  AddRaw(key, array);
+  return *this;
+}
+
 void JsonLine::AddRaw(std::string_view key, std::string_view json_value) {
   if (body_.size() > 1) body_ += ',';
   body_ += Quote(key);

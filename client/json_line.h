@@ -26,6 +26,7 @@ class JsonLine {
   JsonLine& Add(std::string_view key, bool value);
   // A JSON array of numbers, each written as by Add(key, double).
   JsonLine& Add(std::string_view key, const std::vector<double>& values);
+  JsonLine& Add(std::string_view key, const std::vector<std::string>& values);
 
   // The object, e.g. `{"status":"ok","steps":10}`, without a newline.
   std::string ToString() const { return body_ + "}"; }

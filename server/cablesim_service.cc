@@ -366,9 +366,10 @@ grpc::Status CablesimServiceImpl::RunTo(grpc::ServerContext* context,
   if (!slot.acquired()) {
     return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, slot.refusal());
   }
-  const absl::StatusOr<v1::Scene> scene =
+  absl::StatusOr<v1::Scene> scene =
       SceneOfRequest(request->has_scene(), request->scene(), request->scene_json());
   if (!scene.ok()) return ToGrpc(scene.status());
+  if (request->strict()) scene->mutable_solver()->set_strict(true);
   absl::StatusOr<CheckedScene> checked =
       CheckScene(*scene, limits_, ControlFor(context, limits_).should_stop);
   if (!checked.ok()) return ToGrpc(checked.status());
@@ -395,9 +396,10 @@ grpc::Status CablesimServiceImpl::SubmitJob(grpc::ServerContext* context,
   std::string tenant;
   if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   if (jobs_ == nullptr) return NoJobs();
-  const absl::StatusOr<v1::Scene> scene =
+  absl::StatusOr<v1::Scene> scene =
       SceneOfRequest(request->has_scene(), request->scene(), request->scene_json());
   if (!scene.ok()) return ToGrpc(scene.status());
+  if (request->strict()) scene->mutable_solver()->set_strict(true);
   absl::StatusOr<v1::Job> job = jobs_->Submit(*scene, ClientKey(context, tenant), tenant,
                                               ControlFor(context, limits_).should_stop);
   if (!job.ok()) return ToGrpc(job.status());
