@@ -1,4 +1,5 @@
 #include "convert/scene_from_proto.h"
+#include "convert/solver_applicability.h"
 
 #include <algorithm>
 #include <cmath>
@@ -1330,7 +1331,8 @@ class SceneConverter {
     out.error_tolerance_m = s.has_tolerance() || out.adaptive
                                 ? out.tolerance_m
                                 : kDefaultRelativeErrorTolerance * SceneSize();
-    return absl::OkStatus();
+    // Settings given that would do nothing in this run (a table).
+    return CheckSolverSettingsApply(s, out);
   }
 
   // The scene's size for the default error tolerance [m]: its longest
