@@ -58,6 +58,9 @@ RunSummary EveryFieldSet() {
   s.error_estimate_m = 0.032;
   s.error_estimate_method = "richardson";
   s.error_estimate_seconds = 0.033;
+  s.local_error_estimate_m = 0.036;
+  s.error_tolerance_m = 0.037;
+  s.warnings = {"one", "two \"quoted\""};
   return s;
 }
 
