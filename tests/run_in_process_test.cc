@@ -89,6 +89,26 @@ TEST(RunInProcessTest, SameErrorForAStringThatIsNotUtf8) {
   EXPECT_EQ(direct.status(), channel.status());
 }
 
+// RunRequest.strict sets the scene's solver.strict: a run with warnings
+// fails, over the channel as directly.
+TEST(RunInProcessTest, StrictFailsARunWithWarningsOnBothPaths) {
+  v1::RunRequest request = PendulumRequest(0.01);
+  request.mutable_scene()->mutable_solver()->set_tolerance(1e-12);  // every step misses it
+  CollectingSink channel_sink, direct_sink;
+  absl::StatusOr<RunSummary> channel = OverChannel(request, &channel_sink);
+  ASSERT_TRUE(channel.ok()) << channel.status();
+  EXPECT_EQ(channel->status, "ok");
+  EXPECT_EQ(channel->warnings.size(), 1u);
+  request.set_strict(true);
+  channel = OverChannel(request, &channel_sink);
+  const absl::StatusOr<RunSummary> direct = Direct(request, &direct_sink);
+  ASSERT_TRUE(channel.ok()) << channel.status();
+  ASSERT_TRUE(direct.ok()) << direct.status();
+  EXPECT_EQ(channel->status, "failed");
+  EXPECT_EQ(direct->status, "failed");
+  EXPECT_EQ(direct->error, channel->error);
+}
+
 TEST(RunInProcessTest, ASinkErrorStopsTheRunAndIsReturned) {
   class FailingSink : public FrameSink {
    public:
