@@ -39,6 +39,17 @@ class JsonLine {
 
  private:
   void AddRaw(std::string_view key, std::string_view json_value);
+  // `key`: [format(v0),format(v1),...].
+  template <typename T, typename Format>
+  void AddArray(std::string_view key, const std::vector<T>& values, Format format) {
+    std::string array = "[";
+    for (size_t i = 0; i < values.size(); ++i) {
+      if (i > 0) array += ",";
+      array += format(values[i]);
+    }
+    array += "]";
+    AddRaw(key, array);
+  }
 
   std::string body_ = "{";
 };
