@@ -28,17 +28,11 @@ std::string DynamicOnly(const SolverSettings& s) {
 
 const std::vector<Rule>& Rules() {
   static const std::vector<Rule>* rules = new std::vector<Rule>{
-      // Time stepping: a STATIC or MODAL analysis takes no time steps.
-      {"solver.step", [](const v1::Solver& p) { return p.has_step(); }, Dynamic, DynamicOnly},
-      {"solver.output_interval", [](const v1::Solver& p) { return p.has_output_interval(); },
-       Dynamic, DynamicOnly},
-      {"solver.integrator",
-       [](const v1::Solver& p) { return p.integrator() != v1::INTEGRATOR_UNSPECIFIED; },
-       Dynamic, DynamicOnly},
-      {"solver.rho_infinity", [](const v1::Solver& p) { return p.has_rho_infinity(); }, Dynamic,
-       DynamicOnly},
-      {"solver.reuse_factorization",
-       [](const v1::Solver& p) { return p.has_reuse_factorization(); }, Dynamic, DynamicOnly},
+      // Not refused: step, output_interval, integrator, rho_infinity and
+      // reuse_factorization with STATIC or MODAL. They do nothing there, but
+      // switching a dynamic scene's analysis to STATIC or MODAL, keeping its
+      // solver section, is how its equilibrium or modes are had (the tests
+      // and tutorials do it); refusing them would break that.
       // The static solve (STATIC, MODAL, initial_state STATIC) always uses
       // the BLOCK preconditioner and never accepts an inexact solve; these
       // two configure the time steps' Newton solves only.

@@ -317,27 +317,6 @@ std::vector<InvalidCase> InvalidCases() {
                     R"(], "solver": {"analysis": "MODAL", "relative_tolerance": 1e-3}})"),
        "solver.relative_tolerance: ", "applies to DYNAMIC analysis only (solver.analysis is MODAL)"},
       // Settings that would do nothing in the run (convert/solver_applicability.h).
-      {"StepOnStatic",
-       absl::StrCat(R"({"cables": [)", kCable,
-                    R"(], "solver": {"analysis": "STATIC", "step": 1e-3}})"),
-       "solver.step: ", "applies to DYNAMIC analysis only (solver.analysis is STATIC)"},
-      {"OutputIntervalOnModal",
-       absl::StrCat(R"({"cables": [)", kCable,
-                    R"(], "solver": {"analysis": "MODAL", "output_interval": 0.1}})"),
-       "solver.output_interval: ", "applies to DYNAMIC analysis only (solver.analysis is MODAL)"},
-      {"IntegratorOnStatic",
-       absl::StrCat(R"({"cables": [)", kCable,
-                    R"(], "solver": {"analysis": "STATIC", "integrator": "IMPLICIT_EULER"}})"),
-       "solver.integrator: ", "applies to DYNAMIC analysis only (solver.analysis is STATIC)"},
-      {"RhoInfinityOnModal",
-       absl::StrCat(R"({"cables": [)", kCable,
-                    R"(], "solver": {"analysis": "MODAL", "rho_infinity": 0.8}})"),
-       "solver.rho_infinity: ", "applies to DYNAMIC analysis only (solver.analysis is MODAL)"},
-      {"ReuseFactorizationOnStatic",
-       absl::StrCat(R"({"cables": [)", kCable,
-                    R"(], "solver": {"analysis": "STATIC", "reuse_factorization": false}})"),
-       "solver.reuse_factorization: ",
-       "applies to DYNAMIC analysis only (solver.analysis is STATIC)"},
       {"PreconditionerOnStatic",
        absl::StrCat(R"({"cables": [)", kCable,
                     R"(], "solver": {"analysis": "STATIC", "preconditioner": "JACOBI"}})"),
@@ -842,6 +821,11 @@ TEST(SceneConversionTest, ErrorToleranceAndSettingsThatApply) {
   scene = ConvertJson(absl::StrCat(R"({"cables": [)", kCable, R"(], "solver": {
       "duration": 1, "linear_solver": "DIRECT", "linear_tolerance": 1e-9,
       "max_linear_iterations": 50, "preconditioner": "JACOBI"}})"));
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  // A dynamic scene switched to MODAL keeps its time-stepping settings.
+  scene = ConvertJson(absl::StrCat(R"({"cables": [)", kCable, R"(], "solver": {
+      "analysis": "MODAL", "duration": 1, "step": 0.01, "output_interval": 0.1,
+      "integrator": "GENERALIZED_ALPHA", "rho_infinity": 0.8}})"));
   ASSERT_TRUE(scene.ok()) << scene.status();
   // STATIC takes the linear settings its static solve uses.
   scene = ConvertJson(absl::StrCat(R"({"cables": [)", kCable, R"(], "solver": {
