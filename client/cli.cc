@@ -68,7 +68,7 @@ const std::set<std::string>& ValueOptions() {
 // Options that take no value.
 const std::set<std::string>& FlagOptions() {
   static const std::set<std::string>* flags =
-      new std::set<std::string>{"allow-outside", "no-limits"};
+      new std::set<std::string>{"allow-outside", "no-limits", "strict"};
   return *flags;
 }
 
@@ -213,25 +213,41 @@ std::optional<std::string> ShapePath(const std::optional<std::string>& shape_fla
 
 int Run(const std::string& path, const std::optional<std::string>& csv_path,
         const std::optional<std::string>& shape_flag, const std::optional<std::string>& server,
-        std::ostream& out, std::ostream& err) {
+        bool strict, std::ostream& out, std::ostream& err) {
   std::string error;
   std::optional<v1::Scene> proto = ReadScene(path, err, &error);
   if (!proto.has_value()) return kExitBadInput;
   const std::optional<std::string> shape_path = ShapePath(shape_flag, csv_path, &*proto);
-  std::unique_ptr<Connection> c = ConnectOrReport(server, false, 0, err);
+  // Without --server: the service in this process, called directly (the
+  // same service code, no gRPC start-up; see RunInProcess).
+  std::unique_ptr<Connection> c;
+  if (server.has_value()) {
+    c = ConnectOrReport(server, false, 0, err);
+  } else if (absl::StatusOr<std::unique_ptr<Connection>> local = ConnectInProcessDirect();
+             local.ok()) {
+    c = std::move(*local);
+  } else {
+    err << "cablesim: " << local.status().message() << "\n";
+  }
   if (c == nullptr) return kExitIoError;
 
   LazyCsvSink sink(csv_path, shape_path);
   Progress progress(&err, Progress::IsTerminal(err), "run");
-  grpc::ClientContext context;
   v1::RunRequest request;
   *request.mutable_scene() = *proto;
   request.set_frames_per_batch(256);
-  std::unique_ptr<grpc::ClientReader<v1::RunEvent>> reader = c->stub->Run(&context, request);
-  const absl::StatusOr<RunSummary> summary =
-      ReadRunStream(&context, reader.get(), &sink, [&](double t, double end) {
-        progress.Update(end > 0 ? t / end : 0, absl::StrFormat("t = %.4g s", t));
-      });
+  request.set_strict(strict);
+  const auto on_frame_time = [&](double t, double end) {
+    progress.Update(end > 0 ? t / end : 0, absl::StrFormat("t = %.4g s", t));
+  };
+  absl::StatusOr<RunSummary> summary;
+  if (server.has_value()) {
+    grpc::ClientContext context;
+    std::unique_ptr<grpc::ClientReader<v1::RunEvent>> reader = c->stub->Run(&context, request);
+    summary = ReadRunStream(&context, reader.get(), &sink, on_frame_time);
+  } else {
+    summary = RunInProcess(c.get(), request, &sink, on_frame_time);
+  }
   progress.Done();
   const absl::Status csv_status = sink.Finish();
   // A failed CSV write stops the run, whatever the service then reports.
@@ -247,7 +263,7 @@ int Run(const std::string& path, const std::optional<std::string>& csv_path,
 
 std::string CliUsage() {
   return R"(Usage:
-  cablesim run SCENE [--out FILE.csv] [--shape SHAPE.csv] [--server HOST:PORT]
+  cablesim run SCENE [--out FILE.csv] [--shape SHAPE.csv] [--server HOST:PORT] [--strict]
       Run the scene's analysis and print the run summary as one JSON line.
       With --out, write the trajectory (one row per output frame) as CSV.
       With --shape (or the scene's output.shape, beside --out as
@@ -255,10 +271,15 @@ std::string CliUsage() {
       t,cable,node,s,x,y,z.
       The run goes through the cablesim service: one started in this
       process, or the cablesim-server at --server.
+      Warnings (the error estimate over the tolerance, inexact linear
+      solves accepted, steps cut far below solver.step) are printed on
+      standard error and listed in the summary's "warnings"; with --strict
+      they fail the run (exit 3). docs/honest-runs.md.
   cablesim validate SCENE [--server HOST:PORT]
       Check the scene and print one JSON line describing it.
-  cablesim submit SCENE --server HOST:PORT
+  cablesim submit SCENE --server HOST:PORT [--strict]
       Queue the scene as a durable job; print the job (its id) at once.
+      With --strict, a job whose run has warnings fails.
   cablesim jobs --server HOST:PORT [--state STATE] [--sweep ID] [--limit N]
       List jobs, newest first, one JSON line each.
   cablesim watch JOB --server HOST:PORT [--out FILE.csv]
@@ -381,7 +402,8 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
       continue;
     }
     const bool allowed =
-        (command == "run" && name == "shape") ||
+        (command == "run" && (name == "shape" || name == "strict")) ||
+        (command == "submit" && name == "strict") ||
         (command == "jobs" && (name == "state" || name == "sweep" || name == "limit")) ||
         (command == "sweep" && name != "state" && name != "sweep" && name != "limit");
     if (!allowed) return UsageError(err, absl::StrCat(command, ": no option --", name));
@@ -396,7 +418,7 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   if (command == "run") {
     std::optional<std::string> shape;
     if (auto it = a.options.find("shape"); it != a.options.end()) shape = it->second;
-    return Run(a.positional[1], a.out, shape, a.server, out, err);
+    return Run(a.positional[1], a.out, shape, a.server, a.options.count("strict") > 0, out, err);
   }
   if (command == "submit") return cli_internal::Submit(a, out, err);
   if (command == "jobs") return cli_internal::Jobs(a, out, err);

@@ -67,6 +67,9 @@ std::unique_ptr<Connection> ConnectOrReport(const std::optional<std::string>& se
 int ReportSummary(const RunSummary& summary, std::ostream& out, std::ostream& err) {
   out << SummaryToJson(summary) << "\n";
   out.flush();
+  for (const std::string& warning : summary.warnings) {
+    err << "cablesim: warning: " << warning << "\n";
+  }
   if (summary.status == "failed") {
     err << "cablesim: numerical failure at t = " << absl::StrFormat("%.10g", summary.failure_time_s)
         << ": " << summary.error << "\n";

@@ -105,6 +105,7 @@ int Submit(const Arguments& a, std::ostream& out, std::ostream& err) {
   grpc::ClientContext context;
   v1::SubmitJobRequest request;
   *request.mutable_scene() = *proto;
+  request.set_strict(a.options.count("strict") > 0);
   v1::Job job;
   const absl::Status status = FromGrpc(c->stub->SubmitJob(&context, request, &job));
   if (!status.ok()) return CallFailed(err, status, path);

@@ -37,13 +37,12 @@ JsonLine& JsonLine::Add(std::string_view key, bool value) {
 }
 
 JsonLine& JsonLine::Add(std::string_view key, const std::vector<double>& values) {
-  std::string array = "[";
-  for (size_t i = 0; i < values.size(); ++i) {
-    if (i > 0) array += ",";
-    array += Number(values[i]);
-  }
-  array += "]";
-  AddRaw(key, array);
+  AddArray(key, values, [](double v) { return Number(v); });
+  return *this;
+}
+
+JsonLine& JsonLine::Add(std::string_view key, const std::vector<std::string>& values) {
+  AddArray(key, values, [](const std::string& v) { return Quote(v); });
   return *this;
 }
 

@@ -26,6 +26,7 @@ class JsonLine {
   JsonLine& Add(std::string_view key, bool value);
   // A JSON array of numbers, each written as by Add(key, double).
   JsonLine& Add(std::string_view key, const std::vector<double>& values);
+  JsonLine& Add(std::string_view key, const std::vector<std::string>& values);
 
   // Adds `"key":json` with `json` already JSON (an object or array built
   // with JsonLine), written as is.
@@ -45,6 +46,17 @@ class JsonLine {
 
  private:
   void AddRaw(std::string_view key, std::string_view json_value);
+  // `key`: [format(v0),format(v1),...].
+  template <typename T, typename Format>
+  void AddArray(std::string_view key, const std::vector<T>& values, Format format) {
+    std::string array = "[";
+    for (size_t i = 0; i < values.size(); ++i) {
+      if (i > 0) array += ",";
+      array += format(values[i]);
+    }
+    array += "]";
+    AddRaw(key, array);
+  }
 
   std::string body_ = "{";
 };

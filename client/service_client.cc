@@ -51,6 +51,26 @@ class TokenInterceptorFactory : public grpc::experimental::ClientInterceptorFact
   const std::string token_;
 };
 
+// An in-process service: the user's own process, with the server's default
+// costing limits (a 1e9-step scene is refused at once, naming the limit,
+// rather than grinding silently), unless --no-limits (InProcessLimits).
+// Streams, unary-call bounds, the memory budget and the stall timeout
+// protect a server from other clients: none here.
+ServerOptions InProcessOptions(int workers) {
+  ServerOptions options;
+  options.limits = InProcessLimits();
+  options.limits.max_streams = std::numeric_limits<int>::max() / 2;
+  options.limits.max_streams_per_peer = std::numeric_limits<int>::max() / 2;
+  options.limits.max_queued_jobs_per_peer = std::numeric_limits<int64_t>::max();
+  options.limits.max_unary_calls = std::numeric_limits<int>::max();
+  options.limits.max_unary_calls_per_peer = std::numeric_limits<int>::max();
+  options.limits.max_inflight_bytes = std::numeric_limits<int64_t>::max();
+  options.limits.stall_timeout = absl::Hours(24 * 365);
+  options.log = false;
+  options.workers = workers > 0 ? workers : std::max(1u, std::thread::hardware_concurrency());
+  return options;
+}
+
 }  // namespace
 
 void SetRemoteSecurity(RemoteSecurity security) { Security() = std::move(security); }
@@ -114,21 +134,7 @@ absl::StatusOr<std::unique_ptr<Connection>> Connect(const std::optional<std::str
     c->channel = grpc::experimental::CreateCustomChannelWithInterceptors(
         *server, credentials, args, std::move(tokens));
   } else {
-    ServerOptions options;
-    // The user's own process: the server's default costing limits (a
-    // 1e9-step scene is refused at once, naming the limit, rather than
-    // grinding silently), unless --no-limits. Streams and their stall
-    // timeout protect a server from other clients: none here.
-    options.limits = InProcessLimits();
-    options.limits.max_streams = std::numeric_limits<int>::max() / 2;
-    options.limits.max_streams_per_peer = std::numeric_limits<int>::max() / 2;
-    options.limits.max_queued_jobs_per_peer = std::numeric_limits<int64_t>::max();
-    options.limits.max_unary_calls = std::numeric_limits<int>::max();
-    options.limits.max_unary_calls_per_peer = std::numeric_limits<int>::max();
-    options.limits.max_inflight_bytes = std::numeric_limits<int64_t>::max();
-    options.limits.stall_timeout = absl::Hours(24 * 365);
-    options.log = false;
-    options.workers = workers > 0 ? workers : std::max(1u, std::thread::hardware_concurrency());
+    ServerOptions options = InProcessOptions(workers);
     if (jobs) {
       std::string templ = (std::filesystem::temp_directory_path() / "cablesim-XXXXXX").string();
       if (mkdtemp(templ.data()) == nullptr) {
@@ -146,40 +152,88 @@ absl::StatusOr<std::unique_ptr<Connection>> Connect(const std::optional<std::str
   return c;
 }
 
-absl::StatusOr<RunSummary> ReadRunStream(grpc::ClientContext* context,
-                                         grpc::ClientReader<v1::RunEvent>* reader, FrameSink* sink,
-                                         const std::function<void(double, double)>& on_frame_time) {
-  v1::RunEvent event;
-  std::optional<FrameReader> frames;
-  int columns = 0;
-  double end_time = 0;
-  Frame frame;
-  std::optional<RunSummary> summary;
-  absl::Status sink_error;
-  while (reader->Read(&event)) {
+namespace {
+
+// Turns a stream of RunEvents into OnStart/OnFrame calls on a sink and the
+// summary: ReadRunStream's and RunInProcess's one reader.
+class RunEventReader {
+ public:
+  RunEventReader(FrameSink* sink, const std::function<void(double, double)>& on_frame_time)
+      : sink_(sink), on_frame_time_(on_frame_time) {}
+
+  // The sink's error (or a malformed batch's): the stream must stop.
+  absl::Status OnEvent(const v1::RunEvent& event) {
     if (event.has_header()) {
       const ModelInfo info = ModelInfoFromProto(event.header().info());
       // Columns by name: a server older or newer than this client may
       // send fewer or more of them.
       const std::vector<std::string> names(event.header().columns().begin(),
                                            event.header().columns().end());
-      frames.emplace(info, names);
-      columns = frames->row_size();
-      end_time = event.header().end_time_s();
-      sink_error = sink->OnStart(info);
-    } else if (event.has_frames()) {
-      const v1::FrameBatch& b = event.frames();
-      if (columns == 0 || b.values_size() != b.rows() * columns) {
-        sink_error = absl::InternalError("malformed frame batch from the server");
-      }
-      for (int r = 0; sink_error.ok() && r < b.rows(); ++r) {
-        frames->Read(absl::MakeConstSpan(b.values().data() + r * columns, columns), &frame);
-        sink_error = sink->OnFrame(frame);
-        if (on_frame_time) on_frame_time(frame.t, end_time);
-      }
-    } else if (event.has_summary()) {
-      summary = SummaryFromProto(event.summary());
+      frames_.emplace(info, names);
+      columns_ = frames_->row_size();
+      end_time_ = event.header().end_time_s();
+      return sink_->OnStart(info);
     }
+    if (event.has_frames()) {
+      const v1::FrameBatch& b = event.frames();
+      if (columns_ == 0 || b.values_size() != b.rows() * columns_) {
+        return absl::InternalError("malformed frame batch from the server");
+      }
+      for (int r = 0; r < b.rows(); ++r) {
+        frames_->Read(absl::MakeConstSpan(b.values().data() + r * columns_, columns_), &frame_);
+        if (absl::Status s = sink_->OnFrame(frame_); !s.ok()) return s;
+        if (on_frame_time_) on_frame_time_(frame_.t, end_time_);
+      }
+      return absl::OkStatus();
+    }
+    if (event.has_summary()) summary_ = SummaryFromProto(event.summary());
+    return absl::OkStatus();
+  }
+  // The stream's end: `status` is the call's.
+  absl::StatusOr<RunSummary> Finish(const absl::Status& status) const {
+    if (!status.ok()) return status;
+    if (!summary_.has_value()) return absl::UnavailableError("the stream ended without a summary");
+    return *summary_;
+  }
+
+ private:
+  FrameSink* sink_;
+  const std::function<void(double, double)>& on_frame_time_;
+  std::optional<FrameReader> frames_;
+  int columns_ = 0;
+  double end_time_ = 0;
+  Frame frame_;
+  std::optional<RunSummary> summary_;
+};
+
+// The server side of a direct call: each written event goes straight to
+// the reader; a reader error makes the write fail, as a client that went
+// away would.
+class DirectRunWriter final : public grpc::ServerWriterInterface<v1::RunEvent> {
+ public:
+  explicit DirectRunWriter(RunEventReader* reader) : reader_(reader) {}
+  void SendInitialMetadata() override {}
+  bool Write(const v1::RunEvent& event, grpc::WriteOptions) override {
+    if (!error_.ok()) return false;
+    error_ = reader_->OnEvent(event);
+    return error_.ok();
+  }
+  const absl::Status& error() const { return error_; }
+
+ private:
+  RunEventReader* reader_;
+  absl::Status error_;
+};
+
+}  // namespace
+
+absl::StatusOr<RunSummary> ReadRunStream(grpc::ClientContext* context,
+                                         grpc::ClientReader<v1::RunEvent>* reader, FrameSink* sink,
+                                         const std::function<void(double, double)>& on_frame_time) {
+  RunEventReader events(sink, on_frame_time);
+  v1::RunEvent event;
+  while (reader->Read(&event)) {
+    const absl::Status sink_error = events.OnEvent(event);
     if (!sink_error.ok()) {
       context->TryCancel();
       while (reader->Read(&event)) {
@@ -188,10 +242,36 @@ absl::StatusOr<RunSummary> ReadRunStream(grpc::ClientContext* context,
       return sink_error;
     }
   }
-  const absl::Status status = FromGrpc(reader->Finish());
-  if (!status.ok()) return status;
-  if (!summary.has_value()) return absl::UnavailableError("the stream ended without a summary");
-  return *summary;
+  return events.Finish(FromGrpc(reader->Finish()));
+}
+
+absl::StatusOr<std::unique_ptr<Connection>> ConnectInProcessDirect() {
+  auto c = std::make_unique<Connection>();
+  ServerOptions options = InProcessOptions(1);
+  options.defer_grpc = true;
+  absl::StatusOr<std::unique_ptr<CablesimServer>> local = CablesimServer::Start(options);
+  if (!local.ok()) return local.status();
+  c->local = std::move(*local);
+  return c;
+}
+
+absl::StatusOr<RunSummary> RunInProcess(Connection* c, const v1::RunRequest& request,
+                                        FrameSink* sink,
+                                        const std::function<void(double, double)>& on_frame_time) {
+  // What the server would receive: the request through the wire format
+  // (a string that is not UTF-8 does not survive it).
+  v1::RunRequest received;
+  if (!received.ParseFromString(request.SerializeAsString())) {
+    return absl::InvalidArgumentError(
+        "request: not a valid request message for /cablesim.v1.CablesimService/Run (malformed "
+        "protobuf, a field of the wrong type, or a string that is not valid UTF-8)");
+  }
+  RunEventReader events(sink, on_frame_time);
+  DirectRunWriter writer(&events);
+  grpc::ServerContext context;
+  const grpc::Status status = c->local->service()->RunTo(&context, &received, &writer);
+  if (!writer.error().ok()) return writer.error();
+  return events.Finish(FromGrpc(status));
 }
 
 }  // namespace cablesim

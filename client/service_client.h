@@ -50,6 +50,22 @@ ServerLimits InProcessLimits();
 absl::StatusOr<std::unique_ptr<Connection>> Connect(const std::optional<std::string>& server,
                                                     bool jobs, int workers);
 
+// An in-process service for direct calls only (RunInProcess): the same
+// service as Connect's without --server, but gRPC is started only if
+// something asks for c->local->InProcessChannel(); `channel` and `stub`
+// stay null.
+absl::StatusOr<std::unique_ptr<Connection>> ConnectInProcessDirect();
+
+// The Run call of `request` on `c`'s in-process service, made directly
+// (CablesimServiceImpl::RunTo): the same service code as over a channel,
+// the events handed to `sink` as ReadRunStream does, without gRPC's
+// threads, completion queues and serialisation round trips. The request is
+// still checked the way the wire would check it (a request that would not
+// parse answers INVALID_ARGUMENT, as RequestParseInterceptor makes it).
+absl::StatusOr<RunSummary> RunInProcess(Connection* c, const v1::RunRequest& request,
+                                        FrameSink* sink,
+                                        const std::function<void(double, double)>& on_frame_time);
+
 // A gRPC status as an absl::Status (same codes and message).
 absl::Status FromGrpc(const grpc::Status& status);
 

@@ -87,6 +87,11 @@ std::string SummaryToJson(const RunSummary& summary) {
     if (summary.integrator != "IMPLICIT_EULER" && summary.integrator != "CENTRAL_DIFFERENCE" &&
         summary.integrator != "DORMAND_PRINCE")
       json.Add("rho_infinity", summary.rho_infinity);
+    // Every run's error estimate and what it is held to, and the
+    // warnings (docs/honest-runs.md).
+    json.Add("local_error_estimate_m", summary.local_error_estimate_m)
+        .Add("error_tolerance_m", summary.error_tolerance_m)
+        .Add("warnings", summary.warnings);
     if (summary.has_error_estimate) {
       if (summary.error_estimate_m >= 0) json.Add("error_estimate_m", summary.error_estimate_m);
       json.Add("error_estimate_method", summary.error_estimate_method)

@@ -123,6 +123,9 @@ v1::RunSummary SummaryToProto(const RunSummary& s) {
   p.set_error_estimate_method(s.error_estimate_method);
   p.set_error_estimate_seconds(s.error_estimate_seconds);
   if (s.has_statistics) *p.mutable_statistics() = StatisticsToProto(s.statistics);
+  p.set_local_error_estimate_m(s.local_error_estimate_m);
+  p.set_error_tolerance_m(s.error_tolerance_m);
+  for (const std::string& w : s.warnings) p.add_warnings(w);
   return p;
 }
 
@@ -167,6 +170,9 @@ RunSummary SummaryFromProto(const v1::RunSummary& p) {
   s.error_estimate_seconds = p.error_estimate_seconds();
   s.has_statistics = p.has_statistics();
   if (s.has_statistics) s.statistics = StatisticsFromProto(p.statistics());
+  s.local_error_estimate_m = p.local_error_estimate_m();
+  s.error_tolerance_m = p.error_tolerance_m();
+  s.warnings.assign(p.warnings().begin(), p.warnings().end());
   return s;
 }
 

@@ -1,4 +1,5 @@
 #include "convert/scene_from_proto.h"
+#include "convert/solver_applicability.h"
 
 #include <algorithm>
 #include <cmath>
@@ -150,6 +151,14 @@ absl::Status CheckPositiveInRange(absl::string_view path, double value,
   CABLESIM_RETURN_IF_ERROR(CheckPositive(path, value));
   return CheckRange(path, value, range);
 }
+
+// Fixed steps without solver.tolerance: the local error estimate is held to
+// this fraction of the scene's size (SceneSize). 1 % of the size in one
+// step: the estimate is the largest over every unknown and step (slopes
+// and stiff axial modes included), so a tighter default flagged most
+// sample scenes, whose results are checked against references
+// (docs/honest-runs.md has the figures).
+constexpr double kDefaultRelativeErrorTolerance = 1e-2;
 
 // A tolerance in (0, kMaxTolerance].
 absl::Status CheckTolerance(absl::string_view path, double value) {
@@ -1325,11 +1334,17 @@ class SceneConverter {
         if (has) return Invalid(field, why);
       }
     }
+    // The tolerances hold adaptive steps and every DYNAMIC run's error
+    // estimate (engine/run/run_warnings.h).
     for (const auto& [has, name] : {std::pair{s.has_tolerance(), "solver.tolerance"},
                                     std::pair{s.has_relative_tolerance(),
                                               "solver.relative_tolerance"}}) {
-      if (has && !out.adaptive) return Invalid(name, "needs solver.adaptive: true");
+      if (has && out.analysis != Analysis::kDynamic) {
+        return Invalid(name, absl::StrCat("applies to DYNAMIC analysis only (solver.analysis is ",
+                                          std::string(AnalysisName(out.analysis)), ")"));
+      }
     }
+    out.strict = s.strict();
     switch (s.initial_state()) {
       case v1::Solver::INITIAL_STATE_UNSPECIFIED:
       case v1::Solver::AS_GIVEN:
@@ -1364,7 +1379,22 @@ class SceneConverter {
       }
       out.relative_tolerance = s.relative_tolerance();
     }
-    return absl::OkStatus();
+    // What the run's error estimate is held to: the scene's tolerance, the
+    // adaptive controller's default, or for fixed steps a default relative
+    // to the scene's size.
+    out.error_tolerance_m = s.has_tolerance() || out.adaptive
+                                ? out.tolerance_m
+                                : kDefaultRelativeErrorTolerance * SceneSize();
+    // Settings given that would do nothing in this run (a table).
+    return CheckSolverSettingsApply(s, out);
+  }
+
+  // The scene's size for the default error tolerance [m]: its longest
+  // cable, at least 1 m.
+  double SceneSize() const {
+    double size = 1;
+    for (const v1::Cable& c : proto_.cables()) size = std::max(size, c.length());
+    return size;
   }
 
   const v1::Scene& proto_;

@@ -32,6 +32,21 @@ absl::StatusOr<std::unique_ptr<CablesimServer>> CablesimServer::Start(
                                                       options.tokens);
   s->log_ = options.log;
 
+  if (options.defer_grpc && options.listen.empty()) {
+    s->deferred_ = options;
+  } else if (absl::Status st = s->StartGrpc(options); !st.ok()) {
+    return st;
+  }
+  if (s->jobs_ != nullptr) {
+    if (absl::Status st = s->jobs_->Start(); !st.ok()) {
+      s->Shutdown(absl::ZeroDuration());
+      return st;
+    }
+  }
+  return s;
+}
+
+absl::Status CablesimServer::StartGrpc(const ServerOptions& options) {
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
@@ -48,32 +63,32 @@ absl::StatusOr<std::unique_ptr<CablesimServer>> CablesimServer::Start(
       ssl.pem_key_cert_pairs.push_back({options.tls_key_pem, options.tls_cert_pem});
       credentials = grpc::SslServerCredentials(ssl);
     }
-    builder.AddListeningPort(options.listen, credentials, &s->port_);
+    builder.AddListeningPort(options.listen, credentials, &port_);
   }
   builder.SetMaxReceiveMessageSize(options.limits.max_message_bytes);
   builder.SetMaxSendMessageSize(options.limits.max_message_bytes);
-  builder.RegisterService(s->service_.get());
+  builder.RegisterService(service_.get());
   std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> interceptors;
   interceptors.push_back(std::make_unique<RequestParseInterceptorFactory>());
   builder.experimental().SetInterceptorCreators(std::move(interceptors));
-  s->server_ = builder.BuildAndStart();
-  if (s->server_ == nullptr || (!options.listen.empty() && s->port_ == 0)) {
-    s->down_ = true;
+  server_ = builder.BuildAndStart();
+  if (server_ == nullptr || (!options.listen.empty() && port_ == 0)) {
+    down_ = true;
     return absl::UnavailableError(absl::StrCat("cannot listen on ", options.listen));
   }
-  if (s->jobs_ != nullptr) {
-    if (absl::Status st = s->jobs_->Start(); !st.ok()) {
-      s->Shutdown(absl::ZeroDuration());
-      return st;
-    }
-  }
-  s->server_->GetHealthCheckService()->SetServingStatus(true);
-  return s;
+  server_->GetHealthCheckService()->SetServingStatus(true);
+  return absl::OkStatus();
 }
 
 CablesimServer::~CablesimServer() { Shutdown(absl::ZeroDuration()); }
 
 std::shared_ptr<grpc::Channel> CablesimServer::InProcessChannel() {
+  if (server_ == nullptr && !down_) {
+    // Deferred (ServerOptions::defer_grpc); no port, so it cannot fail to
+    // listen.
+    (void)StartGrpc(deferred_);
+  }
+  if (server_ == nullptr) return nullptr;
   grpc::ChannelArguments args;
   args.SetMaxReceiveMessageSize(limits_.max_message_bytes);
   args.SetMaxSendMessageSize(limits_.max_message_bytes);

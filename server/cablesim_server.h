@@ -44,6 +44,10 @@ struct ServerOptions {
   // Bearer tokens -> tenant (CablesimServiceImpl::Authorize); empty: none
   // needed.
   std::map<std::string, std::string> tokens;
+  // Without `listen`: build the gRPC server only at the first
+  // InProcessChannel(). A caller that only calls service() directly (the
+  // command line's `run`) then never starts gRPC's threads.
+  bool defer_grpc = false;
   // TEST ONLY: see JobManager::set_test_only_gate_dir (empty: off).
   std::string test_only_job_gate_dir;
 };
@@ -56,6 +60,8 @@ class CablesimServer {
   // The port bound (0 when not listening).
   int port() const { return port_; }
   std::shared_ptr<grpc::Channel> InProcessChannel();
+  // The service itself, for calls made directly in this process.
+  CablesimServiceImpl* service() { return service_.get(); }
   // The job store, for logs (JobStore::Describe; never a password).
   std::string store_description() const { return store_ ? store_->Describe() : "none"; }
 
@@ -65,6 +71,9 @@ class CablesimServer {
 
  private:
   CablesimServer() = default;
+  // Builds and starts server_ (listening on options.listen, if any).
+  absl::Status StartGrpc(const ServerOptions& options);
+  ServerOptions deferred_;  // the options for a deferred StartGrpc
   ServerLimits limits_;
   std::unique_ptr<JobStore> store_;
   std::unique_ptr<JobManager> jobs_;

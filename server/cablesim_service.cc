@@ -194,7 +194,7 @@ bool Finished(v1::JobState s) {
 
 // Writes `event`, recording the wait for the watchdog.
 template <typename Message>
-bool TimedWrite(grpc::ServerWriter<Message>* writer, const Message& event,
+bool TimedWrite(grpc::ServerWriterInterface<Message>* writer, const Message& event,
                 CablesimServiceImpl::StreamWatch* watch) {
   watch->write_started_ns = NowNs();
   const bool ok = writer->Write(event);
@@ -206,7 +206,8 @@ bool TimedWrite(grpc::ServerWriter<Message>* writer, const Message& event,
 // summary).
 class StreamingSink : public FrameSink {
  public:
-  StreamingSink(grpc::ServerWriter<v1::RunEvent>* writer, CablesimServiceImpl::StreamWatch* watch,
+  StreamingSink(grpc::ServerWriterInterface<v1::RunEvent>* writer,
+                CablesimServiceImpl::StreamWatch* watch,
                 int batch, std::string scene_name, double end_time_s)
       : writer_(writer),
         watch_(watch),
@@ -247,7 +248,7 @@ class StreamingSink : public FrameSink {
     gone_ = true;
     return absl::CancelledError("the client went away");
   }
-  grpc::ServerWriter<v1::RunEvent>* writer_;
+  grpc::ServerWriterInterface<v1::RunEvent>* writer_;
   CablesimServiceImpl::StreamWatch* watch_;
   const int batch_;
   const std::string scene_name_;
@@ -437,15 +438,22 @@ grpc::Status CablesimServiceImpl::Validate(grpc::ServerContext* context,
 
 grpc::Status CablesimServiceImpl::Run(grpc::ServerContext* context, const v1::RunRequest* request,
                                       grpc::ServerWriter<v1::RunEvent>* writer) {
+  return RunTo(context, request, writer);
+}
+
+grpc::Status CablesimServiceImpl::RunTo(grpc::ServerContext* context,
+                                        const v1::RunRequest* request,
+                                        grpc::ServerWriterInterface<v1::RunEvent>* writer) {
   std::string tenant;
   if (grpc::Status auth = Authorize(context, &tenant); !auth.ok()) return auth;
   StreamSlot slot(this, context, /*counted=*/true, ClientKey(context, tenant));
   if (!slot.acquired()) {
     return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, slot.refusal());
   }
-  const absl::StatusOr<v1::Scene> scene =
+  absl::StatusOr<v1::Scene> scene =
       SceneOfRequest(request->has_scene(), request->scene(), request->scene_json());
   if (!scene.ok()) return ToGrpc(scene.status());
+  if (request->strict()) scene->mutable_solver()->set_strict(true);
   absl::StatusOr<CheckedScene> checked =
       CheckScene(*scene, limits_, ControlFor(context, limits_).should_stop);
   if (!checked.ok()) return ToGrpc(checked.status());
@@ -475,9 +483,10 @@ grpc::Status CablesimServiceImpl::SubmitJob(grpc::ServerContext* context,
                  static_cast<int64_t>(request->ByteSizeLong()));
   if (grpc::Status held = slot.status(); !held.ok()) return held;
   if (jobs_ == nullptr) return NoJobs();
-  const absl::StatusOr<v1::Scene> scene =
+  absl::StatusOr<v1::Scene> scene =
       SceneOfRequest(request->has_scene(), request->scene(), request->scene_json());
   if (!scene.ok()) return ToGrpc(scene.status());
+  if (request->strict()) scene->mutable_solver()->set_strict(true);
   absl::StatusOr<v1::Job> job = jobs_->Submit(*scene, ClientKey(context, tenant), tenant,
                                               ControlFor(context, limits_).should_stop);
   if (!job.ok()) return ToGrpc(job.status());

@@ -41,6 +41,12 @@ class CablesimServiceImpl final : public v1::CablesimService::Service {
                         v1::ValidateResponse* response) override;
   grpc::Status Run(grpc::ServerContext* context, const v1::RunRequest* request,
                    grpc::ServerWriter<v1::RunEvent>* writer) override;
+  // Run's body, writing to any stream: `cablesim run` without --server
+  // calls it directly (client/service_client.h RunInProcess), so a run in
+  // the user's own process goes through this same code without starting
+  // gRPC (its threads, completion queues and in-process channel).
+  grpc::Status RunTo(grpc::ServerContext* context, const v1::RunRequest* request,
+                     grpc::ServerWriterInterface<v1::RunEvent>* writer);
   grpc::Status SubmitJob(grpc::ServerContext* context, const v1::SubmitJobRequest* request,
                          v1::Job* response) override;
   grpc::Status GetJob(grpc::ServerContext* context, const v1::GetJobRequest* request,

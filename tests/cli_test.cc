@@ -22,6 +22,7 @@ namespace cablesim {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 using ::testing::StartsWith;
 
 struct CliResult {
@@ -311,6 +312,54 @@ TEST(CliTest, InProcessRunsApplyTheServerDefaultLimitsUnlessNoLimits) {
   EXPECT_EQ(limits.max_steps, 5'000'000);
   EXPECT_EQ(Cli({"validate", path}).code, 2);  // each command sets its own
   EXPECT_EQ(InProcessLimits().max_elements, limits.max_elements);
+}
+
+// Run warnings go to standard error and the summary, exit 0; --strict
+// fails a run with warnings with exit 3 (docs/honest-runs.md).
+// A body falling freely under backward Euler: local error g h^2 / 2 =
+// 4.9e-4 m per step, against the given tolerance.
+std::string FreeFall(double tolerance) {
+  return absl::StrCat(R"({"name": "free-fall", "gravity": {"y": -9.81},
+      "bodies": [{"name": "b", "mass": 2, "inertia": {"x": 1, "y": 1, "z": 1}}],
+      "probes": [{"name": "b", "body": "b"}],
+      "solver": {"duration": 0.05, "step": 0.01, "integrator": "IMPLICIT_EULER",
+                 "tolerance": )",
+                      tolerance, "}}");
+}
+
+TEST(CliStrictTest, WarningsGoToStandardErrorAndTheSummary) {
+  const std::string path = WriteTempFile("strict_loose.json", FreeFall(1e-4));
+  const CliResult r = Cli({"run", path});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr(R"("status":"ok")"));
+  EXPECT_THAT(r.out, HasSubstr(R"("error_tolerance_m":1e-04)"));
+  EXPECT_THAT(r.out, HasSubstr(R"("warnings":["the estimated local error of a step)"));
+  EXPECT_THAT(r.err, HasSubstr("cablesim: warning: the estimated local error of a step"));
+}
+
+TEST(CliStrictTest, StrictFailsARunWithWarningsWithExitThree) {
+  const std::string path = WriteTempFile("strict_strict.json", FreeFall(1e-4));
+  const CliResult r = Cli({"run", path, "--strict"});
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_THAT(r.out, HasSubstr(R"("status":"failed")"));
+  EXPECT_THAT(r.out, HasSubstr(R"("error":"solver.strict: the estimated local error)"));
+  EXPECT_THAT(r.err, HasSubstr("cablesim: numerical failure at t = 0.05: solver.strict:"));
+}
+
+TEST(CliStrictTest, StrictPassesARunWithoutWarnings) {
+  const std::string path = WriteTempFile("strict_quiet.json", FreeFall(1e-3));
+  const CliResult r = Cli({"run", path, "--strict"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr(R"("warnings":[])"));
+  EXPECT_THAT(r.err, Not(HasSubstr("warning")));
+}
+
+TEST(CliStrictTest, StrictIsForRunAndSubmitOnly) {
+  const std::string path = WriteTempFile("strict_validate.json", FreeFall(1e-3));
+  const CliResult r = Cli({"validate", path, "--strict"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("validate: no option --strict"));
+  EXPECT_EQ(Cli({"run", path, "--strict=yes"}).code, 2);
 }
 
 }  // namespace

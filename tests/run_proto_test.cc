@@ -64,6 +64,9 @@ RunSummary EveryFieldSet() {
   s.statistics.sn_slope = 3.5;
   s.statistics.equivalent_cycles = 1e7;
   s.statistics.rainflow = {{"tip.y", 4.5, 3, 0.51, 0.052}};
+  s.local_error_estimate_m = 0.036;
+  s.error_tolerance_m = 0.037;
+  s.warnings = {"one", "two \"quoted\""};
   return s;
 }
 

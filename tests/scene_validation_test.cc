@@ -306,10 +306,29 @@ std::vector<InvalidCase> InvalidCases() {
                     R"(], "solver": {"duration": 1, "integrator": "IMPLICIT_EULER",
                                      "reuse_factorization": true}})"),
        "solver.reuse_factorization: ", "GENERALIZED_ALPHA, HHT and ENERGY_MOMENTUM only"},
-      {"ToleranceWithoutAdaptive",
+      // solver.tolerance holds every DYNAMIC run's error estimate (adaptive
+      // or not: docs/honest-runs.md), and no STATIC or MODAL one.
+      {"ToleranceOnStatic",
        absl::StrCat(R"({"cables": [)", kCable,
-                    R"(], "solver": {"duration": 1, "tolerance": 1e-4}})"),
-       "solver.tolerance: ", "needs solver.adaptive: true"},
+                    R"(], "solver": {"analysis": "STATIC", "tolerance": 1e-4}})"),
+       "solver.tolerance: ", "applies to DYNAMIC analysis only (solver.analysis is STATIC)"},
+      {"RelativeToleranceOnModal",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"analysis": "MODAL", "relative_tolerance": 1e-3}})"),
+       "solver.relative_tolerance: ", "applies to DYNAMIC analysis only (solver.analysis is MODAL)"},
+      // Settings that would do nothing in the run (convert/solver_applicability.h).
+      {"PreconditionerOnStatic",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"analysis": "STATIC", "preconditioner": "JACOBI"}})"),
+       "solver.preconditioner: ", "the static solve always uses BLOCK"},
+      {"AcceptInexactSolvesOnModal",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"analysis": "MODAL", "accept_inexact_solves": true}})"),
+       "solver.accept_inexact_solves: ", "the static solve never accepts an inexact solve"},
+      {"LoadStepsOnDynamicAsGiven",
+       absl::StrCat(R"({"cables": [)", kCable,
+                    R"(], "solver": {"duration": 1, "load_steps": 5}})"),
+       "solver.load_steps: ", "applies to STATIC and MODAL analysis and to solver.initial_state STATIC"},
       {"ZeroTolerance",
        absl::StrCat(R"({"cables": [)", kCable,
                     R"(], "solver": {"duration": 1, "adaptive": true, "tolerance": 0}})"),
@@ -803,6 +822,56 @@ TEST(SceneConversionTest, JointBetweenTwoPointsOfOneCable) {
   ASSERT_TRUE(scene.ok()) << scene.status();
   EXPECT_EQ(scene->joints[0].b.cable, 0);
   EXPECT_EQ(scene->joints[0].b.s_m, 1);
+}
+
+// What every DYNAMIC run's error estimate is held to (docs/honest-runs.md),
+// and the settings that apply although they might look as if they did not.
+TEST(SceneConversionTest, ErrorToleranceAndSettingsThatApply) {
+  // Fixed steps, no tolerance given: 1 % of the longest cable (at least 1 m).
+  const char* kLong =
+      R"({"name": "long", "length": 20, "density": 1000, "youngs_modulus": 1e7, "diameter": 0.01})";
+  absl::StatusOr<Scene> scene =
+      ConvertJson(absl::StrCat(R"({"cables": [)", kCable, ",", kLong, "], ", kSolver, "}"));
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  EXPECT_DOUBLE_EQ(scene->solver.error_tolerance_m, 0.2);
+  scene = ConvertJson(Scene1(""));  // one 1 m cable: the 1 m floor
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  EXPECT_DOUBLE_EQ(scene->solver.error_tolerance_m, 0.01);
+  EXPECT_FALSE(scene->solver.strict);
+  // Given: held to it, fixed steps too.
+  scene = ConvertJson(absl::StrCat(R"({"cables": [)", kCable,
+                                   R"(], "solver": {"duration": 1, "tolerance": 1e-5,
+                                      "relative_tolerance": 1e-3, "strict": true}})"));
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  EXPECT_EQ(scene->solver.error_tolerance_m, 1e-5);
+  EXPECT_EQ(scene->solver.relative_tolerance, 1e-3);
+  EXPECT_TRUE(scene->solver.strict);
+  // Adaptive without a tolerance: the controller's own default.
+  scene = ConvertJson(absl::StrCat(R"({"cables": [)", kCable,
+                                   R"(], "solver": {"duration": 1, "adaptive": true}})"));
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  EXPECT_EQ(scene->solver.error_tolerance_m, scene->solver.tolerance_m);
+  // load_steps with initial_state STATIC (the load path to equilibrium).
+  scene = ConvertJson(absl::StrCat(R"({"cables": [)", kCable, R"(], "solver": {
+      "duration": 1, "initial_state": "STATIC", "load_steps": 4}})"));
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  EXPECT_EQ(scene->solver.load_steps, 4);
+  // DIRECT uses linear_tolerance (its refinement pass) and falls back to
+  // MINRES with max_linear_iterations and the preconditioner.
+  scene = ConvertJson(absl::StrCat(R"({"cables": [)", kCable, R"(], "solver": {
+      "duration": 1, "linear_solver": "DIRECT", "linear_tolerance": 1e-9,
+      "max_linear_iterations": 50, "preconditioner": "JACOBI"}})"));
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  // A dynamic scene switched to MODAL keeps its time-stepping settings.
+  scene = ConvertJson(absl::StrCat(R"({"cables": [)", kCable, R"(], "solver": {
+      "analysis": "MODAL", "duration": 1, "step": 0.01, "output_interval": 0.1,
+      "integrator": "GENERALIZED_ALPHA", "rho_infinity": 0.8}})"));
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  // STATIC takes the linear settings its static solve uses.
+  scene = ConvertJson(absl::StrCat(R"({"cables": [)", kCable, R"(], "solver": {
+      "analysis": "STATIC", "load_steps": 5, "linear_tolerance": 1e-9,
+      "max_linear_iterations": 50, "newton_tolerance": 1e-9}})"));
+  ASSERT_TRUE(scene.ok()) << scene.status();
 }
 
 TEST(SceneConversionTest, SteppersAndTheirSettings) {

@@ -7,6 +7,7 @@
 // analyses and the run loop, which all fill it.
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -218,6 +219,23 @@ struct RunSummary {
   // output.statistics or output.rainflow: what the frames say.
   bool has_statistics = false;
   RunStatistics statistics;
+  // DYNAMIC, every run: the largest estimated local error of an accepted
+  // step [m] (the stepper's embedded estimate, Stepper::LocalErrorNorm,
+  // that adaptive steps are controlled by; units of the coordinates), and
+  // the tolerance it is held to (SolverSettings::error_tolerance_m).
+  double local_error_estimate_m = 0;
+  double error_tolerance_m = 0;
+  // The largest LocalErrorNorm(h, error_tolerance_m, relative_tolerance)
+  // of an accepted step: > 1 means a step missed the tolerance. Engine
+  // only (the warning says it).
+  double local_error_ratio = 0;
+  // Fixed steps: the smallest step that rejections cut solver.step to
+  // (infinity: none was cut; not the last steps shortened to end on the
+  // duration). Engine only.
+  double smallest_cut_step_s = std::numeric_limits<double>::infinity();
+  // What makes the result doubtful although the run finished
+  // (engine/run/run_warnings.h), one sentence each; empty: none.
+  std::vector<std::string> warnings;
 };
 
 }  // namespace cablesim

@@ -144,6 +144,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
         ++summary->rejected_steps;
         successes = 0;
         h = h_try / 2;
+        summary->smallest_cut_step_s = std::min(summary->smallest_cut_step_s, h);
         if (h < h_min * (1 - 1e-12)) {
           Fail(summary, t + h_try,
                absl::StrFormat("step from t = %.9g s raises the total energy by %.3g J down to "
@@ -188,6 +189,14 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
         tick_anchor = tick;
       }
       external_work.After(stepper.z(), t, stepper.lambda(), 1);
+      // Every run's error estimate: the stepper's embedded local error
+      // (one pass over the unknowns), absolute and against the tolerance.
+      summary->local_error_estimate_m =
+          std::max(summary->local_error_estimate_m, stepper.LocalErrorNorm(h_try, 1, 0));
+      summary->local_error_ratio =
+          std::max(summary->local_error_ratio,
+                   stepper.LocalErrorNorm(h_try, settings.error_tolerance_m,
+                                          settings.relative_tolerance));
       ++summary->steps;
       summary->min_step_s = std::min(summary->min_step_s, h_try);
       summary->max_step_s = std::max(summary->max_step_s, h_try);
@@ -240,6 +249,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     ++summary->rejected_steps;
     successes = 0;
     h = h_try / 2;
+    summary->smallest_cut_step_s = std::min(summary->smallest_cut_step_s, h);
     if (h < h_min * (1 - 1e-12)) {
       Fail(summary, t + h_try,
            absl::StrFormat("step from t = %.9g s failed %d times down to h = %.3g s: %s", t,

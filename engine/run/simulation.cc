@@ -12,6 +12,7 @@
 #include "engine/run/dynamic_run.h"
 #include "engine/run/error_estimate.h"
 #include "engine/run/frame_recorder.h"
+#include "engine/run/run_warnings.h"
 #include "engine/run/static_run.h"
 #include "engine/scene/integrator_traits.h"
 
@@ -155,6 +156,7 @@ absl::StatusOr<RunSummary> RunPrepared(PreparedRun* prepared, FrameSink* sink,
   if (settings.analysis == Analysis::kDynamic)
     summary.energy_dissipated =
         summary.energy_initial - summary.energy_final - summary.energy_damped;
+  AddRunWarnings(settings, &summary);
   summary.wall_seconds =
       p.build_seconds + std::chrono::duration<double>(Clock::now() - start).count();
   return summary;

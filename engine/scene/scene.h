@@ -318,6 +318,15 @@ struct SolverSettings {
   bool adaptive = false;
   double tolerance_m = 1e-4;
   double relative_tolerance = 0;
+  // DYNAMIC: the tolerance every run's error estimate is held to (the
+  // summary's error_tolerance_m; engine/run/run_warnings.h): tolerance_m
+  // when the scene gives solver.tolerance or steps adaptively, else 1 % of
+  // the scene's size (convert/). Held with relative_tolerance as the
+  // adaptive controller holds tolerance_m.
+  double error_tolerance_m = 1e-4;
+  // Run warnings (engine/run/run_warnings.h) fail an otherwise successful
+  // run: solver.strict, `cablesim run --strict`, RunRequest.strict.
+  bool strict = false;
   // Adds an estimate of the run's largest probe-position error to the
   // summary, from a companion run (RunScene).
   bool error_estimate = false;

@@ -104,6 +104,9 @@ def main():
     ap.add_argument("new")
     ap.add_argument("scenes", nargs="*")
     ap.add_argument("--rel", type=float, default=1e-12)
+    ap.add_argument("--added", action="append", default=[], metavar="KEY",
+                    help="a summary key the new binary adds (repeatable): compared only "
+                         "for being absent from the old summary")
     args = ap.parse_args()
     scenes = args.scenes or sorted(glob.glob("scenes/*.json")) + sorted(
         glob.glob("scenes/paper/*.json"))
@@ -119,6 +122,11 @@ def main():
             if rca != rcb:
                 problem = f"exit {rca} vs {rcb}: {eb.strip()[:200]}"
             elif rca == 0:
+                for key in args.added:
+                    if key in sa:
+                        problem = f"summary.{key}: not new (in the old summary too)"
+                    sb.pop(key, None)
+            if problem is None and rca == 0:
                 problem = compare_values(sa, sb, "summary.", worst, args.rel) or compare_csv(
                     oa, ob, worst, args.rel)
             verdict = ("DIFFERENT: " + problem if problem else
