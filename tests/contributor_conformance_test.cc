@@ -43,6 +43,7 @@
 #include <functional>
 #include <limits>
 #include <ostream>
+#include <numbers>
 #include <numeric>
 #include <optional>
 #include <string>
@@ -506,7 +507,34 @@ std::string SeabedChain(const char* model, const char* bed) {
                          model, bed);
 }
 
+// A cable lying in the fluid (planar: y up; spatial: z up) with
+// structural damping, or with drag in a current, or drag and flow inertia
+// in waves.
+std::string FluidCable(const char* model, const char* extra, const char* cable_extra) {
+  const char* up = std::string(model) == "PLANAR" ? "y" : "z";
+  return absl::StrFormat(R"({
+    "model": "%s", "gravity": {"%s": -9.81},
+    "fluid": {"density": 1025, "water_depth": 50, "current": {"x": 0.3} %s},
+    "cables": [{"name": "c", "points": [{"%s": -20}, {"x": 8, "%s": -19}], "density": 7850,
+                "youngs_modulus": 2e11, "diameter": 0.05, "elements": 4 %s}],
+    "solver": {"duration": 1}})",
+                         model, up, extra, up, up, cable_extra);
+}
+
+constexpr const char* kDamping = R"(, "damping": {"axial_time": 2e-3, "bending_time": 5e-3,
+    "rayleigh_alpha": 0.3, "rayleigh_beta": 1e-3})";
+constexpr const char* kDrag = R"(, "hydrodynamics": {"normal_drag": 1.2,
+    "tangential_drag": 0.4, "added_mass": 1})";
+constexpr const char* kWaves = R"(, "waves": {"regular": [{"height": 2, "period": 8}],
+    "ramp_time": 5})";
+
 const ElementCase kElementCases[] = {
+    {"CableDampingPlanar", "cable_damping", [] { return SceneFromJson(FluidCable("PLANAR", "", kDamping)); }},
+    {"CableDampingSpatial", "cable_damping", [] { return SceneFromJson(FluidCable("SPATIAL", "", kDamping)); }},
+    {"CableDragInCurrentPlanar", "cable_fluid_load", [] { return SceneFromJson(FluidCable("PLANAR", "", kDrag)); }},
+    {"CableDragInCurrentSpatial", "cable_fluid_load", [] { return SceneFromJson(FluidCable("SPATIAL", "", kDrag)); }},
+    {"CableMorisonInWavesPlanar", "cable_fluid_load", [] { return SceneFromJson(FluidCable("PLANAR", kWaves, kDrag)); }},
+    {"CableMorisonInWavesSpatial", "cable_fluid_load", [] { return SceneFromJson(FluidCable("SPATIAL", kWaves, kDrag)); }},
     {"CableSeabedDamperPlanar", "cable_seabed",
      [] { return SceneFromJson(SeabedChain("PLANAR", R"("stiffness": 3e5, "damping": 1e4)")); }},
     {"CableSeabedFrictionSpatial", "cable_seabed",
@@ -532,6 +560,50 @@ class ElementTermConformanceTest : public ::testing::TestWithParam<ElementCase> 
   void Check() {
     using C = ElementCoords<D>;
     using M = ElementMatrix<D>;
+    const double length = 2;
+    C e, edot;
+    for (int i = 0; i < 4 * D; ++i) edot(i) = 0.1 * std::cos(1.9 * i + 0.3);
+    if (term_->has_potential()) {
+      CheckPotential<D>(length, &e);
+    } else {
+      // Any bent and stretched element (a node's slope 1.05 long).
+      for (int i = 0; i < 4 * D; ++i) e(i) = (i % (2 * D) == D ? 1.0 : 0.0) + 0.05 * std::sin(1.3 * i);
+      e.template segment<D>(2 * D)(0) += length;
+    }
+    if (!term_->dissipates()) return;
+    // The term's first element, on an element of the given length (the
+    // cables' stiffness, as the damping matrix scales with it), at kTime.
+    const AncfCableElement<D> element(length, 2e11 * std::numbers::pi * 0.05 * 0.05 / 4,
+                                      2e11 * std::numbers::pi * std::pow(0.05, 4) / 64, BendingModel::kLinear);
+    const ElementAt<D> at{element, 0, kTime};
+    ASSERT_TRUE(term_->DissipatesOn(0));
+    C f = C::Zero();
+    M c = M::Zero();
+    const double power = term_->AddElementDissipation(at, e, edot, &f, &c);
+    ASSERT_GT(f.template lpNorm<Eigen::Infinity>(), 0) << "no dissipative force";
+    EXPECT_NEAR(power, -f.dot(edot), kPowerRel * f.cwiseProduct(edot).cwiseAbs().sum());
+    if (GetParam().damping == kSymmetricBound) {
+      ExpectSymmetricPositiveSemiDefinite(Eigen::MatrixXd(c));
+      return;
+    }
+    double cerr = 0;
+    for (int i = 0; i < 4 * D; ++i) {
+      C vp = edot, vm = edot;
+      vp(i) += kStep;
+      vm(i) -= kStep;
+      C fp = C::Zero(), fm = C::Zero();
+      term_->AddElementDissipation(at, e, vp, &fp, nullptr);
+      term_->AddElementDissipation(at, e, vm, &fm, nullptr);
+      cerr = std::max(cerr, (-(fp - fm) / (2 * kStep) - c.col(i)).template lpNorm<Eigen::Infinity>());
+    }
+    EXPECT_LE(cerr, kRelative * c.template lpNorm<Eigen::Infinity>());
+  }
+  // The potential's checks, on an element sunk into the seabed (the one
+  // element term with a potential), which it leaves in *e.
+  template <int D>
+  void CheckPotential(double length, ElementCoords<D>* e_out) {
+    using C = ElementCoords<D>;
+    using M = ElementMatrix<D>;
     const Seabed& bed = *model_->seabed();
     // Places the element's nodes below the bed by the given depths (the
     // bed's normal from its height function).
@@ -539,12 +611,10 @@ class ElementTermConformanceTest : public ::testing::TestWithParam<ElementCase> 
     for (int d = 0; d < D; ++d)
       n(d) = bed.Height(Eigen::Vector3d::Unit(d)) - bed.Height(Eigen::Vector3d::Zero());
     const double h0 = bed.Height(Eigen::Vector3d::Zero());
-    const double length = 2;
-    C e, edot;
+    C& e = *e_out;
     const Eigen::Vector3d x = Eigen::Vector3d::UnitX(), r0 = -(h0 + 0.002) * n,
                           r1 = 2 * x - (h0 + 0.005) * n;
     e << r0.head<D>(), (x - 0.0015 * n).head<D>(), r1.head<D>(), (x - 0.0015 * n).head<D>();
-    for (int i = 0; i < 4 * D; ++i) edot(i) = 0.1 * std::cos(1.9 * i + 0.3);
     C g = C::Zero();
     M k = M::Zero();
     const double u = term_->AddPotential(e, length, &g, &k, nullptr);
@@ -564,26 +634,6 @@ class ElementTermConformanceTest : public ::testing::TestWithParam<ElementCase> 
     }
     EXPECT_LE(gerr, kRelative * (g.template lpNorm<Eigen::Infinity>() + u));
     EXPECT_LE(kerr, kRelative * k.template lpNorm<Eigen::Infinity>());
-    if (!term_->dissipates()) return;
-    C f = C::Zero();
-    M c = M::Zero();
-    const double power = term_->AddDissipation(e, edot, length, &f, &c);
-    EXPECT_NEAR(power, -f.dot(edot), kPowerRel * f.cwiseProduct(edot).cwiseAbs().sum());
-    if (GetParam().damping == kSymmetricBound) {
-      ExpectSymmetricPositiveSemiDefinite(Eigen::MatrixXd(c));
-      return;
-    }
-    double cerr = 0;
-    for (int i = 0; i < 4 * D; ++i) {
-      C vp = edot, vm = edot;
-      vp(i) += kStep;
-      vm(i) -= kStep;
-      C fp = C::Zero(), fm = C::Zero();
-      term_->AddDissipation(e, vp, length, &fp, nullptr);
-      term_->AddDissipation(e, vm, length, &fm, nullptr);
-      cerr = std::max(cerr, (-(fp - fm) / (2 * kStep) - c.col(i)).template lpNorm<Eigen::Infinity>());
-    }
-    EXPECT_LE(cerr, kRelative * c.template lpNorm<Eigen::Infinity>());
   }
   std::optional<MultibodyModel> model_;
   const ElementTerm* term_ = nullptr;
@@ -602,6 +652,28 @@ INSTANTIATE_TEST_SUITE_P(ElementTerms, ElementTermConformanceTest,
                          [](const ::testing::TestParamInfo<ElementCase>& info) {
                            return std::string(info.param.label);
                          });
+
+// A scene without damping, fluid or seabed builds no element term, and
+// every element term a sample scene builds has a case above.
+TEST(ElementTermConformance, EveryElementTermOfTheSampleScenesHasACase) {
+  auto plain = MultibodyModel::Build(SampleScene("falling-pendulum.json"));
+  ASSERT_TRUE(plain.ok()) << plain.status();
+  EXPECT_TRUE(plain->element_terms().empty());
+  const char* samples[] = {"cable-in-current.json", "mooring-line-in-waves.json",
+                           "mooring-chain-landing.json", "damped-cantilever.json",
+                           "towed-cable.json", "crane-winch.json"};
+  for (const char* file : samples) {
+    auto model = MultibodyModel::Build(SampleScene(file));
+    ASSERT_TRUE(model.ok()) << file << ": " << model.status();
+    for (const auto& t : model->element_terms()) {
+      bool found = false;
+      for (const ElementCase& k : kElementCases) {
+        if (t->name() == k.term) found = true;
+      }
+      EXPECT_TRUE(found) << file << ": " << t->name() << " has no conformance case";
+    }
+  }
+}
 
 // ---- Constraint families (engine/constraints/constraint.h) ----
 //

@@ -50,6 +50,7 @@
 
 #include <Eigen/Core>
 
+#include "engine/elements/ancf_cable_element.h"
 #include "engine/linear/coordinate_map.h"
 #include "engine/linear/skyline_ldlt.h"
 
@@ -159,11 +160,26 @@ using ElementCoords = Eigen::Matrix<double, 4 * D, 1>;
 template <int D>
 using ElementMatrix = Eigen::Matrix<double, 4 * D, 4 * D>;
 
+// Where an element term's dissipation is evaluated: the element (its
+// current length, quadrature and shape functions: a winch cable's change
+// with time), its index in the model's element list (cable by cable, in
+// scene order; a term keeps per-element data by it) and the time of the
+// model's SetTime.
+template <int D>
+struct ElementAt {
+  const AncfCableElement<D>& element;
+  int index = 0;
+  double time = 0;
+};
+
 class ElementTerm {
  public:
   virtual ~ElementTerm() = default;
   virtual std::string_view name() const = 0;
   virtual EnergyBucket bucket() const { return EnergyBucket::kContact; }
+  // Whether AddPotential and Energy add anything (false: the model leaves
+  // the term out of its elastic loop, as it does for damping and drag).
+  virtual bool has_potential() const { return true; }
 
   // Adds dU/de to `gradient` (minus the force, as the elastic force's
   // gradient), d^2U/de^2 to `hessian` and the gradient's rounding bound to
@@ -205,6 +221,25 @@ class ElementTerm {
                                 ElementMatrix<3>* c) const {
     (void)e, (void)edot, (void)length, (void)force, (void)c;
     return 0;
+  }
+  // Whether AddElementDissipation adds anything on element `index` (the
+  // model skips the elements no term acts on).
+  virtual bool DissipatesOn(int index) const {
+    (void)index;
+    return dissipates();
+  }
+  // AddDissipation with the element itself (what the model calls): a term
+  // whose data is per element, or that needs the element's quadrature or
+  // the time, overrides these; the default forwards to AddDissipation.
+  virtual double AddElementDissipation(const ElementAt<2>& at, const ElementCoords<2>& e,
+                                       const ElementCoords<2>& edot, ElementCoords<2>* force,
+                                       ElementMatrix<2>* c) const {
+    return AddDissipation(e, edot, at.element.length(), force, c);
+  }
+  virtual double AddElementDissipation(const ElementAt<3>& at, const ElementCoords<3>& e,
+                                       const ElementCoords<3>& edot, ElementCoords<3>* force,
+                                       ElementMatrix<3>* c) const {
+    return AddDissipation(e, edot, at.element.length(), force, c);
   }
 
   virtual bool has_static_friction() const { return false; }

@@ -17,6 +17,8 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "engine/forces/cable_damping.h"
+#include "engine/forces/cable_fluid_load.h"
 #include "engine/model/multibody_model.h"
 #include "engine/constraints/quadratic_form.h"
 #include "engine/scene/scene.h"
@@ -268,6 +270,11 @@ class ModelBuilder {
   std::vector<Eigen::Matrix3d> frame0_;  // per body, its axes at t = 0
   Elimination elimination_;
   std::vector<PendingRow> pending_;
+  // BuildElementsOf's per-element damping and fluid-load data, and the
+  // damping term (the winches clear their cables' share).
+  std::vector<CableDamping::Element> damping_elements_;
+  std::vector<CableFluidLoad::Element> fluid_elements_;
+  CableDamping* cable_damping_ = nullptr;
 };
 
 }  // namespace cablesim

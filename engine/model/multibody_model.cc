@@ -225,7 +225,7 @@ double MultibodyModel::ElementForces(const VectorXd& q, VectorXd* full, SkylineL
                            roundoff ? &re : nullptr);
     // Element terms' forces (the seabed's), like the elastic one, are
     // gradients of energies.
-    for (const auto& t : element_terms_)
+    for (const ElementTerm* t : potential_terms_)
       t->AddPotential(q.segment<kN>(e.first_coord), e.element.length(), &fe,
                       stiffness ? &ke : nullptr, roundoff ? &re : nullptr);
     if (!sheaves_.empty()) {
@@ -330,7 +330,7 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
   typename AncfCableElement<D>::Coords fe;
   double size = 0;
   double* values = tangent ? tangent->values() : nullptr;
-  const bool bed = element_terms_dissipate_;
+  const bool terms = !element_dissipates_.empty();
   // Work per element for the stop poll: its Gauss points, each summing
   // every wave component.
   const int64_t components = wave_load_ ? wave_load_->field().components().size() : 0;
@@ -342,28 +342,17 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
       return std::numeric_limits<double>::quiet_NaN();
     }
     const uint64_t wheels = sheaves_dissipate_ ? sheave_mask_[k] : 0;
-    if (!e.damped() && !bed && e.fluid_inertia == 0 && wheels == 0) continue;
-    ce.setZero();
-    if (e.axial_damping_s != 0 || e.bending_damping_s != 0)
-      e.element.AddDampingMatrix(q.segment<kN>(e.first_coord), e.axial_damping_s,
-                                 e.bending_damping_s, &ce);
-    if (e.alpha_1_s != 0) ce += e.alpha_1_s * e.element.MassMatrix(e.mass_per_length);
+    const bool acted_on = terms && element_dissipates_[k];
+    if (!acted_on && wheels == 0) continue;
     const auto ve = qdot.segment<kN>(e.first_coord);
-    // fe: the damping force -C ve, plus the drag (which adds its own
-    // velocity derivative to ce).
-    fe.noalias() = -ce * ve;
-    if (wave_load_) {
-      if (e.drag_n != 0 || e.drag_t != 0 || e.fluid_inertia != 0)
-        wave_load_->Add<D>(e.element, q.segment<kN>(e.first_coord), ve, time_, e.drag_n, e.drag_t,
-                           e.fluid_inertia, &fe, &ce);
-    } else if (e.drag_n != 0 || e.drag_t != 0) {
-      e.element.AddDrag(q.segment<kN>(e.first_coord), ve, current_.head<D>(), e.drag_n, e.drag_t,
-                        &fe, &ce);
-    }
-    if (bed) {
-      for (const auto& t : element_terms_)
-        if (t->dissipates())
-          t->AddDissipation(q.segment<kN>(e.first_coord), ve, e.element.length(), &fe, &ce);
+    // fe: the velocity-dependent force, ce its velocity derivative, summed
+    // over the element terms (damping, the fluid's load, the seabed's).
+    fe.setZero();
+    ce.setZero();
+    if (acted_on) {
+      const ElementAt<D> at{e.element, static_cast<int>(k), time_};
+      for (const ElementTerm* t : dissipative_terms_)
+        t->AddElementDissipation(at, q.segment<kN>(e.first_coord), ve, &fe, &ce);
     }
     for (uint64_t bits = wheels; bits != 0; bits &= bits - 1) {
       const Sheave& wheel = sheaves_[std::countr_zero(bits)];
