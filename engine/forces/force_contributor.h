@@ -165,11 +165,23 @@ using ElementMatrix = Eigen::Matrix<double, 4 * D, 4 * D>;
 // with time), its index in the model's element list (cable by cable, in
 // scene order; a term keeps per-element data by it) and the time of the
 // model's SetTime.
+//
+// A term that couples the element with other coordinates (a sheave carried
+// by a body) also gets the element's first full coordinate, the full state
+// (qdot null in the position-only passes), where to add the terms that
+// reach beyond the element (`coupled`: any pointer in it may be null, then
+// that part is not wanted; null itself in the energy pass) and a running
+// sum for the power those terms dissipate (null: not wanted).
 template <int D>
 struct ElementAt {
   const AncfCableElement<D>& element;
   int index = 0;
   double time = 0;
+  int first_coord = 0;
+  const Eigen::VectorXd* q = nullptr;
+  const Eigen::VectorXd* qdot = nullptr;
+  ForceOutput* coupled = nullptr;
+  double* coupled_power = nullptr;
 };
 
 class ElementTerm {
@@ -195,6 +207,28 @@ class ElementTerm {
                               ElementCoords<3>* roundoff) const {
     (void)e, (void)length, (void)gradient, (void)hessian, (void)roundoff;
     return 0;
+  }
+  // AddPotential and Energy with the element itself (what the model
+  // calls; the energy as a running sum, so that the model's total is summed
+  // term by term): a term with per-element data, or that couples the
+  // element with other coordinates, overrides these; the defaults forward.
+  virtual double AddElementPotential(const ElementAt<2>& at, const ElementCoords<2>& e,
+                                     ElementCoords<2>* gradient, ElementMatrix<2>* hessian,
+                                     ElementCoords<2>* roundoff) const {
+    return AddPotential(e, at.element.length(), gradient, hessian, roundoff);
+  }
+  virtual double AddElementPotential(const ElementAt<3>& at, const ElementCoords<3>& e,
+                                     ElementCoords<3>* gradient, ElementMatrix<3>* hessian,
+                                     ElementCoords<3>* roundoff) const {
+    return AddPotential(e, at.element.length(), gradient, hessian, roundoff);
+  }
+  virtual void AddElementEnergy(const ElementAt<2>& at, const ElementCoords<2>& e,
+                                double* energy) const {
+    *energy += Energy(e, at.element.length());
+  }
+  virtual void AddElementEnergy(const ElementAt<3>& at, const ElementCoords<3>& e,
+                                double* energy) const {
+    *energy += Energy(e, at.element.length());
   }
   // U [J] alone.
   virtual double Energy(const ElementCoords<2>& e, double length) const {

@@ -506,7 +506,7 @@ void ModelBuilder::BuildElements() {
     BuildElementsOf<3>(&model_.elements3_);
   }
   // The element terms, in the order they are summed: damping, the fluid's
-  // load, the seabed.
+  // load, the seabed, the sheaves.
   if (auto damping = MakeCableDamping(std::move(damping_elements_))) {
     cable_damping_ = damping.get();
     model_.element_terms_.push_back(std::move(damping));
@@ -518,6 +518,12 @@ void ModelBuilder::BuildElements() {
     model_.cable_seabed_ = bed.get();
     model_.element_terms_.push_back(std::move(bed));
   }
+  std::vector<int> body_coord;
+  for (const MultibodyModel::BodyData& b : model_.bodies_) body_coord.push_back(b.coord);
+  if (auto wheels = MakeSheaves(scene_, model_.cable_element_begin_, body_coord)) {
+    model_.sheaves_ = wheels.get();
+    model_.element_terms_.push_back(std::move(wheels));
+  }
   for (const auto& t : model_.element_terms_) {
     if (t->has_potential()) {
       model_.potential_terms_.push_back(t.get());
@@ -526,23 +532,6 @@ void ModelBuilder::BuildElements() {
     if (t->dissipates()) {
       model_.dissipative_terms_.push_back(t.get());
       model_.has_damping_ = true;
-    }
-  }
-  BuildSheaves();
-}
-
-void ModelBuilder::BuildSheaves() {
-  MultibodyModel& m = model_;
-  if (scene_.sheaves.empty()) return;
-  m.sheave_mask_.assign(m.elements(), 0);
-  for (size_t i = 0; i < scene_.sheaves.size(); ++i) {
-    const SheaveSpec& spec = scene_.sheaves[i];
-    m.sheaves_.emplace_back(spec);
-    if (m.sheaves_.back().dissipates()) m.sheaves_dissipate_ = m.has_damping_ = true;
-    for (int cable = 0; cable < static_cast<int>(scene_.cables.size()); ++cable) {
-      if (!spec.Touches(cable)) continue;
-      for (int k = m.cable_element_begin_[cable]; k < m.cable_element_begin_[cable + 1]; ++k)
-        m.sheave_mask_[k] |= uint64_t{1} << i;
     }
   }
 }

@@ -173,9 +173,6 @@ class ModelBuilder {
   // the model's energy_roundoff [J], and where each cable's elements begin
   // (for the energy per cable).
   void BuildElements();
-  // The scene's sheaves and which elements each may touch (after the
-  // elements: a sheave touches every element of the cables it lists).
-  void BuildSheaves();
 
   // The force contributors the scene uses (engine/forces/force_contributor.h),
   // each built by the Make... next to its class, in the order the model

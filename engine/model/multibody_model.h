@@ -57,7 +57,7 @@
 #include "engine/forces/body_seabed_contact.h"
 #include "engine/forces/force_contributor.h"
 #include "engine/forces/seabed.h"
-#include "engine/forces/sheave.h"
+#include "engine/forces/sheaves.h"
 #include "engine/forces/wave_load.h"
 #include "engine/constraints/constraint.h"
 #include "engine/constraints/joint_rows.h"
@@ -303,10 +303,10 @@ class MultibodyModel {
   void StaticFriction(const Eigen::VectorXd& q, const Eigen::VectorXd& q_start,
                         Eigen::VectorXd* f, SkylineLdlt* matrix, double scale);
   // Whether frames carry energy.contact (a seabed or sheaves).
-  bool has_contact() const { return has_element_contact_ || !sheaves_.empty(); }
+  bool has_contact() const { return has_element_contact_; }
 
   // The scene's sheaves (engine/forces/sheave.h), none in most scenes.
-  const std::vector<Sheave>& sheaves() const { return sheaves_; }
+  const std::vector<Sheave>& sheaves() const;
 
   // Whether frames carry the nodes' positions (the scene's output.shape).
   bool shape() const { return shape_; }
@@ -437,23 +437,6 @@ class MultibodyModel {
   template <int D>
   Eigen::Vector3d ElementAngularMomentum(const Eigen::VectorXd& q,
                                          const Eigen::VectorXd& qdot) const;
-  // Adds a slider's local force to the full vector `full` (and its rounding
-  // to `roundoff`) and scale times its matrix, mapped onto z, to `a`.
-  // A wheel carried by a body (Sheave::body() >= 0) on the element whose
-  // first full coordinate is first_coord: its force, tangent and rounding
-  // over the element and the body's centre, scattered like a slider's; and
-  // its damping and friction (returns their power).
-  template <int D>
-  void BodySheaveForce(const Sheave& wheel, int first_coord, double length,
-                       const Eigen::VectorXd& q, Eigen::VectorXd* full, Eigen::VectorXd* roundoff,
-                       SkylineLdlt* stiffness, double scale) const;
-  template <int D>
-  double BodySheaveDamping(const Sheave& wheel, int first_coord, double length,
-                           const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
-                           Eigen::VectorXd* full, Eigen::VectorXd* roundoff, SkylineLdlt* tangent,
-                           double scale) const;
-  void ScatterSlider(const SlidingJoint::Local& local, Eigen::VectorXd* full, Eigen::VectorXd* roundoff,
-                     double scale, SkylineLdlt* a) const;
   // The state contributors are evaluated at (time_ and the wave field).
   ForceState StateAt(const Eigen::VectorXd& q, const Eigen::VectorXd* qdot,
                      double load_factor) const {
@@ -536,7 +519,7 @@ class MultibodyModel {
   bool has_damping_ = false;
   // The per-element force terms the scene uses (ElementTerm; none in
   // most scenes), summed in this order inside the element loops (cable
-  // damping, the fluid's load, the seabed); those with a potential and
+  // damping, the fluid's load, the seabed, the sheaves); those with a potential and
   // those that dissipate; per element whether any dissipative term acts on
   // it (empty without any); whether any stores contact energy; the cable
   // seabed's typed view.
@@ -547,11 +530,8 @@ class MultibodyModel {
   const CableSeabed* cable_seabed_ = nullptr;
   // Scratch (full size) for StaticFriction (sized on first use).
   Eigen::VectorXd scratch_static_;
-  // Sheaves, and per element the bit set of those that touch its cable
-  // (empty without sheaves).
-  std::vector<Sheave> sheaves_;
-  std::vector<uint64_t> sheave_mask_;
-  bool sheaves_dissipate_ = false;
+  // The sheaves' typed view (null without sheaves).
+  const Sheaves* sheaves_ = nullptr;
   // Only in a scene whose fluid has waves (then it carries the current
   // too); shared with the cables' fluid load (CableFluidLoad).
   std::shared_ptr<const WaveLoad> wave_load_;
