@@ -5,7 +5,7 @@
 namespace cablesim {
 
 template <int D>
-double CableDamping::Add(const ElementAt<D>& at, const ElementCoords<D>& e,
+double CableDamping::Dissipation(const ElementAt<D>& at, const ElementCoords<D>& e,
                          const ElementCoords<D>& edot, ElementCoords<D>* force,
                          ElementMatrix<D>* c) const {
   const Element& p = elements_[at.index];
@@ -20,10 +20,10 @@ double CableDamping::Add(const ElementAt<D>& at, const ElementCoords<D>& e,
   return edot.dot(f);
 }
 
-template double CableDamping::Add<2>(const ElementAt<2>&, const ElementCoords<2>&,
+template double CableDamping::Dissipation<2>(const ElementAt<2>&, const ElementCoords<2>&,
                                      const ElementCoords<2>&, ElementCoords<2>*,
                                      ElementMatrix<2>*) const;
-template double CableDamping::Add<3>(const ElementAt<3>&, const ElementCoords<3>&,
+template double CableDamping::Dissipation<3>(const ElementAt<3>&, const ElementCoords<3>&,
                                      const ElementCoords<3>&, ElementCoords<3>*,
                                      ElementMatrix<3>*) const;
 

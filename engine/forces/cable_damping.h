@@ -15,11 +15,12 @@
 #include <string_view>
 #include <vector>
 
+#include "engine/forces/element_dissipation_term.h"
 #include "engine/forces/force_contributor.h"
 
 namespace cablesim {
 
-class CableDamping : public ElementTerm {
+class CableDamping : public ElementDissipationTerm<CableDamping> {
  public:
   struct Element {
     double axial_s = 0, bending_s = 0;  // Kelvin-Voigt times, Rayleigh beta included [s]
@@ -32,7 +33,6 @@ class CableDamping : public ElementTerm {
 
   std::string_view name() const override { return "cable_damping"; }
   bool has_potential() const override { return false; }
-  bool dissipates() const override { return true; }
   bool DissipatesOn(int index) const override { return elements_[index].any(); }
   // Removes element `index`'s axial and Rayleigh alpha damping (a winch
   // cable's, which the winch applies to the material motion instead).
@@ -41,20 +41,10 @@ class CableDamping : public ElementTerm {
     elements_[index].alpha_1_s = 0;
   }
 
-  double AddElementDissipation(const ElementAt<2>& at, const ElementCoords<2>& e,
-                               const ElementCoords<2>& edot, ElementCoords<2>* force,
-                               ElementMatrix<2>* c) const override {
-    return Add<2>(at, e, edot, force, c);
-  }
-  double AddElementDissipation(const ElementAt<3>& at, const ElementCoords<3>& e,
-                               const ElementCoords<3>& edot, ElementCoords<3>* force,
-                               ElementMatrix<3>* c) const override {
-    return Add<3>(at, e, edot, force, c);
-  }
-
  private:
+  friend class ElementDissipationTerm<CableDamping>;
   template <int D>
-  double Add(const ElementAt<D>& at, const ElementCoords<D>& e, const ElementCoords<D>& edot,
+  double Dissipation(const ElementAt<D>& at, const ElementCoords<D>& e, const ElementCoords<D>& edot,
              ElementCoords<D>* force, ElementMatrix<D>* c) const;
 
   std::vector<Element> elements_;

@@ -5,7 +5,7 @@
 namespace cablesim {
 
 template <int D>
-double CableFluidLoad::Add(const ElementAt<D>& at, const ElementCoords<D>& e,
+double CableFluidLoad::Dissipation(const ElementAt<D>& at, const ElementCoords<D>& e,
                            const ElementCoords<D>& edot, ElementCoords<D>* force,
                            ElementMatrix<D>* c) const {
   const Element& p = elements_[at.index];
@@ -19,10 +19,10 @@ double CableFluidLoad::Add(const ElementAt<D>& at, const ElementCoords<D>& e,
   return -edot.dot(*force - before);
 }
 
-template double CableFluidLoad::Add<2>(const ElementAt<2>&, const ElementCoords<2>&,
+template double CableFluidLoad::Dissipation<2>(const ElementAt<2>&, const ElementCoords<2>&,
                                        const ElementCoords<2>&, ElementCoords<2>*,
                                        ElementMatrix<2>*) const;
-template double CableFluidLoad::Add<3>(const ElementAt<3>&, const ElementCoords<3>&,
+template double CableFluidLoad::Dissipation<3>(const ElementAt<3>&, const ElementCoords<3>&,
                                        const ElementCoords<3>&, ElementCoords<3>*,
                                        ElementMatrix<3>*) const;
 

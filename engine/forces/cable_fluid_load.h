@@ -16,12 +16,13 @@
 
 #include <Eigen/Core>
 
+#include "engine/forces/element_dissipation_term.h"
 #include "engine/forces/force_contributor.h"
 #include "engine/forces/wave_load.h"
 
 namespace cablesim {
 
-class CableFluidLoad : public ElementTerm {
+class CableFluidLoad : public ElementDissipationTerm<CableFluidLoad> {
  public:
   struct Element {
     double drag_n = 0, drag_t = 0;  // AddDrag's kn, kt [kg/m^2]
@@ -37,23 +38,12 @@ class CableFluidLoad : public ElementTerm {
 
   std::string_view name() const override { return "cable_fluid_load"; }
   bool has_potential() const override { return false; }
-  bool dissipates() const override { return true; }
   bool DissipatesOn(int index) const override { return elements_[index].any(); }
 
-  double AddElementDissipation(const ElementAt<2>& at, const ElementCoords<2>& e,
-                               const ElementCoords<2>& edot, ElementCoords<2>* force,
-                               ElementMatrix<2>* c) const override {
-    return Add<2>(at, e, edot, force, c);
-  }
-  double AddElementDissipation(const ElementAt<3>& at, const ElementCoords<3>& e,
-                               const ElementCoords<3>& edot, ElementCoords<3>* force,
-                               ElementMatrix<3>* c) const override {
-    return Add<3>(at, e, edot, force, c);
-  }
-
  private:
+  friend class ElementDissipationTerm<CableFluidLoad>;
   template <int D>
-  double Add(const ElementAt<D>& at, const ElementCoords<D>& e, const ElementCoords<D>& edot,
+  double Dissipation(const ElementAt<D>& at, const ElementCoords<D>& e, const ElementCoords<D>& edot,
              ElementCoords<D>* force, ElementMatrix<D>* c) const;
 
   std::vector<Element> elements_;
