@@ -43,6 +43,7 @@
 #include <functional>
 #include <limits>
 #include <ostream>
+#include <numbers>
 #include <numeric>
 #include <optional>
 #include <string>
@@ -487,11 +488,19 @@ TEST(ContributorConformance, EveryContributorOfTheSampleScenesHasACase) {
 // symmetric positive semi-definite bound, as forces/seabed.h says), the
 // power against -f . edot. Tolerances as for the contributors above.
 
+// Where a case's element lies for its potential's checks: sunk into the
+// seabed, or pressed into a wheel of radius 0.5 m on the z axis.
+enum Place { kInSeabed, kInWheel };
+
 struct ElementCase {
   const char* label;
   const char* term;
   std::function<Scene()> scene;
   Tangent damping = kExact;
+  Place place = kInSeabed;
+  // The stiffness: exact, or (the sheave's Newton tangent k n n^T,
+  // forces/sheave.h) symmetric positive semi-definite.
+  Tangent stiffness = kExact;
 };
 
 void PrintTo(const ElementCase& c, std::ostream* os) { *os << c.label; }
@@ -506,7 +515,50 @@ std::string SeabedChain(const char* model, const char* bed) {
                          model, bed);
 }
 
+// A cable lying in the fluid (planar: y up; spatial: z up) with
+// structural damping, or with drag in a current, or drag and flow inertia
+// in waves.
+std::string FluidCable(const char* model, const char* extra, const char* cable_extra) {
+  const char* up = std::string(model) == "PLANAR" ? "y" : "z";
+  return absl::StrFormat(R"({
+    "model": "%s", "gravity": {"%s": -9.81},
+    "fluid": {"density": 1025, "water_depth": 50, "current": {"x": 0.3} %s},
+    "cables": [{"name": "c", "points": [{"%s": -20}, {"x": 8, "%s": -19}], "density": 7850,
+                "youngs_modulus": 2e11, "diameter": 0.05, "elements": 4 %s}],
+    "solver": {"duration": 1}})",
+                         model, up, extra, up, up, cable_extra);
+}
+
+constexpr const char* kDamping = R"(, "damping": {"axial_time": 2e-3, "bending_time": 5e-3,
+    "rayleigh_alpha": 0.3, "rayleigh_beta": 1e-3})";
+constexpr const char* kDrag = R"(, "hydrodynamics": {"normal_drag": 1.2,
+    "tangential_drag": 0.4, "added_mass": 1})";
+constexpr const char* kWaves = R"(, "waves": {"regular": [{"height": 2, "period": 8}],
+    "ramp_time": 5})";
+
+// A cable over a wheel (radius 0.5 m at the origin) with damping and
+// friction.
+std::string OverWheel(const char* model) {
+  return absl::StrFormat(R"({
+    "model": "%s", "gravity": {"y": -9.81},
+    "cables": [{"name": "c", "points": [{"x": -4, "y": 0.6}, {"x": 4, "y": 0.6}], "density": 7850,
+                "youngs_modulus": 2e11, "diameter": 0.02, "elements": 4}],
+    "sheaves": [{"name": "w", "radius": 0.5, "stiffness": 1e7, "damping": 1e3, "friction": 0.3}],
+    "solver": {"duration": 1}})",
+                         model);
+}
+
 const ElementCase kElementCases[] = {
+    {"SheavePlanar", "sheaves", [] { return SceneFromJson(OverWheel("PLANAR")); },
+     kSymmetricBound, kInWheel, kSymmetricBound},
+    {"SheaveSpatial", "sheaves", [] { return SceneFromJson(OverWheel("SPATIAL")); },
+     kSymmetricBound, kInWheel, kSymmetricBound},
+    {"CableDampingPlanar", "cable_damping", [] { return SceneFromJson(FluidCable("PLANAR", "", kDamping)); }},
+    {"CableDampingSpatial", "cable_damping", [] { return SceneFromJson(FluidCable("SPATIAL", "", kDamping)); }},
+    {"CableDragInCurrentPlanar", "cable_fluid_load", [] { return SceneFromJson(FluidCable("PLANAR", "", kDrag)); }},
+    {"CableDragInCurrentSpatial", "cable_fluid_load", [] { return SceneFromJson(FluidCable("SPATIAL", "", kDrag)); }},
+    {"CableMorisonInWavesPlanar", "cable_fluid_load", [] { return SceneFromJson(FluidCable("PLANAR", kWaves, kDrag)); }},
+    {"CableMorisonInWavesSpatial", "cable_fluid_load", [] { return SceneFromJson(FluidCable("SPATIAL", kWaves, kDrag)); }},
     {"CableSeabedDamperPlanar", "cable_seabed",
      [] { return SceneFromJson(SeabedChain("PLANAR", R"("stiffness": 3e5, "damping": 1e4)")); }},
     {"CableSeabedFrictionSpatial", "cable_seabed",
@@ -532,42 +584,28 @@ class ElementTermConformanceTest : public ::testing::TestWithParam<ElementCase> 
   void Check() {
     using C = ElementCoords<D>;
     using M = ElementMatrix<D>;
-    const Seabed& bed = *model_->seabed();
-    // Places the element's nodes below the bed by the given depths (the
-    // bed's normal from its height function).
-    Eigen::Vector3d n = Eigen::Vector3d::Zero();
-    for (int d = 0; d < D; ++d)
-      n(d) = bed.Height(Eigen::Vector3d::Unit(d)) - bed.Height(Eigen::Vector3d::Zero());
-    const double h0 = bed.Height(Eigen::Vector3d::Zero());
     const double length = 2;
     C e, edot;
-    const Eigen::Vector3d x = Eigen::Vector3d::UnitX(), r0 = -(h0 + 0.002) * n,
-                          r1 = 2 * x - (h0 + 0.005) * n;
-    e << r0.head<D>(), (x - 0.0015 * n).head<D>(), r1.head<D>(), (x - 0.0015 * n).head<D>();
     for (int i = 0; i < 4 * D; ++i) edot(i) = 0.1 * std::cos(1.9 * i + 0.3);
-    C g = C::Zero();
-    M k = M::Zero();
-    const double u = term_->AddPotential(e, length, &g, &k, nullptr);
-    ASSERT_GT(u, 0) << "the element is not in the bed";
-    EXPECT_NEAR(term_->Energy(e, length), u, 1e-14 * u);
-    double gerr = 0, kerr = 0;
-    for (int i = 0; i < 4 * D; ++i) {
-      C ep = e, em = e;
-      ep(i) += kStep;
-      em(i) -= kStep;
-      gerr = std::max(gerr, std::abs((term_->Energy(ep, length) - term_->Energy(em, length)) /
-                                         (2 * kStep) - g(i)));
-      C gp = C::Zero(), gm = C::Zero();
-      term_->AddPotential(ep, length, &gp, nullptr, nullptr);
-      term_->AddPotential(em, length, &gm, nullptr, nullptr);
-      kerr = std::max(kerr, ((gp - gm) / (2 * kStep) - k.col(i)).template lpNorm<Eigen::Infinity>());
+    // The term's first element, on an element of the given length (the
+    // cables' stiffness, as the damping matrix scales with it), at kTime.
+    const AncfCableElement<D> element(length, 2e11 * std::numbers::pi * 0.05 * 0.05 / 4,
+                                      2e11 * std::numbers::pi * std::pow(0.05, 4) / 64,
+                                      BendingModel::kLinear);
+    const ElementAt<D> at{element, 0, kTime};
+    if (term_->has_potential()) {
+      CheckPotential<D>(at, &e);
+    } else {
+      // Any bent and stretched element (a node's slope 1.05 long).
+      for (int i = 0; i < 4 * D; ++i) e(i) = (i % (2 * D) == D ? 1.0 : 0.0) + 0.05 * std::sin(1.3 * i);
+      e.template segment<D>(2 * D)(0) += length;
     }
-    EXPECT_LE(gerr, kRelative * (g.template lpNorm<Eigen::Infinity>() + u));
-    EXPECT_LE(kerr, kRelative * k.template lpNorm<Eigen::Infinity>());
     if (!term_->dissipates()) return;
+    ASSERT_TRUE(term_->DissipatesOn(0));
     C f = C::Zero();
     M c = M::Zero();
-    const double power = term_->AddDissipation(e, edot, length, &f, &c);
+    const double power = term_->AddElementDissipation(at, e, edot, &f, &c);
+    ASSERT_GT(f.template lpNorm<Eigen::Infinity>(), 0) << "no dissipative force";
     EXPECT_NEAR(power, -f.dot(edot), kPowerRel * f.cwiseProduct(edot).cwiseAbs().sum());
     if (GetParam().damping == kSymmetricBound) {
       ExpectSymmetricPositiveSemiDefinite(Eigen::MatrixXd(c));
@@ -579,11 +617,65 @@ class ElementTermConformanceTest : public ::testing::TestWithParam<ElementCase> 
       vp(i) += kStep;
       vm(i) -= kStep;
       C fp = C::Zero(), fm = C::Zero();
-      term_->AddDissipation(e, vp, length, &fp, nullptr);
-      term_->AddDissipation(e, vm, length, &fm, nullptr);
+      term_->AddElementDissipation(at, e, vp, &fp, nullptr);
+      term_->AddElementDissipation(at, e, vm, &fm, nullptr);
       cerr = std::max(cerr, (-(fp - fm) / (2 * kStep) - c.col(i)).template lpNorm<Eigen::Infinity>());
     }
     EXPECT_LE(cerr, kRelative * c.template lpNorm<Eigen::Infinity>());
+  }
+  // The potential's checks, on an element placed where the term acts
+  // (Place), which it leaves in *e.
+  template <int D>
+  void CheckPotential(const ElementAt<D>& at, ElementCoords<D>* e_out) {
+    using C = ElementCoords<D>;
+    using M = ElementMatrix<D>;
+    C& e = *e_out;
+    const Eigen::Vector3d x = Eigen::Vector3d::UnitX();
+    if (GetParam().place == kInWheel) {
+      // Straight across the wheel's top, 5 mm deep at x = 0 (and out of it
+      // at the ends), tilted slightly.
+      const Eigen::Vector3d y = Eigen::Vector3d::UnitY();
+      const Eigen::Vector3d r0 = -x + 0.496 * y, r1 = x + 0.494 * y, t = x - 0.001 * y;
+      e << r0.head<D>(), t.head<D>(), r1.head<D>(), t.head<D>();
+    } else {
+      const Seabed& bed = *model_->seabed();
+      // Places the element's nodes below the bed by the given depths (the
+      // bed's normal from its height function).
+      Eigen::Vector3d n = Eigen::Vector3d::Zero();
+      for (int d = 0; d < D; ++d)
+        n(d) = bed.Height(Eigen::Vector3d::Unit(d)) - bed.Height(Eigen::Vector3d::Zero());
+      const double h0 = bed.Height(Eigen::Vector3d::Zero());
+      const Eigen::Vector3d r0 = -(h0 + 0.002) * n, r1 = 2 * x - (h0 + 0.005) * n;
+      e << r0.head<D>(), (x - 0.0015 * n).head<D>(), r1.head<D>(), (x - 0.0015 * n).head<D>();
+    }
+    auto energy = [&](const C& ex) {
+      double u = 0;
+      term_->AddElementEnergy(at, ex, &u);
+      return u;
+    };
+    C g = C::Zero();
+    M k = M::Zero();
+    const double u = term_->AddElementPotential(at, e, &g, &k, nullptr);
+    ASSERT_GT(u, 0) << "the element is not where the term acts";
+    EXPECT_NEAR(energy(e), u, 1e-14 * u);
+    double gerr = 0, kerr = 0;
+    for (int i = 0; i < 4 * D; ++i) {
+      C ep = e, em = e;
+      ep(i) += kStep;
+      em(i) -= kStep;
+      gerr = std::max(gerr, std::abs((energy(ep) - energy(em)) / (2 * kStep) - g(i)));
+      C gp = C::Zero(), gm = C::Zero();
+      term_->AddElementPotential(at, ep, &gp, nullptr, nullptr);
+      term_->AddElementPotential(at, em, &gm, nullptr, nullptr);
+      kerr = std::max(kerr, ((gp - gm) / (2 * kStep) - k.col(i)).template lpNorm<Eigen::Infinity>());
+    }
+    EXPECT_LE(gerr, kRelative * (g.template lpNorm<Eigen::Infinity>() + u));
+    if (GetParam().stiffness == kSymmetricBound) {
+      ExpectSymmetricPositiveSemiDefinite(Eigen::MatrixXd(k));
+      EXPECT_GT(k.template lpNorm<Eigen::Infinity>(), 0);
+    } else {
+      EXPECT_LE(kerr, kRelative * k.template lpNorm<Eigen::Infinity>());
+    }
   }
   std::optional<MultibodyModel> model_;
   const ElementTerm* term_ = nullptr;
@@ -602,6 +694,29 @@ INSTANTIATE_TEST_SUITE_P(ElementTerms, ElementTermConformanceTest,
                          [](const ::testing::TestParamInfo<ElementCase>& info) {
                            return std::string(info.param.label);
                          });
+
+// A scene without damping, fluid or seabed builds no element term, and
+// every element term a sample scene builds has a case above.
+TEST(ElementTermConformance, EveryElementTermOfTheSampleScenesHasACase) {
+  auto plain = MultibodyModel::Build(SampleScene("falling-pendulum.json"));
+  ASSERT_TRUE(plain.ok()) << plain.status();
+  EXPECT_TRUE(plain->element_terms().empty());
+  const char* samples[] = {"cable-in-current.json", "mooring-line-in-waves.json",
+                           "mooring-chain-landing.json", "damped-cantilever.json",
+                           "towed-cable.json", "crane-winch.json", "atwood-machine.json",
+                           "hook-block.json"};
+  for (const char* file : samples) {
+    auto model = MultibodyModel::Build(SampleScene(file));
+    ASSERT_TRUE(model.ok()) << file << ": " << model.status();
+    for (const auto& t : model->element_terms()) {
+      bool found = false;
+      for (const ElementCase& k : kElementCases) {
+        if (t->name() == k.term) found = true;
+      }
+      EXPECT_TRUE(found) << file << ": " << t->name() << " has no conformance case";
+    }
+  }
+}
 
 // ---- Constraint families (engine/constraints/constraint.h) ----
 //

@@ -50,6 +50,7 @@
 
 #include <Eigen/Core>
 
+#include "engine/elements/ancf_cable_element.h"
 #include "engine/linear/coordinate_map.h"
 #include "engine/linear/skyline_ldlt.h"
 
@@ -159,11 +160,38 @@ using ElementCoords = Eigen::Matrix<double, 4 * D, 1>;
 template <int D>
 using ElementMatrix = Eigen::Matrix<double, 4 * D, 4 * D>;
 
+// Where an element term's dissipation is evaluated: the element (its
+// current length, quadrature and shape functions: a winch cable's change
+// with time), its index in the model's element list (cable by cable, in
+// scene order; a term keeps per-element data by it) and the time of the
+// model's SetTime.
+//
+// A term that couples the element with other coordinates (a sheave carried
+// by a body) also gets the element's first full coordinate, the full state
+// (qdot null in the position-only passes), where to add the terms that
+// reach beyond the element (`coupled`: any pointer in it may be null, then
+// that part is not wanted; null itself in the energy pass) and a running
+// sum for the power those terms dissipate (null: not wanted).
+template <int D>
+struct ElementAt {
+  const AncfCableElement<D>& element;
+  int index = 0;
+  double time = 0;
+  int first_coord = 0;
+  const Eigen::VectorXd* q = nullptr;
+  const Eigen::VectorXd* qdot = nullptr;
+  ForceOutput* coupled = nullptr;
+  double* coupled_power = nullptr;
+};
+
 class ElementTerm {
  public:
   virtual ~ElementTerm() = default;
   virtual std::string_view name() const = 0;
   virtual EnergyBucket bucket() const { return EnergyBucket::kContact; }
+  // Whether AddPotential and Energy add anything (false: the model leaves
+  // the term out of its elastic loop, as it does for damping and drag).
+  virtual bool has_potential() const { return true; }
 
   // Adds dU/de to `gradient` (minus the force, as the elastic force's
   // gradient), d^2U/de^2 to `hessian` and the gradient's rounding bound to
@@ -179,6 +207,28 @@ class ElementTerm {
                               ElementCoords<3>* roundoff) const {
     (void)e, (void)length, (void)gradient, (void)hessian, (void)roundoff;
     return 0;
+  }
+  // AddPotential and Energy with the element itself (what the model
+  // calls; the energy as a running sum, so that the model's total is summed
+  // term by term): a term with per-element data, or that couples the
+  // element with other coordinates, overrides these; the defaults forward.
+  virtual double AddElementPotential(const ElementAt<2>& at, const ElementCoords<2>& e,
+                                     ElementCoords<2>* gradient, ElementMatrix<2>* hessian,
+                                     ElementCoords<2>* roundoff) const {
+    return AddPotential(e, at.element.length(), gradient, hessian, roundoff);
+  }
+  virtual double AddElementPotential(const ElementAt<3>& at, const ElementCoords<3>& e,
+                                     ElementCoords<3>* gradient, ElementMatrix<3>* hessian,
+                                     ElementCoords<3>* roundoff) const {
+    return AddPotential(e, at.element.length(), gradient, hessian, roundoff);
+  }
+  virtual void AddElementEnergy(const ElementAt<2>& at, const ElementCoords<2>& e,
+                                double* energy) const {
+    *energy += Energy(e, at.element.length());
+  }
+  virtual void AddElementEnergy(const ElementAt<3>& at, const ElementCoords<3>& e,
+                                double* energy) const {
+    *energy += Energy(e, at.element.length());
   }
   // U [J] alone.
   virtual double Energy(const ElementCoords<2>& e, double length) const {
@@ -205,6 +255,25 @@ class ElementTerm {
                                 ElementMatrix<3>* c) const {
     (void)e, (void)edot, (void)length, (void)force, (void)c;
     return 0;
+  }
+  // Whether AddElementDissipation adds anything on element `index` (the
+  // model skips the elements no term acts on).
+  virtual bool DissipatesOn(int index) const {
+    (void)index;
+    return dissipates();
+  }
+  // AddDissipation with the element itself (what the model calls): a term
+  // whose data is per element, or that needs the element's quadrature or
+  // the time, overrides these; the default forwards to AddDissipation.
+  virtual double AddElementDissipation(const ElementAt<2>& at, const ElementCoords<2>& e,
+                                       const ElementCoords<2>& edot, ElementCoords<2>* force,
+                                       ElementMatrix<2>* c) const {
+    return AddDissipation(e, edot, at.element.length(), force, c);
+  }
+  virtual double AddElementDissipation(const ElementAt<3>& at, const ElementCoords<3>& e,
+                                       const ElementCoords<3>& edot, ElementCoords<3>* force,
+                                       ElementMatrix<3>* c) const {
+    return AddDissipation(e, edot, at.element.length(), force, c);
   }
 
   virtual bool has_static_friction() const { return false; }

@@ -463,17 +463,19 @@ void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* 
       e.first_coord = NodeCoord(k);
       e.mass_per_length = mpl + cable.added_mass * displaced;
       e.gravity = e.element.GravityForce(mpl - displaced, g);
-      e.drag_n = drag_n;
-      e.drag_t = drag_t;
-      if (model_.wave_load_) {
-        // The flow's inertia: Froude-Krylov plus added mass (WaveLoad).
-        e.fluid_inertia = (1 + cable.added_mass) * displaced;
-        if (e.fluid_inertia != 0) model_.has_damping_ = true;
-      }
-      e.axial_damping_s = cable.axial_damping_s + cable.rayleigh_beta_s;
-      e.bending_damping_s = cable.bending_damping_s + cable.rayleigh_beta_s;
-      e.alpha_1_s = cable.rayleigh_alpha_1_s;
-      if (e.damped()) model_.has_damping_ = true;
+      CableFluidLoad::Element fluid;
+      fluid.drag_n = drag_n;
+      fluid.drag_t = drag_t;
+      // With waves, the flow's inertia: Froude-Krylov plus added mass
+      // (WaveLoad).
+      if (model_.wave_load_) fluid.fluid_inertia = (1 + cable.added_mass) * displaced;
+      fluid_elements_.push_back(fluid);
+      CableDamping::Element damping;
+      damping.axial_s = cable.axial_damping_s + cable.rayleigh_beta_s;
+      damping.bending_s = cable.bending_damping_s + cable.rayleigh_beta_s;
+      damping.alpha_1_s = cable.rayleigh_alpha_1_s;
+      damping.mass_per_length = e.mass_per_length;
+      damping_elements_.push_back(damping);
       const auto me = e.element.MassMatrix(e.mass_per_length);
       for (int a = 0; a < 4; ++a)
         for (int b = 0; b < 4; ++b) e.mbar(a, b) = me(D * a, D * b);
@@ -484,7 +486,6 @@ void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* 
 }
 
 void ModelBuilder::BuildElements() {
-  model_.current_ = scene_.fluid.current_m_s;
   // Waves need a fluid, gravity (the vertical and the dispersion) and a
   // depth; SceneFromProto refuses waves without them, naming the field.
   const FluidSpec& fluid = scene_.fluid;
@@ -497,36 +498,40 @@ void ModelBuilder::BuildElements() {
     for (const JonswapSpec& j : fluid.waves.jonswap)
       field.AddJonswap(j.significant_height_m, j.peak_period_s, j.peak_factor, j.direction,
                        j.components, j.seed);
-    model_.wave_load_.emplace(std::move(field), fluid.current_m_s);
-  }
-  if (auto bed = MakeCableSeabed(scene_)) {
-    model_.cable_seabed_ = bed.get();
-    model_.element_terms_.push_back(std::move(bed));
-  }
-  for (const auto& t : model_.element_terms_) {
-    if (t->dissipates()) model_.element_terms_dissipate_ = model_.has_damping_ = true;
-    if (t->bucket() == EnergyBucket::kContact) model_.has_element_contact_ = true;
+    model_.wave_load_ = std::make_shared<const WaveLoad>(std::move(field), fluid.current_m_s);
   }
   if (model_.dim_ == 2) {
     BuildElementsOf<2>(&model_.elements2_);
   } else {
     BuildElementsOf<3>(&model_.elements3_);
   }
-  BuildSheaves();
-}
-
-void ModelBuilder::BuildSheaves() {
-  MultibodyModel& m = model_;
-  if (scene_.sheaves.empty()) return;
-  m.sheave_mask_.assign(m.elements(), 0);
-  for (size_t i = 0; i < scene_.sheaves.size(); ++i) {
-    const SheaveSpec& spec = scene_.sheaves[i];
-    m.sheaves_.emplace_back(spec);
-    if (m.sheaves_.back().dissipates()) m.sheaves_dissipate_ = m.has_damping_ = true;
-    for (int cable = 0; cable < static_cast<int>(scene_.cables.size()); ++cable) {
-      if (!spec.Touches(cable)) continue;
-      for (int k = m.cable_element_begin_[cable]; k < m.cable_element_begin_[cable + 1]; ++k)
-        m.sheave_mask_[k] |= uint64_t{1} << i;
+  // The element terms, in the order they are summed: damping, the fluid's
+  // load, the seabed, the sheaves.
+  if (auto damping = MakeCableDamping(std::move(damping_elements_))) {
+    cable_damping_ = damping.get();
+    model_.element_terms_.push_back(std::move(damping));
+  }
+  if (auto load = MakeCableFluidLoad(std::move(fluid_elements_), model_.wave_load_,
+                                     scene_.fluid.current_m_s))
+    model_.element_terms_.push_back(std::move(load));
+  if (auto bed = MakeCableSeabed(scene_)) {
+    model_.cable_seabed_ = bed.get();
+    model_.element_terms_.push_back(std::move(bed));
+  }
+  std::vector<int> body_coord;
+  for (const MultibodyModel::BodyData& b : model_.bodies_) body_coord.push_back(b.coord);
+  if (auto wheels = MakeSheaves(scene_, model_.cable_element_begin_, body_coord)) {
+    model_.sheaves_ = wheels.get();
+    model_.element_terms_.push_back(std::move(wheels));
+  }
+  for (const auto& t : model_.element_terms_) {
+    if (t->has_potential()) {
+      model_.potential_terms_.push_back(t.get());
+      if (t->bucket() == EnergyBucket::kContact) model_.has_element_contact_ = true;
+    }
+    if (t->dissipates()) {
+      model_.dissipative_terms_.push_back(t.get());
+      model_.has_damping_ = true;
     }
   }
 }
@@ -556,7 +561,7 @@ absl::Status ModelBuilder::Contributors() {
     m.body_contact_ = contact.get();
     add(std::move(contact));
   }
-  if (auto fluid = MakeBodyFluidForces(scene_, body_coord, m.dim_, m.wave_load_.has_value())) {
+  if (auto fluid = MakeBodyFluidForces(scene_, body_coord, m.dim_, m.wave_load_ != nullptr)) {
     // The added mass joins the body's mass matrix and kinetic energy.
     for (const BodyFluidLoad& load : fluid->loads()) {
       for (size_t b = 0; b < body_coord.size(); ++b) {
@@ -616,11 +621,7 @@ void ModelBuilder::Winches() {
     for (int k = w.element_begin; k < w.element_end; ++k) {
       m.winch_slot_[k] = elements++;
       // The winch damps the material motion instead (WinchDamping).
-      if (m.dim_ == 2) {
-        m.elements2_[k].axial_damping_s = m.elements2_[k].alpha_1_s = 0;
-      } else {
-        m.elements3_[k].axial_damping_s = m.elements3_[k].alpha_1_s = 0;
-      }
+      if (cable_damping_) cable_damping_->ClearMaterialDamping(k);
     }
   }
   for (auto* v : {&m.winch_cv_, &m.winch_ce_, &m.winch_mdot_, &m.winch_g_, &m.winch_h_})
@@ -747,6 +748,14 @@ MultibodyModel ModelBuilder::Finish() {
     }
   }
   model_.SetTime(0);
+  // Per element, whether a dissipative term acts on it (after the winches
+  // cleared their cables' damping).
+  if (!model_.dissipative_terms_.empty()) {
+    model_.element_dissipates_.assign(model_.elements(), 0);
+    for (int k = 0; k < model_.elements(); ++k)
+      for (const ElementTerm* t : model_.dissipative_terms_)
+        if (t->DissipatesOn(k)) model_.element_dissipates_[k] = 1;
+  }
   if (model_.has_damping_) {
     model_.scratch_damping_ = VectorXd::Zero(q0_.size());
     model_.scratch_damping_roundoff_ = VectorXd::Zero(q0_.size());

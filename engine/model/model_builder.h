@@ -17,6 +17,8 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "engine/forces/cable_damping.h"
+#include "engine/forces/cable_fluid_load.h"
 #include "engine/model/multibody_model.h"
 #include "engine/constraints/quadratic_form.h"
 #include "engine/scene/scene.h"
@@ -171,9 +173,6 @@ class ModelBuilder {
   // the model's energy_roundoff [J], and where each cable's elements begin
   // (for the energy per cable).
   void BuildElements();
-  // The scene's sheaves and which elements each may touch (after the
-  // elements: a sheave touches every element of the cables it lists).
-  void BuildSheaves();
 
   // The force contributors the scene uses (engine/forces/force_contributor.h),
   // each built by the Make... next to its class, in the order the model
@@ -268,6 +267,11 @@ class ModelBuilder {
   std::vector<Eigen::Matrix3d> frame0_;  // per body, its axes at t = 0
   Elimination elimination_;
   std::vector<PendingRow> pending_;
+  // BuildElementsOf's per-element damping and fluid-load data, and the
+  // damping term (the winches clear their cables' share).
+  std::vector<CableDamping::Element> damping_elements_;
+  std::vector<CableFluidLoad::Element> fluid_elements_;
+  CableDamping* cable_damping_ = nullptr;
 };
 
 }  // namespace cablesim

@@ -10,7 +10,6 @@
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
 
-#include <bit>
 
 namespace cablesim {
 
@@ -41,19 +40,10 @@ void MultibodyModel::ElementEnergy(const VectorXd& q, const VectorXd& qdot, Ener
     en->kinetic += kinetic;
     en->axial += se.axial;
     en->bending += se.bending;
-    for (const auto& t : element_terms_)
-      en->contact += t->Energy(ElementCoords<D>(qe), e.element.length());
-    if (!sheaves_.empty()) {
-      for (uint64_t bits = sheave_mask_[k]; bits != 0; bits &= bits - 1) {
-        const Sheave& wheel = sheaves_[std::countr_zero(bits)];
-        if (wheel.body() >= 0) {
-          Eigen::Matrix<double, 5 * D, 1> x;
-          x << qe, q.segment<D>(bodies_[wheel.body()].coord);
-          en->contact += wheel.AddPotentialOnBody<D>(x, e.element.length(), nullptr, nullptr);
-        } else {
-          en->contact += wheel.Energy<D>(qe, e.element.length());
-        }
-      }
+    if (!potential_terms_.empty()) {
+      const ElementAt<D> at{e.element, static_cast<int>(k), time_, e.first_coord, &q, &qdot};
+      for (const ElementTerm* t : potential_terms_)
+        t->AddElementEnergy(at, ElementCoords<D>(qe), &en->contact);
     }
     if (parts == nullptr) continue;
     while (static_cast<int>(k) >= cable_element_begin_[cable + 1]) ++cable;

@@ -1,7 +1,5 @@
 #include "engine/model/multibody_model.h"
 
-#include <bit>
-
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -25,10 +23,9 @@ using Eigen::VectorXd;
 
 }  // namespace
 
-void MultibodyModel::ScatterSlider(const SlidingJoint::Local& local, VectorXd* full,
-                                   VectorXd* roundoff, double scale, SkylineLdlt* a) const {
-  ForceOutput out{full, roundoff, a, scale, Map()};
-  AddLocalTerms(local, &out);
+const std::vector<Sheave>& MultibodyModel::sheaves() const {
+  static const std::vector<Sheave> kNone;
+  return sheaves_ ? sheaves_->wheels() : kNone;
 }
 
 const std::vector<BodyFluidLoad>& MultibodyModel::body_fluid_loads() const {
@@ -153,56 +150,6 @@ void MultibodyModel::RateToFull(const VectorXd& zdot, VectorXd* qdot) const {
 }
 
 template <int D>
-void MultibodyModel::BodySheaveForce(const Sheave& wheel, int first_coord, double length,
-                                     const VectorXd& q, VectorXd* full, VectorXd* roundoff,
-                                     SkylineLdlt* stiffness, double scale) const {
-  constexpr int kN = 4 * D, kX = 5 * D;
-  const int centre = bodies_[wheel.body()].coord;
-  Eigen::Matrix<double, kX, 1> x, gradient = Eigen::Matrix<double, kX, 1>::Zero(),
-                                  rounding = Eigen::Matrix<double, kX, 1>::Zero();
-  x << q.segment<kN>(first_coord), q.segment<D>(centre);
-  Eigen::Matrix<double, kX, kX> hessian;
-  if (stiffness) hessian.setZero();
-  if (wheel.AddPotentialOnBody<D>(x, length, &gradient, stiffness ? &hessian : nullptr,
-                                  roundoff ? &rounding : nullptr) == 0)
-    return;
-  SlidingJoint::Local local;
-  local.n = kX;
-  for (int k = 0; k < kN; ++k) local.coord[k] = first_coord + k;
-  for (int k = 0; k < D; ++k) local.coord[kN + k] = centre + k;
-  local.force = -gradient;
-  if (stiffness) local.matrix = hessian;
-  local.rounding = rounding.maxCoeff();
-  ScatterSlider(local, full, roundoff, scale, stiffness);
-}
-
-template <int D>
-double MultibodyModel::BodySheaveDamping(const Sheave& wheel, int first_coord, double length,
-                                         const VectorXd& q, const VectorXd& qdot, VectorXd* full,
-                                         VectorXd* roundoff, SkylineLdlt* tangent,
-                                         double scale) const {
-  constexpr int kN = 4 * D, kX = 5 * D;
-  const int centre = bodies_[wheel.body()].coord;
-  Eigen::Matrix<double, kX, 1> x, xdot, force = Eigen::Matrix<double, kX, 1>::Zero();
-  x << q.segment<kN>(first_coord), q.segment<D>(centre);
-  xdot << qdot.segment<kN>(first_coord), qdot.segment<D>(centre);
-  Eigen::Matrix<double, kX, kX> c;
-  if (tangent) c.setZero();
-  const double power =
-      wheel.AddDissipationOnBody<D>(x, xdot, length, &force, tangent ? &c : nullptr);
-  if (full == nullptr || power == 0) return power;
-  SlidingJoint::Local local;
-  local.n = kX;
-  for (int k = 0; k < kN; ++k) local.coord[k] = first_coord + k;
-  for (int k = 0; k < D; ++k) local.coord[kN + k] = centre + k;
-  local.force = force;
-  if (tangent) local.matrix = c;
-  local.rounding = kSumRounding * force.cwiseAbs().maxCoeff();
-  ScatterSlider(local, full, roundoff, scale, tangent);
-  return power;
-}
-
-template <int D>
 double MultibodyModel::ElementForces(const VectorXd& q, VectorXd* full, SkylineLdlt* stiffness,
                                      double stiffness_scale, VectorXd* roundoff) const {
   constexpr int kN = 4 * D, kN2 = kN * kN;
@@ -212,6 +159,8 @@ double MultibodyModel::ElementForces(const VectorXd& q, VectorXd* full, SkylineL
   typename AncfCableElement<D>::Matrix ke;
   double size = 0;
   double* values = stiffness ? stiffness->values() : nullptr;
+  // Where terms that couple an element with other coordinates add those.
+  ForceOutput coupled{full, roundoff, stiffness, stiffness_scale, Map()};
   for (size_t k = 0; k < elements.size(); ++k) {
     const ElementData<D>& e = elements[k];
     if (StopNow(e.element.gauss_points())) {  // set_stop_poll
@@ -223,22 +172,14 @@ double MultibodyModel::ElementForces(const VectorXd& q, VectorXd* full, SkylineL
     if (roundoff) re.setZero();
     e.element.ElasticForce(q.segment<kN>(e.first_coord), &fe, stiffness ? &ke : nullptr,
                            roundoff ? &re : nullptr);
-    // Element terms' forces (the seabed's), like the elastic one, are
-    // gradients of energies.
-    for (const auto& t : element_terms_)
-      t->AddPotential(q.segment<kN>(e.first_coord), e.element.length(), &fe,
-                      stiffness ? &ke : nullptr, roundoff ? &re : nullptr);
-    if (!sheaves_.empty()) {
-      for (uint64_t bits = sheave_mask_[k]; bits != 0; bits &= bits - 1) {
-        const Sheave& wheel = sheaves_[std::countr_zero(bits)];
-        if (wheel.body() >= 0) {
-          BodySheaveForce<D>(wheel, e.first_coord, e.element.length(), q, full, roundoff,
-                             stiffness, stiffness_scale);
-        } else {
-          wheel.AddPotential<D>(q.segment<kN>(e.first_coord), e.element.length(), &fe,
-                                stiffness ? &ke : nullptr, roundoff ? &re : nullptr);
-        }
-      }
+    // Element terms' forces (the seabed's, the sheaves'), like the elastic
+    // one, are gradients of energies.
+    if (!potential_terms_.empty()) {
+      const ElementAt<D> at{e.element, static_cast<int>(k), time_, e.first_coord, &q, nullptr,
+                            &coupled};
+      for (const ElementTerm* t : potential_terms_)
+        t->AddElementPotential(at, q.segment<kN>(e.first_coord), &fe, stiffness ? &ke : nullptr,
+                               roundoff ? &re : nullptr);
     }
     full->segment<kN>(e.first_coord) -= fe;
     // The element's own bound, and the rounding of adding it to the node.
@@ -330,7 +271,9 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
   typename AncfCableElement<D>::Coords fe;
   double size = 0;
   double* values = tangent ? tangent->values() : nullptr;
-  const bool bed = element_terms_dissipate_;
+  const bool terms = !element_dissipates_.empty();
+  // Where terms that couple an element with other coordinates add those.
+  ForceOutput coupled{full, roundoff, tangent, tangent_scale, Map()};
   // Work per element for the stop poll: its Gauss points, each summing
   // every wave component.
   const int64_t components = wave_load_ ? wave_load_->field().components().size() : 0;
@@ -341,40 +284,17 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
       if (power) *power = std::numeric_limits<double>::quiet_NaN();
       return std::numeric_limits<double>::quiet_NaN();
     }
-    const uint64_t wheels = sheaves_dissipate_ ? sheave_mask_[k] : 0;
-    if (!e.damped() && !bed && e.fluid_inertia == 0 && wheels == 0) continue;
-    ce.setZero();
-    if (e.axial_damping_s != 0 || e.bending_damping_s != 0)
-      e.element.AddDampingMatrix(q.segment<kN>(e.first_coord), e.axial_damping_s,
-                                 e.bending_damping_s, &ce);
-    if (e.alpha_1_s != 0) ce += e.alpha_1_s * e.element.MassMatrix(e.mass_per_length);
+    if (!terms || !element_dissipates_[k]) continue;
     const auto ve = qdot.segment<kN>(e.first_coord);
-    // fe: the damping force -C ve, plus the drag (which adds its own
-    // velocity derivative to ce).
-    fe.noalias() = -ce * ve;
-    if (wave_load_) {
-      if (e.drag_n != 0 || e.drag_t != 0 || e.fluid_inertia != 0)
-        wave_load_->Add<D>(e.element, q.segment<kN>(e.first_coord), ve, time_, e.drag_n, e.drag_t,
-                           e.fluid_inertia, &fe, &ce);
-    } else if (e.drag_n != 0 || e.drag_t != 0) {
-      e.element.AddDrag(q.segment<kN>(e.first_coord), ve, current_.head<D>(), e.drag_n, e.drag_t,
-                        &fe, &ce);
-    }
-    if (bed) {
-      for (const auto& t : element_terms_)
-        if (t->dissipates())
-          t->AddDissipation(q.segment<kN>(e.first_coord), ve, e.element.length(), &fe, &ce);
-    }
-    for (uint64_t bits = wheels; bits != 0; bits &= bits - 1) {
-      const Sheave& wheel = sheaves_[std::countr_zero(bits)];
-      if (wheel.body() >= 0) {
-        const double p = BodySheaveDamping<D>(wheel, e.first_coord, e.element.length(), q, qdot,
-                                              full, roundoff, tangent, tangent_scale);
-        if (power) *power += p;
-      } else {
-        wheel.AddDissipation<D>(q.segment<kN>(e.first_coord), ve, e.element.length(), &fe, &ce);
-      }
-    }
+    // fe: the velocity-dependent force, ce its velocity derivative, summed
+    // over the element terms (damping, the fluid's load, the seabed's, the
+    // sheaves').
+    fe.setZero();
+    ce.setZero();
+    const ElementAt<D> at{e.element, static_cast<int>(k), time_, e.first_coord, &q, &qdot,
+                          &coupled, power};
+    for (const ElementTerm* t : dissipative_terms_)
+      t->AddElementDissipation(at, q.segment<kN>(e.first_coord), ve, &fe, &ce);
     if (power) *power -= ve.dot(fe);
     if (full) full->segment<kN>(e.first_coord) += fe;
     size = std::max(size, fe.template lpNorm<Eigen::Infinity>());

@@ -57,7 +57,7 @@
 #include "engine/forces/body_seabed_contact.h"
 #include "engine/forces/force_contributor.h"
 #include "engine/forces/seabed.h"
-#include "engine/forces/sheave.h"
+#include "engine/forces/sheaves.h"
 #include "engine/forces/wave_load.h"
 #include "engine/constraints/constraint.h"
 #include "engine/constraints/joint_rows.h"
@@ -271,7 +271,7 @@ class MultibodyModel {
 
   // The scene's wave load (engine/forces/wave_load.h), or null: a scene
   // without waves holds none and its elements take AddDrag's uniform current.
-  const WaveLoad* wave_load() const { return wave_load_ ? &*wave_load_ : nullptr; }
+  const WaveLoad* wave_load() const { return wave_load_.get(); }
   // The run's stop poll (null: none), asked in the element loops of the
   // forces: once it says stop, the forces still to be computed are
   // not-a-number (the step fails at once; the run says "cancelled").
@@ -303,10 +303,10 @@ class MultibodyModel {
   void StaticFriction(const Eigen::VectorXd& q, const Eigen::VectorXd& q_start,
                         Eigen::VectorXd* f, SkylineLdlt* matrix, double scale);
   // Whether frames carry energy.contact (a seabed or sheaves).
-  bool has_contact() const { return has_element_contact_ || !sheaves_.empty(); }
+  bool has_contact() const { return has_element_contact_; }
 
   // The scene's sheaves (engine/forces/sheave.h), none in most scenes.
-  const std::vector<Sheave>& sheaves() const { return sheaves_; }
+  const std::vector<Sheave>& sheaves() const;
 
   // Whether frames carry the nodes' positions (the scene's output.shape).
   bool shape() const { return shape_; }
@@ -390,18 +390,6 @@ class MultibodyModel {
     double mass_per_length = 0;
     Eigen::Matrix<double, 4 * D, 1> gravity;
     Eigen::Matrix4d mbar;  // scalar mass matrix: M = mbar (x) I_D
-    // Damping: Kelvin-Voigt times [s] (Rayleigh beta included) and
-    // Rayleigh alpha [1/s].
-    double axial_damping_s = 0, bending_damping_s = 0, alpha_1_s = 0;
-    // Morison drag factors kn, kt [kg/m^2] (AncfCableElement::AddDrag).
-    double drag_n = 0, drag_t = 0;
-    // With waves: the flow's inertia factor (1 + C_a) rho A [kg/m]
-    // (WaveLoad); 0 without waves.
-    double fluid_inertia = 0;
-    bool damped() const {
-      return axial_damping_s != 0 || bending_damping_s != 0 || alpha_1_s != 0 ||
-             drag_n != 0 || drag_t != 0;
-    }
   };
   struct BodyData {
     int coord = 0;  // full index of r_c
@@ -449,23 +437,6 @@ class MultibodyModel {
   template <int D>
   Eigen::Vector3d ElementAngularMomentum(const Eigen::VectorXd& q,
                                          const Eigen::VectorXd& qdot) const;
-  // Adds a slider's local force to the full vector `full` (and its rounding
-  // to `roundoff`) and scale times its matrix, mapped onto z, to `a`.
-  // A wheel carried by a body (Sheave::body() >= 0) on the element whose
-  // first full coordinate is first_coord: its force, tangent and rounding
-  // over the element and the body's centre, scattered like a slider's; and
-  // its damping and friction (returns their power).
-  template <int D>
-  void BodySheaveForce(const Sheave& wheel, int first_coord, double length,
-                       const Eigen::VectorXd& q, Eigen::VectorXd* full, Eigen::VectorXd* roundoff,
-                       SkylineLdlt* stiffness, double scale) const;
-  template <int D>
-  double BodySheaveDamping(const Sheave& wheel, int first_coord, double length,
-                           const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
-                           Eigen::VectorXd* full, Eigen::VectorXd* roundoff, SkylineLdlt* tangent,
-                           double scale) const;
-  void ScatterSlider(const SlidingJoint::Local& local, Eigen::VectorXd* full, Eigen::VectorXd* roundoff,
-                     double scale, SkylineLdlt* a) const;
   // The state contributors are evaluated at (time_ and the wave field).
   ForceState StateAt(const Eigen::VectorXd& q, const Eigen::VectorXd* qdot,
                      double load_factor) const {
@@ -546,22 +517,24 @@ class MultibodyModel {
   std::vector<double> node_s_;
   double energy_roundoff_ = 0;
   bool has_damping_ = false;
-  Eigen::Vector3d current_ = Eigen::Vector3d::Zero();  // the fluid's [m/s]
   // The per-element force terms the scene uses (ElementTerm; none in
-  // most scenes), summed in this order inside the element loops; whether
-  // any dissipates or stores contact energy; the cable seabed's typed view.
+  // most scenes), summed in this order inside the element loops (cable
+  // damping, the fluid's load, the seabed, the sheaves); those with a potential and
+  // those that dissipate; per element whether any dissipative term acts on
+  // it (empty without any); whether any stores contact energy; the cable
+  // seabed's typed view.
   std::vector<std::unique_ptr<ElementTerm>> element_terms_;
-  bool element_terms_dissipate_ = false, has_element_contact_ = false;
+  std::vector<const ElementTerm*> potential_terms_, dissipative_terms_;
+  std::vector<char> element_dissipates_;
+  bool has_element_contact_ = false;
   const CableSeabed* cable_seabed_ = nullptr;
   // Scratch (full size) for StaticFriction (sized on first use).
   Eigen::VectorXd scratch_static_;
-  // Sheaves, and per element the bit set of those that touch its cable
-  // (empty without sheaves).
-  std::vector<Sheave> sheaves_;
-  std::vector<uint64_t> sheave_mask_;
-  bool sheaves_dissipate_ = false;
-  // Only in a scene whose fluid has waves (then it carries the current too).
-  std::optional<WaveLoad> wave_load_;
+  // The sheaves' typed view (null without sheaves).
+  const Sheaves* sheaves_ = nullptr;
+  // Only in a scene whose fluid has waves (then it carries the current
+  // too); shared with the cables' fluid load (CableFluidLoad).
+  std::shared_ptr<const WaveLoad> wave_load_;
   StopPoll* stop_poll_ = nullptr;
   // Counts `units` of work on the stop poll; true when the run should stop.
   bool StopNow(int64_t units) const { return stop_poll_ != nullptr && stop_poll_->Poll(units); }

@@ -1,0 +1,38 @@
+#include "engine/forces/cable_fluid_load.h"
+
+#include <utility>
+
+namespace cablesim {
+
+template <int D>
+double CableFluidLoad::Dissipation(const ElementAt<D>& at, const ElementCoords<D>& e,
+                           const ElementCoords<D>& edot, ElementCoords<D>* force,
+                           ElementMatrix<D>* c) const {
+  const Element& p = elements_[at.index];
+  if (!p.any()) return 0;
+  const ElementCoords<D> before = *force;
+  if (waves_) {
+    waves_->Add<D>(at.element, e, edot, at.time, p.drag_n, p.drag_t, p.fluid_inertia, force, c);
+  } else {
+    at.element.AddDrag(e, edot, current_.head<D>(), p.drag_n, p.drag_t, force, c);
+  }
+  return -edot.dot(*force - before);
+}
+
+template double CableFluidLoad::Dissipation<2>(const ElementAt<2>&, const ElementCoords<2>&,
+                                       const ElementCoords<2>&, ElementCoords<2>*,
+                                       ElementMatrix<2>*) const;
+template double CableFluidLoad::Dissipation<3>(const ElementAt<3>&, const ElementCoords<3>&,
+                                       const ElementCoords<3>&, ElementCoords<3>*,
+                                       ElementMatrix<3>*) const;
+
+std::unique_ptr<CableFluidLoad> MakeCableFluidLoad(std::vector<CableFluidLoad::Element> elements,
+                                                   std::shared_ptr<const WaveLoad> waves,
+                                                   const Eigen::Vector3d& current) {
+  for (const CableFluidLoad::Element& e : elements)
+    if (e.any())
+      return std::make_unique<CableFluidLoad>(std::move(elements), std::move(waves), current);
+  return nullptr;
+}
+
+}  // namespace cablesim
