@@ -660,6 +660,13 @@ void ModelBuilder::Probes() {
   MultibodyModel& m = model_;
   // The cable nodes (output.shape), a split node's second half left out.
   m.shape_ = scene_.output.shape;
+  for (const JointSpec& joint : scene_.joints) {
+    m.joint_names_.push_back(joint.name);
+    if (!scene_.output.reactions) continue;
+    m.joint_reaction_values_.push_back(joint.type == JointType::kSlide   ? 0
+                                       : joint.type == JointType::kFixed ? 6
+                                                                         : 3);
+  }
   for (size_t c = 0; c + 1 < mesh_.first_node.size(); ++c) {
     int count = 0;
     for (int k = mesh_.first_node[c]; k < mesh_.first_node[c + 1]; ++k) {

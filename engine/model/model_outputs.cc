@@ -250,4 +250,20 @@ void MultibodyModel::ProbeForces(const VectorXd& q, const VectorXd& lambda,
   }
 }
 
+void MultibodyModel::Reactions(const VectorXd& q, const VectorXd* lambda,
+                               std::vector<JointReaction>* out) const {
+  const size_t n = joint_reaction_values_.size();
+  reaction_forces_.assign(n, Eigen::Vector3d::Zero());
+  reaction_moments_.assign(n, Eigen::Vector3d::Zero());
+  if (lambda)
+    for (const ConstraintFamily* f : families_)
+      f->AddReactions(q, *lambda, &reaction_forces_, &reaction_moments_);
+  out->resize(n);
+  for (size_t j = 0; j < n; ++j) {
+    (*out)[j].values = joint_reaction_values_[j];
+    (*out)[j].force = reaction_forces_[j];
+    (*out)[j].moment = reaction_moments_[j];
+  }
+}
+
 }  // namespace cablesim

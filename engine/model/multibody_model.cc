@@ -139,6 +139,8 @@ ModelInfo MultibodyModel::Info() const {
   info.node_s = node_s_;
   info.shape = shape_;
   info.contact = has_contact();
+  info.joint_names = joint_names_;
+  info.joint_reaction_values = joint_reaction_values_;
   return info;
 }
 

@@ -16,6 +16,9 @@
 //   per probe on a moving support (ModelInfo::force_probe_names)
 //                NAME.fx NAME.fy NAME.fz
 //   with a seabed (ModelInfo::contact)  energy.contact
+//   with output.reactions, per joint i (ModelInfo::joint_reaction_values)
+//                joints[i].fx joints[i].fy joints[i].fz
+//                and for FIXED joints[i].mx joints[i].my joints[i].mz
 //   with output.shape (ModelInfo::shape), per cable i and node k
 //                cables[i].nodes[k].x cables[i].nodes[k].y cables[i].nodes[k].z
 //
@@ -92,6 +95,12 @@ void ForEachFrameValue(FrameT& frame, Add&& add) {
     for (int k = 0; k < 3; ++k) add(f[k]);
   }
   if (frame.has_contact) add(e.contact);
+  for (auto& r : frame.reactions) {
+    if (r.values < 3) continue;
+    for (int k = 0; k < 3; ++k) add(r.force[k]);
+    if (r.values < 6) continue;
+    for (int k = 0; k < 3; ++k) add(r.moment[k]);
+  }
 }
 
 // Calls add(value) for x, y, z of every node of `frame` (empty without
@@ -126,6 +135,7 @@ class FrameReader {
   int row_size_ = 0;
   int probes_ = 0, cables_ = 0, bodies_ = 0, forces_ = 0, nodes_ = 0;
   bool contact_ = false;
+  std::vector<int> reaction_values_;
   // The column of every number of ForEachFrameValue's and then
   // ForEachNodeValue's order, or -1.
   std::vector<int> index_;
