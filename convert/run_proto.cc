@@ -22,6 +22,8 @@ v1::ModelInfo ModelInfoToProto(const ModelInfo& info) {
   p.set_contact(info.contact);
   for (const std::string& name : info.joint_names) p.add_joint_names(name);
   for (const int n : info.joint_reaction_values) p.add_joint_reaction_values(n);
+  for (const std::string& name : info.tension_probe_names) p.add_tension_probe_names(name);
+  p.set_node_tension(info.node_tension);
   return p;
 }
 
@@ -44,6 +46,8 @@ ModelInfo ModelInfoFromProto(const v1::ModelInfo& p) {
   info.joint_names.assign(p.joint_names().begin(), p.joint_names().end());
   info.joint_reaction_values.assign(p.joint_reaction_values().begin(),
                                     p.joint_reaction_values().end());
+  info.tension_probe_names.assign(p.tension_probe_names().begin(), p.tension_probe_names().end());
+  info.node_tension = p.node_tension();
   return info;
 }
 

@@ -324,6 +324,7 @@ class SceneConverter {
     scene_.output.shape = proto_.output().shape();
     scene_.output.statistics = proto_.output().statistics();
     scene_.output.reactions = proto_.output().reactions();
+    scene_.output.tension = proto_.output().tension();
     {
       const v1::Rainflow& r = proto_.output().rainflow();
       scene_.output.rainflow.columns.assign(r.columns().begin(), r.columns().end());

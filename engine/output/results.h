@@ -47,6 +47,11 @@ struct ModelInfo {
   // (Frame::reactions): 3 (force), 6 (FIXED: force and moment) or 0
   // (SLIDE). Empty without.
   std::vector<int> joint_reaction_values;
+  // With output.tension: the probes on a cable (scene order), each with a
+  // column NAME.tension; and whether the nodes carry their tension
+  // (output.shape too).
+  std::vector<std::string> tension_probe_names;
+  bool node_tension = false;
 };
 
 // The force [N] a joint exerts on its side a (a joint to ground: on what it
@@ -137,6 +142,11 @@ struct Frame {
   bool has_contact = false;
   // With output.reactions, per joint in scene order; empty otherwise.
   std::vector<JointReaction> reactions;
+  // With output.tension, per probe of ModelInfo::tension_probe_names the
+  // cable's axial force there [N] (compression negative), and with shape
+  // too, per node of `nodes`.
+  std::vector<double> probe_tensions;
+  std::vector<double> node_tensions;
 };
 
 class FrameSink {

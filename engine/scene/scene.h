@@ -362,6 +362,9 @@ struct OutputSpec {
   // Every joint's reaction in every frame (Frame::reactions); joints to
   // ground are then rows with multipliers instead of removed coordinates.
   bool reactions = false;
+  // The axial force of every cable probe (NAME.tension) and, with shape,
+  // of every node in every frame (Frame::probe_tensions, node_tensions).
+  bool tension = false;
 };
 
 struct Scene {
