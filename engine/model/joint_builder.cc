@@ -70,7 +70,8 @@ absl::Status ModelBuilder::Joints() {
         LinearForm diff = pa[d];
         diff.c -= p0(d);
         PendingRow row{QuadraticForm::FromLinear(diff), Row::kPosition, ji, -1};
-        if (joint.HasMotion()) row.motion_axis = d;
+        // (A support kept as rows only for its reaction has no time law.)
+        if (joint.HasMotion() || joint.HasRotation()) row.motion_axis = d;
         row.axis = d;
         pending_.push_back(row);
       }
