@@ -28,7 +28,7 @@ absl::Status ShapeCsvWriter::OnStart(const ModelInfo& info) {
     return status_;
   }
   info_ = info;
-  *file_ << kHeader << '\n';
+  *file_ << kHeader << (info.node_tension ? ",tension" : "") << '\n';
   return Check("writing the header");
 }
 
@@ -44,8 +44,11 @@ absl::Status ShapeCsvWriter::OnFrame(const Frame& frame) {
   for (size_t c = 0; c < info_.cable_nodes.size(); ++c) {
     for (int k = 0; k < info_.cable_nodes[c]; ++k, ++n) {
       const Eigen::Vector3d& r = frame.nodes[n];
-      absl::StrAppendFormat(&row_, "%.17g,%d,%d,%.17g,%.17g,%.17g,%.17g\n", frame.t, c, k,
+      absl::StrAppendFormat(&row_, "%.17g,%d,%d,%.17g,%.17g,%.17g,%.17g", frame.t, c, k,
                             info_.node_s[n], r.x(), r.y(), r.z());
+      if (info_.node_tension && n < frame.node_tensions.size())
+        absl::StrAppendFormat(&row_, ",%.17g", frame.node_tensions[n]);
+      row_ += '\n';
     }
   }
   file_->write(row_.data(), static_cast<std::streamsize>(row_.size()));

@@ -12,6 +12,8 @@
 // its position [m] (17 significant digits). Long rather than wide: cables
 // have different node counts, the header is the same for every scene, and
 // it loads directly as a table (numpy.loadtxt, pandas groupby t or cable).
+// With the scene's output.tension (ModelInfo::node_tension) each row ends
+// with one more column, `tension`: the cable's axial force at the node [N].
 
 #include <cstdint>
 #include <fstream>

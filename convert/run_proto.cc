@@ -20,6 +20,10 @@ v1::ModelInfo ModelInfoToProto(const ModelInfo& info) {
   for (const double s : info.node_s) p.add_node_arc_lengths(s);
   p.set_shape(info.shape);
   p.set_contact(info.contact);
+  for (const std::string& name : info.joint_names) p.add_joint_names(name);
+  for (const int n : info.joint_reaction_values) p.add_joint_reaction_values(n);
+  for (const std::string& name : info.tension_probe_names) p.add_tension_probe_names(name);
+  p.set_node_tension(info.node_tension);
   return p;
 }
 
@@ -39,6 +43,11 @@ ModelInfo ModelInfoFromProto(const v1::ModelInfo& p) {
   info.node_s.assign(p.node_arc_lengths().begin(), p.node_arc_lengths().end());
   info.shape = p.shape();
   info.contact = p.contact();
+  info.joint_names.assign(p.joint_names().begin(), p.joint_names().end());
+  info.joint_reaction_values.assign(p.joint_reaction_values().begin(),
+                                    p.joint_reaction_values().end());
+  info.tension_probe_names.assign(p.tension_probe_names().begin(), p.tension_probe_names().end());
+  info.node_tension = p.node_tension();
   return info;
 }
 

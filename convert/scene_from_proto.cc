@@ -323,6 +323,8 @@ class SceneConverter {
     CABLESIM_ASSIGN_OR_RETURN(scene_.gravity_m_s2, VectorInRange("gravity", proto_.gravity(), plausible::kGravity));
     scene_.output.shape = proto_.output().shape();
     scene_.output.statistics = proto_.output().statistics();
+    scene_.output.reactions = proto_.output().reactions();
+    scene_.output.tension = proto_.output().tension();
     {
       const v1::Rainflow& r = proto_.output().rainflow();
       scene_.output.rainflow.columns.assign(r.columns().begin(), r.columns().end());
@@ -798,6 +800,7 @@ class SceneConverter {
                      absl::StrCat("joins body \"", scene_.bodies[a.body].name, "\" to itself"));
     }
     CABLESIM_RETURN_IF_ERROR(ConvertSlide(path, j, joint));
+    joint->name = j.name();
     if (j.has_motion()) {
       const std::string motion = Sub(path, "motion");
       CABLESIM_ASSIGN_OR_RETURN(joint->motion, ConvertTimeVector(motion, j.motion(), plausible::kCoordinate));

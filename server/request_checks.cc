@@ -230,6 +230,11 @@ absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimi
         force_values += 3;
     }
   }
+  // output.reactions adds every joint's reaction to every row.
+  if (checked.scene.output.reactions) {
+    for (const JointSpec& joint : checked.scene.joints)
+      force_values += joint.type == JointType::kSlide ? 0 : joint.type == JointType::kFixed ? 6 : 3;
+  }
   // A seabed or a sheave adds energy.contact to every row.
   const bool contact = checked.scene.seabed.enabled || !checked.scene.sheaves.empty();
   const int64_t values =

@@ -8,6 +8,7 @@
 
 #include "client/summary_json.h"
 #include "convert/run_proto.h"
+#include "engine/output/frame_columns.h"
 #include "engine/run/simulation.h"
 
 namespace cablesim {
@@ -120,6 +121,40 @@ TEST(RunProtoTest, ProtoCarriesEveryFieldTheStructHas) {
       EXPECT_TRUE(r->HasField(p, f)) << f->name() << " is not set by SummaryToProto";
     }
   }
+}
+
+// Joint names and the reactions' layout survive ModelInfo's round trip, and
+// a frame row written with them reads back into the same reactions.
+TEST(RunProtoTest, JointReactionsRoundTrip) {
+  ModelInfo info;
+  info.joint_names = {"anchor", "", "weld"};
+  info.joint_reaction_values = {3, 0, 6};
+  const ModelInfo back = ModelInfoFromProto(ModelInfoToProto(info));
+  EXPECT_EQ(back.joint_names, info.joint_names);
+  EXPECT_EQ(back.joint_reaction_values, info.joint_reaction_values);
+  const std::vector<std::string> columns = FrameColumns(back);
+  const std::vector<std::string> tail(columns.end() - 9, columns.end());
+  EXPECT_EQ(tail, (std::vector<std::string>{"joints[0].fx", "joints[0].fy", "joints[0].fz",
+                                            "joints[2].fx", "joints[2].fy", "joints[2].fz",
+                                            "joints[2].mx", "joints[2].my", "joints[2].mz"}));
+  Frame frame;
+  frame.energy_parts.loads = 0.5;
+  frame.reactions.resize(3);
+  for (int j = 0; j < 3; ++j) {
+    frame.reactions[j].values = info.joint_reaction_values[j];
+    frame.reactions[j].force = Eigen::Vector3d(j + 1, j + 2, j + 3);
+    frame.reactions[j].moment = Eigen::Vector3d(-j, -2 * j, -3 * j);
+  }
+  std::vector<double> row;
+  ForEachFrameValue(frame, [&row](double v) { row.push_back(v); });
+  ASSERT_EQ(row.size(), columns.size());
+  Frame read;
+  FrameReader(back, columns).Read(row, &read);
+  ASSERT_EQ(read.reactions.size(), 3u);
+  EXPECT_EQ(read.reactions[0].force, frame.reactions[0].force);
+  EXPECT_EQ(read.reactions[1].force, Eigen::Vector3d::Zero());  // SLIDE: no columns
+  EXPECT_EQ(read.reactions[2].force, frame.reactions[2].force);
+  EXPECT_EQ(read.reactions[2].moment, frame.reactions[2].moment);
 }
 
 }  // namespace

@@ -443,6 +443,8 @@ void RunModalAnalysis(MultibodyModel* model, const SolverSettings& settings, int
   frame.energy = model->Energy(q, zero, 1.0, &frame.energy_parts);
   // MODAL reports no support forces: their columns hold 0.
   frame.support_forces.assign(model->force_probe_count(), Eigen::Vector3d::Zero());
+  if (model->reactions()) model->Reactions(q, nullptr, &frame.reactions);
+  if (model->tension()) model->Tensions(q, &frame.probe_tensions, &frame.node_tensions);
   frame.has_contact = model->has_contact();
   frame.constraint_violation = phi.size() ? phi.lpNorm<Eigen::Infinity>() : 0.0;
   summary->energy_initial = summary->energy_final = frame.energy.total;
@@ -484,6 +486,9 @@ void RunModalAnalysis(MultibodyModel* model, const SolverSettings& settings, int
     mode.energy_parts.bodies.resize(frame.energy_parts.bodies.size());
     mode.support_forces.assign(model->force_probe_count(), Eigen::Vector3d::Zero());
     mode.has_contact = frame.has_contact;
+    mode.reactions = frame.reactions;
+    mode.probe_tensions.assign(frame.probe_tensions.size(), 0.0);
+    mode.node_tensions.assign(frame.node_tensions.size(), 0.0);
     mode.probes.resize(samples.size());
     for (size_t p = 0; p < samples.size(); ++p)
       mode.probes[p].position_m = scale * samples[p].velocity_m_s;

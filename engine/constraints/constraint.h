@@ -82,12 +82,14 @@ class ConstraintFamily {
   virtual void AddStepWork(const ConstraintStep& step, double* work) const {
     (void)step, (void)work;
   }
-  // The force [N] each scene joint's rows exert on what they hold, the
-  // multipliers as a force at the joint's point: adds to (*per_joint)[j]
-  // (sized to the scene's joints) for the joints it knows.
-  virtual void AddReactions(const Eigen::VectorXd& lambda,
-                            std::vector<Eigen::Vector3d>* per_joint) const {
-    (void)lambda, (void)per_joint;
+  // The force [N] and moment [N m] each scene joint's rows exert on the
+  // joint's side a at full configuration q, from the multipliers: adds to
+  // (*forces)[j] and (*moments)[j] (sized to the scene's joints) for the
+  // joints it knows.
+  virtual void AddReactions(const Eigen::VectorXd& q, const Eigen::VectorXd& lambda,
+                            std::vector<Eigen::Vector3d>* forces,
+                            std::vector<Eigen::Vector3d>* moments) const {
+    (void)q, (void)lambda, (void)forces, (void)moments;
   }
 };
 

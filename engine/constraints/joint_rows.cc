@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cassert>
 
+#include <Eigen/Geometry>
+
 namespace cablesim {
 
 using Eigen::VectorXd;
@@ -140,6 +142,36 @@ void JointRows::AddGamma(const VectorXd& q, const VectorXd& qdot, VectorXd* gamm
     for (int k = row.mono_begin; k < row.mono_end; ++k)
       acc += mono_w_[k] * qdot(coord[mono_a_[k]]) * qdot(coord[mono_b_[k]]);
     (*gamma)(i) += -2 * acc;
+  }
+}
+
+void JointRows::AddReactions(const VectorXd& q, const VectorXd& lambda,
+                             std::vector<Eigen::Vector3d>* forces,
+                             std::vector<Eigen::Vector3d>* moments) const {
+  double grad[kMaxRowCoords];
+  for (size_t i = 0; i < rows_.size(); ++i) {
+    const Row& row = rows_[i];
+    if (row.joint < 0) continue;
+    if (row.kind == Row::kPosition) {
+      if (row.axis >= 0) (*forces)[row.joint](row.axis) -= lambda(i);
+      continue;
+    }
+    if (row.side_end <= row.side_begin) continue;
+    // dPhi/dx for each of side a's vectors x, then -lambda x x dPhi/dx.
+    Gradient(row, q, grad);
+    const int vectors = (row.side_end - row.side_begin) / dim_;
+    Eigen::Vector3d moment = Eigen::Vector3d::Zero();
+    for (int v = 0; v < vectors; ++v) {
+      const int first = row.side_begin + v * dim_;
+      Eigen::Vector3d x = Eigen::Vector3d::Zero(), g = Eigen::Vector3d::Zero();
+      x.head(dim_) = q.segment(first, dim_);
+      for (int k = row.coord_begin; k < row.coord_end; ++k) {
+        const int c = row_coord_[k];
+        if (c >= first && c < first + dim_) g(c - first) = grad[k - row.coord_begin];
+      }
+      moment += x.cross(g);
+    }
+    (*moments)[row.joint] -= lambda(i) * moment;
   }
 }
 

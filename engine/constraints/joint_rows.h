@@ -31,11 +31,26 @@ class JointRows : public ConstraintFamily {
     int coord_begin = 0, coord_end = 0;  // into row_coord_
     int lin_begin = 0, lin_end = 0;      // into lin_local_, lin_value_
     int mono_begin = 0, mono_end = 0;    // into mono_a_, mono_b_, mono_w_
+    // For the joint's reaction (AddReactions): a position row's axis
+    // (Phi = p_a - p_b along it, so the force on side a is -lambda e_axis),
+    // or -1; a direction or slope row's full coordinates of side a's
+    // direction vectors (D each: a cable node's slope, a body's axes),
+    // [side_begin, side_end).
+    int axis = -1;
+    int side_begin = 0, side_end = 0;
   };
   // The widest row, two welded spatial bodies, touches 24 coordinates.
   static constexpr int kMaxRowCoords = 48;
 
   void AddRow(const QuadraticForm& f, Row::Kind kind, int joint, int body);
+  // The last row's reaction data (Row::axis, side_begin, side_end) and the
+  // dimension D of the coordinates' vectors.
+  void SetReactionData(int axis, int side_begin, int side_end, int dim) {
+    rows_.back().axis = axis;
+    rows_.back().side_begin = side_begin;
+    rows_.back().side_end = side_end;
+    dim_ = dim;
+  }
   int size() const { return static_cast<int>(rows_.size()); }
   const Row& row(int i) const { return rows_[i]; }
   // The full coordinates row `r` touches.
@@ -62,8 +77,16 @@ class JointRows : public ConstraintFamily {
   // -qdot^T Phi_qq qdot (the Hessians are constant).
   void AddGamma(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
                 Eigen::VectorXd* gamma) const override;
+  // Position rows: force -lambda e_axis on side a. Direction and slope
+  // rows (FIXED): the couple of the virtual work -lambda dPhi/dx . (dtheta
+  // x x) over side a's direction vectors x, moment -lambda sum x x dPhi/dx
+  // (planar: its z component). Body axis rows (joint -1) are not joints'.
+  void AddReactions(const Eigen::VectorXd& q, const Eigen::VectorXd& lambda,
+                    std::vector<Eigen::Vector3d>* forces,
+                    std::vector<Eigen::Vector3d>* moments) const override;
 
  private:
+  int dim_ = 3;
   std::vector<Row> rows_;
   std::vector<int> row_coord_;
   std::vector<int> lin_local_;

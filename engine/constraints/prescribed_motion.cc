@@ -79,9 +79,4 @@ void PrescribedMotion::AddStepWork(const ConstraintStep& step, double* work) con
   }
 }
 
-void PrescribedMotion::AddReactions(const VectorXd& lambda,
-                                    std::vector<Vector3d>* per_joint) const {
-  for (const MovingRow& m : moving_) (*per_joint)[m.joint](m.axis) -= lambda(m.row);
-}
-
 }  // namespace cablesim

@@ -9,7 +9,7 @@
 //    d_i(t), so SetTime writes c = c0 - d_i(t) into the row; Phi_t =
 //    -d_i'(t), and its part of gamma is -Phi_tt = d_i''(t). The support
 //    exerts the force -lambda_i along axis i on what it holds (its
-//    reaction), and does the work W = -(lambda_i0 + lambda_i1) / 2
+//    reaction, JointRows::AddReactions as every position row's), and does the work W = -(lambda_i0 + lambda_i1) / 2
 //    (d_i(t1) - d_i(t0)) over a step (second order).
 //  - A turning support (JointSpec::rotation): a direction row n(t) . x = 0,
 //    x the D coordinates from full index `coord` (a clamped slope or a body
@@ -69,8 +69,6 @@ class PrescribedMotion : public ConstraintFamily {
                 Eigen::VectorXd* gamma) const override;
   void AddRate(const Eigen::VectorXd& q, Eigen::VectorXd* phi_t) const override;
   void AddStepWork(const ConstraintStep& step, double* work) const override;
-  void AddReactions(const Eigen::VectorXd& lambda,
-                    std::vector<Eigen::Vector3d>* per_joint) const override;
 
  private:
   JointRows* rows_;

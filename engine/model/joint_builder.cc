@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 #include <utility>
 
 #include <Eigen/Dense>
@@ -44,12 +45,17 @@ absl::Status ModelBuilder::Joints() {
           absl::StrCat("joints[", ji, "].a: a joint needs a cable or a body on one side"));
     }
     const bool fixed = joint.type == JointType::kFixed;
-    if (b.IsGround() && (joint.HasMotion() || joint.HasRotation())) {
+    const bool reactions = scene_.output.reactions;
+    if (b.IsGround() && (joint.HasMotion() || joint.HasRotation() || reactions)) {
       // A moving support: its point stays as rows (below); FIXED keeps the
       // orientation by elimination, as a fixed support does, or, when the
-      // support turns, by rows whose normals turn with it.
+      // support turns, by rows whose normals turn with it. With
+      // output.reactions every support is kept as rows (their multipliers
+      // are its reaction), FIXED by rows with constant normals.
       if (joint.HasRotation()) {
         AddTurningRows(ji, a);
+      } else if (fixed && reactions) {
+        AddTurningRows(ji, a, /*turning=*/false);
       } else if (fixed && a.cable >= 0) {
         const int node = mesh_.Node(a);
         elimination_.clamped[node] = true;
@@ -64,7 +70,9 @@ absl::Status ModelBuilder::Joints() {
         LinearForm diff = pa[d];
         diff.c -= p0(d);
         PendingRow row{QuadraticForm::FromLinear(diff), Row::kPosition, ji, -1};
-        row.motion_axis = d;
+        // (A support kept as rows only for its reaction has no time law.)
+        if (joint.HasMotion() || joint.HasRotation()) row.motion_axis = d;
+        row.axis = d;
         pending_.push_back(row);
       }
       continue;
@@ -95,10 +103,17 @@ absl::Status ModelBuilder::Joints() {
     for (int d = 0; d < D; ++d) {
       LinearForm diff = pa[d];
       diff += pb[d].Scaled(-1);
-      pending_.push_back({QuadraticForm::FromLinear(diff), Row::kPosition, ji, -1});
+      PendingRow row{QuadraticForm::FromLinear(diff), Row::kPosition, ji, -1};
+      row.axis = d;
+      pending_.push_back(row);
     }
     if (!fixed || b.IsGround()) continue;
     if (absl::Status s = AddOrientationRows(ji, a, b); !s.ok()) return s;
+  }
+  // A FIXED joint's direction and slope rows: side a's vectors, for its moment.
+  for (PendingRow& r : pending_) {
+    if (r.joint < 0 || r.kind == Row::kPosition) continue;
+    std::tie(r.side_begin, r.side_end) = SideVectors(scene_.joints[r.joint]);
   }
   // Each body's axes stay unit and orthogonal.
   for (int b = 0; b < static_cast<int>(scene_.bodies.size()); ++b) {
@@ -116,7 +131,18 @@ absl::Status ModelBuilder::Joints() {
   return absl::OkStatus();
 }
 
-void ModelBuilder::AddTurningRows(int ji, Attachment a) {
+std::pair<int, int> ModelBuilder::SideVectors(const JointSpec& joint) const {
+  const Attachment& a = joint.a.IsGround() ? joint.b : joint.a;
+  const int D = model_.dim_;
+  if (a.cable >= 0) {
+    const int slope = NodeCoord(mesh_.Node(a)) + D;
+    return {slope, slope + D};
+  }
+  const int c = BodyCoord(a.body);
+  return {c + D, c + model_.body_stride_};
+}
+
+void ModelBuilder::AddTurningRows(int ji, Attachment a, bool turning) {
   const int D = model_.dim_;
   // One row n . x = 0 per pair (x, n) of a held direction x and a normal
   // n of its initial direction: a clamped slope r_x keeps n . r_x = 0 for
@@ -125,10 +151,13 @@ void ModelBuilder::AddTurningRows(int ji, Attachment a) {
   // which with its unit and orthogonality rows fix its axes to R(t) e0.
   auto add = [&](int coord, const Vector3d& n0) {
     LinearForm f;
-    for (int d = 0; d < D; ++d) f.terms[coord + d] = 1;  // placeholders
+    // Placeholders for a turning support (SetTime writes n(t)).
+    for (int d = 0; d < D; ++d) f.terms[coord + d] = turning ? 1 : n0(d);
     PendingRow row{QuadraticForm::FromLinear(f), Row::kDirection, ji, -1};
-    row.turn_coord = coord;
-    row.turn_n0 = n0;
+    if (turning) {
+      row.turn_coord = coord;
+      row.turn_n0 = n0;
+    }
     pending_.push_back(row);
   };
   auto at_start = [&](int coord) {
@@ -253,6 +282,7 @@ void ModelBuilder::KeepMovableRows() {
     }
     if (grad.lpNorm<Eigen::Infinity>() <= 1e-12) continue;
     m.joint_rows_->AddRow(r.f, r.kind, r.joint, r.body);
+    m.joint_rows_->SetReactionData(r.axis, r.side_begin, r.side_end, m.dim_);
     if (r.motion_axis >= 0) {
       PrescribedMotion::MovingRow moving;
       moving.row = m.joint_rows_->size() - 1;

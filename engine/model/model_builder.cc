@@ -661,6 +661,13 @@ void ModelBuilder::Probes() {
   MultibodyModel& m = model_;
   // The cable nodes (output.shape), a split node's second half left out.
   m.shape_ = scene_.output.shape;
+  for (const JointSpec& joint : scene_.joints) {
+    m.joint_names_.push_back(joint.name);
+    if (!scene_.output.reactions) continue;
+    m.joint_reaction_values_.push_back(joint.type == JointType::kSlide   ? 0
+                                       : joint.type == JointType::kFixed ? 6
+                                                                         : 3);
+  }
   for (size_t c = 0; c + 1 < mesh_.first_node.size(); ++c) {
     int count = 0;
     for (int k = mesh_.first_node[c]; k < mesh_.first_node[c + 1]; ++k) {
@@ -670,6 +677,19 @@ void ModelBuilder::Probes() {
       ++count;
     }
     m.cable_nodes_.push_back(count);
+    m.node_cable_.insert(m.node_cable_.end(), count, static_cast<int>(c));
+  }
+  m.tension_ = scene_.output.tension;
+  if (m.tension_) {
+    for (const CableSpec& cable : scene_.cables)
+      m.cable_ea_.push_back(cable.youngs_modulus_pa * cable.area_m2);
+    for (size_t p = 0; p < scene_.probes.size(); ++p) {
+      const Attachment& at = scene_.probes[p].at;
+      if (at.cable < 0) continue;
+      m.tension_probe_.push_back(static_cast<int>(p));
+      m.tension_cable_.push_back(at.cable);
+      m.tension_s_.push_back(at.s_m);
+    }
   }
   m.probe_term_begin_.push_back(0);
   for (const ProbeSpec& p : scene_.probes) {

@@ -71,6 +71,9 @@ class ModelBuilder {
     // the pattern has every slot n(t) may fill. -1: none.
     int turn_coord = -1;
     Eigen::Vector3d turn_n0 = Eigen::Vector3d::Zero();
+    // The joint's reaction (JointRows::Row::axis, side_begin, side_end).
+    int axis = -1;
+    int side_begin = 0, side_end = 0;
   };
 
   // `should_stop` (empty: never) is asked between cables and every 65,536
@@ -246,7 +249,12 @@ class ModelBuilder {
   absl::Status AddOrientationRows(int joint, Attachment a, Attachment b);
   // The direction rows of a FIXED joint to ground that turns (JointSpec::
   // rotation), holding side `a`'s slope or axes.
-  void AddTurningRows(int joint, Attachment a);
+  // `turning` false: the rows n0 . x = 0 of a FIXED support that does not
+  // turn, kept as rows for its reaction (output.reactions).
+  void AddTurningRows(int joint, Attachment a, bool turning = true);
+  // The full coordinates of the direction vectors of a joint's side a (its
+  // side that is not ground): a cable node's slope or a body's axes.
+  std::pair<int, int> SideVectors(const JointSpec& joint) const;
   template <int D>
   void BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* elements);
   // The element scatter tables (per element, the (4D)^2 skyline slots

@@ -240,4 +240,39 @@ void MultibodyModel::ProbeForces(const VectorXd& q, const VectorXd& lambda,
   }
 }
 
+void MultibodyModel::Reactions(const VectorXd& q, const VectorXd* lambda,
+                               std::vector<JointReaction>* out) const {
+  const size_t n = joint_reaction_values_.size();
+  reaction_forces_.assign(n, Eigen::Vector3d::Zero());
+  reaction_moments_.assign(n, Eigen::Vector3d::Zero());
+  if (lambda)
+    for (const ConstraintFamily* f : families_)
+      f->AddReactions(q, *lambda, &reaction_forces_, &reaction_moments_);
+  out->resize(n);
+  for (size_t j = 0; j < n; ++j) {
+    (*out)[j].values = joint_reaction_values_[j];
+    (*out)[j].force = reaction_forces_[j];
+    (*out)[j].moment = reaction_moments_[j];
+  }
+}
+
+void MultibodyModel::Tensions(const VectorXd& q, std::vector<double>* probes,
+                              std::vector<double>* nodes) const {
+  auto tension = [&](int cable, double s) {
+    Vector3d u;
+    CablePosition(q, cable, s, &u);
+    const double a = u.squaredNorm();
+    return cable_ea_[cable] * 0.5 * (a - 1) * std::sqrt(a);
+  };
+  probes->resize(tension_probe_.size());
+  for (size_t k = 0; k < tension_probe_.size(); ++k)
+    (*probes)[k] = tension(tension_cable_[k], tension_s_[k]);
+  if (!shape_) {
+    nodes->clear();
+    return;
+  }
+  nodes->resize(node_s_.size());
+  for (size_t k = 0; k < node_s_.size(); ++k) (*nodes)[k] = tension(node_cable_[k], node_s_[k]);
+}
+
 }  // namespace cablesim

@@ -136,6 +136,10 @@ ModelInfo MultibodyModel::Info() const {
   info.node_s = node_s_;
   info.shape = shape_;
   info.contact = has_contact();
+  info.joint_names = joint_names_;
+  info.joint_reaction_values = joint_reaction_values_;
+  for (int p : tension_probe_) info.tension_probe_names.push_back(probe_names_[p]);
+  info.node_tension = tension_ && shape_;
   return info;
 }
 

@@ -327,6 +327,25 @@ class MultibodyModel {
   // pointing into the winch; |force| is the tension). `q`: full positions.
   void ProbeForces(const Eigen::VectorXd& q, const Eigen::VectorXd& lambda,
                    std::vector<Eigen::Vector3d>* out) const;
+  // With output.reactions (reactions()), every joint's reaction from full
+  // positions q and the multipliers (ConstraintFamily::AddReactions): the
+  // force on its side a and, FIXED, the moment about its point. `out` is
+  // resized to the scene's joints (no allocation once it has the size).
+  // `lambda` null (no multipliers at hand, MODAL): zeros (a row keeps its
+  // size).
+  bool reactions() const { return !joint_reaction_values_.empty(); }
+  void Reactions(const Eigen::VectorXd& q, const Eigen::VectorXd* lambda,
+                 std::vector<JointReaction>* out) const;
+  // With output.tension (tension()): the cable's axial force [N] at every
+  // probe on a cable (ModelInfo::tension_probe_names) and, with shape,
+  // at every node of NodePositions, from full positions q: EA eps |r_s|,
+  // eps = (r_s . r_s - 1) / 2 (Green-Lagrange, the element's strain), the
+  // component along the tangent of the section force EA eps r_s that the
+  // element's internal force holds (AncfCableElement). `probes` and
+  // `nodes` are resized (no allocation once they have the size).
+  bool tension() const { return tension_; }
+  void Tensions(const Eigen::VectorXd& q, std::vector<double>* probes,
+                std::vector<double>* nodes) const;
   // The number of probes on a moving support or a winch's end (ProbeForces' size).
   int force_probe_count() const { return static_cast<int>(force_probes_.size()); }
 
@@ -512,6 +531,18 @@ class MultibodyModel {
   // The cable nodes of ModelInfo: per distinct node its position's first
   // full coordinate; per cable the count; per node its arc length [m].
   bool shape_ = false;
+  // Per scene joint its name, and with output.reactions the numbers of its
+  // reaction in a row (ModelInfo::joint_reaction_values).
+  std::vector<std::string> joint_names_;
+  std::vector<int> joint_reaction_values_;
+  // output.tension: per probe on a cable, its probe, cable and arc length;
+  // per cable its EA [N]; per shape node, its cable.
+  bool tension_ = false;
+  std::vector<int> tension_probe_, tension_cable_;
+  std::vector<double> tension_s_, cable_ea_;
+  std::vector<int> node_cable_;
+  // Reactions' work space, per joint.
+  mutable std::vector<Eigen::Vector3d> reaction_forces_, reaction_moments_;
   std::vector<int> shape_coord_;
   std::vector<int> cable_nodes_;
   std::vector<double> node_s_;

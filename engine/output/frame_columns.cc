@@ -33,12 +33,26 @@ std::vector<std::string> FrameColumns(const ModelInfo& info, bool with_nodes) {
     for (const char* c : {"fx", "fy", "fz"}) columns.push_back(absl::StrCat(name, ".", c));
   }
   if (info.contact) columns.push_back("energy.contact");
+  for (size_t i = 0; i < info.joint_reaction_values.size(); ++i) {
+    const int n = info.joint_reaction_values[i];
+    if (n >= 3)
+      for (const char* c : {"fx", "fy", "fz"}) columns.push_back(absl::StrCat("joints[", i, "].", c));
+    if (n >= 6)
+      for (const char* c : {"mx", "my", "mz"}) columns.push_back(absl::StrCat("joints[", i, "].", c));
+  }
+  for (const std::string& name : info.tension_probe_names) columns.push_back(name + ".tension");
   if (!info.shape || !with_nodes) return columns;
   for (size_t i = 0; i < info.cable_nodes.size(); ++i) {
     for (int k = 0; k < info.cable_nodes[i]; ++k) {
       for (const char* c : {"x", "y", "z"}) {
         columns.push_back(absl::StrCat("cables[", i, "].nodes[", k, "].", c));
       }
+    }
+  }
+  if (!info.node_tension) return columns;
+  for (size_t i = 0; i < info.cable_nodes.size(); ++i) {
+    for (int k = 0; k < info.cable_nodes[i]; ++k) {
+      columns.push_back(absl::StrCat("cables[", i, "].nodes[", k, "].tension"));
     }
   }
   return columns;
@@ -58,7 +72,10 @@ FrameReader::FrameReader(const ModelInfo& info, absl::Span<const std::string> co
       bodies_(static_cast<int>(info.body_names.size())),
       forces_(static_cast<int>(info.force_probe_names.size())),
       nodes_(info.shape ? static_cast<int>(info.node_s.size()) : 0),
-      contact_(info.contact) {
+      contact_(info.contact),
+      reaction_values_(info.joint_reaction_values),
+      tension_probes_(static_cast<int>(info.tension_probe_names.size())),
+      node_tension_(info.shape && info.node_tension) {
   absl::flat_hash_map<std::string_view, int> column;
   for (size_t i = 0; i < columns.size(); ++i) column.emplace(columns[i], static_cast<int>(i));
   for (const std::string& name : FrameColumns(info)) {
@@ -74,6 +91,11 @@ void FrameReader::Read(absl::Span<const double> row, Frame* frame) const {
   frame->support_forces.resize(forces_);
   frame->nodes.resize(nodes_);
   frame->has_contact = contact_;
+  frame->probe_tensions.resize(tension_probes_);
+  frame->node_tensions.resize(node_tension_ ? nodes_ : 0);
+  frame->reactions.resize(reaction_values_.size());
+  for (size_t j = 0; j < reaction_values_.size(); ++j)
+    frame->reactions[j].values = reaction_values_[j];
   size_t k = 0;
   auto read = [&](double& value) {
     const int i = index_[k++];

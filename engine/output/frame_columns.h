@@ -16,8 +16,15 @@
 //   per probe on a moving support (ModelInfo::force_probe_names)
 //                NAME.fx NAME.fy NAME.fz
 //   with a seabed (ModelInfo::contact)  energy.contact
+//   with output.reactions, per joint i (ModelInfo::joint_reaction_values)
+//                joints[i].fx joints[i].fy joints[i].fz
+//                and for FIXED joints[i].mx joints[i].my joints[i].mz
+//   with output.tension, per probe on a cable (ModelInfo::tension_probe_names)
+//                NAME.tension
 //   with output.shape (ModelInfo::shape), per cable i and node k
 //                cables[i].nodes[k].x cables[i].nodes[k].y cables[i].nodes[k].z
+//   with output.shape and output.tension (ModelInfo::node_tension), per
+//   cable i and node k  cables[i].nodes[k].tension
 //
 // (EnergyParts, output/results.h). Parts are named by their index in the scene
 // file, as field paths are (`cables[1].length`): a cable's name is free
@@ -92,6 +99,13 @@ void ForEachFrameValue(FrameT& frame, Add&& add) {
     for (int k = 0; k < 3; ++k) add(f[k]);
   }
   if (frame.has_contact) add(e.contact);
+  for (auto& r : frame.reactions) {
+    if (r.values < 3) continue;
+    for (int k = 0; k < 3; ++k) add(r.force[k]);
+    if (r.values < 6) continue;
+    for (int k = 0; k < 3; ++k) add(r.moment[k]);
+  }
+  for (auto& t : frame.probe_tensions) add(t);
 }
 
 // Calls add(value) for x, y, z of every node of `frame` (empty without
@@ -101,6 +115,7 @@ void ForEachNodeValue(FrameT& frame, Add&& add) {
   for (auto& r : frame.nodes) {
     for (int k = 0; k < 3; ++k) add(r[k]);
   }
+  for (auto& t : frame.node_tensions) add(t);
 }
 
 // Reads frames back from rows whose columns are known by name: each
@@ -126,6 +141,9 @@ class FrameReader {
   int row_size_ = 0;
   int probes_ = 0, cables_ = 0, bodies_ = 0, forces_ = 0, nodes_ = 0;
   bool contact_ = false;
+  std::vector<int> reaction_values_;
+  int tension_probes_ = 0;
+  bool node_tension_ = false;
   // The column of every number of ForEachFrameValue's and then
   // ForEachNodeValue's order, or -1.
   std::vector<int> index_;

@@ -41,6 +41,26 @@ struct ModelInfo {
   bool shape = false;
   // Whether the scene has a seabed: frames then carry energy.contact.
   bool contact = false;
+  // Joint names (JointSpec::name, may be empty) in scene order.
+  std::vector<std::string> joint_names;
+  // With output.reactions, per joint: the numbers of its reaction in a row
+  // (Frame::reactions): 3 (force), 6 (FIXED: force and moment) or 0
+  // (SLIDE). Empty without.
+  std::vector<int> joint_reaction_values;
+  // With output.tension: the probes on a cable (scene order), each with a
+  // column NAME.tension; and whether the nodes carry their tension
+  // (output.shape too).
+  std::vector<std::string> tension_probe_names;
+  bool node_tension = false;
+};
+
+// The force [N] a joint exerts on its side a (a joint to ground: on what it
+// holds) and, for FIXED, the moment [N m] about the joint's point.
+struct JointReaction {
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+  Eigen::Vector3d moment = Eigen::Vector3d::Zero();
+  // The numbers it has in a row (ModelInfo::joint_reaction_values).
+  int values = 3;
 };
 
 struct ProbeSample {
@@ -120,6 +140,13 @@ struct Frame {
   std::vector<Eigen::Vector3d> nodes;
   // Whether the row carries energy.contact (ModelInfo::contact).
   bool has_contact = false;
+  // With output.reactions, per joint in scene order; empty otherwise.
+  std::vector<JointReaction> reactions;
+  // With output.tension, per probe of ModelInfo::tension_probe_names the
+  // cable's axial force there [N] (compression negative), and with shape
+  // too, per node of `nodes`.
+  std::vector<double> probe_tensions;
+  std::vector<double> node_tensions;
 };
 
 class FrameSink {

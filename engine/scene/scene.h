@@ -163,6 +163,8 @@ struct JointSpec {
   TimeFunction rotation;
   Eigen::Vector3d rotation_axis = Eigen::Vector3d::UnitZ();
   bool HasRotation() const { return !rotation.IsZero(); }
+  // Free text naming the joint in the outputs (ModelInfo::joint_names).
+  std::string name;
 };
 
 struct LoadSpec {
@@ -357,6 +359,12 @@ struct OutputSpec {
   // deviation over the run's frames (RunSummary::statistics).
   bool statistics = false;
   RainflowSpec rainflow;
+  // Every joint's reaction in every frame (Frame::reactions); joints to
+  // ground are then rows with multipliers instead of removed coordinates.
+  bool reactions = false;
+  // The axial force of every cable probe (NAME.tension) and, with shape,
+  // of every node in every frame (Frame::probe_tensions, node_tensions).
+  bool tension = false;
 };
 
 struct Scene {

@@ -1,0 +1,97 @@
+// Tension along a line (Scene.output.tension): NAME.tension of a probe on
+// a cable and the shape's per-node tension, the element's own axial force
+// EA eps |r_s| (eps Green-Lagrange), against a hanging rod's linear profile.
+
+#include <cmath>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "absl/strings/str_format.h"
+#include "engine/output/frame_columns.h"
+#include "engine/run/simulation.h"
+#include "test_util.h"
+
+namespace cablesim {
+namespace {
+
+using testing::CollectingSink;
+using testing::RunOk;
+using testing::SceneFromJson;
+
+// A 10 m steel rod (1 cm diameter) hanging from a pin at its top, statics:
+// at arc length s from the top it carries the weight below it,
+// T(s) = rho A g (L - s) (exact for any stretch: the weight of the
+// undeformed length below). The strain is 4e-6 at most, the profile linear,
+// so the cubic elements hold it closely; the tolerance, 1e-6 of the top
+// tension (6 N), is far below what a wrong sign or a tension read one
+// node off (0.6 N) would give.
+std::string HangingRod(const std::string& shape) {
+  return absl::StrFormat(R"({"gravity": {"y": -9.81},
+    "cables": [{"name": "rod", "length": 10, "elements": 10, "density": 7850,
+                "youngs_modulus": 2e11, "diameter": 0.01, "direction": {"y": -1}}],
+    "joints": [{"type": "PIN", "a": {"cable": "rod", "s": 0}}],
+    "probes": [{"name": "top", "cable": "rod", "s": 0}, {"name": "mid", "cable": "rod", "s": 5},
+               {"name": "quarter", "cable": "rod", "s": 7.5}, {"name": "end", "cable": "rod", "s": 10}],
+    "output": {"tension": true, "shape": %s},
+    "solver": {"analysis": "STATIC"}})",
+                         shape);
+}
+
+TEST(CableTensionTest, HangingRodCarriesTheWeightBelow) {
+  CollectingSink sink;
+  RunOk(SceneFromJson(HangingRod("true")), &sink);
+  const double w = 7850 * (M_PI / 4 * 1e-4) * 9.81;  // N/m
+  ASSERT_EQ(sink.info().tension_probe_names,
+            (std::vector<std::string>{"top", "mid", "quarter", "end"}));
+  ASSERT_TRUE(sink.info().node_tension);
+  const Frame& f = sink.frames().back();
+  ASSERT_EQ(f.t, 1.0);
+  const double tol = 1e-6 * w * 10;
+  const double s_probe[] = {0, 5, 7.5, 10};
+  ASSERT_EQ(f.probe_tensions.size(), 4u);
+  for (int k = 0; k < 4; ++k)
+    EXPECT_NEAR(f.probe_tensions[k], w * (10 - s_probe[k]), tol) << s_probe[k];
+  ASSERT_EQ(f.node_tensions.size(), sink.info().node_s.size());
+  for (size_t k = 0; k < f.node_tensions.size(); ++k)
+    EXPECT_NEAR(f.node_tensions[k], w * (10 - sink.info().node_s[k]), tol) << sink.info().node_s[k];
+  const std::vector<std::string> columns = FrameColumns(sink.info());
+  EXPECT_THAT(columns, ::testing::Contains("mid.tension"));
+  EXPECT_THAT(columns, ::testing::Contains("cables[0].nodes[3].tension"));
+  // The last column: the last node's tension (a node is inserted at the
+  // probe at s = 7.5, so 12 nodes).
+  EXPECT_EQ(columns.back(), absl::StrFormat("cables[0].nodes[%d].tension",
+                                            sink.info().node_s.size() - 1));
+}
+
+// The same rod standing on its pin (gravity reversed, pushed from below
+// by its own weight towards the pin): compression is negative, T(s) =
+// -rho A g (L - s). Statics of a compressed straight rod is the same
+// linear system (the rod stays straight: no lateral load).
+TEST(CableTensionTest, CompressionIsNegative) {
+  std::string json = HangingRod("false");
+  json.replace(json.find(R"({"y": -9.81})"), 12, R"({"y": 9.81})");
+  CollectingSink sink;
+  RunOk(SceneFromJson(json), &sink);
+  const double w = 7850 * (M_PI / 4 * 1e-4) * 9.81;
+  const Frame& f = sink.frames().back();
+  ASSERT_EQ(f.probe_tensions.size(), 4u);
+  EXPECT_NEAR(f.probe_tensions[1], -w * 5, 1e-6 * w * 10);
+  EXPECT_FALSE(sink.info().node_tension);  // no shape: no node tensions
+  EXPECT_TRUE(f.node_tensions.empty());
+}
+
+// Without output.tension: no tension columns.
+TEST(CableTensionTest, NoneUnlessAskedFor) {
+  std::string json = HangingRod("true");
+  json.replace(json.find(R"("tension": true)"), 15, R"("tension": false)");
+  CollectingSink sink;
+  RunOk(SceneFromJson(json), &sink);
+  EXPECT_TRUE(sink.info().tension_probe_names.empty());
+  EXPECT_TRUE(sink.frames().back().probe_tensions.empty());
+  EXPECT_TRUE(sink.frames().back().node_tensions.empty());
+}
+
+}  // namespace
+}  // namespace cablesim
