@@ -15,6 +15,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/string_view.h"
+#include "convert/plausibility_warnings.h"
 #include "convert/plausible_ranges.h"
 #include "engine/scene/polyline.h"
 #include "engine/scene/integrator_traits.h"
@@ -1413,7 +1414,9 @@ absl::Status UnknownEnumValue(absl::string_view path, int value, absl::string_vi
 }  // namespace
 
 absl::StatusOr<Scene> SceneFromProto(const v1::Scene& proto) {
-  return SceneConverter(proto).Convert();
+  absl::StatusOr<Scene> scene = SceneConverter(proto).Convert();
+  if (scene.ok()) scene->warnings = PlausibilityWarnings(proto, *scene);
+  return scene;
 }
 
 absl::StatusOr<BendingModel> BendingFromProto(v1::Bending bending, std::string_view path_std) {

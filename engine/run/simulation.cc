@@ -96,6 +96,7 @@ absl::StatusOr<RunSummary> RunPrepared(PreparedRun* prepared, FrameSink* sink,
   const Scene& scene = p.scene;
   RunSummary summary;
   summary.info = p.info;
+  summary.warnings = scene.warnings;
   const SolverSettings& settings = scene.solver;
   summary.analysis = std::string(AnalysisName(settings.analysis));
   const int modes = p.modes;

@@ -374,6 +374,9 @@ struct Scene {
   FluidSpec fluid;
   SeabedSpec seabed;
   std::vector<SheaveSpec> sheaves;
+  // Plausibility warnings found when the scene was read (convert/
+  // plausibility_warnings.h): a run puts them first in RunSummary::warnings.
+  std::vector<std::string> warnings;
 };
 
 }  // namespace cablesim
