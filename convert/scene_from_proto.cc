@@ -1280,6 +1280,25 @@ class SceneConverter {
     }
 
     const IntegratorTraits& traits = TraitsOf(out.integrator);
+    out.auto_integrator = s.integrator() == v1::AUTO_STEPPER;
+    if (out.auto_integrator) {
+      // The settings that only an implicit stepper uses keep AUTO implicit
+      // (rather than be ignored by an explicit one, or refused).
+      for (const auto& [has, field] :
+           {std::pair{s.has_rho_infinity(), "solver.rho_infinity"},
+            std::pair{s.has_reuse_factorization(), "solver.reuse_factorization"},
+            std::pair{s.linear_solver() == v1::MINRES || s.linear_solver() == v1::GMRES,
+                      "solver.linear_solver"},
+            std::pair{s.has_newton_tolerance(), "solver.newton_tolerance"},
+            std::pair{s.has_max_newton_iterations(), "solver.max_newton_iterations"},
+            std::pair{s.has_linear_tolerance(), "solver.linear_tolerance"},
+            std::pair{s.has_max_linear_iterations(), "solver.max_linear_iterations"},
+            std::pair{s.preconditioner() != v1::Solver::PRECONDITIONER_UNSPECIFIED,
+                      "solver.preconditioner"},
+            std::pair{s.accept_inexact_solves(), "solver.accept_inexact_solves"}}) {
+        if (has && out.auto_keep_implicit.empty()) out.auto_keep_implicit = field;
+      }
+    }
     if (s.has_rho_infinity()) {
       if (!traits.has_rho_infinity) {
         return Invalid("solver.rho_infinity",
@@ -1474,6 +1493,8 @@ absl::StatusOr<Integrator> IntegratorFromProto(v1::Integrator integrator,
     case v1::INTEGRATOR_UNSPECIFIED:
     case v1::HHT:
       return Integrator::kHht;
+    case v1::AUTO_STEPPER:  // HHT until the run chooses (SolverSettings::auto_integrator)
+      return Integrator::kHht;
     case v1::ENERGY_MOMENTUM:
       return Integrator::kEnergyMomentum;
     case v1::DORMAND_PRINCE:
@@ -1483,7 +1504,7 @@ absl::StatusOr<Integrator> IntegratorFromProto(v1::Integrator integrator,
     default:
       return UnknownEnumValue(path, integrator,
                               "IMPLICIT_EULER, GENERALIZED_ALPHA, HHT, ENERGY_MOMENTUM, "
-                              "DORMAND_PRINCE or CENTRAL_DIFFERENCE");
+                              "DORMAND_PRINCE, CENTRAL_DIFFERENCE or AUTO_STEPPER");
   }
 }
 
