@@ -190,7 +190,13 @@ TEST(CliTest, TextFormatScene) {
 TEST(CliTest, ValidateSampleScenes) {
   const CliResult pendulum = Cli({"validate", SampleScene("falling-pendulum.json")});
   EXPECT_EQ(pendulum.code, 0) << pendulum.err;
-  EXPECT_EQ(pendulum.err, "");
+  // The paper's soft beam (E = 0.7 MPa) would stretch 9 % hanging: its one
+  // plausibility warning, listed in the JSON line and on standard error.
+  EXPECT_THAT(pendulum.err,
+              StartsWith("cablesim: warning: cables[0] 'beam': the static strain under its "
+                         "weight, payload and loads is about 9.32 %"));
+  EXPECT_EQ(pendulum.err.find('\n'), pendulum.err.size() - 1) << pendulum.err;
+  EXPECT_THAT(pendulum.out, HasSubstr(R"("warnings":["cables[0] 'beam': the static strain)"));
   EXPECT_THAT(pendulum.out, StartsWith(R"({"status":"ok",)"));
   EXPECT_THAT(pendulum.out,
               HasSubstr(R"("name":"falling-pendulum","cables":1,"bodies":0,"joints":1,)"
@@ -200,6 +206,8 @@ TEST(CliTest, ValidateSampleScenes) {
 
   const CliResult cylinder = Cli({"validate", SampleScene("cable-with-end-cylinder.json")});
   EXPECT_EQ(cylinder.code, 0) << cylinder.err;
+  EXPECT_EQ(cylinder.err, "");  // no plausibility warning
+  EXPECT_THAT(cylinder.out, HasSubstr(R"("warnings":[])"));
   EXPECT_THAT(cylinder.out, HasSubstr(R"("bodies":1,"joints":2,)"));
 
   const CliResult cantilever = Cli({"validate", SampleScene("cantilever-large-deflection.json")});
@@ -223,7 +231,10 @@ TEST(CliTest, RunWritesSummaryAndCsv) {
     if (out_flag == "--out") args.push_back(csv);
     const CliResult r = Cli(args);
     ASSERT_EQ(r.code, 0) << r.err;
-    EXPECT_EQ(r.err, "");
+    // The one plausibility warning of this tiny scene, and nothing else.
+    EXPECT_THAT(r.err, StartsWith("cablesim: warning: cables[0].elements: 2 elements of 0.25 m "
+                                  "are longer than 1/10 of the cable"));
+    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << r.err;
     EXPECT_THAT(r.out, StartsWith(R"({"status":"ok",)"));
     EXPECT_THAT(r.out, HasSubstr(R"("model":"planar")"));
     const std::vector<std::string> lines = ReadLines(csv);
