@@ -299,6 +299,22 @@ bool IsProbeNameChar(char c) {
 
 // Validates a scene and builds the engine's scene from it, stopping at the
 // first invalid field.
+// The first Newton or linear-solver setting `s` gives (the settings only an
+// implicit step uses), or nullptr.
+const char* NewtonSettingGiven(const v1::Solver& s) {
+  for (const auto& [has, field] :
+       {std::pair{s.has_newton_tolerance(), "solver.newton_tolerance"},
+        std::pair{s.has_max_newton_iterations(), "solver.max_newton_iterations"},
+        std::pair{s.has_linear_tolerance(), "solver.linear_tolerance"},
+        std::pair{s.has_max_linear_iterations(), "solver.max_linear_iterations"},
+        std::pair{s.preconditioner() != v1::Solver::PRECONDITIONER_UNSPECIFIED,
+                  "solver.preconditioner"},
+        std::pair{s.accept_inexact_solves(), "solver.accept_inexact_solves"}}) {
+    if (has) return field;
+  }
+  return nullptr;
+}
+
 class SceneConverter {
  public:
   explicit SceneConverter(const v1::Scene& proto) : proto_(proto) {}
@@ -1284,19 +1300,14 @@ class SceneConverter {
     if (out.auto_integrator) {
       // The settings that only an implicit stepper uses keep AUTO implicit
       // (rather than be ignored by an explicit one, or refused).
-      for (const auto& [has, field] :
-           {std::pair{s.has_rho_infinity(), "solver.rho_infinity"},
-            std::pair{s.has_reuse_factorization(), "solver.reuse_factorization"},
-            std::pair{s.linear_solver() == v1::MINRES || s.linear_solver() == v1::GMRES,
-                      "solver.linear_solver"},
-            std::pair{s.has_newton_tolerance(), "solver.newton_tolerance"},
-            std::pair{s.has_max_newton_iterations(), "solver.max_newton_iterations"},
-            std::pair{s.has_linear_tolerance(), "solver.linear_tolerance"},
-            std::pair{s.has_max_linear_iterations(), "solver.max_linear_iterations"},
-            std::pair{s.preconditioner() != v1::Solver::PRECONDITIONER_UNSPECIFIED,
-                      "solver.preconditioner"},
-            std::pair{s.accept_inexact_solves(), "solver.accept_inexact_solves"}}) {
-        if (has && out.auto_keep_implicit.empty()) out.auto_keep_implicit = field;
+      if (s.has_rho_infinity()) {
+        out.auto_keep_implicit = "solver.rho_infinity";
+      } else if (s.has_reuse_factorization()) {
+        out.auto_keep_implicit = "solver.reuse_factorization";
+      } else if (s.linear_solver() == v1::MINRES || s.linear_solver() == v1::GMRES) {
+        out.auto_keep_implicit = "solver.linear_solver";
+      } else if (const char* field = NewtonSettingGiven(s); field != nullptr) {
+        out.auto_keep_implicit = field;
       }
     }
     if (s.has_rho_infinity()) {
@@ -1343,16 +1354,7 @@ class SceneConverter {
                               "mass matrix, factored once)";
       if (s.linear_solver() == v1::MINRES || s.linear_solver() == v1::GMRES)
         return Invalid("solver.linear_solver", why);
-      for (const auto& [has, field] :
-           {std::pair{s.has_newton_tolerance(), "solver.newton_tolerance"},
-            std::pair{s.has_max_newton_iterations(), "solver.max_newton_iterations"},
-            std::pair{s.has_linear_tolerance(), "solver.linear_tolerance"},
-            std::pair{s.has_max_linear_iterations(), "solver.max_linear_iterations"},
-            std::pair{s.preconditioner() != v1::Solver::PRECONDITIONER_UNSPECIFIED,
-                      "solver.preconditioner"},
-            std::pair{s.accept_inexact_solves(), "solver.accept_inexact_solves"}}) {
-        if (has) return Invalid(field, why);
-      }
+      if (const char* field = NewtonSettingGiven(s); field != nullptr) return Invalid(field, why);
     }
     // The tolerances hold adaptive steps and every DYNAMIC run's error
     // estimate (engine/run/run_warnings.h).

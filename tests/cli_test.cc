@@ -289,7 +289,12 @@ TEST(CliTest, NumericalFailureExitsWith3AndKeepsTheCsv) {
   EXPECT_EQ(r.code, 3) << r.err;
   EXPECT_THAT(r.out, StartsWith(R"({"status":"failed","error":")"));
   EXPECT_THAT(r.out, HasSubstr(R"("failure_time_s":)"));
-  EXPECT_THAT(r.err, StartsWith("cablesim: numerical failure at t = "));
+  // The scene's two plausibility warnings (4 coarse elements; a 0.5 s
+  // step over the cable's 3.6 ms axial bounce), then the failure.
+  EXPECT_THAT(r.err, StartsWith("cablesim: warning: cables[0].elements: 4 elements"));
+  EXPECT_THAT(r.err, HasSubstr("\ncablesim: warning: solver.step: 0.5 s is above the shortest "
+                               "period"));
+  EXPECT_THAT(r.err, HasSubstr("\ncablesim: numerical failure at t = "));
   const std::vector<std::string> lines = ReadLines(csv);
   ASSERT_GE(lines.size(), 2);  // the header and the frame at t = 0
   EXPECT_EQ(lines[0], CsvWriter::Header(OneCable({})));
