@@ -226,8 +226,13 @@ int Validate(const std::string& path, const std::optional<std::string>& server, 
   } else {
     json.Add("load_steps", solver.load_steps);
   }
+  // Plausibility warnings (the service's, so that --server lists its own).
+  const std::vector<std::string> warnings(response.warnings().begin(),
+                                          response.warnings().end());
+  json.Add("warnings", warnings);
   out << json.ToString() << "\n";
   out.flush();
+  for (const std::string& warning : warnings) err << "cablesim: warning: " << warning << "\n";
   return kExitOk;
 }
 

@@ -49,6 +49,8 @@ std::string SummaryToJson(const RunSummary& summary) {
   json.Add("model", summary.info.model)
       .Add("analysis", summary.analysis)
       .Add("integrator", summary.integrator)
+      .Add("integrator_requested", summary.integrator_requested)
+      .Add("integrator_reason", summary.integrator_reason)
       .Add("linear_solver", summary.linear_solver)
       .Add("coordinates", summary.info.coordinates)
       .Add("dofs", summary.info.dofs)

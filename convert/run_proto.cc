@@ -135,6 +135,8 @@ v1::RunSummary SummaryToProto(const RunSummary& s) {
   p.set_local_error_estimate_m(s.local_error_estimate_m);
   p.set_error_tolerance_m(s.error_tolerance_m);
   for (const std::string& w : s.warnings) p.add_warnings(w);
+  p.set_integrator_requested(s.integrator_requested);
+  p.set_integrator_reason(s.integrator_reason);
   return p;
 }
 
@@ -182,6 +184,8 @@ RunSummary SummaryFromProto(const v1::RunSummary& p) {
   s.local_error_estimate_m = p.local_error_estimate_m();
   s.error_tolerance_m = p.error_tolerance_m();
   s.warnings.assign(p.warnings().begin(), p.warnings().end());
+  s.integrator_requested = p.integrator_requested();
+  s.integrator_reason = p.integrator_reason();
   return s;
 }
 

@@ -15,6 +15,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/string_view.h"
+#include "convert/plausibility_warnings.h"
 #include "convert/plausible_ranges.h"
 #include "engine/scene/polyline.h"
 #include "engine/scene/integrator_traits.h"
@@ -298,6 +299,22 @@ bool IsProbeNameChar(char c) {
 
 // Validates a scene and builds the engine's scene from it, stopping at the
 // first invalid field.
+// The first Newton or linear-solver setting `s` gives (the settings only an
+// implicit step uses), or nullptr.
+const char* NewtonSettingGiven(const v1::Solver& s) {
+  for (const auto& [has, field] :
+       {std::pair{s.has_newton_tolerance(), "solver.newton_tolerance"},
+        std::pair{s.has_max_newton_iterations(), "solver.max_newton_iterations"},
+        std::pair{s.has_linear_tolerance(), "solver.linear_tolerance"},
+        std::pair{s.has_max_linear_iterations(), "solver.max_linear_iterations"},
+        std::pair{s.preconditioner() != v1::Solver::PRECONDITIONER_UNSPECIFIED,
+                  "solver.preconditioner"},
+        std::pair{s.accept_inexact_solves(), "solver.accept_inexact_solves"}}) {
+    if (has) return field;
+  }
+  return nullptr;
+}
+
 class SceneConverter {
  public:
   explicit SceneConverter(const v1::Scene& proto) : proto_(proto) {}
@@ -1282,6 +1299,20 @@ class SceneConverter {
     }
 
     const IntegratorTraits& traits = TraitsOf(out.integrator);
+    out.auto_integrator = s.integrator() == v1::AUTO_STEPPER;
+    if (out.auto_integrator) {
+      // The settings that only an implicit stepper uses keep AUTO implicit
+      // (rather than be ignored by an explicit one, or refused).
+      if (s.has_rho_infinity()) {
+        out.auto_keep_implicit = "solver.rho_infinity";
+      } else if (s.has_reuse_factorization()) {
+        out.auto_keep_implicit = "solver.reuse_factorization";
+      } else if (s.linear_solver() == v1::MINRES || s.linear_solver() == v1::GMRES) {
+        out.auto_keep_implicit = "solver.linear_solver";
+      } else if (const char* field = NewtonSettingGiven(s); field != nullptr) {
+        out.auto_keep_implicit = field;
+      }
+    }
     if (s.has_rho_infinity()) {
       if (!traits.has_rho_infinity) {
         return Invalid("solver.rho_infinity",
@@ -1326,16 +1357,7 @@ class SceneConverter {
                               "mass matrix, factored once)";
       if (s.linear_solver() == v1::MINRES || s.linear_solver() == v1::GMRES)
         return Invalid("solver.linear_solver", why);
-      for (const auto& [has, field] :
-           {std::pair{s.has_newton_tolerance(), "solver.newton_tolerance"},
-            std::pair{s.has_max_newton_iterations(), "solver.max_newton_iterations"},
-            std::pair{s.has_linear_tolerance(), "solver.linear_tolerance"},
-            std::pair{s.has_max_linear_iterations(), "solver.max_linear_iterations"},
-            std::pair{s.preconditioner() != v1::Solver::PRECONDITIONER_UNSPECIFIED,
-                      "solver.preconditioner"},
-            std::pair{s.accept_inexact_solves(), "solver.accept_inexact_solves"}}) {
-        if (has) return Invalid(field, why);
-      }
+      if (const char* field = NewtonSettingGiven(s); field != nullptr) return Invalid(field, why);
     }
     // The tolerances hold adaptive steps and every DYNAMIC run's error
     // estimate (engine/run/run_warnings.h).
@@ -1416,7 +1438,9 @@ absl::Status UnknownEnumValue(absl::string_view path, int value, absl::string_vi
 }  // namespace
 
 absl::StatusOr<Scene> SceneFromProto(const v1::Scene& proto) {
-  return SceneConverter(proto).Convert();
+  absl::StatusOr<Scene> scene = SceneConverter(proto).Convert();
+  if (scene.ok()) scene->warnings = PlausibilityWarnings(proto, *scene);
+  return scene;
 }
 
 absl::StatusOr<BendingModel> BendingFromProto(v1::Bending bending, std::string_view path_std) {
@@ -1474,6 +1498,8 @@ absl::StatusOr<Integrator> IntegratorFromProto(v1::Integrator integrator,
     case v1::INTEGRATOR_UNSPECIFIED:
     case v1::HHT:
       return Integrator::kHht;
+    case v1::AUTO_STEPPER:  // HHT until the run chooses (SolverSettings::auto_integrator)
+      return Integrator::kHht;
     case v1::ENERGY_MOMENTUM:
       return Integrator::kEnergyMomentum;
     case v1::DORMAND_PRINCE:
@@ -1483,7 +1509,7 @@ absl::StatusOr<Integrator> IntegratorFromProto(v1::Integrator integrator,
     default:
       return UnknownEnumValue(path, integrator,
                               "IMPLICIT_EULER, GENERALIZED_ALPHA, HHT, ENERGY_MOMENTUM, "
-                              "DORMAND_PRINCE or CENTRAL_DIFFERENCE");
+                              "DORMAND_PRINCE, CENTRAL_DIFFERENCE or AUTO_STEPPER");
   }
 }
 

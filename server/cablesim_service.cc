@@ -414,6 +414,7 @@ grpc::Status CablesimServiceImpl::Validate(grpc::ServerContext* context,
   if (checked.ok()) {
     response->set_valid(true);
     *response->mutable_model() = ModelInfoToProto(checked->info);
+    for (const std::string& w : checked->scene.warnings) response->add_warnings(w);
     return grpc::Status::OK;
   }
   const absl::StatusCode code = checked.status().code();

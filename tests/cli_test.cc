@@ -217,7 +217,13 @@ TEST(CliTest, TextFormatScene) {
 TEST(CliTest, ValidateSampleScenes) {
   const CliResult pendulum = Cli({"validate", SampleScene("falling-pendulum.json")});
   EXPECT_EQ(pendulum.code, 0) << pendulum.err;
-  EXPECT_EQ(pendulum.err, "");
+  // The paper's soft beam (E = 0.7 MPa) would stretch 9 % hanging: its one
+  // plausibility warning, listed in the JSON line and on standard error.
+  EXPECT_THAT(pendulum.err,
+              StartsWith("cablesim: warning: cables[0] 'beam': the static strain under its "
+                         "weight, payload and loads is about 9.32 %"));
+  EXPECT_EQ(pendulum.err.find('\n'), pendulum.err.size() - 1) << pendulum.err;
+  EXPECT_THAT(pendulum.out, HasSubstr(R"("warnings":["cables[0] 'beam': the static strain)"));
   EXPECT_THAT(pendulum.out, StartsWith(R"({"status":"ok",)"));
   EXPECT_THAT(pendulum.out,
               HasSubstr(R"("name":"falling-pendulum","cables":1,"bodies":0,"joints":1,)"
@@ -227,6 +233,8 @@ TEST(CliTest, ValidateSampleScenes) {
 
   const CliResult cylinder = Cli({"validate", SampleScene("cable-with-end-cylinder.json")});
   EXPECT_EQ(cylinder.code, 0) << cylinder.err;
+  EXPECT_EQ(cylinder.err, "");  // no plausibility warning
+  EXPECT_THAT(cylinder.out, HasSubstr(R"("warnings":[])"));
   EXPECT_THAT(cylinder.out, HasSubstr(R"("bodies":1,"joints":2,)"));
 
   const CliResult cantilever = Cli({"validate", SampleScene("cantilever-large-deflection.json")});
@@ -250,7 +258,10 @@ TEST(CliTest, RunWritesSummaryAndCsv) {
     if (out_flag == "--out") args.push_back(csv);
     const CliResult r = Cli(args);
     ASSERT_EQ(r.code, 0) << r.err;
-    EXPECT_EQ(r.err, "");
+    // The one plausibility warning of this tiny scene, and nothing else.
+    EXPECT_THAT(r.err, StartsWith("cablesim: warning: cables[0].elements: 2 elements of 0.25 m "
+                                  "are longer than 1/10 of the cable"));
+    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << r.err;
     EXPECT_THAT(r.out, StartsWith(R"({"status":"ok",)"));
     EXPECT_THAT(r.out, HasSubstr(R"("model":"planar")"));
     const std::vector<std::string> lines = ReadLines(csv);
@@ -305,7 +316,12 @@ TEST(CliTest, NumericalFailureExitsWith3AndKeepsTheCsv) {
   EXPECT_EQ(r.code, 3) << r.err;
   EXPECT_THAT(r.out, StartsWith(R"({"status":"failed","error":")"));
   EXPECT_THAT(r.out, HasSubstr(R"("failure_time_s":)"));
-  EXPECT_THAT(r.err, StartsWith("cablesim: numerical failure at t = "));
+  // The scene's two plausibility warnings (4 coarse elements; a 0.5 s
+  // step over the cable's 3.6 ms axial bounce), then the failure.
+  EXPECT_THAT(r.err, StartsWith("cablesim: warning: cables[0].elements: 4 elements"));
+  EXPECT_THAT(r.err, HasSubstr("\ncablesim: warning: solver.step: 0.5 s is above the shortest "
+                               "period"));
+  EXPECT_THAT(r.err, HasSubstr("\ncablesim: numerical failure at t = "));
   const std::vector<std::string> lines = ReadLines(csv);
   ASSERT_GE(lines.size(), 2);  // the header and the frame at t = 0
   EXPECT_EQ(lines[0], CsvWriter::Header(OneCable({})));

@@ -21,6 +21,8 @@ RunSummary EveryFieldSet() {
   s.failure_time_s = 1.5;
   s.analysis = "DYNAMIC";
   s.integrator = "HHT";
+  s.integrator_requested = "AUTO";
+  s.integrator_reason = "HHT: the scene has 1 constraint rows";
   s.linear_solver = "AUTO";
   s.info.model = "spatial";
   s.info.coordinates = 7;

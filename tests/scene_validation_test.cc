@@ -358,8 +358,8 @@ std::vector<InvalidCase> InvalidCases() {
       {"UnknownIntegrator",
        absl::StrCat(R"({"cables": [)", kCable, R"(], "solver": {"duration": 1, "integrator": 9}})"),
        "solver.integrator: ",
-       "IMPLICIT_EULER, GENERALIZED_ALPHA, HHT, ENERGY_MOMENTUM, DORMAND_PRINCE or "
-       "CENTRAL_DIFFERENCE"},
+       "IMPLICIT_EULER, GENERALIZED_ALPHA, HHT, ENERGY_MOMENTUM, DORMAND_PRINCE, "
+       "CENTRAL_DIFFERENCE or AUTO_STEPPER"},
       {"UnknownLinearSolver",
        absl::StrCat(R"({"cables": [)", kCable,
                     R"(], "solver": {"duration": 1, "linear_solver": 9}})"),

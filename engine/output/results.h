@@ -192,7 +192,11 @@ struct RunSummary {
   std::string error;          // why, when not ok (with the time)
   double failure_time_s = 0;  // time of the step that failed
   std::string analysis;       // "DYNAMIC" or "STATIC"
-  std::string integrator;
+  std::string integrator;  // the stepper that ran
+  // What the scene asked for ("AUTO" or a stepper's name) and, with AUTO,
+  // why `integrator` was chosen (engine/run/auto_integrator.h).
+  std::string integrator_requested;
+  std::string integrator_reason;
   std::string linear_solver;
   ModelInfo info;
   int64_t frames = 0;

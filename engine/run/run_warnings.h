@@ -10,8 +10,10 @@
 //  - fixed steps were cut to kStepCutWarning times below solver.step or
 //    further (the requested step did not hold; the run was not the one
 //    asked for).
-// With SolverSettings::strict, a run with warnings fails (status
-// "failed", the warnings as its error).
+// The scene's plausibility warnings (Scene::warnings, convert/
+// plausibility_warnings.h) come first in the list (RunPrepared puts them).
+// With SolverSettings::strict, a run with warnings (plausibility ones
+// included) fails (status "failed", the warnings as its error).
 
 #include "engine/output/results.h"
 #include "engine/scene/scene.h"

@@ -9,6 +9,7 @@
 #include "engine/linear/saddle_point_solver.h"
 #include "engine/model/multibody_model.h"
 #include "engine/output/run_statistics.h"
+#include "engine/run/auto_integrator.h"
 #include "engine/run/dynamic_run.h"
 #include "engine/run/error_estimate.h"
 #include "engine/run/frame_recorder.h"
@@ -93,9 +94,14 @@ absl::StatusOr<RunSummary> RunPrepared(PreparedRun* prepared, FrameSink* sink,
   PreparedModel& p = *prepared->model_;
   p.used = true;
   MultibodyModel& model = p.model;
-  const Scene& scene = p.scene;
   RunSummary summary;
+  summary.integrator_requested =
+      p.scene.solver.auto_integrator ? "AUTO" : std::string(IntegratorName(p.scene.solver.integrator));
+  if (p.scene.solver.auto_integrator && p.scene.solver.analysis == Analysis::kDynamic)
+    p.scene.solver.integrator = ChooseIntegrator(&model, p.scene, &summary.integrator_reason);
+  const Scene& scene = p.scene;
   summary.info = p.info;
+  summary.warnings = scene.warnings;
   const SolverSettings& settings = scene.solver;
   summary.analysis = std::string(AnalysisName(settings.analysis));
   const int modes = p.modes;

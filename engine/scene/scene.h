@@ -329,6 +329,12 @@ struct SolverSettings {
   // Run warnings (engine/run/run_warnings.h) fail an otherwise successful
   // run: solver.strict, `cablesim run --strict`, RunRequest.strict.
   bool strict = false;
+  // solver.integrator AUTO: `integrator` is HHT until the run chooses
+  // (engine/run/auto_integrator.h). auto_keep_implicit: when not empty, a
+  // setting that applies to implicit steppers only was given (its field),
+  // and AUTO keeps HHT.
+  bool auto_integrator = false;
+  std::string auto_keep_implicit;
   // Adds an estimate of the run's largest probe-position error to the
   // summary, from a companion run (RunScene).
   bool error_estimate = false;
@@ -382,6 +388,9 @@ struct Scene {
   FluidSpec fluid;
   SeabedSpec seabed;
   std::vector<SheaveSpec> sheaves;
+  // Plausibility warnings found when the scene was read (convert/
+  // plausibility_warnings.h): a run puts them first in RunSummary::warnings.
+  std::vector<std::string> warnings;
 };
 
 }  // namespace cablesim

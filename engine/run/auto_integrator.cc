@@ -1,0 +1,68 @@
+#include "engine/run/auto_integrator.h"
+
+#include <memory>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "engine/steppers/make_stepper.h"
+
+namespace cablesim {
+namespace {
+
+// Why the scene needs an implicit stepper; empty: it does not.
+std::string ImplicitNeed(const MultibodyModel& model, const Scene& scene) {
+  const SolverSettings& s = scene.solver;
+  if (!s.auto_keep_implicit.empty())
+    return absl::StrCat(s.auto_keep_implicit, " is given, which applies to implicit steppers only");
+  if (model.multipliers() > 0)
+    return absl::StrFormat(
+        "the scene has %d constraint rows (bodies, joints between parts or moving supports), "
+        "which the explicit steppers do not take",
+        model.multipliers());
+  for (int c = 0; c < static_cast<int>(scene.cables.size()); ++c)
+    if (scene.cables[c].winch.enabled)
+      return absl::StrFormat("cables[%d] has a winch (a mass that changes with time)", c);
+  if (scene.seabed.enabled) return "the seabed's contact stiffens the scene mid-run";
+  if (!scene.sheaves.empty()) return "the sheaves' contact stiffens the scene mid-run";
+  for (int b = 0; b < static_cast<int>(scene.bodies.size()); ++b)
+    if (!scene.bodies[b].contact_points_m.empty())
+      return absl::StrFormat("bodies[%d]'s contact points stiffen the scene mid-run", b);
+  if (scene.fluid.density_kg_m3 > 0) return "the fluid's loads (drag, waves) are not checked for the explicit steppers' stability";
+  return "";
+}
+
+}  // namespace
+
+Integrator ChooseIntegrator(MultibodyModel* model, const Scene& scene, std::string* reason) {
+  const SolverSettings& s = scene.solver;
+  if (const std::string need = ImplicitNeed(*model, scene); !need.empty()) {
+    *reason = absl::StrCat("HHT: ", need);
+    return Integrator::kHht;
+  }
+  if (s.adaptive) {
+    // Measured (docs/honest-runs.md): adaptive DORMAND_PRINCE is held to
+    // its stable step (six force evaluations a step) and was 2-7 times
+    // slower than adaptive CENTRAL_DIFFERENCE on the two pendulums.
+    *reason =
+        "CENTRAL_DIFFERENCE: no constraint rows, winch, contact or fluid; adaptive steps hold "
+        "its error (and its stability: a growing mode's error is rejected)";
+    return Integrator::kCentralDifference;
+  }
+  SolverSettings trial = s;
+  trial.integrator = Integrator::kCentralDifference;
+  std::string why;
+  const std::unique_ptr<Stepper> stepper = MakeStepper(model, trial);
+  const bool fits = stepper->Initialize(&why);
+  model->SetTime(0);
+  if (!fits) {
+    *reason = absl::StrCat("HHT: CENTRAL_DIFFERENCE does not fit: ", why);
+    return Integrator::kHht;
+  }
+  *reason = absl::StrFormat(
+      "CENTRAL_DIFFERENCE: no constraint rows, winch, contact or fluid, and solver.step (%g s) "
+      "is within its stable step at the initial state (h omega_max < 2)",
+      s.step_s);
+  return Integrator::kCentralDifference;
+}
+
+}  // namespace cablesim
