@@ -246,7 +246,8 @@ absl::Status CouplingSession::Step(double t_end, const std::vector<Eigen::Vector
       ++steps_;
       continue;
     }
-    stepper_->Restore();
+    // A step that did not converge leaves the stepper where it was (as in
+    // RunDynamic): halve it.
     ++rejected_;
     h = h_try / 2;
     if (h < h_min * (1 - 1e-12)) {
