@@ -31,7 +31,8 @@ std::string Pendulum(const std::string& pivot_joint) {
     "joints": [{"type": "PIN", "a": {"body": "bob", "point": {"y": 1}}, )",
                       pivot_joint, R"(}],
     "probes": [{"name": "bob", "body": "bob"}, {"name": "pivot", "body": "bob", "point": {"y": 1}}],
-    "solver": {"duration": 1, "step": 0.01, "output_interval": 0.1}})");
+    "solver": {"duration": 1, "step": 0.01, "output_interval": 0.1,
+               "newton_tolerance": 1e-12}})");
 }
 
 std::unique_ptr<CouplingSession> Open(const std::string& json) {
@@ -61,7 +62,8 @@ TEST(CouplingSession, ForceAtRestIsTheWeight) {
 // linear motion inside each coupling step is exact) is the same run as
 // the scene whose pivot has that motion prescribed (a ramp): the same
 // steps of the same stepper, so the pivot's force agrees to rounding
-// (1e-9 N against forces of 10 N; a sign error, a force a step late or a
+// (1e-9 N against forces of 10 N: both runs converge Newton to 1e-12
+// relative, and their times differ by rounding; a sign error, a force a step late or a
 // sub-step that lost its motion is off by 1e-3 N or more). The coupling
 // step 0.05 s holds five scene steps.
 TEST(CouplingSession, MatchesPrescribedMotion) {
@@ -104,6 +106,7 @@ TEST(CouplingSession, BadInputNamesTheArgument) {
               HasSubstr("xd[0].y: must be finite"));
   EXPECT_THAT(s->Step(0.1, {Eigen::Vector3d(0, 0, 1)}, At(0, 0)).message(),
               HasSubstr("x[0].z: the scene is planar"));
+  s->set_max_jump_m(1);  // no cable here: no limit by default
   EXPECT_THAT(s->Step(0.1, At(5, 0), At(0, 0)).message(), HasSubstr("x[0]: moves 5 m"));
   ASSERT_TRUE(s->Step(0.1, At(0, 0), At(0, 0)).ok());
   const absl::Status back = s->Step(0.05, At(0, 0), At(0, 0));

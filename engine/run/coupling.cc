@@ -74,7 +74,7 @@ absl::StatusOr<std::unique_ptr<CouplingSession>> CouplingSession::Open(const Sce
     node += c;
   }
   // Where the scene places the coupled points.
-  Eigen::VectorXd q, zero = Eigen::VectorXd::Zero(s.model.coordinates());
+  Eigen::VectorXd q(s.model.coordinates()), zero = Eigen::VectorXd::Zero(s.model.coordinates());
   s.model.ToFull(s.model.initial_z(), &q);
   std::vector<ProbeSample> probes;
   s.model.Probes(q, zero, zero, &probes);
@@ -144,7 +144,7 @@ void CouplingSession::SetMotion(double t0, double t1, const std::vector<Eigen::V
 }
 
 void CouplingSession::UpdateForces() {
-  Eigen::VectorXd q;
+  Eigen::VectorXd q(s_->model.coordinates());
   s_->model.ToFull(stepper_->z(), &q);
   std::vector<Eigen::Vector3d> support;
   s_->model.ProbeForces(q, stepper_->lambda(), &support);
@@ -172,8 +172,15 @@ absl::Status CouplingSession::Initialize(const std::vector<Eigen::Vector3d>& x,
       }
     }
   }
-  SetMotion(0, 0, d, d);
+  // At t = 0 the points move with the host's velocities (the rate of the
+  // supports' rows there), so the lines' initial velocity is projected
+  // onto them, as for a prescribed motion that starts moving (the velocity
+  // right after an inelastic impulse at the supports).
+  std::vector<Eigen::Vector3d> d1(n);
+  for (int i = 0; i < n; ++i) d1[i] = d[i] + v[i];
+  SetMotion(0, 1, d, d1);
   model.SetTime(0);
+  if (!statics) model.SetInitialState(model.initial_z());
   if (statics) {
     RunSummary summary;
     if (!StartFromEquilibrium(&model, settings, RunControl{}, &summary)) {
@@ -268,7 +275,7 @@ const std::string& CouplingSession::cable_name(int c) const { return s_->info.ca
 int CouplingSession::cable_nodes(int c) const { return s_->info.cable_nodes[c]; }
 
 std::vector<Eigen::Vector3d> CouplingSession::NodePositions(int c) const {
-  Eigen::VectorXd q;
+  Eigen::VectorXd q(s_->model.coordinates());
   const Eigen::VectorXd& z = stepper_ ? stepper_->z() : s_->model.initial_z();
   s_->model.ToFull(z, &q);
   std::vector<Eigen::Vector3d> all;

@@ -10,7 +10,10 @@
 //   Initialize(x0, v0)          the coupled points where the host has them
 //                               at t = 0; the scene's static equilibrium
 //                               there when solver.initial_state is STATIC
-//                               (else x0 must be the scene's points)
+//                               (else x0 must be the scene's points); the
+//                               initial velocity is projected onto the
+//                               points' velocities v0 (as for a prescribed
+//                               motion that starts moving)
 //   Step(t1, x1, v1)            advances from the session's time t0 to t1
 //                               with the scene's own steps (solver.step,
 //                               the last shortened so that the sub-steps
