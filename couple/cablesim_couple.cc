@@ -131,7 +131,7 @@ int CableSim_Step(CableSimSystem sys, const double* x, const double* xd, double*
   if (int rc = FromStatus(s.Step(*t + *dt, Points(x, n), Points(xd, n))); rc != CABLESIM_OK)
     return rc;
   *t = s.time();
-  return CableSim_GetForces(sys, f);
+  return CableSim_GetMeanForces(sys, f);
 }
 
 int CableSim_GetForces(CableSimSystem sys, double* f) {
@@ -139,6 +139,14 @@ int CableSim_GetForces(CableSimSystem sys, double* f) {
   const cablesim::CouplingSession& s = *sys->session;
   for (int i = 0; i < s.coupled_points(); ++i)
     for (int d = 0; d < 3; ++d) f[3 * i + d] = s.forces()[i](d);
+  return FromStatus(absl::OkStatus());
+}
+
+int CableSim_GetMeanForces(CableSimSystem sys, double* f) {
+  if (int rc = Check(sys, {{f, "f"}}); rc != CABLESIM_OK) return rc;
+  const cablesim::CouplingSession& s = *sys->session;
+  for (int i = 0; i < s.coupled_points(); ++i)
+    for (int d = 0; d < 3; ++d) f[3 * i + d] = s.mean_forces()[i](d);
   return FromStatus(absl::OkStatus());
 }
 
@@ -169,17 +177,17 @@ int CableSim_GetLineNodePos(CableSimSystem sys, unsigned int line, unsigned int 
   return FromStatus(absl::OkStatus());
 }
 
-int CableSim_GetLineTension(CableSimSystem sys, unsigned int line, unsigned int segment,
+int CableSim_GetLineTension(CableSimSystem sys, unsigned int line, unsigned int node,
                             double* tension) {
   if (int rc = Check(sys, {{tension, "tension"}}); rc != CABLESIM_OK) return rc;
   if (int rc = CheckLine(sys, line); rc != CABLESIM_OK) return rc;
-  const auto t = sys->session->SegmentTensions(static_cast<int>(line));
-  if (segment >= t.size()) {
+  const auto t = sys->session->NodeTensions(static_cast<int>(line));
+  if (node >= t.size()) {
     return Error(CABLESIM_INVALID_ARGUMENT,
-                 absl::StrFormat("segment: %u is not a segment of line %u (it has %d)", segment,
-                                 line, static_cast<int>(t.size())));
+                 absl::StrFormat("node: %u is not a node of line %u (it has %d)", node, line,
+                                 static_cast<int>(t.size())));
   }
-  *tension = t[segment];
+  *tension = t[node];
   return FromStatus(absl::OkStatus());
 }
 

@@ -13,7 +13,7 @@
  *   CableSim_GetNumberLines(sys, &n)      MoorDyn_GetNumberLines
  *   CableSim_GetLineNumberNodes(...)      MoorDyn_GetLineNumberNodes
  *   CableSim_GetLineNodePos(...)          MoorDyn_GetLineNodePos
- *   CableSim_GetLineTension(...)          MoorDyn_GetLineNodeTen
+ *   CableSim_GetLineTension(...)          MoorDyn_GetLineNodeTen (the tension's magnitude)
  *   CableSim_Close(sys)                   MoorDyn_Close
  *
  * The scene file is a cablesim scene (JSON or text format) whose coupled
@@ -55,20 +55,29 @@ int CableSim_Init(CableSimSystem sys, const double* x, const double* xd);
 /* Advances from *t (the system's time) to *t + *dt with x, xd the coupled
  * points' kinematics at *t + *dt (the points move linearly in between,
  * with cablesim's own steps inside); f receives the forces [N] the lines
- * exert on the points at the step's end. On success *t is the new time. */
+ * exert on the points, their mean over the step (as
+ * CableSim_GetMeanForces: the impulse over the step divided by dt, which
+ * converges where the end forces do not; CableSim_GetForces gives the end
+ * forces). On success *t is the new time. */
 int CableSim_Step(CableSimSystem sys, const double* x, const double* xd, double* f, double* t,
                   double* dt);
 /* f: the forces [N] on the coupled points at the system's time (after
- * CableSim_Init: those of the initial state; after a step: as Step's). */
+ * CableSim_Init: those of the initial state; after a step: at its end). */
 int CableSim_GetForces(CableSimSystem sys, double* f);
+/* f: the forces' mean over the last step [N] (their impulse over the step
+ * divided by it; after CableSim_Init: the initial forces). It carries the
+ * impulse the lines' mass next to the points takes when their velocity
+ * changes at the start of a step, which the end forces miss: a host that
+ * integrates momentum uses these (docs/coupling.md). */
+int CableSim_GetMeanForces(CableSimSystem sys, double* f);
 /* Lines are the scene's cables, 0-based in scene order. */
 int CableSim_GetNumberLines(CableSimSystem sys, unsigned int* n);
 int CableSim_GetLineNumberNodes(CableSimSystem sys, unsigned int line, unsigned int* n);
 int CableSim_GetLineNodePos(CableSimSystem sys, unsigned int line, unsigned int node,
                             double pos[3]);
-/* The tension [N] of segment `segment` (between nodes segment and
- * segment + 1; nodes - 1 segments): EA times its chord strain. */
-int CableSim_GetLineTension(CableSimSystem sys, unsigned int line, unsigned int segment,
+/* The tension [N] at node `node`: EA (|r'| - 1) from the cable's slope r'
+ * there (negative in compression). */
+int CableSim_GetLineTension(CableSimSystem sys, unsigned int line, unsigned int node,
                             double* tension);
 /* The system's time [s]. */
 int CableSim_GetTime(CableSimSystem sys, double* t);

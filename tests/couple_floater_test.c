@@ -1,26 +1,33 @@
 /* The coupled floater through libcablesim_couple (C, no C++).
  *
  * A floater (point mass m, buoyancy of a vertical cylinder rho g A s(z),
- * linear damping c, a harmonic external force) is integrated here, by the
- * host, with velocity Verlet (the damping implicit), and moored by three
- * lines in cablesim through CableSim_Init / CableSim_Step. The reference
- * is the same floater modelled as a cablesim body in one scene
- * (tests/data/couple_floater_body.json, run by the cablesim CLI before
- * this test: argv[2] is its CSV). The coupled motion must agree with it to
- * the coupling scheme's order as the coupling step shrinks: the error at
- * the frames (every 0.2 s over 10 s) is measured at coupling steps 0.2,
- * 0.1, 0.05 and 0.025 s, and the observed order of each halving printed.
- * The scheme is explicit (the lines see the host's position at the step's
- * end, moved linearly, so the fairlead velocity inside a step is the
- * mid-step velocity): first order at least, so each halving must divide
- * the error by at least 2^0.8 (0.8: a margin under 1 for the pre-asymptotic
- * range), and the finest error must be below 1 % of the largest
- * excursion of the reference (the mooring is stiff against the floater:
- * the error scale is the motion's).
+ * linear damping c, a harmonic external force in x and z) is integrated
+ * here, by the host, with velocity Verlet (the damping implicit), and
+ * moored by three lines in cablesim through CableSim_Init / CableSim_Step
+ * (the forces Step returns: their mean over the coupling step). The
+ * reference is the same floater modelled as a cablesim body in one scene
+ * (tests/data/couple_floater_body.json, run by the cablesim CLI before this
+ * test: argv[2] is its CSV; its step, 2.5 ms, is converged: the run at
+ * 0.625 ms differs by 1e-5 m). The coupled motion must agree with it to the
+ * coupling scheme's order as the coupling step shrinks: the largest error
+ * in the plane of the forcing (x, z) over the frames (every 0.2 s for 5 s)
+ * at coupling steps 0.05, 0.025, 0.0125 and 0.00625 s, the observed order
+ * of each halving printed. The scheme is explicit (the lines see the
+ * host's position at the step's end, reached linearly; the host uses the
+ * lines' mean force over the step as the force at its end): first order.
+ * Measured: 4.3e-3, 1.8e-3, 7.7e-4, 2.9e-4 m (orders 1.3, 1.2, 1.4). Each
+ * halving must divide the error by at least 2^0.8 (0.8: a margin under the
+ * first order for the pre-asymptotic range), and the finest error must be
+ * below 1 % of the largest excursion of the reference. (Later than about
+ * 6 s this symmetric motion loses its symmetry about the x-z plane: y grows
+ * from rounding, differently in the two models, a bifurcation that no
+ * coupling step follows; hence 5 s. The lines' end forces instead of the
+ * means do not converge: 5e-2 m at every step, the impulse that the lines'
+ * mass next to the fairlead takes at each step's start left out.)
  * Bad input: each named argument gets CABLESIM_INVALID_ARGUMENT with a
  * message naming it, and the system stays usable.
  *
- * usage: couple_floater_test COUPLED_SCENE REFERENCE_CSV */
+ * usage: couple_floater_test COUPLED_SCENE REFERENCE_CSV [COUPLING_STEP...] */
 
 #include <math.h>
 #include <stdio.h>
@@ -30,6 +37,8 @@
 #include "couple/cablesim_couple.h"
 
 #define MAX_FRAMES 1000
+/* The frames compared: up to 5 s (see main). */
+static const double kCompareUntil = 5.0;
 static const double kMass = 20000.0, kDamping = 20000.0, kRho = 1025.0, kG = 9.81;
 static const double kDiameter = 4.0, kHeight = 4.0;
 
@@ -109,6 +118,11 @@ static double Coupled(const char* scene, double dt) {
   double host[3], fm[3];
   if (CableSim_GetForces(sys, F) != CABLESIM_OK) return -1;
   for (int d = 0; d < 3; ++d) fm[d] = F[d] + F[3 + d] + F[6 + d];
+  if (getenv("COUPLE_DEBUG")) {
+    HostForce(x, 0, host);
+    fprintf(stderr, "t=0 balance: %g %g %g (lines %g %g %g)\n", fm[0] + host[0], fm[1] + host[1],
+            fm[2] + host[2], fm[0], fm[1], fm[2]);
+  }
   double t = 0, err = 0;
   int next = 1;
   const long steps = lround(ref_t[frames - 1] / dt);
@@ -128,20 +142,23 @@ static double Coupled(const char* scene, double dt) {
       CableSim_Close(sys);
       return -1;
     }
+    if (getenv("COUPLE_END_FORCES")) CableSim_GetForces(sys, F); /* for measurements */
     HostForce(x, t, host);
     for (int d = 0; d < 3; ++d) {
       fm[d] = F[d] + F[3 + d] + F[6 + d];
       v[d] = (vh[d] + 0.5 * dt * (host[d] + fm[d]) / kMass) / (1 + 0.5 * dt * kDamping / kMass);
     }
-    while (next < frames && fabs(ref_t[next] - t) <= 1e-9) {
-      const double e = sqrt(pow(x[0] - ref_x[next][0], 2) + pow(x[1] - ref_x[next][1], 2) +
-                            pow(x[2] - ref_x[next][2], 2));
+    while (next < frames && fabs(ref_t[next] - t) <= 1e-9 && ref_t[next] <= kCompareUntil) {
+      const double e = sqrt(pow(x[0] - ref_x[next][0], 2) + pow(x[2] - ref_x[next][2], 2));
       if (e > err) err = e;
+      if (getenv("COUPLE_DEBUG") && next % 5 == 0)
+        fprintf(stderr, "dt %g t %g err %g  dx %g %g %g\n", dt, t, e, x[0] - ref_x[next][0],
+                x[1] - ref_x[next][1], x[2] - ref_x[next][2]);
       ++next;
     }
   }
   CableSim_Close(sys);
-  return next == frames ? err : -1;
+  return ref_t[next - 1] + 1e-9 >= kCompareUntil ? err : -1;
 }
 
 static void BadInput(const char* scene) {
@@ -193,8 +210,12 @@ static void BadInput(const char* scene) {
   EXPECT(CableSim_GetLineNodePos(sys, 0, nodes - 1, pos) == CABLESIM_OK &&
              fabs(pos[2] - X[2]) < 1e-6,
          "fairlead node z %g against %g", pos[2], X[2]);
-  EXPECT(CableSim_GetLineTension(sys, 0, nodes - 2, &tension) == CABLESIM_OK && tension > 0,
-         "fairlead tension %g", tension);
+  EXPECT(CableSim_GetLineTension(sys, 0, nodes - 1, &tension) == CABLESIM_OK && tension > 1e4 &&
+             tension < 1e5,
+         "fairlead tension %g (the lines hold about a third of 58 kN up each)", tension);
+  EXPECT(CableSim_GetLineTension(sys, 0, nodes, &tension) == CABLESIM_INVALID_ARGUMENT &&
+             strstr(CableSim_ErrorMessage(), "node:") != NULL,
+         "node past the end: %s", CableSim_ErrorMessage());
   EXPECT(CableSim_Create("/nonexistent/scene.json") == NULL &&
              strstr(CableSim_ErrorMessage(), "/nonexistent/scene.json") != NULL,
          "missing file: %s", CableSim_ErrorMessage());
@@ -202,7 +223,7 @@ static void BadInput(const char* scene) {
 }
 
 int main(int argc, char** argv) {
-  if (argc != 3 || !ReadReference(argv[2])) {
+  if (argc < 3 || !ReadReference(argv[2])) {
     fprintf(stderr, "usage: %s COUPLED_SCENE REFERENCE_CSV (readable, with floater.x)\n", argv[0]);
     return 2;
   }
@@ -213,20 +234,26 @@ int main(int argc, char** argv) {
     if (e > excursion) excursion = e;
   }
   BadInput(argv[1]);
-  const double steps[] = {0.2, 0.1, 0.05, 0.025};
-  double err[4];
-  for (int i = 0; i < 4; ++i) {
+  double steps[8] = {0.05, 0.025, 0.0125, 0.00625};
+  int count = 4;
+  if (argc > 3) { /* other coupling steps, halving, for measurements */
+    count = 0;
+    for (int i = 3; i < argc && count < 8; ++i) steps[count++] = atof(argv[i]);
+  }
+  double err[8];
+  for (int i = 0; i < count; ++i) {
     err[i] = Coupled(argv[1], steps[i]);
     printf("coupling step %.3f s: largest distance from the reference %.4e m\n", steps[i], err[i]);
     EXPECT(err[i] >= 0, "coupled run at %g s failed", steps[i]);
   }
-  for (int i = 1; i < 4; ++i) {
+  for (int i = 1; i < count; ++i) {
     const double order = log(err[i - 1] / err[i]) / log(2.0);
     printf("observed order %.3f -> %.3f s: %.2f\n", steps[i - 1], steps[i], order);
     EXPECT(order >= 0.8, "order %.2f from %g to %g s", order, steps[i - 1], steps[i]);
   }
   printf("reference excursion %.4f m\n", excursion);
-  EXPECT(err[3] < 0.01 * excursion, "finest error %g against excursion %g", err[3], excursion);
+  EXPECT(err[count - 1] < 0.01 * excursion, "finest error %g against excursion %g", err[count - 1],
+         excursion);
   printf("%d passed, %d failed\n", failures == 0 ? 1 : 0, failures == 0 ? 0 : 1);
   return failures == 0 ? 0 : 1;
 }

@@ -81,6 +81,7 @@ absl::StatusOr<std::unique_ptr<CouplingSession>> CouplingSession::Open(const Sce
   for (int i = 0; i < n; ++i) session->p0_.push_back(probes[s.probe[i]].position_m);
   session->x_ = session->p0_;
   session->forces_.assign(n, Eigen::Vector3d::Zero());
+  session->mean_forces_ = session->forces_;
   double jump = std::numeric_limits<double>::infinity();
   for (const CableSpec& c : s.scene.cables)
     jump = std::min(jump, c.length_m / std::max(1, c.elements));
@@ -199,6 +200,7 @@ absl::Status CouplingSession::Initialize(const std::vector<Eigen::Vector3d>& x,
   t_ = 0;
   x_ = x;
   UpdateForces();
+  mean_forces_ = forces_;
   return absl::OkStatus();
 }
 
@@ -245,12 +247,15 @@ absl::Status CouplingSession::Step(double t_end, const std::vector<Eigen::Vector
   const double h_nominal = dt / static_cast<double>(count);
   const double h_min = std::ldexp(h_nominal, -settings.max_step_halvings);
   double t = t0, h = h_nominal;
+  std::vector<Eigen::Vector3d> impulse(n, Eigen::Vector3d::Zero());
   while (t_end - t > 1e-12 * std::max(1.0, std::abs(t_end))) {
     const double h_try = std::min(h, t_end - t);
     const Stepper::StepStats st = stepper_->Step(h_try);
     if (st.converged) {
       t += h_try;
       ++steps_;
+      UpdateForces();
+      for (int i = 0; i < n; ++i) impulse[i] += h_try * forces_[i];
       continue;
     }
     // A step that did not converge leaves the stepper where it was (as in
@@ -266,7 +271,7 @@ absl::Status CouplingSession::Step(double t_end, const std::vector<Eigen::Vector
   }
   t_ = t_end;
   x_ = x;
-  UpdateForces();
+  for (int i = 0; i < n; ++i) mean_forces_[i] = impulse[i] / (t - t0);
   return absl::OkStatus();
 }
 
@@ -284,14 +289,16 @@ std::vector<Eigen::Vector3d> CouplingSession::NodePositions(int c) const {
   return std::vector<Eigen::Vector3d>(begin, begin + s_->info.cable_nodes[c]);
 }
 
-std::vector<double> CouplingSession::SegmentTensions(int c) const {
-  const std::vector<Eigen::Vector3d> r = NodePositions(c);
+std::vector<double> CouplingSession::NodeTensions(int c) const {
+  Eigen::VectorXd q(s_->model.coordinates());
+  s_->model.ToFull(stepper_ ? stepper_->z() : s_->model.initial_z(), &q);
   const CableSpec& cable = s_->scene.cables[c];
   const double ea = cable.youngs_modulus_pa * cable.area_m2;
   std::vector<double> tension;
-  for (size_t k = 0; k + 1 < r.size(); ++k) {
-    const double ds = s_->info.node_s[s_->first_node[c] + k + 1] - s_->info.node_s[s_->first_node[c] + k];
-    tension.push_back(ea * ((r[k + 1] - r[k]).norm() / ds - 1));
+  for (int k = 0; k < s_->info.cable_nodes[c]; ++k) {
+    Eigen::Vector3d slope;
+    s_->model.CablePosition(q, c, s_->info.node_s[s_->first_node[c] + k], &slope);
+    tension.push_back(ea * (slope.norm() - 1));
   }
   return tension;
 }

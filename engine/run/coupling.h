@@ -74,6 +74,13 @@ class CouplingSession {
   double time() const { return t_; }
   // Forces on the coupled points at time() [N] (zero before Initialize).
   const std::vector<Eigen::Vector3d>& forces() const { return forces_; }
+  // The forces' mean over the last coupling step [N]: their impulse over
+  // the step (the sub-steps' end forces, each times its sub-step) divided
+  // by the step. It carries the impulse that starts each coupling step,
+  // when the points' velocity changes and the lines' mass next to them
+  // takes it in the first sub-step, which the end forces miss: a host
+  // that integrates the impulse exchanges momentum exactly.
+  const std::vector<Eigen::Vector3d>& mean_forces() const { return mean_forces_; }
   // The largest jump of a coupled point in one coupling step [m]: the
   // shortest cable element it holds (a longer jump is an input error; the
   // host's step is too long for the lines). Settable.
@@ -84,13 +91,13 @@ class CouplingSession {
   long rejected_steps() const { return rejected_; }
 
   // The cables: count, names, and per cable the nodes' positions [m] and
-  // the segments' tensions [N] (EA times the chord strain between
-  // neighbouring nodes, >= 0 for a slack-free line; compression negative).
+  // axial forces [N], EA (|r'| - 1) from the slope r' there (negative in
+  // compression).
   int cables() const;
   const std::string& cable_name(int c) const;
   int cable_nodes(int c) const;
   std::vector<Eigen::Vector3d> NodePositions(int c) const;
-  std::vector<double> SegmentTensions(int c) const;
+  std::vector<double> NodeTensions(int c) const;
 
  private:
   struct State;
@@ -104,7 +111,7 @@ class CouplingSession {
   std::unique_ptr<State> s_;
   std::unique_ptr<class Stepper> stepper_;
   std::vector<int> joints_;
-  std::vector<Eigen::Vector3d> p0_, x_, forces_;
+  std::vector<Eigen::Vector3d> p0_, x_, forces_, mean_forces_;
   std::vector<int> force_probe_;  // per coupled point: its force probe
   double t_ = 0;
   double max_jump_m_ = 0;
