@@ -67,6 +67,15 @@ int CheckLine(CableSimSystem sys, unsigned int line) {
   return CABLESIM_OK;
 }
 
+int CheckNode(unsigned int node, unsigned int line, size_t nodes) {
+  if (node >= nodes) {
+    return Error(CABLESIM_INVALID_ARGUMENT,
+                 absl::StrFormat("node: %u is not a node of line %u (it has %d)", node, line,
+                                 static_cast<int>(nodes)));
+  }
+  return CABLESIM_OK;
+}
+
 }  // namespace
 
 extern "C" {
@@ -168,11 +177,7 @@ int CableSim_GetLineNodePos(CableSimSystem sys, unsigned int line, unsigned int 
   if (int rc = Check(sys, {{pos, "pos"}}); rc != CABLESIM_OK) return rc;
   if (int rc = CheckLine(sys, line); rc != CABLESIM_OK) return rc;
   const auto r = sys->session->NodePositions(static_cast<int>(line));
-  if (node >= r.size()) {
-    return Error(CABLESIM_INVALID_ARGUMENT,
-                 absl::StrFormat("node: %u is not a node of line %u (it has %d)", node, line,
-                                 static_cast<int>(r.size())));
-  }
+  if (int rc = CheckNode(node, line, r.size()); rc != CABLESIM_OK) return rc;
   for (int d = 0; d < 3; ++d) pos[d] = r[node](d);
   return FromStatus(absl::OkStatus());
 }
@@ -182,11 +187,7 @@ int CableSim_GetLineTension(CableSimSystem sys, unsigned int line, unsigned int 
   if (int rc = Check(sys, {{tension, "tension"}}); rc != CABLESIM_OK) return rc;
   if (int rc = CheckLine(sys, line); rc != CABLESIM_OK) return rc;
   const auto t = sys->session->NodeTensions(static_cast<int>(line));
-  if (node >= t.size()) {
-    return Error(CABLESIM_INVALID_ARGUMENT,
-                 absl::StrFormat("node: %u is not a node of line %u (it has %d)", node, line,
-                                 static_cast<int>(t.size())));
-  }
+  if (int rc = CheckNode(node, line, t.size()); rc != CABLESIM_OK) return rc;
   *tension = t[node];
   return FromStatus(absl::OkStatus());
 }
