@@ -848,6 +848,14 @@ class SceneConverter {
                                               Num(start), " rad)"));
       }
     }
+    if (j.coupled()) {
+      const std::string coupled = Sub(path, "coupled");
+      if (!b.IsGround()) return Invalid(coupled, "only a joint to ground is coupled (side b must be the ground)");
+      if (joint->type == JointType::kSlide) return Invalid(coupled, "not with type SLIDE");
+      if (!IsZero(joint->motion)) return Invalid(coupled, "not with motion (the host moves the point)");
+      if (joint->HasRotation()) return Invalid(coupled, "not with rotation (the host moves the point)");
+      joint->coupled = true;
+    }
     if (j.has_rotation_axis()) {
       const std::string axis = Sub(path, "rotation_axis");
       if (!j.has_rotation()) return Invalid(axis, "only with rotation");

@@ -61,6 +61,9 @@ class PrescribedMotion : public ConstraintFamily {
                    std::vector<TurningRow> turning, int dim);
 
   const std::vector<MovingRow>& moving() const { return moving_; }
+  // Replaces moving row i's motion (a coupled support's motion, set by the
+  // coupling session for each coupling step); SetTime applies it.
+  void SetMotion(int i, TimeFunction motion) { moving_[i].motion = std::move(motion); }
 
   std::string_view name() const override { return "prescribed_motion"; }
   bool time_dependent() const override { return true; }

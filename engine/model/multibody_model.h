@@ -397,6 +397,9 @@ class MultibodyModel {
   const std::vector<const ConstraintFamily*>& constraint_families() const {
     return families_view_;
   }
+  // The moving and turning supports' rows (null without any): a coupling
+  // session (engine/run/coupling.h) sets its coupled supports' motions.
+  PrescribedMotion* prescribed_motion() { return motion_.get(); }
 
  private:
   // Build's steps fill in the members below.

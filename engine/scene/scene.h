@@ -156,7 +156,11 @@ struct JointSpec {
   // direction (the support translates). Zero: a fixed support.
   TimeVector motion;
   SlideSpec slide;  // SLIDE only
-  bool HasMotion() const { return !IsZero(motion); }
+  // Joints to ground only: the ground point is driven by a coupling host
+  // (engine/run/coupling.h), a moving support whose motion the host sets
+  // step by step; zero motion outside a coupling session.
+  bool coupled = false;
+  bool HasMotion() const { return coupled || !IsZero(motion); }
   // FIXED joints to ground only: the support also turns by the angle
   // rotation(t) [rad] (rotation(0) = 0) about the unit `rotation_axis`
   // (world axes), and the held slope or body axes turn with it.

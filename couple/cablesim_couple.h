@@ -1,0 +1,93 @@
+#ifndef CABLESIM_COUPLE_CABLESIM_COUPLE_H_
+#define CABLESIM_COUPLE_CABLESIM_COUPLE_H_
+
+/* libcablesim_couple: cablesim's lines driven step by step by a host
+ * program, from C (or anything that calls C). The functions map one to one
+ * onto those of MoorDyn's C interface, so a host written against it changes
+ * the names and the link line only:
+ *
+ *   CableSim_Create(file)                 MoorDyn_Create
+ *   CableSim_NCoupledDOF(sys, &n)         MoorDyn_NCoupledDOF
+ *   CableSim_Init(sys, x, xd)             MoorDyn_Init
+ *   CableSim_Step(sys, x, xd, f, &t, &dt) MoorDyn_Step
+ *   CableSim_GetNumberLines(sys, &n)      MoorDyn_GetNumberLines
+ *   CableSim_GetLineNumberNodes(...)      MoorDyn_GetLineNumberNodes
+ *   CableSim_GetLineNodePos(...)          MoorDyn_GetLineNodePos
+ *   CableSim_GetLineTension(...)          MoorDyn_GetLineNodeTen (the tension's magnitude)
+ *   CableSim_Close(sys)                   MoorDyn_Close
+ *
+ * The scene file is a cablesim scene (JSON or text format) whose coupled
+ * supports are joints to ground with "coupled": true. The coupled degrees
+ * of freedom are 3 per coupled support (x, y, z), in scene order of the
+ * joints: x, xd and f have 3 n entries. See docs/coupling.md.
+ *
+ * Every function but Create returns CABLESIM_OK (0) or an error code; on an
+ * error CableSim_ErrorMessage() (this thread's last error) says why and
+ * names the argument ("x[1].z: must be finite (got nan)"). An input error
+ * leaves the system as it was. A step that fails (the lines' Newton
+ * iterations do not converge even at the smallest sub-step) returns
+ * CABLESIM_STEP_FAILED and the system refuses further steps. */
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct CableSimSystemImpl* CableSimSystem;
+
+enum {
+  CABLESIM_OK = 0,
+  CABLESIM_INVALID_ARGUMENT = 1, /* bad input: names the argument */
+  CABLESIM_INVALID_SCENE = 2,    /* the file is not a usable scene */
+  CABLESIM_STEP_FAILED = 3,      /* the lines could not be advanced */
+  CABLESIM_WRONG_STATE = 4       /* not initialised yet, or failed */
+};
+
+/* Reads and checks the scene, builds the model. NULL on error (see
+ * CableSim_ErrorMessage). */
+CableSimSystem CableSim_Create(const char* scene_file);
+/* The number of coupled degrees of freedom, 3 per coupled support. */
+int CableSim_NCoupledDOF(CableSimSystem sys, unsigned int* n);
+/* x, xd: the coupled points' positions [m] and velocities [m/s] at t = 0.
+ * With solver.initial_state STATIC, the lines start from their static
+ * equilibrium with the points there; otherwise x must be the scene's
+ * points. */
+int CableSim_Init(CableSimSystem sys, const double* x, const double* xd);
+/* Advances from *t (the system's time) to *t + *dt with x, xd the coupled
+ * points' kinematics at *t + *dt (the points move linearly in between,
+ * with cablesim's own steps inside); f receives the forces [N] the lines
+ * exert on the points, their mean over the step (as
+ * CableSim_GetMeanForces: the impulse over the step divided by dt, which
+ * converges where the end forces do not; CableSim_GetForces gives the end
+ * forces). On success *t is the new time. */
+int CableSim_Step(CableSimSystem sys, const double* x, const double* xd, double* f, double* t,
+                  double* dt);
+/* f: the forces [N] on the coupled points at the system's time (after
+ * CableSim_Init: those of the initial state; after a step: at its end). */
+int CableSim_GetForces(CableSimSystem sys, double* f);
+/* f: the forces' mean over the last step [N] (their impulse over the step
+ * divided by it; after CableSim_Init: the initial forces). It carries the
+ * impulse the lines' mass next to the points takes when their velocity
+ * changes at the start of a step, which the end forces miss: a host that
+ * integrates momentum uses these (docs/coupling.md). */
+int CableSim_GetMeanForces(CableSimSystem sys, double* f);
+/* Lines are the scene's cables, 0-based in scene order. */
+int CableSim_GetNumberLines(CableSimSystem sys, unsigned int* n);
+int CableSim_GetLineNumberNodes(CableSimSystem sys, unsigned int line, unsigned int* n);
+int CableSim_GetLineNodePos(CableSimSystem sys, unsigned int line, unsigned int node,
+                            double pos[3]);
+/* The tension [N] at node `node`: EA (|r'| - 1) from the cable's slope r'
+ * there (negative in compression). */
+int CableSim_GetLineTension(CableSimSystem sys, unsigned int line, unsigned int node,
+                            double* tension);
+/* The system's time [s]. */
+int CableSim_GetTime(CableSimSystem sys, double* t);
+/* Frees the system (NULL is allowed). */
+int CableSim_Close(CableSimSystem sys);
+/* This thread's last error message ("" after success). */
+const char* CableSim_ErrorMessage(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* CABLESIM_COUPLE_CABLESIM_COUPLE_H_ */
