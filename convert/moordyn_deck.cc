@@ -23,6 +23,8 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 using Eigen3 = std::array<double, 3>;  // a point [m]
+// A sagging line is laid this much longer than it is (a stretch).
+constexpr double kSagLayStretch = 1e-3;
 
 // MoorDyn's defaults (its MoorDyn2.cpp), used when OPTIONS omits them.
 constexpr double kDefaultGravity = 9.80665;
@@ -99,7 +101,7 @@ class DeckReader {
         absl::StartsWith(name, "NODE"))
       return Section::kPoints;
     if (absl::StartsWith(name, "LINE")) return Section::kLines;
-    if (absl::StartsWith(name, "OPTION")) return Section::kOptions;
+    if (absl::StrContains(name, "OPTIONS")) return Section::kOptions;  // also SOLVER OPTIONS
     if (absl::StartsWith(name, "OUTPUT")) return Section::kOutputs;
     return Section::kUnsupported;
   }
@@ -154,6 +156,13 @@ class DeckReader {
       }
       std::vector<absl::string_view> w = absl::StrSplit(raw, absl::ByAnyChar(" \t"),
                                                       absl::SkipEmpty());
+      // A word starting with '#' starts a comment.
+      for (size_t k = 0; k < w.size(); ++k)
+        if (absl::StartsWith(w[k], "#")) {
+          w.resize(k);
+          break;
+        }
+      if (w.empty()) continue;
       absl::Status s;
       switch (section) {
         case Section::kLineTypes: s = ParseLineType(n, w); break;
@@ -181,11 +190,23 @@ class DeckReader {
   absl::Status ParseLineType(int n, const std::vector<absl::string_view>& w) {
     static constexpr const char* kColumns[] = {"TypeName", "Diam", "Mass/m", "EA", "BA/-zeta",
                                                "EI", "Cd", "Ca", "CdAx", "CaAx"};
-    if (w.size() != 10) {
+    if (w.size() < 10 || w.size() > 13) {
       return Error(n, "LINE TYPES",
                    absl::StrCat("expected the 10 columns TypeName Diam Mass/m EA BA/-zeta EI Cd "
-                                "Ca CdAx CaAx, got ",
+                                "Ca CdAx CaAx (and MoorDyn's optional Cl dF cF), got ",
                                 w.size()));
+    }
+    // MoorDyn's 11th to 13th columns: the vortex-induced vibration's lift
+    // coefficient and its synchronisation range and centre (which act only
+    // with a lift coefficient).
+    if (w.size() > 10) {
+      double cl = 0;
+      if (!absl::SimpleAtod(w[10], &cl) || cl != 0) {
+        return Error(n, "LINE TYPES Cl",
+                     absl::StrCat("\"", w[10],
+                                  "\": vortex-induced vibration (a lift coefficient) cannot be "
+                                  "expressed yet (0 only)"));
+      }
     }
     LineType t;
     t.name = std::string(w[0]);
@@ -450,14 +471,20 @@ class DeckReader {
 
   // The polyline a line is laid along at the start of the static solve:
   // straight when taut, else with one corner below the chord (on the
-  // seabed when the corner of the symmetric sag would lie below it), so
-  // that its length is the unstretched length.
+  // seabed when an end lies on it or the corner of the symmetric sag would
+  // lie below it), so that its length is the unstretched length (a free
+  // sag: stretched by kSagLayStretch).
   std::vector<Eigen3> Layout(const Point& a, const Point& b, double length, double depth) const {
     const Eigen3 pa{a.x, a.y, a.z}, pb{b.x, b.y, b.z};
     const double span = Dist(pa, pb);
     if (length <= span * (1 + 1e-9)) return {pa, pb};
-    // The symmetric sag: corner below the midpoint, in the vertical plane.
-    const double h = std::sqrt(std::max(0.0, length * length - span * span)) / 2;
+    // The symmetric sag: corner below the midpoint, in the vertical plane,
+    // laid 0.1 % longer than the line: a line hanging free from a kink
+    // with no tension has no stiffness across it at the first load
+    // increment (measured: MoorDyn's local_euler/hanging.txt failed there;
+    // 0.01 % still failed), a little tension gives it some.
+    const double laid = length * (1 + kSagLayStretch);
+    const double h = std::sqrt(std::max(0.0, laid * laid - span * span)) / 2;
     Eigen3 mid{(pa[0] + pb[0]) / 2, (pa[1] + pb[1]) / 2, (pa[2] + pb[2]) / 2};
     // The unit vector perpendicular to the chord, in its vertical plane,
     // pointing down (straight down for a horizontal chord).
@@ -471,13 +498,18 @@ class DeckReader {
     } else {
       corner[0] += h;  // a vertical chord: the corner beside it
     }
-    if (corner[2] >= -depth) return {pa, corner, pb};
-    // On the seabed: the corner at z = -depth on the horizontal path from
-    // a to b, where the two legs add up to the length (bisection: the sum
-    // grows with the corner's distance from the end nearer the bed).
+    // An end on the bed (an anchor, within 1 % of the depth) lays the line
+    // along the bed first, as a catenary mooring lies: a sag hanging free
+    // from it has no tension to hold its kink at the start of the solve
+    // (measured: the 600 m chain case's first load increment failed so).
     const bool a_low = pa[2] <= pb[2];
     const Eigen3& low = a_low ? pa : pb;
     const Eigen3& high = a_low ? pb : pa;
+    const bool anchored = low[2] <= -depth + 0.01 * depth;
+    if (corner[2] >= -depth && !anchored) return {pa, corner, pb};
+    // On the seabed: the corner at z = -depth on the horizontal path from
+    // a to b, where the two legs add up to the length (bisection: the sum
+    // grows with the corner's distance from the end nearer the bed).
     auto corner_at = [&](double t) {
       return Eigen3{low[0] + t * (high[0] - low[0]), low[1] + t * (high[1] - low[1]), -depth};
     };

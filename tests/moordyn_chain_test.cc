@@ -10,9 +10,11 @@
 // solved by STATIC. The fairlead's tension is the force its support exerts:
 // cablesim reports it for a moving support's probe, so the test gives the
 // fairlead a motion that is zero at t = 0 (statics solve at t = 0, so the
-// equilibrium is unchanged). Seabed friction is left out, as a static
-// catenary reference has none (the line's laid length on the bed is set by
-// the catenary, not by where a solver first laid it).
+// equilibrium is unchanged). The decks keep MoorDyn's seabed friction
+// (0.5): without it the part of the chain laid on the bed has no stiffness
+// across the line at the first load increment (no tension yet), and the
+// 600 m case's statics failed there (measured); statics regularise it over
+// seabed.friction_length from where the line was laid.
 
 #include <cmath>
 #include <cstdio>
@@ -56,6 +58,7 @@ ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
 1025.0               WtrDnsty             water density (kg/m^3)
 %g                   WtrDpth              water depth (m)
 100.0                TmaxIC               max time for ic gen (s)
+0.5                  FrictionCoefficient  general bottom friction coefficient (-)
 ------------------------- need this line --------------------------------------
 )",
                          c.depth_m, static_cast<int>(c.depth_m), c.anchor_x_m, -c.depth_m,
