@@ -121,7 +121,9 @@ class DeckReader {
   }
   absl::StatusOr<double> Positive(int line, absl::string_view field, absl::string_view word) const {
     absl::StatusOr<double> v = Number(line, field, word);
-    if (v.ok() && !(*v > 0)) return Error(line, field, absl::StrCat("must be > 0 (got ", word, ")"));
+    if (v.ok() && !(*v > 0)) {
+      return Error(line, field, absl::StrCat("must be > 0 (got ", word, ")"));
+    }
     return v;
   }
 
@@ -217,27 +219,23 @@ class DeckReader {
                      absl::StrCat("\"", t.name, "\" already defined on line ", o.line));
     auto col = [&](int k) { return absl::StrCat("LINE TYPES ", kColumns[k]); };
     double v = 0;
-    auto positive = [&](int k, double* out) -> absl::Status {
-      absl::StatusOr<double> r = Positive(n, col(k), w[k]);
+    // Column k into *out, > 0 (positive) or >= 0.
+    auto column = [&](int k, bool positive, double* out) -> absl::Status {
+      absl::StatusOr<double> r =
+          positive ? Positive(n, col(k), w[k]) : NonNegative(n, col(k), w[k]);
       if (!r.ok()) return r.status();
       *out = *r;
       return absl::OkStatus();
     };
-    auto non_negative = [&](int k, double* out) -> absl::Status {
-      absl::StatusOr<double> r = NonNegative(n, col(k), w[k]);
-      if (!r.ok()) return r.status();
-      *out = *r;
-      return absl::OkStatus();
-    };
-    if (absl::Status s = positive(1, &t.diameter); !s.ok()) return s;
-    if (absl::Status s = positive(2, &t.mass_per_length); !s.ok()) return s;
+    if (absl::Status s = column(1, true, &t.diameter); !s.ok()) return s;
+    if (absl::Status s = column(2, true, &t.mass_per_length); !s.ok()) return s;
     if (!absl::SimpleAtod(w[3], &v)) {
       return Error(n, col(3),
                    absl::StrCat("\"", w[3],
                                 "\": only a constant EA can be expressed (a tension-strain table "
                                 "or a viscoelastic law is not supported yet)"));
     }
-    if (absl::Status s = positive(3, &t.ea); !s.ok()) return s;
+    if (absl::Status s = column(3, true, &t.ea); !s.ok()) return s;
     if (!absl::SimpleAtod(w[4], &v)) {
       return Error(n, col(4),
                    absl::StrCat("\"", w[4],
@@ -252,11 +250,11 @@ class DeckReader {
     if (!absl::SimpleAtod(w[5], &v)) {
       return Error(n, col(5), absl::StrCat("\"", w[5], "\": only a constant EI can be expressed"));
     }
-    if (absl::Status s = non_negative(5, &t.ei); !s.ok()) return s;
-    if (absl::Status s = non_negative(6, &t.cd); !s.ok()) return s;
-    if (absl::Status s = non_negative(7, &t.ca); !s.ok()) return s;
-    if (absl::Status s = non_negative(8, &t.cd_axial); !s.ok()) return s;
-    if (absl::Status s = non_negative(9, &t.ca_axial); !s.ok()) return s;
+    if (absl::Status s = column(5, false, &t.ei); !s.ok()) return s;
+    if (absl::Status s = column(6, false, &t.cd); !s.ok()) return s;
+    if (absl::Status s = column(7, false, &t.ca); !s.ok()) return s;
+    if (absl::Status s = column(8, false, &t.cd_axial); !s.ok()) return s;
+    if (absl::Status s = column(9, false, &t.ca_axial); !s.ok()) return s;
     line_types_.push_back(t);
     return absl::OkStatus();
   }
@@ -358,7 +356,8 @@ class DeckReader {
     if (!length.ok()) return length.status();
     l.length = *length;
     if (!absl::SimpleAtoi(w[5], &l.segments) || l.segments < 1) {
-      return Error(n, "LINES NumSegs", absl::StrCat("must be a whole number >= 1 (got ", w[5], ")"));
+      return Error(n, "LINES NumSegs",
+                   absl::StrCat("must be a whole number >= 1 (got ", w[5], ")"));
     }
     lines_.push_back(l);
     return absl::OkStatus();
@@ -623,7 +622,8 @@ class DeckReader {
       c->set_name(name);
       const Point& a = points_.at(l.a);
       const Point& b = points_.at(l.b);
-      for (const Eigen3& p : Layout(a, b, l.length, depth)) SetVec(c->add_points(), p[0], p[1], p[2]);
+      for (const Eigen3& p : Layout(a, b, l.length, depth))
+        SetVec(c->add_points(), p[0], p[1], p[2]);
       c->set_length(l.length);
       c->set_elements(l.segments);
       const double area = kPi * t.diameter * t.diameter / 4;
