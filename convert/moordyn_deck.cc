@@ -477,6 +477,8 @@ class DeckReader {
     const Eigen3 pa{a.x, a.y, a.z}, pb{b.x, b.y, b.z};
     const double span = Dist(pa, pb);
     if (length <= span * (1 + 1e-9)) return {pa, pb};
+    // Both ends at one place: the line hangs below them, folded.
+    if (span < 1e-9 * length) return {pa, {pa[0], pa[1], pa[2] - length / 2}, pb};
     // The symmetric sag: corner below the midpoint, in the vertical plane,
     // laid 0.1 % longer than the line: a line hanging free from a kink
     // with no tension has no stiffness across it at the first load
@@ -517,8 +519,11 @@ class DeckReader {
       return Dist(low, c) + Dist(c, high);
     };
     double lo = 0, hi = 1;
-    if (legs(0) > length) return {pa, corner, pb};  // too short to reach the bed as an L
-    while (legs(hi) < length) hi *= 2;
+    // Too short to reach the bed as an L, or one end above the other (the
+    // legs' sum does not grow along the bed): the sag.
+    const double run = std::hypot(high[0] - low[0], high[1] - low[1]);
+    if (legs(0) > length || run < 1e-9 * length) return {pa, corner, pb};
+    while (legs(hi) < length) hi *= 2;  // grows by about run per doubling: ends
     for (int k = 0; k < 200; ++k) {
       const double t = (lo + hi) / 2;
       (legs(t) < length ? lo : hi) = t;

@@ -277,6 +277,26 @@ TEST(MoorDynDeckTest, ReadsOptionalColumnsCommentsAndSolverOptions) {
   EXPECT_DOUBLE_EQ(s.fluid().water_depth(), 100);
 }
 
+// Degenerate placements are laid without a loop that never ends or a
+// division by zero: a slack line from an anchor straight below its
+// fairlead, and one whose two ends coincide.
+TEST(MoorDynDeckTest, LaysDegeneratePlacements) {
+  std::string text =
+      Edited("1     Fixed     400     0       -100", "1     Fixed     0       0       -100");
+  text = absl::StrReplaceAll(
+      text, {{"2     Vessel    0       0       -5", "2     Vessel    0       0       0"}});
+  const v1::Scene s = Read(text);
+  const v1::Cable& chain = CableNamed(s, "line1");
+  ASSERT_EQ(chain.points_size(), 3);
+  for (const v1::Vec3& p : chain.points())
+    EXPECT_TRUE(std::isfinite(p.x()) && std::isfinite(p.z()));
+  const v1::Scene t =
+      Read(Edited("3     Fixed     -300    0       -100", "3     Fixed     -200    0       -40"));
+  const v1::Cable& rope = CableNamed(t, "line2");
+  ASSERT_EQ(rope.points_size(), 3);
+  EXPECT_DOUBLE_EQ(rope.points(1).z(), -40 - 75);
+}
+
 TEST(MoorDynDeckTest, RecognisesDecksByNameOrContents) {
   EXPECT_TRUE(IsMoorDynDeck("a/b/mooring.dat", ""));
   EXPECT_TRUE(IsMoorDynDeck("lines.txt", kDeck));
