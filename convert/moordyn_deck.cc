@@ -17,6 +17,7 @@
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
+#include "convert/scene_from_proto.h"
 
 namespace cablesim {
 namespace {
@@ -75,10 +76,45 @@ class DeckReader {
 
   absl::StatusOr<v1::Scene> Read() {
     if (absl::Status s = Parse(); !s.ok()) return s;
-    return Build();
+    absl::StatusOr<v1::Scene> scene = Build();
+    if (!scene.ok()) return scene;
+    // A value the deck allows but the scene's ranges refuse (a million
+    // segments, a density no material has): the scene's message, led by
+    // the deck's line it came from.
+    const absl::StatusOr<Scene> checked = SceneFromProto(*scene);
+    if (!checked.ok()) return Located(checked.status());
+    return scene;
   }
 
  private:
+  // A scene validation error (`cables[1].elements: ...`) led by the deck's
+  // line of what became that part of the scene: a line's LINES row (and
+  // its type's row), a free point's POINTS row, an option's row.
+  absl::Status Located(const absl::Status& status) const {
+    const absl::string_view m = status.message();
+    int line = 1;
+    std::string where;
+    int index = -1;
+    auto indexed = [&](absl::string_view prefix) {
+      if (!absl::StartsWith(m, prefix)) return false;
+      const absl::string_view rest = m.substr(prefix.size());
+      return absl::SimpleAtoi(rest.substr(0, rest.find(']')), &index);
+    };
+    if (indexed("cables[") && index >= 0 && index < static_cast<int>(lines_.size())) {
+      line = lines_[index].line;
+      where = absl::StrCat(" (its line type on line ", lines_[index].type->line, ")");
+    } else if (indexed("bodies[") && index >= 0 && index < static_cast<int>(body_points_.size())) {
+      line = body_points_[index];
+    } else {
+      for (const auto& [prefix, key] :
+           {std::pair{"seabed", "kbot"}, std::pair{"fluid", "rho"}, std::pair{"gravity", "g"}}) {
+        const auto it = options_.find(key);
+        if (absl::StartsWith(m, prefix) && it != options_.end()) line = it->second.line;
+      }
+    }
+    return absl::Status(status.code(), absl::StrCat(file_, ":", line, where, ": ", m));
+  }
+
   absl::Status Error(int line, absl::string_view field, absl::string_view message) const {
     return absl::InvalidArgumentError(absl::StrCat(file_, ":", line, ": ", field, ": ", message));
   }
@@ -477,27 +513,47 @@ class DeckReader {
     const Eigen3 pa{a.x, a.y, a.z}, pb{b.x, b.y, b.z};
     const double span = Dist(pa, pb);
     if (length <= span * (1 + 1e-9)) return {pa, pb};
-    // Both ends at one place: the line hangs below them, folded.
-    if (span < 1e-9 * length) return {pa, {pa[0], pa[1], pa[2] - length / 2}, pb};
-    // The symmetric sag: corner below the midpoint, in the vertical plane,
-    // laid 0.1 % longer than the line: a line hanging free from a kink
-    // with no tension has no stiffness across it at the first load
+    // The sag, laid 0.1 % longer than the line: a line hanging free from
+    // a kink with no tension has no stiffness across it at the first load
     // increment (measured: MoorDyn's local_euler/hanging.txt failed there;
     // 0.01 % still failed), a little tension gives it some.
     const double laid = length * (1 + kSagLayStretch);
-    const double h = std::sqrt(std::max(0.0, laid * laid - span * span)) / 2;
-    Eigen3 mid{(pa[0] + pb[0]) / 2, (pa[1] + pb[1]) / 2, (pa[2] + pb[2]) / 2};
-    // The unit vector perpendicular to the chord, in its vertical plane,
-    // pointing down (straight down for a horizontal chord).
-    Eigen3 chord{(pb[0] - pa[0]) / span, (pb[1] - pa[1]) / span, (pb[2] - pa[2]) / span};
-    // down = -e_z + (e_z . chord) chord.
-    const Eigen3 down{chord[2] * chord[0], chord[2] * chord[1], chord[2] * chord[2] - 1};
+    // Both ends at one place: a square loop below them (scene polylines
+    // may turn by at most 135 degrees at a corner).
+    if (span < 1e-9 * length) {
+      const double q = laid / 4;
+      return {pa, {pa[0], pa[1], pa[2] - q}, {pa[0] + q, pa[1], pa[2] - q},
+              {pa[0] + q, pa[1], pa[2]}, pb};
+    }
+    // "Down": the unit vector across the chord in its vertical plane,
+    // pointing down (straight down for a horizontal chord; beside a
+    // vertical chord, along x).
+    const Eigen3 chord{(pb[0] - pa[0]) / span, (pb[1] - pa[1]) / span, (pb[2] - pa[2]) / span};
+    Eigen3 down{chord[2] * chord[0], chord[2] * chord[1], chord[2] * chord[2] - 1};
     const double dn = std::sqrt(down[0] * down[0] + down[1] * down[1] + down[2] * down[2]);
-    Eigen3 corner = mid;
     if (dn > 1e-12) {
-      for (int d = 0; d < 3; ++d) corner[d] += h * down[d] / dn;
+      for (double& x : down) x /= dn;
     } else {
-      corner[0] += h;  // a vertical chord: the corner beside it
+      down = {1, 0, 0};
+    }
+    // A V (one corner below the midpoint) while its corner turns by at
+    // most 120 degrees, else a U (two right-angled corners, the ends
+    // moved down by the same distance) for a very slack line.
+    const double h = std::sqrt(std::max(0.0, laid * laid - span * span)) / 2;
+    std::vector<Eigen3> sag;
+    Eigen3 corner{(pa[0] + pb[0]) / 2, (pa[1] + pb[1]) / 2, (pa[2] + pb[2]) / 2};
+    if (std::atan2(span / 2, h) >= kPi / 6) {
+      for (int d = 0; d < 3; ++d) corner[d] += h * down[d];
+      sag = {pa, corner, pb};
+    } else {
+      const double u = (laid - span) / 2;
+      Eigen3 ca = pa, cb = pb;
+      for (int d = 0; d < 3; ++d) {
+        ca[d] += u * down[d];
+        cb[d] += u * down[d];
+      }
+      sag = {pa, ca, cb, pb};
+      corner = ca[2] < cb[2] ? ca : cb;
     }
     // An end on the bed (an anchor, within 1 % of the depth) lays the line
     // along the bed first, as a catenary mooring lies: a sag hanging free
@@ -507,7 +563,7 @@ class DeckReader {
     const Eigen3& low = a_low ? pa : pb;
     const Eigen3& high = a_low ? pb : pa;
     const bool anchored = low[2] <= -depth + 0.01 * depth;
-    if (corner[2] >= -depth && !anchored) return {pa, corner, pb};
+    if (corner[2] >= -depth && !anchored) return sag;
     // On the seabed: the corner at z = -depth on the horizontal path from
     // a to b, where the two legs add up to the length (bisection: the sum
     // grows with the corner's distance from the end nearer the bed).
@@ -522,12 +578,14 @@ class DeckReader {
     // Too short to reach the bed as an L, or one end above the other (the
     // legs' sum does not grow along the bed): the sag.
     const double run = std::hypot(high[0] - low[0], high[1] - low[1]);
-    if (legs(0) > length || run < 1e-9 * length) return {pa, corner, pb};
+    if (legs(0) > length || run < 1e-9 * length) return sag;
     while (legs(hi) < length) hi *= 2;  // grows by about run per doubling: ends
     for (int k = 0; k < 200; ++k) {
       const double t = (lo + hi) / 2;
       (legs(t) < length ? lo : hi) = t;
     }
+    // Beyond the higher end: the rising leg would fold back; the sag.
+    if ((lo + hi) / 2 > 1) return sag;
     const Eigen3 c = corner_at((lo + hi) / 2);
     if (Dist(low, c) < 1e-9 * length || Dist(high, c) < 1e-9 * length) return {pa, pb};
     return {pa, c, pb};
@@ -596,6 +654,7 @@ class DeckReader {
                      "sizes the body's fluid loads)");
       }
       v1::Body* body = scene.add_bodies();
+      body_points_.push_back(p.line);
       const std::string name = absl::StrCat("point", id);
       body->set_name(name);
       body_of[id] = name;
@@ -717,6 +776,8 @@ class DeckReader {
   std::vector<Line> lines_;
   std::map<std::string, Option> options_;
   std::vector<int> probe_points_;
+  // The POINTS row of each body Build made, in scene order (for Located).
+  mutable std::vector<int> body_points_;
 };
 
 }  // namespace

@@ -258,6 +258,11 @@ TEST(MoorDynDeckTest, RefusalsNameTheLineAndField) {
        "---------------------- WHATEVER ----\n---------------------- OPTIONS",
        "bad.dat:23: section"},
       {"0.4     0.0\n", "0.4     0.0     0.7   0.08  0.18\n", "bad.dat:6: LINE TYPES Cl: \"0.7\""},
+      // Values the deck's syntax allows but the scene's ranges refuse: the
+      // scene's message, led by the deck's line.
+      {"450       30 ", "450       3000000 ",
+       "bad.dat:19 (its line type on line 6): cables[0].elements: must be in"},
+      {"2000   1.5 ", "1e12   1.5 ", "bad.dat:14: bodies[0].mass"},
   };
   for (const Case& c : cases) {
     const std::string message = Refusal(Edited(c.from, c.to));
@@ -277,24 +282,26 @@ TEST(MoorDynDeckTest, ReadsOptionalColumnsCommentsAndSolverOptions) {
   EXPECT_DOUBLE_EQ(s.fluid().water_depth(), 100);
 }
 
-// Degenerate placements are laid without a loop that never ends or a
-// division by zero: a slack line from an anchor straight below its
-// fairlead, and one whose two ends coincide.
+// Degenerate placements are laid without a search that never ends, a
+// division by zero or a fold: a slack line from an anchor straight below
+// its fairlead, and one whose two ends coincide.
 TEST(MoorDynDeckTest, LaysDegeneratePlacements) {
   std::string text =
       Edited("1     Fixed     400     0       -100", "1     Fixed     0       0       -100");
   text = absl::StrReplaceAll(
       text, {{"2     Vessel    0       0       -5", "2     Vessel    0       0       0"}});
+  // (Read also converts the scene: no corner folds back by more than
+  // scenes allow, 135 degrees; a V here would turn by 154.)
   const v1::Scene s = Read(text);
   const v1::Cable& chain = CableNamed(s, "line1");
-  ASSERT_EQ(chain.points_size(), 3);
+  ASSERT_EQ(chain.points_size(), 4);  // a U: 450 m between ends 100 m apart
   for (const v1::Vec3& p : chain.points())
     EXPECT_TRUE(std::isfinite(p.x()) && std::isfinite(p.z()));
   const v1::Scene t =
       Read(Edited("3     Fixed     -300    0       -100", "3     Fixed     -200    0       -40"));
   const v1::Cable& rope = CableNamed(t, "line2");
-  ASSERT_EQ(rope.points_size(), 3);
-  EXPECT_DOUBLE_EQ(rope.points(1).z(), -40 - 75);
+  ASSERT_EQ(rope.points_size(), 5);  // a square loop of side 150 m / 4, 0.1 % long
+  EXPECT_DOUBLE_EQ(rope.points(1).z(), -40 - 150 * 1.001 / 4);
 }
 
 TEST(MoorDynDeckTest, RecognisesDecksByNameOrContents) {
