@@ -10,6 +10,7 @@
 
 #include <google/protobuf/util/json_util.h>
 
+#include "CLI/CLI.hpp"
 #include "absl/status/status.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
@@ -31,10 +32,10 @@
 #include "engine/run/simulation.h"
 #include "engine/scene/integrator_traits.h"
 
-// The arguments are parsed here rather than with absl flags: absl's parser
-// exits the process (with status 1) on an unknown flag or --help and keeps
-// the flag values in globals, while RunCli must return exit code 2 for usage
-// errors and be callable any number of times in one process.
+// The arguments are parsed with CLI11 rather than with absl flags: absl's
+// parser exits the process (with status 1) on an unknown flag or --help and
+// keeps the flag values in globals, while RunCli must return exit code 2 for
+// usage errors and be callable any number of times in one process.
 
 namespace cablesim {
 namespace {
@@ -74,63 +75,98 @@ const std::set<std::string>& FlagOptions() {
   return *flags;
 }
 
-// Parses `args`; returns an error message for a usage error.
+// Parses `args` with CLI11 (Debian's libcli11-dev); returns an error
+// message for a usage error. Kept from the parser this replaced: a single
+// dash before a long name (`-out`, `-help`, as Go's flag package and the
+// server's Abseil flags take them), `--name=value`, `-o` for --out, and the
+// messages users' scripts have seen ("unknown option --x", "--out needs a
+// file", "--strict takes no value").
 absl::StatusOr<Arguments> ParseArguments(const std::vector<std::string>& args) {
   Arguments parsed;
+  // CLI11 reads long names after two dashes only: `-name` becomes `--name`
+  // (but `-o`, `-h` and what follows `--` stay as they are).
+  std::vector<std::string> argv;
   bool options_done = false;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& arg = args[i];
-    if (options_done || arg.size() < 2 || arg[0] != '-') {
-      parsed.positional.push_back(arg);
-      continue;
+  for (const std::string& arg : args) {
+    if (arg == "--") options_done = true;
+    if (!options_done && arg.size() > 2 && arg[0] == '-' && arg[1] != '-' && arg[2] != '=') {
+      argv.push_back("-" + arg);
+    } else {
+      argv.push_back(arg);
     }
-    if (arg == "--") {
-      options_done = true;
-      continue;
+  }
+  CLI::App app("cablesim");
+  app.set_help_flag();  // --help is a flag of ours: the usage text is CliUsage()
+  app.allow_extras();   // unknown options are reported below, in our words
+  app.add_flag("-h,--help", parsed.help);
+  app.add_flag("--version", parsed.version);
+  std::map<std::string, CLI::Option*> valued;
+  auto add_valued = [&](const std::string& name) {
+    CLI::Option* o = app.add_option(name == "out" ? "-o,--out" : "--" + name);
+    o->type_size(1)->expected(1)->allow_extra_args(false);
+    o->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+    valued[name] = o;
+  };
+  add_valued("out");
+  add_valued("server");
+  for (const std::string& name : ValueOptions()) add_valued(name);
+  std::map<std::string, CLI::Option*> flags;
+  for (const std::string& name : FlagOptions()) {
+    flags[name] = app.add_flag("--" + name)->disable_flag_override();
+  }
+  app.add_option("positional", parsed.positional);
+  // CLI11 takes the arguments last first.
+  std::vector<std::string> reversed(argv.rbegin(), argv.rend());
+  try {
+    app.parse(reversed);
+  } catch (const CLI::ParseError& e) {
+    // The option CLI11 names: the first "--name" in its message.
+    const std::string what = e.what();
+    std::string name;
+    // (some messages give the name without its dashes, first: "strict was
+    // given a disallowed flag override").
+    const size_t dashes = what.find("--");
+    if (const size_t at = dashes != std::string::npos ? dashes + 2 : 0; true) {
+      size_t end = at;
+      while (end < what.size() && (absl::ascii_isalnum(what[end]) || what[end] == '-')) ++end;
+      name = what.substr(at, end - at);
     }
-    if (arg == "--help" || arg == "-h" || arg == "-help") {
-      parsed.help = true;
-      continue;
+    if (flags.count(name)) {
+      return absl::InvalidArgumentError(absl::StrCat("--", name, " takes no value"));
     }
-    if (arg == "--version" || arg == "-version") {
-      parsed.version = true;
-      continue;
+    if (valued.count(name)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("--", name, name == "out" ? " needs a file" : " needs a value"));
     }
-    std::string name = arg.substr(arg[1] == '-' ? 2 : 1);
-    std::optional<std::string> value;
-    if (const size_t eq = name.find('='); eq != std::string::npos) {
-      value = name.substr(eq + 1);
-      name = name.substr(0, eq);
-    }
-    if (name == "o") name = "out";
-    if (FlagOptions().count(name)) {
-      if (value.has_value()) {
-        return absl::InvalidArgumentError(absl::StrCat("--", name, " takes no value"));
-      }
-      parsed.options[name] = "";
-      continue;
-    }
-    if (name != "out" && name != "server" && !ValueOptions().count(name)) {
-      return absl::InvalidArgumentError(absl::StrCat("unknown option ", arg));
-    }
-    if (!value.has_value()) {
-      if (i + 1 >= args.size()) {
-        return absl::InvalidArgumentError(
-            absl::StrCat(arg, name == "out" ? " needs a file" : " needs a value"));
-      }
-      value = args[++i];
-    }
-    if (value->empty()) {
+    return absl::InvalidArgumentError(what);
+  }
+  for (const std::string& extra : app.remaining()) {
+    return absl::InvalidArgumentError(absl::StrCat("unknown option ", extra));
+  }
+  for (const auto& [name, option] : flags) {
+    if (option->count() > 0) parsed.options[name] = "";
+  }
+  // Values in the order given (the last wins for a single option; --max and
+  // --min keep every one, in order).
+  std::map<const CLI::Option*, size_t> seen;
+  std::map<const CLI::Option*, std::string> name_of;
+  for (const auto& [name, option] : valued) name_of[option] = name;
+  for (const CLI::Option* option : app.parse_order()) {
+    const auto named = name_of.find(option);
+    if (named == name_of.end()) continue;
+    const std::string& name = named->second;
+    const std::string& value = option->results().at(seen[option]++);
+    if (value.empty()) {
       return absl::InvalidArgumentError(
           absl::StrCat("--", name, name == "out" ? " needs a file" : " needs a value"));
     }
     if (name == "out") {
-      parsed.out = *value;
+      parsed.out = value;
     } else if (name == "server") {
-      parsed.server = *value;
+      parsed.server = value;
     } else {
-      parsed.options[name] = *value;
-      if (name == "max" || name == "min") parsed.repeated.emplace_back(name, *value);
+      parsed.options[name] = value;
+      if (name == "max" || name == "min") parsed.repeated.emplace_back(name, value);
     }
   }
   return parsed;
@@ -351,7 +387,8 @@ std::string CliUsage() {
       Print the version and the build type.
 
 SCENE is a cablesim.v1.Scene (proto/cablesim/v1/scene.proto) in protobuf
-JSON, or in text format when its name ends in .txtpb, .textproto or .pbtxt.
+JSON, or in text format when its name ends in .txtpb, .textproto or .pbtxt,
+or a MoorDyn v2 input file (docs/moordyn-files.md).
 SWEEP.json is a cablesim.v1.SweepFile (proto/cablesim/v1/service.proto).
 
 --server takes any gRPC target: HOST:PORT, several servers sharing one job

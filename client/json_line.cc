@@ -3,8 +3,9 @@
 #include <charconv>
 #include <cmath>
 
+#include <nlohmann/json.hpp>
+
 #include "absl/strings/str_cat.h"
-#include "absl/strings/str_format.h"
 
 namespace cablesim {
 
@@ -53,42 +54,14 @@ void JsonLine::AddRaw(std::string_view key, std::string_view json_value) {
   body_.append(json_value.data(), json_value.size());
 }
 
+// Strings are written by nlohmann::json (Debian's nlohmann-json3-dev): its
+// escaping of control characters and its replacement of invalid UTF-8 by
+// U+FFFD, so that a line is always valid JSON. Numbers by std::to_chars,
+// the shortest form that reads back to the same double (nlohmann's form
+// differs only in spelling, 1.0 for 1 and 0.0001 for 1e-04, and the
+// summaries' spelling is kept for the scripts that read them as text).
 std::string JsonLine::Quote(std::string_view value) {
-  std::string out = "\"";
-  out.reserve(value.size() + 2);
-  for (const char c : value) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      case '\b':
-        out += "\\b";
-        break;
-      case '\f':
-        out += "\\f";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
-          absl::StrAppendFormat(&out, "\\u%04x", static_cast<unsigned char>(c));
-        } else {
-          out += c;
-        }
-    }
-  }
-  out += '"';
-  return out;
+  return nlohmann::json(value).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 std::string JsonLine::Number(double value) {

@@ -39,7 +39,7 @@ class JsonLine {
   std::string ToString() const { return body_ + "}"; }
 
   // `value` as a JSON string literal, quotes included. Control characters
-  // are escaped; invalid UTF-8 is passed through unchanged.
+  // are escaped; invalid UTF-8 becomes U+FFFD.
   static std::string Quote(std::string_view value);
   // `value` as a JSON number, or `null` when it is not finite.
   static std::string Number(double value);

@@ -8,7 +8,7 @@ packages=(
   libeigen3-dev libabsl-dev libspectra-dev
   libprotobuf-dev protobuf-compiler
   libgrpc++-dev protobuf-compiler-grpc
-  libgtest-dev libgmock-dev libbenchmark-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
   libsqlite3-dev zlib1g-dev libzstd-dev libssl-dev
   libpq-dev postgresql
   python3 python3-grpcio python3-protobuf python3-numpy python3-matplotlib python3-pil

@@ -767,6 +767,11 @@ grpc::Status CablesimServiceImpl::WatchSweep(grpc::ServerContext* context,
   std::set<std::string> reported;
   if (grpc::Status s = Owned(request->id(), tenant); !s.ok()) return s;
   bool first = true;
+  // The `finished` count of the last event sent: the sweep row and its
+  // items are read one after the other, so an item can finish in between
+  // and be reported with the count from before it; the last event must
+  // still carry the final count (a client's progress ends at items/items).
+  int64_t sent_finished = -1;
   while (true) {
     const uint64_t seen = jobs_->version();
     absl::StatusOr<v1::Sweep> sweep = jobs_->store()->GetSweep(request->id());
@@ -780,6 +785,7 @@ grpc::Status CablesimServiceImpl::WatchSweep(grpc::ServerContext* context,
       if (!TimedWrite(writer, event, slot.watch())) {
         return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
       }
+      sent_finished = sweep->finished();
       first = false;
     }
     // Oldest item first.
@@ -792,8 +798,18 @@ grpc::Status CablesimServiceImpl::WatchSweep(grpc::ServerContext* context,
       if (!TimedWrite(writer, event, slot.watch())) {
         return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
       }
+      sent_finished = sweep->finished();
     }
-    if (sweep->finished() == sweep->items()) return grpc::Status::OK;
+    if (sweep->finished() == sweep->items()) {
+      if (sent_finished != sweep->finished()) {
+        v1::SweepEvent event;
+        *event.mutable_progress() = *sweep;
+        if (!TimedWrite(writer, event, slot.watch())) {
+          return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
+        }
+      }
+      return grpc::Status::OK;
+    }
     if (context->IsCancelled()) return grpc::Status(grpc::StatusCode::CANCELLED, "cancelled");
     if (jobs_->shutting_down()) {
       return grpc::Status(grpc::StatusCode::UNAVAILABLE, "the server is shutting down");

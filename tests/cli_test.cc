@@ -8,6 +8,7 @@
 
 #include <cstdio>
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -15,6 +16,7 @@
 #include <unistd.h>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "client/csv_writer.h"
 
@@ -94,6 +96,31 @@ TEST(CliTest, UnknownOptionIsAUsageError) {
   const CliResult r = Cli({"run", SampleScene("falling-pendulum.json"), "--outt=x.csv"});
   EXPECT_EQ(r.code, 2);
   EXPECT_THAT(r.err, HasSubstr("unknown option --outt=x.csv"));
+}
+
+// The spellings the parser (CLI11) takes, as the hand-written one did: a
+// single dash before a long name, --name=value, -o, the last --out wins,
+// and a value that is missing or empty is named.
+TEST(CliTest, OptionSpellings) {
+  const std::string scene = WriteTempFile("spellings_scene.json", kTinyScene);
+  const std::string first = WriteTempFile("spellings_first.csv", ""),
+                    last = WriteTempFile("spellings_last.csv", "");
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"run", scene, "-out", last},
+        {"run", scene, "--out=" + last},
+        {"run", "--out", first, scene, "-o", last}}) {
+    std::filesystem::remove(first);
+    std::filesystem::remove(last);
+    const CliResult r = Cli(args);
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(std::filesystem::exists(last)) << absl::StrJoin(args, " ");
+    EXPECT_FALSE(std::filesystem::exists(first)) << absl::StrJoin(args, " ");
+  }
+  EXPECT_EQ(Cli({"-version"}).code, 0);
+  EXPECT_THAT(Cli({"run", scene, "--out="}).err, HasSubstr("--out needs a file"));
+  EXPECT_THAT(Cli({"run", scene, "--server"}).err, HasSubstr("--server needs a value"));
+  EXPECT_THAT(Cli({"run", scene, "--strict=1"}).err, HasSubstr("--strict takes no value"));
+  EXPECT_THAT(Cli({"run", scene, "-strikt"}).err, HasSubstr("unknown option --strikt"));
 }
 
 TEST(CliTest, MissingSceneArgument) {

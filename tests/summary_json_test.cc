@@ -130,6 +130,8 @@ TEST(SummaryJsonTest, FailedSummaryHasErrorAndTime) {
 TEST(JsonLineTest, Escaping) {
   EXPECT_EQ(JsonLine::Quote("a\"b\\c\td\x01"), R"("a\"b\\c\td\u0001")");
   EXPECT_EQ(JsonLine::Quote("caf\xc3\xa9"), "\"caf\xc3\xa9\"");  // UTF-8 kept
+  // Invalid UTF-8 (a lone byte 0xff) becomes U+FFFD: the line stays JSON.
+  EXPECT_EQ(JsonLine::Quote("a\xff"), "\"a\xef\xbf\xbd\"");
   EXPECT_EQ(JsonLine().ToString(), "{}");
   EXPECT_EQ(JsonLine().Add("a", 1).Add("b", true).Add("c", 0.1).Add("d", "x").ToString(),
             R"({"a":1,"b":true,"c":0.1,"d":"x"})");
