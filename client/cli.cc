@@ -8,6 +8,8 @@
 #include <set>
 #include <utility>
 
+#include <google/protobuf/util/json_util.h>
+
 #include "CLI/CLI.hpp"
 #include "absl/status/status.h"
 #include "absl/strings/match.h"
@@ -300,6 +302,35 @@ int Run(const std::string& path, const std::optional<std::string>& csv_path,
   return ReportSummary(*summary, out, err);
 }
 
+// `cablesim import`: a MoorDyn deck (or any scene file) written as a JSON
+// scene file, proto field names, two-space indents.
+int Import(const std::string& path, const std::optional<std::string>& out_path,
+           std::ostream& out, std::ostream& err) {
+  if (!out_path.has_value()) return UsageError(err, "import: missing --out SCENE.json");
+  std::string error;
+  const std::optional<v1::Scene> proto = ReadScene(path, err, &error);
+  if (!proto.has_value()) return kExitBadInput;
+  google::protobuf::util::JsonPrintOptions options;
+  options.add_whitespace = true;
+  options.preserve_proto_field_names = true;
+  std::string json;
+  if (const auto s = google::protobuf::util::MessageToJsonString(*proto, &json, options); !s.ok()) {
+    err << "cablesim: " << path << ": " << s.message() << "\n";
+    return kExitBadInput;
+  }
+  std::ofstream file(*out_path, std::ios::binary);
+  file << json;
+  file.close();
+  if (!file) {
+    err << "cablesim: cannot write " << *out_path << "\n";
+    return kExitIoError;
+  }
+  out << JsonLine().Add("status", "ok").Add("file", path).Add("out", *out_path).ToString()
+      << "\n";
+  out.flush();
+  return kExitOk;
+}
+
 }  // namespace
 
 std::string CliUsage() {
@@ -316,8 +347,15 @@ std::string CliUsage() {
       solves accepted, steps cut far below solver.step) are printed on
       standard error and listed in the summary's "warnings"; with --strict
       they fail the run (exit 3). docs/honest-runs.md.
+      SCENE may also be a MoorDyn v2 input file (a .dat file, or MoorDyn's
+      .txt inputs): it is read as docs/moordyn-files.md describes (here and
+      in validate, submit and energy).
   cablesim validate SCENE [--server HOST:PORT]
       Check the scene and print one JSON line describing it.
+  cablesim import FILE.dat --out SCENE.json
+      Translate a MoorDyn v2 input file into a cablesim scene file (JSON),
+      to read or edit; a deck the scene cannot express exits 2 naming the
+      file's line and field.
   cablesim submit SCENE --server HOST:PORT [--strict]
       Queue the scene as a durable job; print the job (its id) at once.
       With --strict, a job whose run has warnings fails.
@@ -354,7 +392,8 @@ std::string CliUsage() {
       Print the version and the build type.
 
 SCENE is a cablesim.v1.Scene (proto/cablesim/v1/scene.proto) in protobuf
-JSON, or in text format when its name ends in .txtpb, .textproto or .pbtxt.
+JSON, or in text format when its name ends in .txtpb, .textproto or .pbtxt,
+or a MoorDyn v2 input file (docs/moordyn-files.md).
 SWEEP.json is a cablesim.v1.SweepFile (proto/cablesim/v1/service.proto).
 
 --server takes any gRPC target: HOST:PORT, several servers sharing one job
@@ -397,7 +436,7 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   static const std::map<std::string, const char*> kArgument = {
       {"run", "SCENE"}, {"validate", "SCENE"}, {"submit", "SCENE"},        {"jobs", nullptr},
       {"watch", "JOB"}, {"cancel", "JOB"},     {"energy", "SCENE or JOB"}, {"sweep", "SWEEP.json"},
-      {"health", nullptr}};
+      {"health", nullptr}, {"import", "FILE.dat"}};
   const auto known = kArgument.find(command);
   if (known == kArgument.end()) {
     return UsageError(err, absl::StrCat("unknown command \"", command, "\""));
@@ -450,7 +489,7 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
     if (!allowed) return UsageError(err, absl::StrCat(command, ": no option --", name));
   }
   if (a.out.has_value() && command != "run" && command != "watch" && command != "energy" &&
-      command != "sweep") {
+      command != "sweep" && command != "import") {
     return UsageError(err, absl::StrCat(command, ": --out is only for run"));
   }
   SetRemoteSecurity(security);
@@ -461,6 +500,7 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
     if (auto it = a.options.find("shape"); it != a.options.end()) shape = it->second;
     return Run(a.positional[1], a.out, shape, a.server, a.options.count("strict") > 0, out, err);
   }
+  if (command == "import") return Import(a.positional[1], a.out, out, err);
   if (command == "submit") return cli_internal::Submit(a, out, err);
   if (command == "jobs") return cli_internal::Jobs(a, out, err);
   if (command == "watch") return cli_internal::Watch(a, out, err);

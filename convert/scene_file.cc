@@ -21,6 +21,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
+#include "convert/moordyn_deck.h"
 
 namespace cablesim {
 namespace {
@@ -457,6 +458,8 @@ bool IsTextFormatScenePath(std::string_view path_std) {
 absl::StatusOr<v1::Scene> ReadSceneFile(const std::string& path) {
   absl::StatusOr<std::string> text = ReadBoundedFile(path, "scene file");
   if (!text.ok()) return text.status();
+  // A MoorDyn deck's messages already start with the path and its line.
+  if (IsMoorDynDeck(path, *text)) return SceneFromMoorDyn(*text, path);
   absl::StatusOr<v1::Scene> scene =
       IsTextFormatScenePath(path) ? ParseSceneTextFormat(*text) : ParseSceneJson(*text);
   if (!scene.ok()) return WithPath(path, scene.status());

@@ -62,7 +62,8 @@ absl::StatusOr<v1::Scene> ParseSceneTextFormat(std::string_view text);
 bool IsTextFormatScenePath(std::string_view path);
 
 // Reads and parses the scene file at `path` (see IsTextFormatScenePath for
-// the format), with ReadBoundedFile. Returns NotFound when the file does not
+// the format; a MoorDyn deck, IsMoorDynDeck, is read by SceneFromMoorDyn:
+// convert/moordyn_deck.h), with ReadBoundedFile. Returns NotFound when the file does not
 // exist, another non-OK status when it cannot be read, and InvalidArgument
 // when it is too large or does not parse.
 // Every error message starts with `path: `.

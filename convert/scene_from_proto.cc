@@ -532,7 +532,25 @@ class SceneConverter {
         cable->hydro_diameter_m = h.diameter();
       }
     }
+    switch (c.axial_law()) {
+      case v1::AXIAL_LAW_UNSPECIFIED:
+      case v1::GREEN_LAGRANGE:
+        cable->axial_law = AxialLaw::kGreenLagrange;
+        break;
+      case v1::ENGINEERING:
+        cable->axial_law = AxialLaw::kEngineering;
+        break;
+      default:
+        return Invalid(Sub(path, "axial_law"),
+                       absl::StrCat("unknown value ", c.axial_law(),
+                                    " (must be GREEN_LAGRANGE or ENGINEERING)"));
+    }
     if (c.has_winch()) {
+      if (cable->axial_law == AxialLaw::kEngineering) {
+        return Invalid(Sub(path, "axial_law"),
+                       "ENGINEERING is not available on a cable with a winch (its line tension "
+                       "is the Green-Lagrange law's)");
+      }
       cable->winch.enabled = true;
       CABLESIM_ASSIGN_OR_RETURN(cable->winch.speed,
                                 ConvertTimeFunction(Sub(Sub(path, "winch"), "speed"),

@@ -407,7 +407,8 @@ grpc::Status CablesimServiceImpl::Validate(grpc::ServerContext* context,
   // server would refuse is never called valid, and costs no more to
   // validate than to refuse).
   const absl::StatusOr<v1::Scene> scene =
-      SceneOfRequest(request->has_scene(), request->scene(), request->scene_json());
+      SceneOrDeckOfRequest(request->has_scene(), request->scene(), request->scene_json(),
+                           request->scene_moordyn());
   absl::StatusOr<CheckedScene> checked =
       scene.ok() ? CheckScene(*scene, limits_, ControlFor(context, limits_).should_stop)
                  : absl::StatusOr<CheckedScene>(scene.status());
@@ -452,7 +453,8 @@ grpc::Status CablesimServiceImpl::RunTo(grpc::ServerContext* context,
     return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, slot.refusal());
   }
   absl::StatusOr<v1::Scene> scene =
-      SceneOfRequest(request->has_scene(), request->scene(), request->scene_json());
+      SceneOrDeckOfRequest(request->has_scene(), request->scene(), request->scene_json(),
+                           request->scene_moordyn());
   if (!scene.ok()) return ToGrpc(scene.status());
   if (request->strict()) scene->mutable_solver()->set_strict(true);
   absl::StatusOr<CheckedScene> checked =
@@ -485,7 +487,8 @@ grpc::Status CablesimServiceImpl::SubmitJob(grpc::ServerContext* context,
   if (grpc::Status held = slot.status(); !held.ok()) return held;
   if (jobs_ == nullptr) return NoJobs();
   absl::StatusOr<v1::Scene> scene =
-      SceneOfRequest(request->has_scene(), request->scene(), request->scene_json());
+      SceneOrDeckOfRequest(request->has_scene(), request->scene(), request->scene_json(),
+                           request->scene_moordyn());
   if (!scene.ok()) return ToGrpc(scene.status());
   if (request->strict()) scene->mutable_solver()->set_strict(true);
   absl::StatusOr<v1::Job> job = jobs_->Submit(*scene, ClientKey(context, tenant), tenant,

@@ -12,6 +12,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "convert/moordyn_deck.h"
 #include "convert/run_proto.h"
 #include "convert/scene_field_path.h"
 #include "convert/scene_file.h"
@@ -119,6 +120,21 @@ absl::StatusOr<v1::Scene> SceneOfRequest(bool has_scene, const v1::Scene& scene,
     return absl::InvalidArgumentError(absl::StrCat(json_field, ": ", parsed.status().message()));
   }
   return parsed;
+}
+
+absl::StatusOr<v1::Scene> SceneOrDeckOfRequest(bool has_scene, const v1::Scene& scene,
+                                               const std::string& json,
+                                               const std::string& moordyn) {
+  if (moordyn.empty()) return SceneOfRequest(has_scene, scene, json);
+  if (has_scene || !json.empty()) {
+    return absl::InvalidArgumentError(
+        "scene_moordyn: give the scene as a message, as JSON text or as a MoorDyn file, only one");
+  }
+  if (moordyn.size() > static_cast<size_t>(kMaxSceneBytes)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("scene_moordyn: larger than ", kMaxSceneBytes, " bytes"));
+  }
+  return SceneFromMoorDyn(moordyn, "scene_moordyn");
 }
 
 ServerLimits DefaultServerLimits() {

@@ -99,6 +99,13 @@ struct CheckedScene {
 absl::StatusOr<v1::Scene> SceneOfRequest(bool has_scene, const v1::Scene& scene,
                                          const std::string& json,
                                          absl::string_view json_field = "scene_json");
+// The same, or `moordyn`, a MoorDyn v2 input file's text (the request
+// field scene_moordyn), read by SceneFromMoorDyn (convert/moordyn_deck.h):
+// its errors start with `scene_moordyn:` and the deck's line. At most one
+// of the three.
+absl::StatusOr<v1::Scene> SceneOrDeckOfRequest(bool has_scene, const v1::Scene& scene,
+                                               const std::string& json,
+                                               const std::string& moordyn);
 
 // Validates `proto`, builds its model and checks it against `limits`:
 // every string's length, the steps, frames and numbers kept, the elements

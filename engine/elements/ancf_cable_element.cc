@@ -11,8 +11,9 @@ namespace cablesim {
 
 template <int D>
 AncfCableElement<D>::AncfCableElement(double length_m, double ea_n, double ei_n_m2,
-                                      BendingModel bending, int gauss_points)
-    : length_(length_m), ea_(ea_n), ei_(ei_n_m2), bending_(bending),
+                                      BendingModel bending, int gauss_points,
+                                      AxialLaw axial_law)
+    : length_(length_m), ea_(ea_n), ei_(ei_n_m2), bending_(bending), axial_law_(axial_law),
       rule_(MakeGaussRule(gauss_points)) {
   set_length(length_m);
 }
@@ -99,7 +100,8 @@ typename AncfCableElement<D>::Energy AncfCableElement<D>::StrainEnergy(const Coo
       w += d2_[g][k] * e.template segment<D>(k * D);
     }
     const double a = u.squaredNorm(), b = u.dot(w), c = w.squaredNorm();
-    const double eps = (a - 1) / 2;
+    const double eps =
+        axial_law_ == AxialLaw::kEngineering ? std::sqrt(a) - 1 : (a - 1) / 2;
     const double wl = rule_.weight[g] * length_;
     energy.axial += wl * 0.5 * ea_ * eps * eps;
     double kappa2 = 0;
@@ -137,11 +139,24 @@ void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* t
     double nuu = 0, nuw = 0, nww = 0;
 
     // Gradient (gu, gw) and Hessian blocks of psi with respect to (u, w).
-    const double eps = (a - 1) / 2;
-    Point gu = ea_ * eps * u, gw = Point::Zero();
+    Point gu = Point::Zero(), gw = Point::Zero();
     Block huu = Block::Zero(), huw = Block::Zero(), hww = Block::Zero();
-    if (tangent) huu = ea_ * (eps * Id::Identity() + u * u.transpose());
-    if (roundoff) nuu = ea_ * (std::abs(eps) + a);
+    if (axial_law_ == AxialLaw::kEngineering) {
+      // psi_a = EA/2 (s - 1)^2, s = |u|: gradient EA (1 - 1/s) u, Hessian
+      // EA ((1 - 1/s) I + u u^T / s^3) (eigenvalues 1 - 1/s and 1).
+      const double s = std::sqrt(a);
+      if (s > 0) {
+        const double f = 1 - 1 / s;
+        gu = ea_ * f * u;
+        if (tangent) huu = ea_ * (f * Id::Identity() + u * u.transpose() / (a * s));
+        if (roundoff) nuu = ea_ * (std::abs(f) + 1);
+      }
+    } else {
+      const double eps = (a - 1) / 2;
+      gu = ea_ * eps * u;
+      if (tangent) huu = ea_ * (eps * Id::Identity() + u * u.transpose());
+      if (roundoff) nuu = ea_ * (std::abs(eps) + a);
+    }
     if (bending_ == BendingModel::kLinear) {
       gw += ei_ * w;
       if (tangent) hww += ei_ * Id::Identity();
@@ -239,7 +254,10 @@ void AncfCableElement<D>::AddDampingMatrix(const Coords& e, double axial_s, doub
       w += d2_[g][k] * e.template segment<D>(k * D);
     }
     const double wl = rule_.weight[g] * length_;
-    Block huu = ca * u * u.transpose(), huw = Block::Zero(), hww = Block::Zero();
+    // Engineering strain: d eps/dt = u.udot / |u|.
+    const double axial_scale =
+        axial_law_ == AxialLaw::kEngineering && u.squaredNorm() > 0 ? 1 / u.squaredNorm() : 1.0;
+    Block huu = (ca * axial_scale) * u * u.transpose(), huw = Block::Zero(), hww = Block::Zero();
     if (cb != 0) {
       // k = u x w / a^(3/2), a = u.u: dk/dw = [u]x / a^(3/2),
       // dk/du = -[w]x / a^(3/2) - 3 k u^T / a.
@@ -376,6 +394,13 @@ void AncfCableElement<D>::AddDiscreteGradientCorrection(const Coords& e0, const 
     // LINEAR bending psi_c = EI / 2 (constant).
     double fa = 0.25 * ea_ * (0.5 * (a0 + a1) - 1), fb = 0, fc = 0;
     double ga = 0.25 * ea_ * (am - 1), gb = 0, gc = 0;
+    if (axial_law_ == AxialLaw::kEngineering) {
+      // psi = EA/2 (s - 1)^2, s = sqrt(a): the exact difference quotient
+      // (psi(a1) - psi(a0)) / (a1 - a0) = EA/2 (s0 + s1 - 2) / (s0 + s1).
+      const double s0 = std::sqrt(a0), s1 = std::sqrt(a1), sm = std::sqrt(am);
+      fa = 0.5 * ea_ * (s0 + s1 - 2) / (s0 + s1);
+      ga = 0.5 * ea_ * (sm - 1) / sm;
+    }
     if (bending_ == BendingModel::kLinear) fc = gc = k;
     if (exact) {
       // psi = k (c A(a) - b^2 B(a)), A = a^-2, B = a^-3: the discrete

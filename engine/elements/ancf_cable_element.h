@@ -11,6 +11,11 @@
 //
 //   psi = EA/2 eps^2 + EI/2 kappa^2,   eps = (u.u - 1) / 2   (Green-Lagrange)
 //
+// or, with AxialLaw::kEngineering, eps = |u| - 1 (the engineering strain:
+// the tension EA eps along the tangent is linear in the stretch, the law a
+// mooring data sheet's EA means; Green-Lagrange's tension is
+// EA (e + e^2/2)(1 + e) in the engineering strain e, 1.5 % stiffer at 1 %).
+//
 // and, writing a = u.u, b = u.w, c = w.w,
 //
 //   EXACT:  kappa^2 = |u x w|^2 / |u|^6 = (a c - b^2) / a^3     (eq. 17)
@@ -54,7 +59,10 @@ class AncfCableElement {
 
   AncfCableElement() = default;
   AncfCableElement(double length_m, double ea_n, double ei_n_m2, BendingModel bending,
-                   int gauss_points = kDefaultGaussPoints);
+                   int gauss_points = kDefaultGaussPoints,
+                   AxialLaw axial_law = AxialLaw::kGreenLagrange);
+
+  AxialLaw axial_law() const { return axial_law_; }
 
   double length() const { return length_; }
   // A new undeformed length [m] (a winch cable's elements, whose length
@@ -112,7 +120,9 @@ class AncfCableElement {
   // c) is taken in (a, b, c):
   //  - axial: psi_a = EA (a - 1) / 4 at the mean a (psi is quadratic in
   //    a: exact; the strain at the mean of its end values, Simo and
-  //    Tarnow, ZAMP 43:757-792, 1992);
+  //    Tarnow, ZAMP 43:757-792, 1992); engineering strain, psi =
+  //    EA/2 (s - 1)^2 with s = sqrt(a): the exact difference quotient
+  //    EA/2 (s0 + s1 - 2) / (s0 + s1) (no cancellation as a1 -> a0);
   //  - LINEAR bending: psi = EI c / 2 is linear: exact;
   //  - EXACT bending, psi = k (c A(a) - b^2 B(a)), k = EI / 2, A = a^-2,
   //    B = a^-3, by the discrete product rule
@@ -139,7 +149,8 @@ class AncfCableElement {
   //
   //   D = EA axial_s / 2 (d eps/dt)^2 + EI bending_s / 2 |d k/dt|^2,
   //
-  // d eps/dt = u.udot, k = u x w / |u|^3 the curvature vector (a scalar in
+  // d eps/dt = u.udot (engineering strain: u.udot / |u|, so its term is
+  // EA axial_s u u^T / |u|^2), k = u x w / |u|^3 the curvature vector (a scalar in
   // the plane; |k| is the EXACT model's curvature), so that
   // C = int B^T (EA axial_s u u^T + EI bending_s G^T G) B dx with
   // G = dk/d(u, w). This is exactly axial_s times the material part of the
@@ -204,6 +215,7 @@ class AncfCableElement {
   double ea_ = 0;
   double ei_ = 0;
   BendingModel bending_ = BendingModel::kExact;
+  AxialLaw axial_law_ = AxialLaw::kGreenLagrange;
   GaussRule rule_;
   // Shape-function derivatives at the Gauss points: d1_[g][k] = s_k'(x),
   // d2_[g][k] = s_k''(x), derivatives in x.

@@ -24,6 +24,11 @@ namespace cablesim {
 // AUTO: planar when the whole scene lies in the x-y plane (model_choice.h).
 enum class ModelChoice { kAuto, kPlanar, kSpatial };
 enum class BendingModel { kExact, kLinear, kNone };
+// The axial law (engine/elements/ancf_cable_element.h): the strain energy
+// EA/2 eps^2 of the Green-Lagrange strain eps = (|r'|^2 - 1) / 2, or of the
+// engineering strain e = |r'| - 1 (tension T = EA e, as mooring decks
+// mean their EA).
+enum class AxialLaw { kGreenLagrange, kEngineering };
 // kSlide: a body point kept on a cable, free to slide along it
 // (SlidingJoint; JointSpec::slide).
 enum class JointType { kPin, kFixed, kSlide };
@@ -68,6 +73,7 @@ struct CableSpec {
   double area_m2 = 0;
   double second_moment_m4 = 0;
   BendingModel bending = BendingModel::kExact;
+  AxialLaw axial_law = AxialLaw::kGreenLagrange;
   // Damping (MultibodyModel::DampingForce; 0: none). Kelvin-Voigt
   // retardation times [s]: axial stress E (eps + axial_damping_s deps/dt),
   // bending moment EI (kappa + bending_damping_s dkappa/dt). Rayleigh:

@@ -1,6 +1,6 @@
 // Fuzz target: a scene file's bytes through everything `cablesim validate`
-// does with them: strict JSON parsing (or text format), validation and
-// conversion, and building the model. Any input must end in a status, never
+// does with them: strict JSON parsing (or text format, or a MoorDyn deck),
+// validation and conversion, and building the model. Any input must end in a status, never
 // a crash, a sanitizer report or a hang.
 //
 // Built as a libFuzzer binary with clang (-DCABLESIM_FUZZ=ON), and in every
@@ -11,6 +11,7 @@
 #include <string_view>
 
 #include "absl/status/statusor.h"
+#include "convert/moordyn_deck.h"
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
 #include "engine/run/simulation.h"
@@ -41,5 +42,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   Check(cablesim::ParseSceneJson(text));
   Check(cablesim::ParseSceneTextFormat(text));
+  Check(cablesim::SceneFromMoorDyn(text, "fuzz.dat"));
   return 0;
 }

@@ -1,0 +1,810 @@
+#include "convert/moordyn_deck.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/strings/ascii.h"
+#include "absl/strings/match.h"
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+#include "absl/strings/str_split.h"
+#include "absl/strings/strip.h"
+#include "convert/scene_from_proto.h"
+
+namespace cablesim {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+using Eigen3 = std::array<double, 3>;  // a point [m]
+// A sagging line is laid this much longer than it is (a stretch).
+constexpr double kSagLayStretch = 1e-3;
+
+// MoorDyn's defaults (its MoorDyn2.cpp), used when OPTIONS omits them.
+constexpr double kDefaultGravity = 9.80665;
+constexpr double kDefaultDensity = 1025;
+constexpr double kDefaultKBot = 3.0e6;  // [Pa/m]
+constexpr double kDefaultCBot = 3.0e5;  // [Pa s/m]
+
+enum class Section {
+  kPreamble, kLineTypes, kRodTypes, kBodies, kRods, kPoints, kLines, kOptions, kOutputs,
+  kUnsupported, kEnd
+};
+
+struct LineType {
+  std::string name;
+  int line = 0;
+  double diameter = 0, mass_per_length = 0, ea = 0, ba = 0, ei = 0;
+  double cd = 0, ca = 0, cd_axial = 0, ca_axial = 0;
+};
+
+enum class PointKind { kFixed, kCoupled, kFree };
+
+struct Point {
+  int id = 0;
+  int line = 0;
+  PointKind kind = PointKind::kFixed;
+  double x = 0, y = 0, z = 0;
+  double mass = 0, volume = 0, cda = 0, ca = 0;
+};
+
+struct Line {
+  int id = 0;
+  int line = 0;
+  const LineType* type = nullptr;
+  int a = 0, b = 0;  // point ids
+  double length = 0;
+  int segments = 0;
+};
+
+struct Option {
+  double value = 0;
+  int line = 0;
+};
+
+class DeckReader {
+ public:
+  DeckReader(absl::string_view text, absl::string_view file_name)
+      : text_(text), file_(file_name) {}
+
+  absl::StatusOr<v1::Scene> Read() {
+    if (absl::Status s = Parse(); !s.ok()) return s;
+    absl::StatusOr<v1::Scene> scene = Build();
+    if (!scene.ok()) return scene;
+    // A value the deck allows but the scene's ranges refuse (a million
+    // segments, a density no material has): the scene's message, led by
+    // the deck's line it came from.
+    const absl::StatusOr<Scene> checked = SceneFromProto(*scene);
+    if (!checked.ok()) return Located(checked.status());
+    return scene;
+  }
+
+ private:
+  // A scene validation error (`cables[1].elements: ...`) led by the deck's
+  // line of what became that part of the scene: a line's LINES row (and
+  // its type's row), a free point's POINTS row, an option's row.
+  absl::Status Located(const absl::Status& status) const {
+    const absl::string_view m = status.message();
+    int line = 1;
+    std::string where;
+    int index = -1;
+    auto indexed = [&](absl::string_view prefix) {
+      if (!absl::StartsWith(m, prefix)) return false;
+      const absl::string_view rest = m.substr(prefix.size());
+      return absl::SimpleAtoi(rest.substr(0, rest.find(']')), &index);
+    };
+    if (indexed("cables[") && index >= 0 && index < static_cast<int>(lines_.size())) {
+      line = lines_[index].line;
+      where = absl::StrCat(" (its line type on line ", lines_[index].type->line, ")");
+    } else if (indexed("bodies[") && index >= 0 && index < static_cast<int>(body_points_.size())) {
+      line = body_points_[index];
+    } else {
+      for (const auto& [prefix, key] :
+           {std::pair{"seabed", "kbot"}, std::pair{"fluid", "rho"}, std::pair{"gravity", "g"}}) {
+        const auto it = options_.find(key);
+        if (absl::StartsWith(m, prefix) && it != options_.end()) line = it->second.line;
+      }
+    }
+    return absl::Status(status.code(), absl::StrCat(file_, ":", line, where, ": ", m));
+  }
+
+  absl::Status Error(int line, absl::string_view field, absl::string_view message) const {
+    return absl::InvalidArgumentError(absl::StrCat(file_, ":", line, ": ", field, ": ", message));
+  }
+
+  static Section SectionOf(std::string upper) {
+    // Words only: "---- LINE TYPES ----" -> "LINE TYPES".
+    for (char& c : upper)
+      if (c == '-' || c == '=') c = ' ';
+    std::vector<std::string> words = absl::StrSplit(upper, ' ', absl::SkipEmpty());
+    const std::string name = absl::StrJoin(words, " ");
+    if (absl::StrContains(name, "NEED THIS LINE") || name == "END") return Section::kEnd;
+    if (absl::StrContains(name, "MOORDYN")) return Section::kPreamble;
+    if (absl::StrContains(name, "LINE TYPE") || absl::StrContains(name, "LINE DICTIONARY"))
+      return Section::kLineTypes;
+    if (absl::StrContains(name, "ROD TYPE") || absl::StrContains(name, "ROD DICTIONARY"))
+      return Section::kRodTypes;
+    if (absl::StrContains(name, "BOD")) return Section::kBodies;
+    if (absl::StartsWith(name, "ROD")) return Section::kRods;
+    if (absl::StartsWith(name, "POINT") || absl::StartsWith(name, "CONNECTION") ||
+        absl::StartsWith(name, "NODE"))
+      return Section::kPoints;
+    if (absl::StartsWith(name, "LINE")) return Section::kLines;
+    if (absl::StrContains(name, "OPTIONS")) return Section::kOptions;  // also SOLVER OPTIONS
+    if (absl::StartsWith(name, "OUTPUT")) return Section::kOutputs;
+    return Section::kUnsupported;
+  }
+
+  absl::StatusOr<double> Number(int line, absl::string_view field, absl::string_view word) const {
+    double v = 0;
+    if (!absl::SimpleAtod(word, &v) || !std::isfinite(v)) {
+      return Error(line, field, absl::StrCat("\"", word, "\" is not a number"));
+    }
+    return v;
+  }
+  absl::StatusOr<double> NonNegative(int line, absl::string_view field,
+                                     absl::string_view word) const {
+    absl::StatusOr<double> v = Number(line, field, word);
+    if (v.ok() && *v < 0) return Error(line, field, absl::StrCat("must be >= 0 (got ", word, ")"));
+    return v;
+  }
+  absl::StatusOr<double> Positive(int line, absl::string_view field, absl::string_view word) const {
+    absl::StatusOr<double> v = Number(line, field, word);
+    if (v.ok() && !(*v > 0)) {
+      return Error(line, field, absl::StrCat("must be > 0 (got ", word, ")"));
+    }
+    return v;
+  }
+
+  absl::Status Parse() {
+    std::vector<absl::string_view> lines = absl::StrSplit(text_, '\n');
+    Section section = Section::kPreamble;
+    int skip = 0;  // column-name and unit lines still to skip
+    absl::string_view header;
+    for (size_t i = 0; i < lines.size(); ++i) {
+      const int n = static_cast<int>(i) + 1;
+      absl::string_view raw = absl::StripAsciiWhitespace(lines[i]);
+      if (absl::StartsWith(raw, "---")) {
+        section = SectionOf(absl::AsciiStrToUpper(raw));
+        header = raw;
+        if (section == Section::kEnd) break;
+        if (section == Section::kUnsupported) {
+          return Error(n, "section", absl::StrCat("\"", raw,
+                                                  "\" is not a section cablesim reads (it reads "
+                                                  "LINE TYPES, POINTS, LINES, OPTIONS, OUTPUTS)"));
+        }
+        // Tables start with a line of column names and one of units.
+        const bool table = section == Section::kLineTypes || section == Section::kRodTypes ||
+                           section == Section::kBodies || section == Section::kRods ||
+                           section == Section::kPoints || section == Section::kLines;
+        skip = table ? 2 : 0;
+        continue;
+      }
+      if (raw.empty() || section == Section::kPreamble) continue;
+      if (skip > 0) {
+        --skip;
+        continue;
+      }
+      std::vector<absl::string_view> w = absl::StrSplit(raw, absl::ByAnyChar(" \t"),
+                                                      absl::SkipEmpty());
+      // A word starting with '#' starts a comment.
+      for (size_t k = 0; k < w.size(); ++k)
+        if (absl::StartsWith(w[k], "#")) {
+          w.resize(k);
+          break;
+        }
+      if (w.empty()) continue;
+      absl::Status s;
+      switch (section) {
+        case Section::kLineTypes: s = ParseLineType(n, w); break;
+        case Section::kPoints: s = ParsePoint(n, w); break;
+        case Section::kLines: s = ParseLine(n, w); break;
+        case Section::kOptions: s = ParseOption(n, w); break;
+        case Section::kOutputs: s = ParseOutput(n, w); break;
+        case Section::kRodTypes:
+        case Section::kRods:
+          s = Error(n, "rods", "MoorDyn rods (rigid or pinned cylinders) are not read yet");
+          break;
+        case Section::kBodies:
+          s = Error(n, "bodies",
+                    "MoorDyn bodies are not read yet (give the points as Fixed, Vessel or Free)");
+          break;
+        default: break;
+      }
+      if (!s.ok()) return s;
+    }
+    if (line_types_.empty()) return Error(1, "LINE TYPES", "the deck defines no line type");
+    if (lines_.empty()) return Error(1, "LINES", "the deck defines no line");
+    return absl::OkStatus();
+  }
+
+  absl::Status ParseLineType(int n, const std::vector<absl::string_view>& w) {
+    static constexpr const char* kColumns[] = {"TypeName", "Diam", "Mass/m", "EA", "BA/-zeta",
+                                               "EI", "Cd", "Ca", "CdAx", "CaAx"};
+    if (w.size() < 10 || w.size() > 13) {
+      return Error(n, "LINE TYPES",
+                   absl::StrCat("expected the 10 columns TypeName Diam Mass/m EA BA/-zeta EI Cd "
+                                "Ca CdAx CaAx (and MoorDyn's optional Cl dF cF), got ",
+                                w.size()));
+    }
+    // MoorDyn's 11th to 13th columns: the vortex-induced vibration's lift
+    // coefficient and its synchronisation range and centre (which act only
+    // with a lift coefficient).
+    if (w.size() > 10) {
+      double cl = 0;
+      if (!absl::SimpleAtod(w[10], &cl) || cl != 0) {
+        return Error(n, "LINE TYPES Cl",
+                     absl::StrCat("\"", w[10],
+                                  "\": vortex-induced vibration (a lift coefficient) cannot be "
+                                  "expressed yet (0 only)"));
+      }
+    }
+    LineType t;
+    t.name = std::string(w[0]);
+    t.line = n;
+    for (const LineType& o : line_types_)
+      if (o.name == t.name)
+        return Error(n, "LINE TYPES TypeName",
+                     absl::StrCat("\"", t.name, "\" already defined on line ", o.line));
+    auto col = [&](int k) { return absl::StrCat("LINE TYPES ", kColumns[k]); };
+    double v = 0;
+    // Column k into *out, > 0 (positive) or >= 0.
+    auto column = [&](int k, bool positive, double* out) -> absl::Status {
+      absl::StatusOr<double> r =
+          positive ? Positive(n, col(k), w[k]) : NonNegative(n, col(k), w[k]);
+      if (!r.ok()) return r.status();
+      *out = *r;
+      return absl::OkStatus();
+    };
+    if (absl::Status s = column(1, true, &t.diameter); !s.ok()) return s;
+    if (absl::Status s = column(2, true, &t.mass_per_length); !s.ok()) return s;
+    if (!absl::SimpleAtod(w[3], &v)) {
+      return Error(n, col(3),
+                   absl::StrCat("\"", w[3],
+                                "\": only a constant EA can be expressed (a tension-strain table "
+                                "or a viscoelastic law is not supported yet)"));
+    }
+    if (absl::Status s = column(3, true, &t.ea); !s.ok()) return s;
+    if (!absl::SimpleAtod(w[4], &v)) {
+      return Error(n, col(4),
+                   absl::StrCat("\"", w[4],
+                                "\": only one number, a damping coefficient [N s] or a negative "
+                                "damping ratio, can be expressed"));
+    }
+    if (absl::StatusOr<double> r = Number(n, col(4), w[4]); r.ok()) {
+      t.ba = *r;
+    } else {
+      return r.status();
+    }
+    if (!absl::SimpleAtod(w[5], &v)) {
+      return Error(n, col(5), absl::StrCat("\"", w[5], "\": only a constant EI can be expressed"));
+    }
+    if (absl::Status s = column(5, false, &t.ei); !s.ok()) return s;
+    if (absl::Status s = column(6, false, &t.cd); !s.ok()) return s;
+    if (absl::Status s = column(7, false, &t.ca); !s.ok()) return s;
+    if (absl::Status s = column(8, false, &t.cd_axial); !s.ok()) return s;
+    if (absl::Status s = column(9, false, &t.ca_axial); !s.ok()) return s;
+    line_types_.push_back(t);
+    return absl::OkStatus();
+  }
+
+  absl::Status ParsePoint(int n, const std::vector<absl::string_view>& w) {
+    static constexpr const char* kColumns[] = {"ID", "Type", "X", "Y", "Z",
+                                               "Mass", "Volume", "CdA", "Ca"};
+    if (w.size() != 9) {
+      return Error(n, "POINTS",
+                   absl::StrCat("expected the 9 columns ID Type X Y Z Mass Volume CdA Ca, got ",
+                                w.size()));
+    }
+    auto col = [&](int k) { return absl::StrCat("POINTS ", kColumns[k]); };
+    Point p;
+    p.line = n;
+    if (!absl::SimpleAtoi(w[0], &p.id)) {
+      return Error(n, col(0), absl::StrCat("\"", w[0], "\" is not a whole number"));
+    }
+    if (points_.count(p.id)) {
+      return Error(n, col(0), absl::StrCat("point ", p.id, " already defined on line ",
+                                           points_[p.id].line));
+    }
+    const std::string type = absl::AsciiStrToLower(w[1]);
+    if (type == "fixed" || type == "fix" || type == "anchor") {
+      p.kind = PointKind::kFixed;
+    } else if (type == "vessel" || type == "vess" || type == "coupled" || type == "cpld" ||
+               type == "fairlead") {
+      p.kind = PointKind::kCoupled;
+    } else if (type == "free" || type == "connect" || type == "con" || type == "point") {
+      p.kind = PointKind::kFree;
+    } else if (absl::StartsWith(type, "body") || absl::StartsWith(type, "b") ||
+               absl::StartsWith(type, "turbine")) {
+      return Error(n, col(1), absl::StrCat("\"", w[1],
+                                           "\": points on MoorDyn bodies or turbines are not "
+                                           "read yet"));
+    } else {
+      return Error(n, col(1), absl::StrCat("unknown point type \"", w[1],
+                                           "\" (Fixed, Vessel, Coupled or Free)"));
+    }
+    double* values[] = {&p.x, &p.y, &p.z, &p.mass, &p.volume, &p.cda, &p.ca};
+    for (int k = 2; k < 9; ++k) {
+      absl::StatusOr<double> v = k < 5 ? Number(n, col(k), w[k]) : NonNegative(n, col(k), w[k]);
+      if (!v.ok()) return v.status();
+      *values[k - 2] = *v;
+    }
+    points_[p.id] = p;
+    return absl::OkStatus();
+  }
+
+  absl::StatusOr<int> PointRef(int n, absl::string_view field, absl::string_view word) const {
+    absl::string_view id = word;
+    if (absl::StartsWithIgnoreCase(id, "point")) {
+      id.remove_prefix(5);
+    } else if (absl::StartsWithIgnoreCase(id, "p")) {
+      id.remove_prefix(1);
+    }
+    int k = 0;
+    if (!absl::SimpleAtoi(id, &k)) {
+      return Error(n, field, absl::StrCat("\"", word,
+                                          "\": only points can be line ends (rods and bodies "
+                                          "are not read yet)"));
+    }
+    if (!points_.count(k)) {
+      return Error(n, field, absl::StrCat("point ", k, " does not exist (define it in POINTS "
+                                          "before the LINES section)"));
+    }
+    return k;
+  }
+
+  absl::Status ParseLine(int n, const std::vector<absl::string_view>& w) {
+    if (w.size() != 6 && w.size() != 7) {
+      return Error(n, "LINES",
+                   absl::StrCat("expected the columns ID LineType AttachA AttachB UnstrLen "
+                                "NumSegs [LineOutputs], got ",
+                                w.size()));
+    }
+    Line l;
+    l.line = n;
+    if (!absl::SimpleAtoi(w[0], &l.id)) {
+      return Error(n, "LINES ID", absl::StrCat("\"", w[0], "\" is not a whole number"));
+    }
+    for (const Line& o : lines_)
+      if (o.id == l.id)
+        return Error(n, "LINES ID", absl::StrCat("line ", l.id, " already defined on line ",
+                                                 o.line));
+    for (const LineType& t : line_types_)
+      if (t.name == w[1]) l.type = &t;
+    if (l.type == nullptr) {
+      return Error(n, "LINES LineType", absl::StrCat("unknown line type \"", w[1], "\""));
+    }
+    absl::StatusOr<int> a = PointRef(n, "LINES AttachA", w[2]);
+    if (!a.ok()) return a.status();
+    absl::StatusOr<int> b = PointRef(n, "LINES AttachB", w[3]);
+    if (!b.ok()) return b.status();
+    if (*a == *b) return Error(n, "LINES AttachB", "a line cannot start and end at one point");
+    l.a = *a;
+    l.b = *b;
+    absl::StatusOr<double> length = Positive(n, "LINES UnstrLen", w[4]);
+    if (!length.ok()) return length.status();
+    l.length = *length;
+    if (!absl::SimpleAtoi(w[5], &l.segments) || l.segments < 1) {
+      return Error(n, "LINES NumSegs",
+                   absl::StrCat("must be a whole number >= 1 (got ", w[5], ")"));
+    }
+    lines_.push_back(l);
+    return absl::OkStatus();
+  }
+
+  absl::Status ParseOption(int n, const std::vector<absl::string_view>& w) {
+    if (w.size() < 2) {
+      return Error(n, "OPTIONS", "expected a value and an option name");
+    }
+    const std::string name = absl::AsciiStrToLower(w[1]);
+    const std::string field = absl::StrCat("OPTIONS ", w[1]);
+    // Options about MoorDyn's own run (its time step and integrator, how
+    // it searches for the initial condition, its log and output files):
+    // they do not change the equilibrium the scene solves, and cablesim's
+    // STATIC analysis (Newton) has no counterpart (docs/moordyn-files.md).
+    static const char* const kNoEffect[] = {
+        "dtm", "dt", "cfl", "tscheme", "writelog", "writeunits", "disableoutput",
+        "disableouttime", "dtout", "dtic", "icdt", "tmaxic", "ictmax", "cdscaleic", "icdfac",
+        "threshic", "icthresh", "icgendynamic", "gendynamicic", "fileic", "icfile", "echo",
+        "dtwave", "fricdamp", "cv", "unifycurrentgrid"};
+    for (const char* k : kNoEffect)
+      if (name == k) return absl::OkStatus();
+    // Names of the translated options and their MoorDyn synonyms.
+    static const std::map<std::string, std::string> kTranslated = {
+        {"g", "g"},          {"gravity", "g"},     {"rho", "rho"},
+        {"wtrdnsty", "rho"}, {"wtrdpth", "depth"}, {"kbot", "kbot"},
+        {"kb", "kbot"},      {"cbot", "cbot"},     {"cb", "cbot"},
+        {"frictioncoefficient", "mu"}, {"mu_kt", "mu_t"}, {"mu_ka", "mu_a"},
+        {"wavekin", "wavekin"}, {"currents", "currents"}, {"statdynfricscale", "mc"},
+        {"mc", "mc"}, {"seafloorfile", "seafloor"}};
+    const auto it = kTranslated.find(name);
+    if (it == kTranslated.end()) {
+      return Error(n, field, "an option cablesim does not know (nothing is dropped: remove it or "
+                             "ask for its translation)");
+    }
+    const std::string& key = it->second;
+    if (key == "seafloor") {
+      return Error(n, field, "a seafloor file (bathymetry) is not read yet");
+    }
+    absl::StatusOr<double> v = Number(n, field, w[0]);
+    if (!v.ok()) return v.status();
+    if (key == "wavekin" || key == "currents") {
+      if (*v != 0) {
+        return Error(n, field, "MoorDyn's wave and current kinematics inputs are not read yet "
+                               "(0 only)");
+      }
+      return absl::OkStatus();
+    }
+    if (key == "mc") {
+      if (*v != 1) {
+        return Error(n, field, "static friction above the kinetic one cannot be expressed "
+                               "(cablesim's friction is Coulomb's, one coefficient: 1 only)");
+      }
+      return absl::OkStatus();
+    }
+    if (key == "g" || key == "rho" || key == "depth" || key == "kbot") {
+      if (!(*v > 0)) return Error(n, field, absl::StrCat("must be > 0 (got ", w[0], ")"));
+    } else if (*v < 0) {
+      return Error(n, field, absl::StrCat("must be >= 0 (got ", w[0], ")"));
+    }
+    options_[key] = Option{*v, n};
+    return absl::OkStatus();
+  }
+
+  absl::Status ParseOutput(int n, const std::vector<absl::string_view>& w) {
+    for (absl::string_view channel : w) {
+      for (absl::string_view c : absl::StrSplit(channel, ',', absl::SkipEmpty())) {
+        const std::string lower = absl::AsciiStrToLower(c);
+        if (absl::StartsWith(lower, "fairten") || absl::StartsWith(lower, "anchten") ||
+            absl::StrContains(lower, "ten")) {
+          return Error(n, absl::StrCat("OUTPUTS ", c),
+                       "tension channels cannot be expressed yet (cablesim reports a support's "
+                       "force only where it moves: docs/moordyn-files.md)");
+        }
+        // Point<n> position channels: Point<n>Px, PointnPy, PointnPz.
+        absl::string_view rest = c;
+        if (absl::ConsumePrefix(&rest, "Point") || absl::ConsumePrefix(&rest, "point") ||
+            absl::ConsumePrefix(&rest, "POINT")) {
+          const size_t digits = rest.find_first_not_of("0123456789");
+          int id = 0;
+          if (digits != 0 && digits != absl::string_view::npos &&
+              absl::SimpleAtoi(rest.substr(0, digits), &id) &&
+              absl::EqualsIgnoreCase(rest.substr(digits, 1), "p") && rest.size() == digits + 2) {
+            if (!points_.count(id)) {
+              return Error(n, absl::StrCat("OUTPUTS ", c), absl::StrCat("point ", id,
+                                                                        " does not exist"));
+            }
+            if (std::find(probe_points_.begin(), probe_points_.end(), id) == probe_points_.end())
+              probe_points_.push_back(id);
+            continue;
+          }
+        }
+        return Error(n, absl::StrCat("OUTPUTS ", c),
+                     "only point positions (Point<n>Px, Py, Pz) are translated (as probes)");
+      }
+    }
+    return absl::OkStatus();
+  }
+
+  double OptionOr(const std::string& key, double fallback) const {
+    const auto it = options_.find(key);
+    return it == options_.end() ? fallback : it->second.value;
+  }
+
+  static void SetVec(v1::Vec3* v, double x, double y, double z) {
+    v->set_x(x);
+    v->set_y(y);
+    v->set_z(z);
+  }
+
+  // The polyline a line is laid along at the start of the static solve:
+  // straight when taut, else with one corner below the chord (on the
+  // seabed when an end lies on it or the corner of the symmetric sag would
+  // lie below it), so that its length is the unstretched length (a free
+  // sag: stretched by kSagLayStretch).
+  std::vector<Eigen3> Layout(const Point& a, const Point& b, double length, double depth) const {
+    const Eigen3 pa{a.x, a.y, a.z}, pb{b.x, b.y, b.z};
+    const double span = Dist(pa, pb);
+    if (length <= span * (1 + 1e-9)) return {pa, pb};
+    // The sag, laid 0.1 % longer than the line: a line hanging free from
+    // a kink with no tension has no stiffness across it at the first load
+    // increment (measured: MoorDyn's local_euler/hanging.txt failed there;
+    // 0.01 % still failed), a little tension gives it some.
+    const double laid = length * (1 + kSagLayStretch);
+    // Both ends at one place: a square loop below them (scene polylines
+    // may turn by at most 135 degrees at a corner).
+    if (span < 1e-9 * length) {
+      const double q = laid / 4;
+      return {pa, {pa[0], pa[1], pa[2] - q}, {pa[0] + q, pa[1], pa[2] - q},
+              {pa[0] + q, pa[1], pa[2]}, pb};
+    }
+    // "Down": the unit vector across the chord in its vertical plane,
+    // pointing down (straight down for a horizontal chord; beside a
+    // vertical chord, along x).
+    const Eigen3 chord{(pb[0] - pa[0]) / span, (pb[1] - pa[1]) / span, (pb[2] - pa[2]) / span};
+    Eigen3 down{chord[2] * chord[0], chord[2] * chord[1], chord[2] * chord[2] - 1};
+    const double dn = std::sqrt(down[0] * down[0] + down[1] * down[1] + down[2] * down[2]);
+    if (dn > 1e-12) {
+      for (double& x : down) x /= dn;
+    } else {
+      down = {1, 0, 0};
+    }
+    // A V (one corner below the midpoint) while its corner turns by at
+    // most 120 degrees, else a U (two right-angled corners, the ends
+    // moved down by the same distance) for a very slack line.
+    const double h = std::sqrt(std::max(0.0, laid * laid - span * span)) / 2;
+    std::vector<Eigen3> sag;
+    Eigen3 corner{(pa[0] + pb[0]) / 2, (pa[1] + pb[1]) / 2, (pa[2] + pb[2]) / 2};
+    if (std::atan2(span / 2, h) >= kPi / 6) {
+      for (int d = 0; d < 3; ++d) corner[d] += h * down[d];
+      sag = {pa, corner, pb};
+    } else {
+      const double u = (laid - span) / 2;
+      Eigen3 ca = pa, cb = pb;
+      for (int d = 0; d < 3; ++d) {
+        ca[d] += u * down[d];
+        cb[d] += u * down[d];
+      }
+      sag = {pa, ca, cb, pb};
+      corner = ca[2] < cb[2] ? ca : cb;
+    }
+    // An end on the bed (an anchor, within 1 % of the depth) lays the line
+    // along the bed first, as a catenary mooring lies: a sag hanging free
+    // from it has no tension to hold its kink at the start of the solve
+    // (measured: the 600 m chain case's first load increment failed so).
+    const bool a_low = pa[2] <= pb[2];
+    const Eigen3& low = a_low ? pa : pb;
+    const Eigen3& high = a_low ? pb : pa;
+    const bool anchored = low[2] <= -depth + 0.01 * depth;
+    if (corner[2] >= -depth && !anchored) return sag;
+    // On the seabed: the corner at z = -depth on the horizontal path from
+    // a to b, where the two legs add up to the length (bisection: the sum
+    // grows with the corner's distance from the end nearer the bed).
+    auto corner_at = [&](double t) {
+      return Eigen3{low[0] + t * (high[0] - low[0]), low[1] + t * (high[1] - low[1]), -depth};
+    };
+    auto legs = [&](double t) {
+      const Eigen3 c = corner_at(t);
+      return Dist(low, c) + Dist(c, high);
+    };
+    double lo = 0, hi = 1;
+    // Too short to reach the bed as an L, or one end above the other (the
+    // legs' sum does not grow along the bed): the sag.
+    const double run = std::hypot(high[0] - low[0], high[1] - low[1]);
+    if (legs(0) > length || run < 1e-9 * length) return sag;
+    while (legs(hi) < length) hi *= 2;  // grows by about run per doubling: ends
+    for (int k = 0; k < 200; ++k) {
+      const double t = (lo + hi) / 2;
+      (legs(t) < length ? lo : hi) = t;
+    }
+    // Beyond the higher end: the rising leg would fold back; the sag.
+    if ((lo + hi) / 2 > 1) return sag;
+    const Eigen3 c = corner_at((lo + hi) / 2);
+    if (Dist(low, c) < 1e-9 * length || Dist(high, c) < 1e-9 * length) return {pa, pb};
+    return {pa, c, pb};
+  }
+  static double Dist(const Eigen3& p, const Eigen3& q) {
+    return std::sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+                     (p[2] - q[2]) * (p[2] - q[2]));
+  }
+
+  absl::StatusOr<v1::Scene> Build() const {
+    v1::Scene scene;
+    absl::string_view base = file_;
+    if (const size_t slash = base.find_last_of('/'); slash != absl::string_view::npos)
+      base.remove_prefix(slash + 1);
+    if (const size_t dot = base.find_last_of('.'); dot != absl::string_view::npos && dot > 0)
+      base = base.substr(0, dot);
+    scene.set_name(std::string(base));
+    const double g = OptionOr("g", kDefaultGravity);
+    const double rho = OptionOr("rho", kDefaultDensity);
+    SetVec(scene.mutable_gravity(), 0, 0, -g);
+    scene.mutable_fluid()->set_density(rho);
+    const auto depth_it = options_.find("depth");
+    if (depth_it == options_.end()) {
+      return Error(1, "OPTIONS WtrDpth",
+                   "required (MoorDyn's default of 0 puts the seabed at the water surface)");
+    }
+    const double depth = depth_it->second.value;
+    scene.mutable_fluid()->set_water_depth(depth);
+
+    // The seabed: kBot [Pa/m] and cBot [Pa s/m] act on the line's
+    // diameter, cablesim's per unit length: one value per scene, so every
+    // line type must share a diameter (else refused).
+    const double d0 = line_types_.front().diameter;
+    for (const LineType& t : line_types_) {
+      if (std::abs(t.diameter - d0) > 1e-12 * d0) {
+        const auto k = options_.find("kbot");
+        return Error(k != options_.end() ? k->second.line : t.line, "OPTIONS kBot",
+                     absl::StrCat("line types \"", line_types_.front().name, "\" and \"", t.name,
+                                  "\" differ in diameter, and cablesim's seabed has one "
+                                  "stiffness per unit length (kBot times the diameter) per scene"));
+      }
+    }
+    v1::Seabed* bed = scene.mutable_seabed();
+    bed->set_depth(depth);
+    bed->set_stiffness(OptionOr("kbot", kDefaultKBot) * d0);
+    bed->set_damping(OptionOr("cbot", kDefaultCBot) * d0);
+    const double mu = OptionOr("mu", 0);
+    bed->set_friction_axial(OptionOr("mu_a", mu));
+    bed->set_friction_transverse(OptionOr("mu_t", mu));
+    scene.mutable_solver()->set_analysis(v1::STATIC);
+
+    // The points where free points become bodies (mass or volume) or where
+    // line ends join each other.
+    std::map<int, std::string> body_of;
+    for (const auto& [id, p] : points_) {
+      if (p.kind != PointKind::kFree) continue;
+      if (p.mass == 0 && p.volume == 0 && p.cda == 0 && p.ca == 0) continue;
+      if (!(p.mass > 0)) {
+        return Error(p.line, "POINTS Mass",
+                     "a free point with volume, drag or added mass needs a mass > 0 (cablesim's "
+                     "bodies have mass)");
+      }
+      if (p.volume == 0 && (p.cda > 0 || p.ca > 0)) {
+        return Error(p.line, "POINTS Volume",
+                     "a free point with drag (CdA) or added mass (Ca) needs a volume > 0 (it "
+                     "sizes the body's fluid loads)");
+      }
+      v1::Body* body = scene.add_bodies();
+      body_points_.push_back(p.line);
+      const std::string name = absl::StrCat("point", id);
+      body->set_name(name);
+      body_of[id] = name;
+      body->set_mass(p.mass);
+      // The lines hold the body at its centre, so its rotation is free and
+      // unloaded; a sphere of its volume (or of 0.1 m) gives it inertia.
+      const double r = p.volume > 0 ? std::cbrt(3 * p.volume / (4 * kPi)) : 0.1;
+      const double inertia = 0.4 * p.mass * r * r;
+      SetVec(body->mutable_inertia(), inertia, inertia, inertia);
+      SetVec(body->mutable_position(), p.x, p.y, p.z);
+      if (p.volume > 0) {
+        // A vertical cylinder as tall as wide with the point's volume.
+        const double d = std::cbrt(4 * p.volume / kPi);
+        v1::BodyHydrodynamics* h = body->mutable_hydrodynamics();
+        h->set_diameter(d);
+        h->set_height(d);
+        h->set_drag_coefficient(p.cda / (d * d));
+        h->set_heave_drag_coefficient(p.cda / (kPi * d * d / 4));
+        h->set_added_mass(p.ca);
+        h->set_heave_added_mass(p.ca);
+      }
+    }
+
+    std::map<int, std::pair<std::string, double>> first_end_at;  // free point -> (cable, s)
+    for (const Line& l : lines_) {
+      const LineType& t = *l.type;
+      v1::Cable* c = scene.add_cables();
+      const std::string name = absl::StrCat("line", l.id);
+      c->set_name(name);
+      const Point& a = points_.at(l.a);
+      const Point& b = points_.at(l.b);
+      for (const Eigen3& p : Layout(a, b, l.length, depth))
+        SetVec(c->add_points(), p[0], p[1], p[2]);
+      c->set_length(l.length);
+      c->set_elements(l.segments);
+      const double area = kPi * t.diameter * t.diameter / 4;
+      c->set_area(area);
+      c->set_density(t.mass_per_length / area);
+      c->set_youngs_modulus(t.ea / area);
+      if (t.ei > 0) {
+        c->set_bending(v1::EXACT);
+        c->set_second_moment(t.ei / (t.ea / area));
+      } else {
+        c->set_bending(v1::NONE);
+      }
+      c->set_axial_law(v1::ENGINEERING);
+      // BA: a coefficient [N s] on the strain rate, or minus a damping
+      // ratio of a segment's axial mode (MoorDyn: BA = zeta (L / N)
+      // sqrt(EA m)); cablesim's Kelvin-Voigt time is BA / EA.
+      const double ba =
+          t.ba < 0 ? -t.ba * (l.length / l.segments) * std::sqrt(t.ea * t.mass_per_length) : t.ba;
+      if (ba > 0) c->mutable_damping()->set_axial_time(ba / t.ea);
+      v1::Hydrodynamics* h = c->mutable_hydrodynamics();
+      h->set_normal_drag(t.cd);
+      h->set_tangential_drag(t.cd_axial);
+      h->set_added_mass(t.ca);
+      h->set_diameter(t.diameter);
+      for (const auto& [end, pid] : {std::pair{0.0, l.a}, std::pair{l.length, l.b}}) {
+        const Point& p = points_.at(pid);
+        if (p.kind != PointKind::kFree) {
+          v1::Joint* j = scene.add_joints();
+          j->set_type(v1::PIN);
+          j->mutable_a()->set_cable(name);
+          j->mutable_a()->set_s(end);
+          continue;
+        }
+        if (const auto body = body_of.find(pid); body != body_of.end()) {
+          v1::Joint* j = scene.add_joints();
+          j->set_type(v1::PIN);
+          j->mutable_a()->set_cable(name);
+          j->mutable_a()->set_s(end);
+          j->mutable_b()->set_body(body->second);
+          continue;
+        }
+        // A massless connection: the ends that meet there are pinned to
+        // the first one.
+        const auto first = first_end_at.find(pid);
+        if (first == first_end_at.end()) {
+          first_end_at[pid] = {name, end};
+          continue;
+        }
+        v1::Joint* j = scene.add_joints();
+        j->set_type(v1::PIN);
+        j->mutable_a()->set_cable(name);
+        j->mutable_a()->set_s(end);
+        j->mutable_b()->set_cable(first->second.first);
+        j->mutable_b()->set_s(first->second.second);
+      }
+    }
+    for (int id : probe_points_) {
+      const Point& p = points_.at(id);
+      v1::Probe* probe = scene.add_probes();
+      probe->set_name(absl::StrCat("Point", id));
+      if (const auto body = body_of.find(id); body != body_of.end()) {
+        probe->set_body(body->second);
+        continue;
+      }
+      // On the first line end at the point.
+      bool found = false;
+      for (const Line& l : lines_) {
+        if (l.a != id && l.b != id) continue;
+        probe->set_cable(absl::StrCat("line", l.id));
+        probe->set_s(l.a == id ? 0.0 : l.length);
+        found = true;
+        break;
+      }
+      if (!found) {
+        return Error(p.line, "POINTS ID",
+                     absl::StrCat("point ", id, " has an output channel but no line"));
+      }
+    }
+    return scene;
+  }
+
+  absl::string_view text_;
+  std::string file_;
+  std::vector<LineType> line_types_;
+  std::map<int, Point> points_;
+  std::vector<Line> lines_;
+  std::map<std::string, Option> options_;
+  std::vector<int> probe_points_;
+  // The POINTS row of each body Build made, in scene order (for Located).
+  mutable std::vector<int> body_points_;
+};
+
+}  // namespace
+
+absl::StatusOr<v1::Scene> SceneFromMoorDyn(std::string_view text, std::string_view file_name) {
+  return DeckReader(absl::string_view(text.data(), text.size()),
+                    absl::string_view(file_name.data(), file_name.size()))
+      .Read();
+}
+
+bool IsMoorDynDeck(std::string_view path_std, std::string_view text_std) {
+  const absl::string_view path(path_std.data(), path_std.size());
+  const absl::string_view text(text_std.data(), text_std.size());
+  if (absl::EndsWithIgnoreCase(path, ".dat")) return true;
+  if (absl::EndsWith(path, ".json") || absl::EndsWith(path, ".txtpb") ||
+      absl::EndsWith(path, ".textproto") || absl::EndsWith(path, ".pbtxt"))
+    return false;
+  const absl::string_view start = absl::StripLeadingAsciiWhitespace(text);
+  if (absl::StartsWith(start, "{")) return false;
+  for (absl::string_view line : absl::StrSplit(text, '\n')) {
+    line = absl::StripAsciiWhitespace(line);
+    if (!absl::StartsWith(line, "---")) continue;
+    const std::string upper = absl::AsciiStrToUpper(line);
+    if (absl::StrContains(upper, "LINE TYPES") || absl::StrContains(upper, "LINE DICTIONARY"))
+      return true;
+  }
+  return false;
+}
+
+}  // namespace cablesim
