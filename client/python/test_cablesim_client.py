@@ -64,6 +64,46 @@ class ClientTest(unittest.TestCase):
         with open(png, "rb") as f:
             self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
 
+    def test_reactions_tensions_and_the_csv_loader(self):
+        """Reactions and tensions by name, and load_csv reading the CLI's CSV
+        into the same Result (the numbers are checked against closed forms
+        in tests/joint_reactions_test.cc and cable_tension_test.cc)."""
+        import cablesim
+        scene = self.scene()
+        scene.solver.duration = 0.02
+        scene.joints[0].name = "pin"
+        scene.output.reactions = True
+        scene.output.tension = True
+        result = cablesim_client.run(self.stub, scene)
+        self.assertEqual(result.summary.status, "ok")
+        self.assertEqual(list(result.info.joint_names), ["pin"])
+        force = result.reaction("pin")
+        self.assertEqual(force.shape, (21, 3))
+        np.testing.assert_array_equal(force, result.reaction(0))
+        np.testing.assert_array_equal(force[:, 1], result["joints[0].fy"])
+        # The pin holds the beam up while it falls: the vertical force on
+        # the beam is upward and below the beam's weight.
+        weight = -scene.gravity.y * scene.cables[0].density * scene.cables[0].area \
+            * scene.cables[0].length if scene.cables[0].area else None
+        self.assertTrue(np.all(force[1:, 1] > 0), force[:, 1])
+        if weight:
+            self.assertTrue(np.all(force[1:, 1] < weight), (force[:, 1], weight))
+        # The free tip carries no axial force.
+        self.assertLess(np.max(np.abs(result.tension("tip"))), 1e-6 * np.max(np.abs(force)))
+        with self.assertRaises(KeyError):
+            result.reaction("no-such-joint")
+        scene_path = os.path.join(self.tmp.name, "reactions.json")
+        csv_path = os.path.join(self.tmp.name, "reactions.csv")
+        from google.protobuf import json_format
+        with open(scene_path, "w") as f:
+            f.write(json_format.MessageToJson(scene))
+        subprocess.run([os.path.join(BIN, "cablesim"), "run", scene_path, "--out", csv_path],
+                       check=True, stdout=subprocess.DEVNULL)
+        loaded = cablesim.load_csv(csv_path)
+        self.assertEqual(loaded.columns, result.columns)
+        np.testing.assert_array_equal(loaded.data, result.data)
+        np.testing.assert_array_equal(loaded.reaction(0), force)
+
     def test_job_keeps_the_streamed_trajectory(self):
         scene = self.scene()
         streamed = cablesim_client.run(self.stub, scene)

@@ -23,7 +23,7 @@ _LAZY = {
     "animate": "cablesim.animation",
     "Client": "cablesim.client", "open_channel": "cablesim.client", "read_token": "cablesim.client",
     "Energy": "cablesim.results", "Job": "cablesim.results", "Record": "cablesim.results",
-    "Result": "cablesim.results", "SweepResult": "cablesim.results",
+    "Result": "cablesim.results", "SweepResult": "cablesim.results", "load_csv": "cablesim.results",
     "load_scene": "cablesim.scenes", "scene_to_dict": "cablesim.scenes",
 }
 
@@ -41,4 +41,4 @@ def __getattr__(name):
 
 
 __all__ = ["animate", "Client", "Energy", "Error", "Job", "Record", "Result", "SceneError",
-           "SweepResult", "load_scene", "open_channel", "read_token", "scene_to_dict"]
+           "SweepResult", "load_csv", "load_scene", "open_channel", "read_token", "scene_to_dict"]

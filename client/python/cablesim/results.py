@@ -89,6 +89,33 @@ class Result:
         """The trajectory as a pandas DataFrame with the same columns."""
         return _pandas().DataFrame(self.data, columns=self.columns)
 
+    def _joint(self, joint) -> int:
+        if isinstance(joint, int):
+            return joint
+        names = list(self.info.get("joint_names", []) if isinstance(self.info, dict) else [])
+        if joint not in names:
+            raise KeyError("no joint named %r (joint names: %s)" % (joint, ", ".join(names)))
+        return names.index(joint)
+
+    def reaction(self, joint) -> np.ndarray:
+        """The force [N] joint `joint` (its index in the scene, or its name)
+        carries, frames x 3: the columns joints[i].fx, .fy, .fz that a scene
+        with `output.reactions: true` adds (the force the joint exerts on
+        the cable or body it holds)."""
+        i = self._joint(joint)
+        return np.column_stack([self.column("joints[%d].f%s" % (i, c)) for c in "xyz"])
+
+    def reaction_moment(self, joint) -> np.ndarray:
+        """The moment [N m] a FIXED joint carries about its point, frames x 3
+        (joints[i].mx, .my, .mz)."""
+        i = self._joint(joint)
+        return np.column_stack([self.column("joints[%d].m%s" % (i, c)) for c in "xyz"])
+
+    def tension(self, probe: str) -> np.ndarray:
+        """The axial force [N] at a cable probe (NAME.tension, with
+        `output.tension: true`; compression is negative)."""
+        return self.column(probe + ".tension")
+
     def cable_nodes(self, cable: int) -> np.ndarray:
         """The positions [m] of cable `cable`'s nodes (its index in the scene)
         in every frame, frames x nodes x 3: the columns cables[i].nodes[k].x,
@@ -128,6 +155,24 @@ class Result:
         fig.tight_layout()
         fig.savefig(png_path, dpi=100)
         plt.close(fig)
+
+
+def load_csv(path: str) -> Result:
+    """Reads the CSV of `cablesim run SCENE --out FILE.csv` (or `watch
+    --out`) into a Result with the same columns and numbers as the service
+    streams them (17 significant digits read back exactly). `info` and
+    `summary` are empty: the CSV carries the frames only."""
+    with open(path) as f:
+        columns = f.readline().strip().split(",")
+    if columns == [""]:
+        raise ValueError("%s: empty file, not a cablesim CSV" % path)
+    data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    if data.size == 0:
+        data = np.zeros((0, len(columns)))
+    if data.shape[1] != len(columns):
+        raise ValueError("%s: %d columns in the header, %d in the rows"
+                         % (path, len(columns), data.shape[1]))
+    return Result(columns=columns, data=data, info=Record(), summary=Record())
 
 
 def result_from_events(events, on_time=None) -> Result:
