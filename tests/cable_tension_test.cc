@@ -82,6 +82,28 @@ TEST(CableTensionTest, CompressionIsNegative) {
   EXPECT_TRUE(f.node_tensions.empty());
 }
 
+// A soft rod (E = 4e7 Pa: about 1.9 % strain at its top) under either
+// axial law carries the same weight below each point, T(s) = rho A g
+// (L - s), and the output must be the law's own tension: EA e under
+// ENGINEERING, EA eps |r_s| under GREEN_LAGRANGE. Read with the other law's
+// formula, the top tension would be off by about 1.5 times the strain
+// (2.8 %), far above the tolerance, 1e-4 of the top tension (the cubic
+// elements hold the nearly linear profile of the stretched rod closely).
+TEST(CableTensionTest, EachAxialLawReportsItsOwnTension) {
+  const double w = 7850 * (M_PI / 4 * 1e-4) * 9.81;
+  for (const char* law : {"ENGINEERING", "GREEN_LAGRANGE"}) {
+    std::string json = HangingRod("false");
+    json.replace(json.find(R"("youngs_modulus": 2e11)"), 22,
+                 absl::StrFormat(R"("youngs_modulus": 4e7, "axial_law": "%s")", law));
+    CollectingSink sink;
+    RunOk(SceneFromJson(json), &sink);
+    const Frame& f = sink.frames().back();
+    ASSERT_EQ(f.probe_tensions.size(), 4u);
+    EXPECT_NEAR(f.probe_tensions[0], w * 10, 1e-4 * w * 10) << law;
+    EXPECT_NEAR(f.probe_tensions[1], w * 5, 1e-4 * w * 10) << law;
+  }
+}
+
 // Without output.tension: no tension columns.
 TEST(CableTensionTest, NoneUnlessAskedFor) {
   std::string json = HangingRod("true");

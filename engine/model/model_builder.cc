@@ -682,8 +682,10 @@ void ModelBuilder::Probes() {
   }
   m.tension_ = scene_.output.tension;
   if (m.tension_) {
-    for (const CableSpec& cable : scene_.cables)
+    for (const CableSpec& cable : scene_.cables) {
       m.cable_ea_.push_back(cable.youngs_modulus_pa * cable.area_m2);
+      m.cable_engineering_.push_back(cable.axial_law == AxialLaw::kEngineering);
+    }
     for (size_t p = 0; p < scene_.probes.size(); ++p) {
       const Attachment& at = scene_.probes[p].at;
       if (at.cable < 0) continue;

@@ -262,6 +262,9 @@ void MultibodyModel::Tensions(const VectorXd& q, std::vector<double>* probes,
     Vector3d u;
     CablePosition(q, cable, s, &u);
     const double a = u.squaredNorm();
+    // The element's own tension along the tangent: EA e (engineering
+    // strain e = |u| - 1) or EA eps |u| (Green-Lagrange eps = (a - 1) / 2).
+    if (cable_engineering_[cable]) return cable_ea_[cable] * (std::sqrt(a) - 1);
     return cable_ea_[cable] * 0.5 * (a - 1) * std::sqrt(a);
   };
   probes->resize(tension_probe_.size());

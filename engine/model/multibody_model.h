@@ -543,6 +543,7 @@ class MultibodyModel {
   bool tension_ = false;
   std::vector<int> tension_probe_, tension_cable_;
   std::vector<double> tension_s_, cable_ea_;
+  std::vector<bool> cable_engineering_;  // per cable: AxialLaw::kEngineering
   std::vector<int> node_cable_;
   // Reactions' work space, per joint.
   mutable std::vector<Eigen::Vector3d> reaction_forces_, reaction_moments_;
