@@ -24,6 +24,7 @@ v1::ModelInfo ModelInfoToProto(const ModelInfo& info) {
   for (const int n : info.joint_reaction_values) p.add_joint_reaction_values(n);
   for (const std::string& name : info.tension_probe_names) p.add_tension_probe_names(name);
   p.set_node_tension(info.node_tension);
+  p.set_body_orientation(info.body_orientation);
   return p;
 }
 
@@ -48,6 +49,7 @@ ModelInfo ModelInfoFromProto(const v1::ModelInfo& p) {
                                     p.joint_reaction_values().end());
   info.tension_probe_names.assign(p.tension_probe_names().begin(), p.tension_probe_names().end());
   info.node_tension = p.node_tension();
+  info.body_orientation = p.body_orientation();
   return info;
 }
 

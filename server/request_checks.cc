@@ -251,6 +251,13 @@ absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimi
     for (const JointSpec& joint : checked.scene.joints)
       force_values += joint.type == JointType::kSlide ? 0 : joint.type == JointType::kFixed ? 6 : 3;
   }
+  // output.tension adds NAME.tension per probe on a cable, and
+  // output.orientation 10 values per body, to every row.
+  if (checked.scene.output.tension) {
+    for (const ProbeSpec& probe : checked.scene.probes) force_values += probe.at.cable >= 0 ? 1 : 0;
+  }
+  if (checked.scene.output.orientation)
+    force_values += 10 * static_cast<int64_t>(checked.scene.bodies.size());
   // A seabed or a sheave adds energy.contact to every row.
   const bool contact = checked.scene.seabed.enabled || !checked.scene.sheaves.empty();
   const int64_t values =

@@ -681,6 +681,7 @@ void ModelBuilder::Probes() {
     m.node_cable_.insert(m.node_cable_.end(), count, static_cast<int>(c));
   }
   m.tension_ = scene_.output.tension;
+  m.orientation_ = scene_.output.orientation;
   if (m.tension_) {
     for (const CableSpec& cable : scene_.cables) {
       m.cable_ea_.push_back(cable.youngs_modulus_pa * cable.area_m2);

@@ -256,6 +256,46 @@ void MultibodyModel::Reactions(const VectorXd& q, const VectorXd* lambda,
   }
 }
 
+void MultibodyModel::Orientations(const VectorXd& q, const VectorXd& qdot,
+                                  std::vector<double>* out) const {
+  out->resize(10 * bodies_.size());
+  for (size_t b = 0; b < bodies_.size(); ++b) {
+    const int c = bodies_[b].coord;
+    double* o = out->data() + 10 * b;
+    if (dim_ == 2) {
+      const Eigen::Vector2d u = q.segment<2>(c + 2), ud = qdot.segment<2>(c + 2);
+      const double angle = std::atan2(u.y(), u.x());  // (-pi, pi]: cos(angle / 2) >= 0
+      o[0] = std::cos(angle / 2);
+      o[1] = o[2] = 0;
+      o[3] = std::sin(angle / 2);
+      o[4] = o[5] = 0;
+      o[6] = angle;
+      o[7] = o[8] = 0;
+      o[9] = (u.x() * ud.y() - u.y() * ud.x()) / u.squaredNorm();
+      continue;
+    }
+    Eigen::Matrix3d r;
+    Vector3d omega = Vector3d::Zero();
+    for (int i = 0; i < 3; ++i) {
+      r.col(i) = q.segment<3>(c + 3 + 3 * i);
+      omega += 0.5 * r.col(i).cross(qdot.segment<3>(c + 3 + 3 * i));
+    }
+    Eigen::Quaterniond rotation(r);
+    rotation.normalize();
+    if (rotation.w() < 0) rotation.coeffs() *= -1;
+    o[0] = rotation.w();
+    o[1] = rotation.x();
+    o[2] = rotation.y();
+    o[3] = rotation.z();
+    o[4] = std::atan2(r(2, 1), r(2, 2));                     // roll
+    o[5] = std::asin(std::clamp(-r(2, 0), -1.0, 1.0));      // pitch
+    o[6] = std::atan2(r(1, 0), r(0, 0));                     // yaw
+    o[7] = omega.x();
+    o[8] = omega.y();
+    o[9] = omega.z();
+  }
+}
+
 void MultibodyModel::Tensions(const VectorXd& q, std::vector<double>* probes,
                               std::vector<double>* nodes) const {
   auto tension = [&](int cable, double s) {

@@ -140,6 +140,7 @@ ModelInfo MultibodyModel::Info() const {
   info.joint_reaction_values = joint_reaction_values_;
   for (int p : tension_probe_) info.tension_probe_names.push_back(probe_names_[p]);
   info.node_tension = tension_ && shape_;
+  info.body_orientation = orientation_;
   return info;
 }
 

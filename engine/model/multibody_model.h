@@ -346,6 +346,17 @@ class MultibodyModel {
   bool tension() const { return tension_; }
   void Tensions(const Eigen::VectorXd& q, std::vector<double>* probes,
                 std::vector<double>* nodes) const;
+  // With output.orientation (orientation()): per body 10 values
+  // (Frame::body_orientation) from full q and qdot. The body's axes are its
+  // natural coordinates (e1 = u, e2 = v, e3 = w, the columns of R), so
+  // R = [u v w]; the quaternion is R's (qw >= 0), roll/pitch/yaw its
+  // Z-Y-X angles, and the angular velocity omega = (1/2) sum_i e_i x de_i/dt
+  // (from dR/dt = [omega]x R). Planar: angle = atan2(u_y, u_x) about z,
+  // omega_z = (u x udot)_z / |u|^2. `out` is resized (no allocation once
+  // it has the size).
+  bool orientation() const { return orientation_; }
+  void Orientations(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
+                    std::vector<double>* out) const;
   // The number of probes on a moving support or a winch's end (ProbeForces' size).
   int force_probe_count() const { return static_cast<int>(force_probes_.size()); }
 
@@ -544,6 +555,7 @@ class MultibodyModel {
   std::vector<int> tension_probe_, tension_cable_;
   std::vector<double> tension_s_, cable_ea_;
   std::vector<bool> cable_engineering_;  // per cable: AxialLaw::kEngineering
+  bool orientation_ = false;  // output.orientation
   std::vector<int> node_cable_;
   // Reactions' work space, per joint.
   mutable std::vector<Eigen::Vector3d> reaction_forces_, reaction_moments_;

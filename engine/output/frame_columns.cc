@@ -41,6 +41,13 @@ std::vector<std::string> FrameColumns(const ModelInfo& info, bool with_nodes) {
       for (const char* c : {"mx", "my", "mz"}) columns.push_back(absl::StrCat("joints[", i, "].", c));
   }
   for (const std::string& name : info.tension_probe_names) columns.push_back(name + ".tension");
+  if (info.body_orientation) {
+    for (size_t i = 0; i < info.body_names.size(); ++i) {
+      for (const char* c : {"qw", "qx", "qy", "qz", "roll", "pitch", "yaw", "wx", "wy", "wz"}) {
+        columns.push_back(absl::StrCat("bodies[", i, "].", c));
+      }
+    }
+  }
   if (!info.shape || !with_nodes) return columns;
   for (size_t i = 0; i < info.cable_nodes.size(); ++i) {
     for (int k = 0; k < info.cable_nodes[i]; ++k) {
@@ -75,7 +82,9 @@ FrameReader::FrameReader(const ModelInfo& info, absl::Span<const std::string> co
       contact_(info.contact),
       reaction_values_(info.joint_reaction_values),
       tension_probes_(static_cast<int>(info.tension_probe_names.size())),
-      node_tension_(info.shape && info.node_tension) {
+      node_tension_(info.shape && info.node_tension),
+      orientation_values_(info.body_orientation ? 10 * static_cast<int>(info.body_names.size())
+                                                : 0) {
   absl::flat_hash_map<std::string_view, int> column;
   for (size_t i = 0; i < columns.size(); ++i) column.emplace(columns[i], static_cast<int>(i));
   for (const std::string& name : FrameColumns(info)) {
@@ -93,6 +102,7 @@ void FrameReader::Read(absl::Span<const double> row, Frame* frame) const {
   frame->has_contact = contact_;
   frame->probe_tensions.resize(tension_probes_);
   frame->node_tensions.resize(node_tension_ ? nodes_ : 0);
+  frame->body_orientation.resize(orientation_values_);
   frame->reactions.resize(reaction_values_.size());
   for (size_t j = 0; j < reaction_values_.size(); ++j)
     frame->reactions[j].values = reaction_values_[j];

@@ -21,6 +21,8 @@
 //                and for FIXED joints[i].mx joints[i].my joints[i].mz
 //   with output.tension, per probe on a cable (ModelInfo::tension_probe_names)
 //                NAME.tension
+//   with output.orientation (ModelInfo::body_orientation), per body i
+//                bodies[i].qw .qx .qy .qz .roll .pitch .yaw .wx .wy .wz
 //   with output.shape (ModelInfo::shape), per cable i and node k
 //                cables[i].nodes[k].x cables[i].nodes[k].y cables[i].nodes[k].z
 //   with output.shape and output.tension (ModelInfo::node_tension), per
@@ -106,6 +108,7 @@ void ForEachFrameValue(FrameT& frame, Add&& add) {
     for (int k = 0; k < 3; ++k) add(r.moment[k]);
   }
   for (auto& t : frame.probe_tensions) add(t);
+  for (auto& o : frame.body_orientation) add(o);
 }
 
 // Calls add(value) for x, y, z of every node of `frame` (empty without
@@ -144,6 +147,7 @@ class FrameReader {
   std::vector<int> reaction_values_;
   int tension_probes_ = 0;
   bool node_tension_ = false;
+  int orientation_values_ = 0;
   // The column of every number of ForEachFrameValue's and then
   // ForEachNodeValue's order, or -1.
   std::vector<int> index_;

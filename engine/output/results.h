@@ -52,6 +52,9 @@ struct ModelInfo {
   // (output.shape too).
   std::vector<std::string> tension_probe_names;
   bool node_tension = false;
+  // With output.orientation: every frame carries each body's orientation
+  // (Frame::body_orientation).
+  bool body_orientation = false;
 };
 
 // The force [N] a joint exerts on its side a (a joint to ground: on what it
@@ -147,6 +150,11 @@ struct Frame {
   // too, per node of `nodes`.
   std::vector<double> probe_tensions;
   std::vector<double> node_tensions;
+  // With output.orientation, per body (scene order) 10 values: the unit
+  // quaternion qw, qx, qy, qz (body axes to world, qw >= 0), roll, pitch,
+  // yaw [rad] (R = Rz(yaw) Ry(pitch) Rx(roll)) and the angular velocity
+  // wx, wy, wz [rad/s] in world axes.
+  std::vector<double> body_orientation;
 };
 
 class FrameSink {

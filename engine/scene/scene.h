@@ -381,6 +381,9 @@ struct OutputSpec {
   // The axial force of every cable probe (NAME.tension) and, with shape,
   // of every node in every frame (Frame::probe_tensions, node_tensions).
   bool tension = false;
+  // Every body's orientation (a unit quaternion and roll, pitch, yaw) and
+  // angular velocity in every frame (Frame::body_orientation).
+  bool orientation = false;
 };
 
 struct Scene {
