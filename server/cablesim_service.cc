@@ -767,12 +767,21 @@ grpc::Status CablesimServiceImpl::WatchSweep(grpc::ServerContext* context,
   StreamSlot slot(this, context, /*counted=*/false);
   std::set<std::string> reported;
   if (grpc::Status s = Owned(request->id(), tenant); !s.ok()) return s;
-  bool first = true;
-  // The `finished` count of the last event sent: the sweep row and its
+  // The `finished` count of the last event sent (-1: none yet, so the
+  // first pass sends the progress as it is): the sweep row and its
   // items are read one after the other, so an item can finish in between
   // and be reported with the count from before it; the last event must
   // still carry the final count (a client's progress ends at items/items).
   int64_t sent_finished = -1;
+  // Sends the sweep's progress, with `item` when given; false when the
+  // client is gone.
+  auto send = [&](const v1::Sweep& sweep, const v1::Job* item) {
+    v1::SweepEvent event;
+    *event.mutable_progress() = sweep;
+    if (item != nullptr) *event.mutable_item() = ItemOf(jobs_, sweep, *item);
+    sent_finished = sweep.finished();
+    return TimedWrite(writer, event, slot.watch());
+  };
   while (true) {
     const uint64_t seen = jobs_->version();
     absl::StatusOr<v1::Sweep> sweep = jobs_->store()->GetSweep(request->id());
@@ -780,37 +789,17 @@ grpc::Status CablesimServiceImpl::WatchSweep(grpc::ServerContext* context,
     absl::StatusOr<std::vector<v1::Job>> items =
         jobs_->store()->ListJobs(v1::JOB_STATE_UNSPECIFIED, request->id(), sweep->items());
     if (!items.ok()) return ToGrpc(items.status());
-    if (first) {
-      v1::SweepEvent event;
-      *event.mutable_progress() = *sweep;
-      if (!TimedWrite(writer, event, slot.watch())) {
-        return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
-      }
-      sent_finished = sweep->finished();
-      first = false;
-    }
+    bool sent = sent_finished >= 0 || send(*sweep, nullptr);
     // Oldest item first.
-    for (auto it = items->rbegin(); it != items->rend(); ++it) {
+    for (auto it = items->rbegin(); sent && it != items->rend(); ++it) {
       if (!Finished(it->state()) || reported.count(it->id())) continue;
       reported.insert(it->id());
-      v1::SweepEvent event;
-      *event.mutable_progress() = *sweep;
-      *event.mutable_item() = ItemOf(jobs_, *sweep, *it);
-      if (!TimedWrite(writer, event, slot.watch())) {
-        return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
-      }
-      sent_finished = sweep->finished();
+      sent = send(*sweep, &*it);
     }
-    if (sweep->finished() == sweep->items()) {
-      if (sent_finished != sweep->finished()) {
-        v1::SweepEvent event;
-        *event.mutable_progress() = *sweep;
-        if (!TimedWrite(writer, event, slot.watch())) {
-          return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
-        }
-      }
-      return grpc::Status::OK;
-    }
+    const bool done = sweep->finished() == sweep->items();
+    if (sent && done && sent_finished != sweep->finished()) sent = send(*sweep, nullptr);
+    if (!sent) return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
+    if (done) return grpc::Status::OK;
     if (context->IsCancelled()) return grpc::Status(grpc::StatusCode::CANCELLED, "cancelled");
     if (jobs_->shutting_down()) {
       return grpc::Status(grpc::StatusCode::UNAVAILABLE, "the server is shutting down");

@@ -92,7 +92,7 @@ class Result:
     def _joint(self, joint) -> int:
         if isinstance(joint, int):
             return joint
-        names = list(self.info.get("joint_names", []) if isinstance(self.info, dict) else [])
+        names = list(self.info.get("joint_names", []))
         if joint not in names:
             raise KeyError("no joint named %r (joint names: %s)" % (joint, ", ".join(names)))
         return names.index(joint)
