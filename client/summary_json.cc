@@ -1,12 +1,20 @@
 #include "client/summary_json.h"
 
+#include <string>
+#include <vector>
+
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "client/json_line.h"
 
 namespace cablesim {
 
 std::string StatisticsToJson(const RunStatistics& statistics) {
-  std::string columns = "[";
+  // A JSON array of objects already written.
+  auto array = [](const std::vector<std::string>& objects) {
+    return absl::StrCat("[", absl::StrJoin(objects, ","), "]");
+  };
+  std::vector<std::string> columns;
   for (const ColumnStatistics& c : statistics.columns) {
     JsonLine item;
     item.Add("column", c.column)
@@ -17,10 +25,9 @@ std::string StatisticsToJson(const RunStatistics& statistics) {
         .Add("max_t", c.max_t)
         .Add("mean", c.mean)
         .Add("stddev", c.stddev);
-    absl::StrAppend(&columns, columns.size() > 1 ? "," : "", item.ToString());
+    columns.push_back(item.ToString());
   }
-  columns += "]";
-  std::string rainflow = "[";
+  std::vector<std::string> rainflow;
   for (const RainflowStatistics& r : statistics.rainflow) {
     JsonLine item;
     item.Add("column", r.column)
@@ -28,15 +35,14 @@ std::string StatisticsToJson(const RunStatistics& statistics) {
         .Add("half_cycles", r.half_cycles)
         .Add("max_range", r.max_range)
         .Add("damage_equivalent_load", r.damage_equivalent_load);
-    absl::StrAppend(&rainflow, rainflow.size() > 1 ? "," : "", item.ToString());
+    rainflow.push_back(item.ToString());
   }
-  rainflow += "]";
   JsonLine json;
-  json.AddJson("columns", columns);
+  json.AddJson("columns", array(columns));
   if (!statistics.rainflow.empty()) {
     json.Add("sn_slope", statistics.sn_slope)
         .Add("equivalent_cycles", statistics.equivalent_cycles)
-        .AddJson("rainflow", rainflow);
+        .AddJson("rainflow", array(rainflow));
   }
   return json.ToString();
 }
