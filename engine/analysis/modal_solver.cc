@@ -444,7 +444,7 @@ void RunModalAnalysis(MultibodyModel* model, const SolverSettings& settings, int
   // MODAL reports no support forces: their columns hold 0.
   frame.support_forces.assign(model->force_probe_count(), Eigen::Vector3d::Zero());
   if (model->reactions()) model->Reactions(q, nullptr, &frame.reactions);
-  if (model->tension()) model->Tensions(q, &frame.probe_tensions, &frame.node_tensions);
+  if (model->tension()) model->Tensions(q, 1.0, &frame.probe_tensions, &frame.node_tensions);
   if (model->orientation()) model->Orientations(q, zero, &frame.body_orientation);
   frame.has_contact = model->has_contact();
   frame.constraint_violation = phi.size() ? phi.lpNorm<Eigen::Infinity>() : 0.0;
