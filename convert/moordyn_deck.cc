@@ -750,10 +750,15 @@ class DeckReader {
       for (const auto& [end, pid] : {std::pair{0.0, l.a}, std::pair{l.length, l.b}}) {
         const Point& p = points_.at(pid);
         if (p.kind != PointKind::kFree) {
+          // Named by the point, so that the reactions' columns and a
+          // coupling host (couple/moordyn/MoorDyn2.h) find it; a Vessel
+          // point is a coupled support (held where it is in a run).
           v1::Joint* j = scene.add_joints();
+          j->set_name(absl::StrCat("point", pid));
           j->set_type(v1::PIN);
           j->mutable_a()->set_cable(name);
           j->mutable_a()->set_s(end);
+          if (p.kind == PointKind::kCoupled) j->set_coupled(true);
           continue;
         }
         if (const auto body = body_of.find(pid); body != body_of.end()) {
