@@ -378,6 +378,51 @@ void MultibodyModel::CableNodeTensionsOf(const VectorXd& q, int cable, double lo
   }
 }
 
+template <int D>
+Vector3d MultibodyModel::BendingMomentOf(const VectorXd& q, int cable, double s,
+                                         double load_factor) const {
+  constexpr int kN = 4 * D;
+  const auto& elements = Elements<D>();
+  const int begin = cable_element_begin_[cable], end = cable_element_begin_[cable + 1];
+  int k = begin;
+  double start = 0;
+  for (; k + 1 < end; ++k) {
+    const double l = elements[k].element.length();
+    if (s <= start + l) break;
+    start += l;
+  }
+  const double xi = std::clamp((s - start) / elements[k].element.length(), 0.0, 1.0);
+  // The moment at an end of element e, u x (Q_e - lf G_e)[u rows]: at its
+  // end (the cable beyond acting on e) and, negated, at its start (e acting
+  // on the cable before it).
+  auto at = [&](int e, bool at_end) {
+    const ElementData<D>& el = elements[e];
+    Eigen::Matrix<double, kN, 1> f = Eigen::Matrix<double, kN, 1>::Zero();  // ElasticForce adds
+    el.element.ElasticForce(q.segment<kN>(el.first_coord), &f, nullptr);
+    f -= load_factor * el.gravity;
+    const int row = at_end ? 3 * D : D;  // (r_i, u_i, r_j, u_j)
+    Vector3d u = Vector3d::Zero(), g = Vector3d::Zero();
+    u.head<D>() = q.segment<D>(el.first_coord + row);
+    g.head<D>() = f.template segment<D>(row);
+    return at_end ? Vector3d(u.cross(g)) : Vector3d(-u.cross(g));
+  };
+  Vector3d m_start = at(k, false), m_end = at(k, true);
+  if (k > begin) m_start = 0.5 * (m_start + at(k - 1, true));
+  if (k + 1 < end) m_end = 0.5 * (m_end + at(k + 1, false));
+  return (1 - xi) * m_start + xi * m_end;
+}
+
+void MultibodyModel::BendingMoments(const VectorXd& q, double load_factor,
+                                    std::vector<double>* out) const {
+  out->resize(tension_probe_.size());
+  for (size_t k = 0; k < tension_probe_.size(); ++k) {
+    const Vector3d m =
+        dim_ == 2 ? BendingMomentOf<2>(q, tension_cable_[k], tension_s_[k], load_factor)
+                  : BendingMomentOf<3>(q, tension_cable_[k], tension_s_[k], load_factor);
+    (*out)[k] = dim_ == 2 ? m.z() : m.norm();
+  }
+}
+
 std::vector<double> MultibodyModel::CableNodeTensions(const VectorXd& q, int cable,
                                                       double load_factor) const {
   std::vector<double> out(cable_element_begin_[cable + 1] - cable_element_begin_[cable] + 1);

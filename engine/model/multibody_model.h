@@ -346,6 +346,15 @@ class MultibodyModel {
   bool tension() const { return tension_; }
   void Tensions(const Eigen::VectorXd& q, double load_factor, std::vector<double>* probes,
                 std::vector<double>* nodes) const;
+  // With output.bending_moment (bending_moment()): the bending moment [N m]
+  // at every probe on a cable (ModelInfo::bending_moment_probe_names), from
+  // the elements' slope rows as Tensions reads their position rows: the
+  // moment u x Q_u the cable beyond the probe exerts on the cable before
+  // it, averaged over the two elements at a node; planar: about z,
+  // spatial: its size. `out` is resized.
+  bool bending_moment() const { return bending_moment_; }
+  void BendingMoments(const Eigen::VectorXd& q, double load_factor,
+                      std::vector<double>* out) const;
   // The same at each node of cable `cable` (its elements' ends, in order).
   std::vector<double> CableNodeTensions(const Eigen::VectorXd& q, int cable,
                                         double load_factor) const;
@@ -475,6 +484,10 @@ class MultibodyModel {
                         Eigen::Vector3d* start, Eigen::Vector3d* end) const;
   template <int D>
   double TensionOf(const Eigen::VectorXd& q, int cable, double s, double load_factor) const;
+  // The bending moment vector at (cable, s) (model_outputs.cc).
+  template <int D>
+  Eigen::Vector3d BendingMomentOf(const Eigen::VectorXd& q, int cable, double s,
+                                  double load_factor) const;
   template <int D>
   void CableNodeTensionsOf(const Eigen::VectorXd& q, int cable, double load_factor,
                            double* out) const;
@@ -566,6 +579,7 @@ class MultibodyModel {
   // output.tension: per probe on a cable, its probe, cable and arc length;
   // per cable its EA [N]; per shape node, its cable.
   bool tension_ = false;
+  bool bending_moment_ = false;
   std::vector<int> tension_probe_, tension_cable_;
   std::vector<double> tension_s_, cable_ea_;
   std::vector<bool> cable_engineering_;  // per cable: AxialLaw::kEngineering

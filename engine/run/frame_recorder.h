@@ -48,6 +48,9 @@ class FrameRecorder {
       model_->Tensions(q_, load_factor, &frame_.probe_tensions, &frame_.node_tensions);
     }
     if (model_->orientation()) model_->Orientations(q_, qd_, &frame_.body_orientation);
+    if (model_->bending_moment()) {
+      model_->BendingMoments(q_, load_factor, &frame_.probe_bending_moments);
+    }
     if (model_->shape()) model_->NodePositions(q_, &frame_.nodes);
     frame_.energy = model_->Energy(q_, qd_, load_factor, &frame_.energy_parts);
     frame_.energy.damped = Damped(t);

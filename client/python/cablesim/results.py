@@ -116,6 +116,12 @@ class Result:
         `output.tension: true`; compression is negative)."""
         return self.column(probe + ".tension")
 
+    def bending_moment(self, probe: str) -> np.ndarray:
+        """The bending moment [N m] at a cable probe (NAME.bending_moment,
+        with `output.bending_moment: true`; planar: about z, spatial: its
+        size)."""
+        return self.column(probe + ".bending_moment")
+
     def cable_nodes(self, cable: int) -> np.ndarray:
         """The positions [m] of cable `cable`'s nodes (its index in the scene)
         in every frame, frames x nodes x 3: the columns cables[i].nodes[k].x,
