@@ -30,17 +30,8 @@
 #include <moordyn/MoorDyn2.h>
 
 #include "couple/cablesim_couple.h" /* CableSim_ErrorMessage only */
+#include "tests/c_expect.h"
 
-static int failures = 0;
-#define EXPECT(cond, ...)                                    \
-  do {                                                       \
-    if (!(cond)) {                                           \
-      ++failures;                                            \
-      fprintf(stderr, "FAILED %s:%d: ", __FILE__, __LINE__); \
-      fprintf(stderr, __VA_ARGS__);                          \
-      fprintf(stderr, "\n");                                 \
-    }                                                        \
-  } while (0)
 
 static double Norm(const double* v) { return sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
 
