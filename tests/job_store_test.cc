@@ -8,7 +8,7 @@
 // several PostgreSQL stores share one queue, leases expire and a stale
 // claim stores nothing, migrations are versioned.
 
-#include "server/job_store.h"
+#include "server/store/job_store.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -27,8 +27,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
-#include "server/postgres_job_store.h"
-#include "server/sqlite_job_store.h"
+#include "server/store/postgres_job_store.h"
+#include "server/store/sqlite_job_store.h"
 #include "server/result_codec.h"
 #include "tests/postgres_test_util.h"
 

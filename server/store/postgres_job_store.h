@@ -1,5 +1,5 @@
-#ifndef CABLESIM_SERVER_POSTGRES_JOB_STORE_H_
-#define CABLESIM_SERVER_POSTGRES_JOB_STORE_H_
+#ifndef CABLESIM_SERVER_STORE_POSTGRES_JOB_STORE_H_
+#define CABLESIM_SERVER_STORE_POSTGRES_JOB_STORE_H_
 
 // The shared job store: one PostgreSQL database (libpq) that any number
 // of servers use at once, as one queue.
@@ -41,7 +41,7 @@
 #include <vector>
 
 #include "absl/synchronization/mutex.h"
-#include "server/job_store.h"
+#include "server/store/job_store.h"
 
 typedef struct pg_conn PGconn;
 
@@ -130,4 +130,4 @@ class PostgresJobStore final : public JobStore {
 
 }  // namespace cablesim
 
-#endif  // CABLESIM_SERVER_POSTGRES_JOB_STORE_H_
+#endif  // CABLESIM_SERVER_STORE_POSTGRES_JOB_STORE_H_

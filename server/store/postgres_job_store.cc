@@ -1,4 +1,4 @@
-#include "server/postgres_job_store.h"
+#include "server/store/postgres_job_store.h"
 
 #include <endian.h>
 #include <libpq-fe.h>

@@ -1,5 +1,5 @@
-#ifndef CABLESIM_SERVER_SQLITE_JOB_STORE_H_
-#define CABLESIM_SERVER_SQLITE_JOB_STORE_H_
+#ifndef CABLESIM_SERVER_STORE_SQLITE_JOB_STORE_H_
+#define CABLESIM_SERVER_STORE_SQLITE_JOB_STORE_H_
 
 // The embedded job store, the default: one SQLite database
 // (DIR/cablesim.db, write-ahead log, synchronous=FULL) that one server
@@ -34,7 +34,7 @@
 #include <vector>
 
 #include "absl/synchronization/mutex.h"
-#include "server/job_store.h"
+#include "server/store/job_store.h"
 
 struct sqlite3;
 
@@ -109,4 +109,4 @@ class SqliteJobStore final : public JobStore {
 
 }  // namespace cablesim
 
-#endif  // CABLESIM_SERVER_SQLITE_JOB_STORE_H_
+#endif  // CABLESIM_SERVER_STORE_SQLITE_JOB_STORE_H_
