@@ -5,10 +5,14 @@
 #include <poll.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <utility>
+#include <variant>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
@@ -18,19 +22,6 @@
 
 namespace cablesim {
 namespace {
-
-// SQL with the job states named: {QUEUED}, {RUNNING}, {SUCCEEDED},
-// {FAILED} and {CANCELLED} become the numbers of the contract's JobState
-// (service.proto), which is what the jobs table stores, so no query spells
-// a state as a bare integer.
-std::string NamedStates(absl::string_view sql) {
-  return absl::StrReplaceAll(
-      sql, {{"{QUEUED}", absl::StrCat(static_cast<int>(v1::QUEUED))},
-            {"{RUNNING}", absl::StrCat(static_cast<int>(v1::RUNNING))},
-            {"{SUCCEEDED}", absl::StrCat(static_cast<int>(v1::SUCCEEDED))},
-            {"{FAILED}", absl::StrCat(static_cast<int>(v1::FAILED))},
-            {"{CANCELLED}", absl::StrCat(static_cast<int>(v1::CANCELLED))}});
-}
 
 // The database's clock in Unix milliseconds: leases are compared with one
 // clock, whichever server looks.
@@ -133,6 +124,14 @@ CREATE TRIGGER jobs_row_sum BEFORE INSERT OR UPDATE OF seq, pid, state, name, en
 CREATE TRIGGER sweeps_row_sum BEFORE INSERT OR UPDATE OF seq, pid, name, axes, created_ms, tenant
   ON sweeps FOR EACH ROW EXECUTE FUNCTION cablesim_sweep_sum_trigger();
 )sql"},
+    {6, "job states by name: queries bind a state's name, stored rows keep its number", R"sql(
+-- The contract's JobState (service.proto): a state's name to the number
+-- jobs.state stores. Immutable, so that a query's bound name folds to a
+-- constant when it is planned (indexes on state still serve).
+CREATE FUNCTION cablesim_state(name TEXT) RETURNS INTEGER LANGUAGE SQL IMMUTABLE AS $$
+  SELECT CASE name WHEN 'JOB_STATE_UNSPECIFIED' THEN 0 WHEN 'QUEUED' THEN 1 WHEN 'RUNNING' THEN 2
+    WHEN 'SUCCEEDED' THEN 3 WHEN 'FAILED' THEN 4 WHEN 'CANCELLED' THEN 5 END $$;
+)sql"},
 };
 
 // An arbitrary constant: the advisory lock under which migrations run.
@@ -234,16 +233,17 @@ class Params {
   }
 
   PgResult Run(PGconn* conn, const std::string& sql) const {
+    return PgResult(Exec(conn, sql), conn);
+  }
+  PGresult* Exec(PGconn* conn, const std::string& sql) const {
     std::vector<const char*> values;
     std::vector<int> lengths;
     for (const std::string& v : values_) {
       values.push_back(v.data());
       lengths.push_back(static_cast<int>(v.size()));
     }
-    return PgResult(PQexecParams(conn, sql.c_str(), static_cast<int>(values_.size()), nullptr,
-                                 values.data(), lengths.data(), formats_.data(),
-                                 /*resultFormat=*/1),
-                    conn);
+    return PQexecParams(conn, sql.c_str(), static_cast<int>(values_.size()), nullptr,
+                        values.data(), lengths.data(), formats_.data(), /*resultFormat=*/1);
   }
 
  private:
@@ -290,37 +290,156 @@ constexpr char kJobColumns[] =
     "(j.row_sum IS NOT DISTINCT FROM cablesim_job_sum(j) AND (j.sweep_seq IS NULL OR "
     "(SELECT w.row_sum IS NOT DISTINCT FROM cablesim_sweep_sum(w) FROM sweeps w "
     "WHERE w.seq = j.sweep_seq) IS TRUE))";
-// Whether the row passed its checksum (the last of kJobColumns).
-constexpr int kJobIntactColumn = 15;
-
-v1::Job JobFromRow(const PgResult& r, int row) {
-  v1::Job job;
-  job.set_id(r.Bytes(row, 12));
-  job.set_state(static_cast<v1::JobState>(r.Int(row, 1)));
-  job.set_name(r.Bytes(row, 2));
-  job.set_created_unix_ms(r.Int(row, 3));
-  job.set_started_unix_ms(r.Int(row, 4));
-  job.set_finished_unix_ms(r.Int(row, 5));
-  job.set_attempts(static_cast<int>(r.Int(row, 6)));
-  job.set_end_time_s(r.Real(row, 7));
-  const std::string summary = r.Bytes(row, 8);
-  if (!summary.empty()) job.mutable_summary()->ParseFromString(summary);
-  if (r.Int(row, 9) > 0) {
-    job.set_sweep_id(r.Bytes(row, 13));
-    job.set_sweep_index(static_cast<int>(r.Int(row, 10)));
-  }
-  job.set_stored_bytes(r.Int(row, 11));
-  if (job.state() == v1::RUNNING) job.set_progress_time_s(r.Real(row, 14));
-  return job;
-}
-
 // The URL without its password, for logs.
 std::string DescribeConnection(PGconn* conn) {
   return absl::StrCat("postgresql://", PQuser(conn), "@", PQhost(conn), ":", PQport(conn), "/",
                       PQdb(conn));
 }
 
-constexpr char kFinishedStates[] = "(3, 4, 5)";  // SUCCEEDED, FAILED, CANCELLED
+// A state bound by name (SqlState), as the number the jobs table stores.
+#define CABLESIM_STATE(param) "cablesim_state(@" param ")"
+constexpr char kFinishedStates[] =
+    "(" CABLESIM_STATE("succeeded") ", " CABLESIM_STATE("failed") ", " CABLESIM_STATE(
+        "cancelled") ")";
+constexpr char kResultBytes[] = "octet_length(header) + octet_length(vals)";
+
+// PostgreSQL's statements (SqlStatements): states are bound by name and
+// mapped by cablesim_state (migration 6); leases and claim times are the
+// database's clock; a claim skips the rows another server is claiming.
+const SqlStatements& Statements() {
+  static const SqlStatements* sql = new SqlStatements{
+      .begin = "BEGIN",
+      .requeue_running = absl::StrCat(
+          "UPDATE jobs SET state = ", CABLESIM_STATE("queued"), ", owner = '' WHERE state = ",
+          CABLESIM_STATE("running"), " AND lease_until_ms < ", kNowMs),
+      // One peer's submissions one at a time, across servers, until commit.
+      .peer_lock = "SELECT pg_advisory_xact_lock(hashtext(@peer))",
+      .peer_unfinished = "SELECT COUNT(*) FROM jobs WHERE peer = @peer AND state IN (" CABLESIM_STATE(
+          "queued") ", " CABLESIM_STATE("running") ")",
+      .insert_job = "INSERT INTO jobs (state, name, scene, end_time_s, created_ms, peer, tenant, "
+                    "pid) VALUES (" CABLESIM_STATE("queued") ", @name, @scene, @end_time_s, "
+                    "@now_ms, @peer, @tenant, @id)",
+      .insert_sweep = "INSERT INTO sweeps (name, axes, created_ms, tenant, pid) VALUES (@name, "
+                      "@axes, @created_ms, @tenant, @id) RETURNING seq",
+      .insert_item = "INSERT INTO jobs (state, name, scene, end_time_s, created_ms, sweep_seq, "
+                     "sweep_index, peer, tenant, pid) VALUES (" CABLESIM_STATE("queued") ", "
+                     "@name, @scene, @end_time_s, @created_ms, @sweep_seq, @sweep_index, @peer, "
+                     "@tenant, @id)",
+      .job_by_id = absl::StrCat("SELECT ", kJobColumns, " FROM jobs j WHERE j.pid = @id"),
+      .scene_by_id = "SELECT scene FROM jobs WHERE pid = @id",
+      .sweep_seq_by_id = "SELECT seq FROM sweeps WHERE pid = @id",
+      .list_jobs = absl::StrCat(
+          "SELECT ", kJobColumns,
+          " FROM jobs j WHERE (@any_state::int = 1 OR j.state = ", CABLESIM_STATE("state"),
+          ") AND (@sweep_seq::bigint = 0 OR j.sweep_seq = @sweep_seq::bigint) AND j.seq < "
+          "@before_seq::bigint AND (@any_tenant::int = 1 OR j.tenant = @tenant) ORDER BY j.seq "
+          "DESC LIMIT @limit::bigint"),
+      .tenant_of_job = "SELECT tenant, (j.row_sum IS NOT DISTINCT FROM cablesim_job_sum(j)) "
+                       "FROM jobs j WHERE pid = @id",
+      .tenant_of_sweep = "SELECT tenant, (s.row_sum IS NOT DISTINCT FROM cablesim_sweep_sum(s)) "
+                         "FROM sweeps s WHERE pid = @id",
+      .damaged_rows =
+          "SELECT 'job', seq, pid FROM jobs j WHERE j.row_sum IS DISTINCT FROM "
+          "cablesim_job_sum(j) UNION ALL SELECT 'sweep', seq, pid FROM sweeps s WHERE s.row_sum "
+          "IS DISTINCT FROM cablesim_sweep_sum(s) ORDER BY 1, 2",
+      .all_results = "SELECT r.job_seq, COALESCE(j.pid, ''), r.header, r.vals, r.checksum, "
+                     "r.encoding FROM results r LEFT JOIN jobs j ON j.seq = r.job_seq ORDER BY "
+                     "r.job_seq",
+      .queued_ids =
+          "SELECT pid FROM jobs WHERE state = " CABLESIM_STATE("queued") " ORDER BY seq",
+      // A job no live claim holds, round-robin across tenants
+      // (JobStore::ClaimNext); rows another server is claiming right now
+      // are skipped, not waited for.
+      .claim_next = absl::StrCat(
+          "UPDATE jobs SET state = ", CABLESIM_STATE("running"),
+          ", owner = @owner, lease_until_ms = ", kNowMs, " + @lease_ms::bigint, started_ms = ",
+          kNowMs,
+          ", attempts = attempts + 1, cancel_requested = FALSE, progress_time_s = 0 WHERE seq = "
+          "(SELECT seq FROM jobs j WHERE state = ",
+          CABLESIM_STATE("queued"), " OR (state = ", CABLESIM_STATE("running"),
+          " AND lease_until_ms < ", kNowMs, ") ORDER BY ", kFairShareOrder,
+          " LIMIT 1 FOR UPDATE SKIP LOCKED) RETURNING pid, attempts"),
+      .mark_running = absl::StrCat(
+          "UPDATE jobs SET state = ", CABLESIM_STATE("running"),
+          ", owner = @owner, lease_until_ms = ", kNowMs, " + @lease_ms::bigint, started_ms = ",
+          kNowMs, ", attempts = attempts + 1, cancel_requested = FALSE WHERE pid = @id AND state = ",
+          CABLESIM_STATE("queued"), " RETURNING seq"),
+      .requeue = "UPDATE jobs SET state = " CABLESIM_STATE("queued") ", owner = '', "
+                 "lease_until_ms = 0 WHERE pid = @id AND state = " CABLESIM_STATE("running") " "
+                 "AND owner = @owner AND (@attempt::int = 0 OR attempts = @attempt::int)",
+      // A job whose server died (lease expired) is as good as queued.
+      .cancel_queued = absl::StrCat(
+          "UPDATE jobs SET state = ", CABLESIM_STATE("cancelled"), ", finished_ms = ", kNowMs,
+          ", owner = '' WHERE pid = @id AND (state = ", CABLESIM_STATE("queued"),
+          " OR (state = ", CABLESIM_STATE("running"), " AND lease_until_ms < ", kNowMs,
+          ")) RETURNING seq"),
+      .finish = absl::StrCat(
+          "UPDATE jobs SET state = ", CABLESIM_STATE("state"), ", finished_ms = ", kNowMs,
+          ", summary = @summary, lease_until_ms = 0 WHERE pid = @id AND state = ",
+          CABLESIM_STATE("running"),
+          " AND owner = @owner AND (@attempt::int = 0 OR attempts = @attempt::int) RETURNING seq"),
+      .store_result =
+          "INSERT INTO results (job_seq, header, vals, checksum, encoding) VALUES "
+          "(@seq::bigint, @header, @vals, @checksum::bigint, @encoding::int) ON CONFLICT "
+          "(job_seq) DO UPDATE SET header = EXCLUDED.header, vals = EXCLUDED.vals, checksum = "
+          "EXCLUDED.checksum, encoding = EXCLUDED.encoding",
+      .result_by_id = "SELECT r.header, r.vals, r.checksum, r.encoding FROM results r JOIN jobs j "
+                      "ON j.seq = r.job_seq WHERE j.pid = @id",
+      .sweep_by_id = "SELECT name, axes, created_ms, seq, (w.row_sum IS NOT DISTINCT FROM "
+                     "cablesim_sweep_sum(w)) FROM sweeps w WHERE pid = @id",
+      .sweep_items = "SELECT pid, state, (j.row_sum IS NOT DISTINCT FROM cablesim_job_sum(j)) "
+                     "FROM jobs j WHERE sweep_seq = @seq::bigint ORDER BY sweep_index",
+      .job_for_delete = absl::StrCat(
+          "SELECT j.state, COALESCE(j.sweep_seq, 0), COALESCE((SELECT ", kResultBytes,
+          " FROM results WHERE job_seq = j.seq), 0)::bigint, COALESCE((SELECT pid FROM sweeps "
+          "WHERE sweeps.seq = j.sweep_seq), ''), j.seq FROM jobs j WHERE j.pid = @id FOR UPDATE"),
+      .sweep_for_delete = "SELECT seq FROM sweeps WHERE pid = @id FOR UPDATE",
+      .sweep_unfinished = absl::StrCat(
+          "SELECT COUNT(*) FILTER (WHERE state NOT IN ", kFinishedStates,
+          "), COALESCE(SUM((SELECT ", kResultBytes,
+          " FROM results WHERE job_seq = jobs.seq)), 0)::bigint FROM jobs WHERE sweep_seq = "
+          "@seq::bigint"),
+      // Retention: another server may have deleted the job meanwhile, or
+      // (not finished) may not let it go.
+      .delete_job_results = absl::StrCat(
+          "DELETE FROM results WHERE job_seq IN (SELECT seq FROM jobs WHERE seq = @seq::bigint "
+          "AND sweep_seq IS NULL AND state IN ", kFinishedStates, ")"),
+      .delete_job = absl::StrCat(
+          "DELETE FROM jobs WHERE seq = @seq::bigint AND sweep_seq IS NULL AND state IN ",
+          kFinishedStates),
+      .delete_sweep_results = "DELETE FROM results WHERE job_seq IN (SELECT seq FROM jobs WHERE "
+                              "sweep_seq = @seq::bigint)",
+      .delete_sweep_jobs = "DELETE FROM jobs WHERE sweep_seq = @seq::bigint",
+      .delete_sweep = "DELETE FROM sweeps WHERE seq = @seq::bigint",
+      .results_bytes =
+          absl::StrCat("SELECT COALESCE(SUM(", kResultBytes, "), 0)::bigint FROM results"),
+      .retention_candidates = absl::StrCat(
+          "SELECT 0, seq, finished_ms, COALESCE((SELECT ", kResultBytes,
+          " FROM results WHERE job_seq = jobs.seq), 0)::bigint FROM jobs WHERE sweep_seq IS "
+          "NULL AND state IN ",
+          kFinishedStates,
+          " UNION ALL SELECT 1, sweep_seq, MAX(finished_ms), COALESCE(SUM((SELECT ", kResultBytes,
+          " FROM results WHERE job_seq = jobs.seq)), 0)::bigint FROM jobs WHERE sweep_seq IS NOT "
+          "NULL GROUP BY sweep_seq HAVING COUNT(*) FILTER (WHERE state NOT IN ",
+          kFinishedStates, ") = 0 ORDER BY 3"),
+  };
+  return *sql;
+}
+
+// A PgResult read through SqlRows.
+class PgRows final : public SqlRows {
+ public:
+  PgRows(PGresult* r, PGconn* conn) : r_(r, conn) {}
+  const PgResult& result() const { return r_; }
+  int size() const override { return r_.rows(); }
+  int64_t Int(int row, int col) const override { return r_.Int(row, col); }
+  double Real(int row, int col) const override { return r_.Real(row, col); }
+  std::string Bytes(int row, int col) const override { return r_.Bytes(row, col); }
+  int64_t changed() const override { return r_.changed(); }
+
+ private:
+  PgResult r_;
+};
 
 }  // namespace
 
@@ -329,7 +448,7 @@ int PostgresJobStore::LatestSchemaVersion() {
 }
 
 PostgresJobStore::PostgresJobStore(PGconn* conn, std::string url, const StoreOptions& options)
-    : url_(std::move(url)), options_(options), conn_(conn) {
+    : SqlJobStore(Statements()), url_(std::move(url)), options_(options), conn_(conn) {
   char host[256] = "host";
   ::gethostname(host, sizeof(host) - 1);
   const absl::StatusOr<std::string> random = RandomId();
@@ -465,307 +584,62 @@ void PostgresJobStore::Listen() {
   PQfinish(conn);
 }
 
-absl::StatusOr<int> PostgresJobStore::RequeueRunning() {
-  absl::MutexLock lock(&mu_);
-  EnsureConnected();
-  PgResult r(Params().Run(conn_, NamedStates(absl::StrCat("UPDATE jobs SET state = {QUEUED}, owner = '' WHERE "
-                                                          "state = {RUNNING} AND lease_until_ms < ",
-                                                          kNowMs))));
-  if (!r.ok()) return r.status();
-  return static_cast<int>(r.changed());
-}
-
-absl::Status PostgresJobStore::CheckPeerRoom(const std::string& peer, int64_t adding,
-                                             int64_t max_unfinished) {
-  if (max_unfinished == std::numeric_limits<int64_t>::max()) return absl::OkStatus();
-  // One peer's submissions one at a time, across servers, until commit.
-  PgResult lock(Params().Text(peer).Run(conn_, "SELECT pg_advisory_xact_lock(hashtext($1))"));
-  if (!lock.ok()) return lock.status();
-  PgResult c(Params().Text(peer).Run(
-      conn_, NamedStates("SELECT COUNT(*) FROM jobs WHERE peer = $1 AND state IN ({QUEUED}, {RUNNING})")));
-  if (!c.ok()) return c.status();
-  const int64_t unfinished = c.Int(0, 0);
-  if (unfinished + adding > max_unfinished) {
-    return PeerLimitExceeded(peer, unfinished, adding, max_unfinished);
-  }
-  return absl::OkStatus();
-}
-
-absl::StatusOr<v1::Job> PostgresJobStore::InsertJob(const v1::Scene& scene, double end_time_s,
-                                                    const std::string& peer,
-                                                    int64_t max_unfinished,
-                                                    const std::string& tenant) {
-  absl::StatusOr<std::string> pid = NewPublicId('j');
-  if (!pid.ok()) return pid.status();
-  {
-    absl::MutexLock lock(&mu_);
-    EnsureConnected();
-    Transaction tx(conn_);
-    if (!tx.begun().ok()) return tx.begun();
-    if (absl::Status st = CheckPeerRoom(peer, 1, max_unfinished); !st.ok()) return (st);
-    PgResult r(Params()
-                   .Text(scene.name())
-                   .Bytes(scene.SerializeAsString())
-                   .Real(end_time_s)
-                   .Int(NowUnixMs())
-                   .Text(peer)
-                   .Text(tenant)
-                   .Text(*pid)
-                   .Run(conn_,
-                        "INSERT INTO jobs (state, name, scene, end_time_s, created_ms, peer, "
-                        "tenant, pid) VALUES (1, $1, $2, $3, $4, $5, $6, $7)"));
-    if (!r.ok()) return (r.status());
-    Notify();
-    if (absl::Status st = tx.Commit(); !st.ok()) return st;
-  }
-  return GetJob(*pid);
-}
-
-absl::StatusOr<v1::Sweep> PostgresJobStore::InsertSweep(const v1::SubmitSweepRequest& request,
-                                                        const std::vector<v1::Scene>& items,
-                                                        const std::vector<double>& end_times_s,
-                                                        const std::string& peer,
-                                                        int64_t max_unfinished,
-                                                        const std::string& tenant) {
-  absl::StatusOr<std::string> sweep_pid = NewPublicId('s');
-  if (!sweep_pid.ok()) return sweep_pid.status();
-  {
-    absl::MutexLock lock(&mu_);
-    EnsureConnected();
-    Transaction tx(conn_);
-    if (!tx.begun().ok()) return tx.begun();
-    if (absl::Status st =
-            CheckPeerRoom(peer, static_cast<int64_t>(items.size()), max_unfinished);
-        !st.ok()) {
-      return (st);
+absl::StatusOr<std::unique_ptr<SqlRows>> PostgresJobStore::Run(const std::string& sql,
+                                                               const SqlParams& params) {
+  // `@name` becomes `$n`, the n-th parameter this statement names.
+  std::string text;
+  std::vector<const SqlValue*> bound;
+  std::vector<std::string> names;
+  for (size_t i = 0; i < sql.size();) {
+    if (sql[i] != '@') {
+      text.push_back(sql[i++]);
+      continue;
     }
-    v1::Sweep axes;
-    *axes.mutable_axes() = request.axes();
-    *axes.mutable_thresholds() = request.thresholds();  // kept with the axes
-    const int64_t now = NowUnixMs();
-    PgResult s(Params()
-                   .Text(request.name())
-                   .Bytes(axes.SerializeAsString())
-                   .Int(now)
-                   .Text(tenant)
-                   .Text(*sweep_pid)
-                   .Run(conn_,
-                        "INSERT INTO sweeps (name, axes, created_ms, tenant, pid) "
-                        "VALUES ($1, $2, $3, $4, $5) RETURNING seq"));
-    if (!s.ok()) return (s.status());
-    const int64_t sweep_seq = s.Int(0, 0);
-    for (size_t i = 0; i < items.size(); ++i) {
-      absl::StatusOr<std::string> item_pid = NewPublicId('j');
-      if (!item_pid.ok()) return (item_pid.status());
-      PgResult r(Params()
-                     .Text(items[i].name())
-                     .Bytes(items[i].SerializeAsString())
-                     .Real(end_times_s[i])
-                     .Int(now)
-                     .Int(sweep_seq)
-                     .Int(static_cast<int64_t>(i))
-                     .Text(peer)
-                     .Text(tenant)
-                     .Text(*item_pid)
-                     .Run(conn_,
-                          "INSERT INTO jobs (state, name, scene, end_time_s, created_ms, "
-                          "sweep_seq, sweep_index, peer, tenant, pid) "
-                          "VALUES (1, $1, $2, $3, $4, $5, $6, $7, $8, $9)"));
-      if (!r.ok()) return (r.status());
+    size_t end = i + 1;
+    while (end < sql.size() && (std::isalnum(static_cast<unsigned char>(sql[end])) || sql[end] == '_')) {
+      ++end;
     }
-    Notify();
-    if (absl::Status st = tx.Commit(); !st.ok()) return st;
+    const std::string name = sql.substr(i + 1, end - i - 1);
+    size_t n = std::find(names.begin(), names.end(), name) - names.begin();
+    if (n == names.size()) {
+      const auto it = std::find_if(params.begin(), params.end(),
+                                   [&](const auto& p) { return name == p.first; });
+      if (it == params.end()) {
+        return absl::InternalError(absl::StrCat("postgresql: no value for @", name));
+      }
+      names.push_back(name);
+      bound.push_back(&it->second);
+    }
+    absl::StrAppend(&text, "$", n + 1);
+    i = end;
   }
-  return GetSweep(*sweep_pid);
-}
-
-absl::StatusOr<v1::Job> PostgresJobStore::GetJob(const std::string& id) {
-  absl::MutexLock lock(&mu_);
-  EnsureConnected();
-  PgResult r(Params().Text(id).Run(
-      conn_, absl::StrCat("SELECT ", kJobColumns, " FROM jobs j WHERE j.pid = $1")));
-  if (!r.ok()) return r.status();
-  if (r.rows() == 0) return absl::NotFoundError(absl::StrCat("no job \"", id, "\""));
-  if (r.Int(0, kJobIntactColumn) != 1) return DamagedRow("job", id);
-  return JobFromRow(r, 0);
-}
-
-absl::StatusOr<v1::Scene> PostgresJobStore::GetScene(const std::string& id) {
-  absl::MutexLock lock(&mu_);
-  EnsureConnected();
-  PgResult r(Params().Text(id).Run(conn_, "SELECT scene FROM jobs WHERE pid = $1"));
-  if (!r.ok()) return r.status();
-  if (r.rows() == 0) return absl::NotFoundError(absl::StrCat("no job \"", id, "\""));
-  v1::Scene scene;
-  if (!scene.ParseFromString(r.Bytes(0, 0))) return absl::DataLossError("stored scene unreadable");
-  return scene;
-}
-
-absl::StatusOr<std::vector<v1::Job>> PostgresJobStore::ListJobs(v1::JobState state,
-                                                                const std::string& sweep_id,
-                                                                int limit, int64_t after_key,
-                                                                const std::string* tenant,
-                                                                std::vector<int64_t>* keys) {
-  absl::MutexLock lock(&mu_);
-  EnsureConnected();
-  const int64_t before_seq = after_key > 0 ? after_key : std::numeric_limits<int64_t>::max();
-  int64_t sweep_seq = 0;
-  if (!sweep_id.empty()) {
-    sweep_seq = -1;
-    if (IsSweepId(sweep_id)) {
-      PgResult r(Params().Text(sweep_id).Run(conn_, "SELECT seq FROM sweeps WHERE pid = $1"));
-      if (!r.ok()) return r.status();
-      if (r.rows() > 0) sweep_seq = r.Int(0, 0);
+  // Numbers and text as text, bytes as binary, states by name.
+  Params values;
+  for (const SqlValue* v : bound) {
+    if (const auto* x = std::get_if<int64_t>(v)) {
+      values.Int(*x);
+    } else if (const auto* x = std::get_if<double>(v)) {
+      values.Real(*x);
+    } else if (const auto* x = std::get_if<std::string>(v)) {
+      values.Text(*x);
+    } else if (const auto* x = std::get_if<SqlBytes>(v)) {
+      values.Bytes(x->data);
+    } else {
+      values.Text(v1::JobState_Name(std::get<SqlState>(*v).state));
     }
   }
-  PgResult r(Params()
-                 .Int(state)
-                 .Int(sweep_seq)
-                 .Int(limit)
-                 .Int(before_seq)
-                 .Int(tenant != nullptr)
-                 .Text(tenant != nullptr ? *tenant : std::string())
-                 .Run(conn_, absl::StrCat(
-                                 "SELECT ", kJobColumns,
-                                 " FROM jobs j WHERE ($1::int = 0 OR j.state = $1::int) AND "
-                                 "($2::bigint = 0 OR j.sweep_seq = $2::bigint) AND "
-                                 "j.seq < $4::bigint AND ($5::int = 0 OR j.tenant = $6) "
-                                 "ORDER BY j.seq DESC LIMIT $3::bigint")));
-  if (!r.ok()) return r.status();
-  std::vector<v1::Job> jobs;
-  if (keys != nullptr) keys->clear();
-  for (int i = 0; i < r.rows(); ++i) {
-    // A damaged row: a placeholder (JobStore::ListJobs).
-    jobs.push_back(r.Int(i, kJobIntactColumn) == 1 ? JobFromRow(r, i) : v1::Job());
-    if (keys != nullptr) keys->push_back(r.Int(i, 0));
-  }
-  return jobs;
-}
-
-absl::StatusOr<std::string> PostgresJobStore::Tenant(const std::string& id) {
-  const bool sweep = IsSweepId(id);
-  absl::MutexLock lock(&mu_);
-  EnsureConnected();
-  PgResult r(Params().Text(id).Run(
-      conn_, sweep ? "SELECT tenant, (s.row_sum IS NOT DISTINCT FROM cablesim_sweep_sum(s)) "
-                     "FROM sweeps s WHERE pid = $1"
-                   : "SELECT tenant, (j.row_sum IS NOT DISTINCT FROM cablesim_job_sum(j)) "
-                     "FROM jobs j WHERE pid = $1"));
-  if (!r.ok()) return r.status();
-  if (r.rows() == 0) {
-    return absl::NotFoundError(absl::StrCat("no ", sweep ? "sweep" : "job", " \"", id, "\""));
-  }
-  // A damaged row's tenant cannot be trusted: DataLoss for everyone.
-  if (r.Int(0, 1) != 1) return DamagedRow(sweep ? "sweep" : "job", id);
-  return r.Bytes(0, 0);
-}
-
-absl::StatusOr<std::vector<std::string>> PostgresJobStore::CheckRows() {
-  absl::MutexLock lock(&mu_);
-  EnsureConnected();
-  std::vector<std::string> damaged;
-  PgResult rows(Params().Run(
-      conn_,
-      "SELECT 'job', seq, pid FROM jobs j WHERE j.row_sum IS DISTINCT FROM cablesim_job_sum(j) "
-      "UNION ALL SELECT 'sweep', seq, pid FROM sweeps s "
-      "WHERE s.row_sum IS DISTINCT FROM cablesim_sweep_sum(s) ORDER BY 1, 2"));
-  if (!rows.ok()) return rows.status();
-  for (int i = 0; i < rows.rows(); ++i) {
-    damaged.push_back(absl::StrCat(rows.Bytes(i, 0), " ", rows.Bytes(i, 2), " (row ",
-                                   rows.Int(i, 1), "): the row fails its checksum"));
-  }
-  PgResult r(Params().Run(conn_,
-                          "SELECT r.job_seq, COALESCE(j.pid, ''), r.header, r.vals, r.checksum, "
-                          "r.encoding FROM results r LEFT JOIN jobs j ON j.seq = r.job_seq "
-                          "ORDER BY r.job_seq"));
-  if (!r.ok()) return r.status();
-  for (int i = 0; i < r.rows(); ++i) {
-    const std::string id = r.Bytes(i, 1);
-    absl::StatusOr<StoredResult> result =
-        CheckedResult(id, r.Bytes(i, 2), r.Bytes(i, 3), r.Int(i, 4), r.Int(i, 5));
-    if (!result.ok()) {
-      damaged.push_back(absl::StrCat("result of job ", id, " (row ", r.Int(i, 0),
-                                     "): ", result.status().message()));
-    }
-  }
-  return damaged;
-}
-
-absl::StatusOr<std::vector<std::string>> PostgresJobStore::QueuedJobIds() {
-  absl::MutexLock lock(&mu_);
-  EnsureConnected();
-  PgResult r(Params().Run(conn_, NamedStates("SELECT pid FROM jobs WHERE state = {QUEUED} ORDER BY seq")));
-  if (!r.ok()) return r.status();
-  std::vector<std::string> ids;
-  for (int i = 0; i < r.rows(); ++i) ids.push_back(r.Bytes(i, 0));
-  return ids;
-}
-
-absl::StatusOr<std::optional<Claim>> PostgresJobStore::ClaimNext() {
-  absl::MutexLock lock(&mu_);
-  EnsureConnected();
-  // A job no live claim holds, round-robin across tenants (JobStore::
-  // ClaimNext); rows another server is claiming right now are skipped,
-  // not waited for.
-  PgResult r(Params().Text(owner_).Int(options_.lease_ms).Run(
-      conn_,
-      NamedStates(absl::StrCat("UPDATE jobs SET state = {RUNNING}, owner = $1, lease_until_ms = ", kNowMs,
-                   " + $2::bigint, started_ms = ", kNowMs,
-                   ", attempts = attempts + 1, cancel_requested = FALSE, progress_time_s = 0 "
-                   "WHERE seq = (SELECT seq FROM jobs j WHERE state = {QUEUED} OR (state = {RUNNING} AND "
-                   "lease_until_ms < ",
-                   kNowMs, ") ORDER BY ", kFairShareOrder,
-                   " LIMIT 1 FOR UPDATE SKIP LOCKED) "
-                   "RETURNING pid, attempts"))));
-  if (!r.ok()) return r.status();
-  if (r.rows() == 0) return std::nullopt;
-  Notify();
-  return Claim{r.Bytes(0, 0), static_cast<int>(r.Int(0, 1))};
-}
-
-absl::StatusOr<bool> PostgresJobStore::MarkRunning(const std::string& id) {
-  absl::MutexLock lock(&mu_);
-  EnsureConnected();
-  PgResult r(Params().Text(owner_).Int(options_.lease_ms).Text(id).Run(
-      conn_, NamedStates(absl::StrCat("UPDATE jobs SET state = {RUNNING}, owner = $1, lease_until_ms = ", kNowMs,
-                          " + $2::bigint, started_ms = ", kNowMs,
-                          ", attempts = attempts + 1, cancel_requested = FALSE "
-                          "WHERE pid = $3 AND state = {QUEUED} RETURNING seq"))));
-  if (!r.ok()) return r.status();
-  return r.rows() == 1;
-}
-
-absl::Status PostgresJobStore::Requeue(const std::string& id, int attempt) {
-  absl::MutexLock lock(&mu_);
-  EnsureConnected();
-  PgResult r(Params().Text(id).Text(owner_).Int(attempt).Run(
-      conn_,
-      NamedStates("UPDATE jobs SET state = {QUEUED}, owner = '', lease_until_ms = 0 WHERE pid = $1 "
-                  "AND state = {RUNNING} AND owner = $2 AND ($3::int = 0 OR attempts = $3::int)")));
-  if (!r.ok()) return r.status();
-  Notify();
-  return absl::OkStatus();
-}
-
-absl::StatusOr<bool> PostgresJobStore::CancelQueued(const std::string& id) {
-  absl::MutexLock lock(&mu_);
-  EnsureConnected();
-  // A job whose server died (lease expired) is as good as queued.
-  PgResult r(Params().Text(id).Run(
-      conn_, NamedStates(absl::StrCat("UPDATE jobs SET state = {CANCELLED}, finished_ms = ", kNowMs,
-                          ", owner = '' WHERE pid = $1 AND (state = {QUEUED} OR (state = {RUNNING} AND "
-                          "lease_until_ms < ",
-                          kNowMs, ")) RETURNING seq"))));
-  if (!r.ok()) return r.status();
-  if (r.rows() == 1) Notify();
-  return r.rows() == 1;
+  auto rows = std::make_unique<PgRows>(values.Exec(conn_, text), conn_);
+  if (!rows->result().ok()) return rows->result().status();
+  return rows;
 }
 
 absl::Status PostgresJobStore::RequestCancel(const std::string& id) {
   absl::MutexLock lock(&mu_);
   EnsureConnected();
-  PgResult r(Params().Text(id).Run(
-      conn_, NamedStates("UPDATE jobs SET cancel_requested = TRUE WHERE pid = $1 AND state = {RUNNING}")));
+  absl::StatusOr<std::unique_ptr<SqlRows>> r =
+      Query("UPDATE jobs SET cancel_requested = TRUE WHERE pid = @id AND state = " CABLESIM_STATE(
+                "running"),
+            {{"id", id}});
   if (!r.ok()) return r.status();
   Notify();
   return absl::OkStatus();
@@ -775,237 +649,27 @@ absl::StatusOr<HeartbeatReply> PostgresJobStore::Heartbeat(
     const std::vector<RunningJob>& running) {
   HeartbeatReply reply;
   if (running.empty()) return reply;
+  static const std::string* const kRenew = new std::string(absl::StrCat(
+      "UPDATE jobs SET lease_until_ms = ", kNowMs,
+      " + @lease_ms::bigint, progress_time_s = @progress::float8 WHERE pid = @id AND state = ",
+      CABLESIM_STATE("running"),
+      " AND owner = @owner AND attempts = @attempt::int RETURNING cancel_requested"));
   absl::MutexLock lock(&mu_);
   EnsureConnected();
   for (const RunningJob& job : running) {
-    PgResult r(Params()
-                   .Int(options_.lease_ms)
-                   .Real(job.progress_time_s)
-                   .Text(job.id)
-                   .Text(owner_)
-                   .Int(job.attempt)
-                   .Run(conn_, NamedStates(absl::StrCat("UPDATE jobs SET lease_until_ms = ", kNowMs,
-                                            " + $1::bigint, progress_time_s = $2::float8 "
-                                            "WHERE pid = $3 AND state = {RUNNING} AND owner = $4 AND "
-                                            "attempts = $5::int RETURNING cancel_requested"))));
+    absl::StatusOr<std::unique_ptr<SqlRows>> r =
+        Query(*kRenew, {{"progress", job.progress_time_s},
+                        {"id", job.id},
+                        {"attempt", int64_t{job.attempt}}});
     if (!r.ok()) return r.status();
-    if (r.rows() == 0) {
+    if ((*r)->size() == 0) {
       reply.lost.push_back(job.id);
-    } else if (r.Int(0, 0) != 0) {
+    } else if ((*r)->Int(0, 0) != 0) {
       reply.cancel.push_back(job.id);
     }
   }
   Notify();
   return reply;
-}
-
-absl::StatusOr<bool> PostgresJobStore::Finish(const std::string& id, v1::JobState state,
-                                              const v1::RunSummary& summary,
-                                              const StoredResult& result, int attempt) {
-  const std::string header = result.header.SerializeAsString();
-  const EncodedValues vals = EncodeValues(result.values, result.header.columns_size());
-  const int64_t checksum =
-      ResultChecksum(header.data(), header.size(), vals.blob.data(), vals.blob.size());
-  absl::MutexLock lock(&mu_);
-  EnsureConnected();
-  Transaction tx(conn_);
-  if (!tx.begun().ok()) return tx.begun();
-  PgResult u(Params()
-                 .Int(state)
-                 .Bytes(summary.SerializeAsString())
-                 .Text(id)
-                 .Text(owner_)
-                 .Int(attempt)
-                 .Run(conn_, NamedStates(absl::StrCat("UPDATE jobs SET state = $1::int, finished_ms = ",
-                                          kNowMs,
-                                          ", summary = $2, lease_until_ms = 0 WHERE pid = $3 AND "
-                                          "state = {RUNNING} AND owner = $4 AND ($5::int = 0 OR "
-                                          "attempts = $5::int) RETURNING seq"))));
-  if (!u.ok()) return (u.status());
-  if (u.rows() != 1) return false;
-  PgResult r(Params()
-                 .Int(u.Int(0, 0))
-                 .Bytes(header)
-                 .Bytes(vals.blob)
-                 .Int(checksum)
-                 .Int(vals.encoding)
-                 .Run(conn_,
-                      "INSERT INTO results (job_seq, header, vals, checksum, encoding) VALUES "
-                      "($1::bigint, $2, $3, $4::bigint, $5::int) ON CONFLICT (job_seq) DO "
-                      "UPDATE SET header = EXCLUDED.header, vals = EXCLUDED.vals, checksum = "
-                      "EXCLUDED.checksum, encoding = EXCLUDED.encoding"));
-  if (!r.ok()) return (r.status());
-  Notify();
-  if (absl::Status st = tx.Commit(); !st.ok()) return st;
-  return true;
-}
-
-absl::StatusOr<StoredResult> PostgresJobStore::GetResult(const std::string& id) {
-  absl::MutexLock lock(&mu_);
-  EnsureConnected();
-  PgResult r(Params().Text(id).Run(conn_,
-                                   "SELECT r.header, r.vals, r.checksum, r.encoding FROM "
-                                   "results r JOIN jobs "
-                                   "j ON j.seq = r.job_seq WHERE j.pid = $1"));
-  if (!r.ok()) return r.status();
-  if (r.rows() == 0) return absl::NotFoundError(absl::StrCat("job \"", id, "\" has no result"));
-  return CheckedResult(id, r.Bytes(0, 0), r.Bytes(0, 1), r.Int(0, 2), r.Int(0, 3));
-}
-
-absl::StatusOr<v1::Sweep> PostgresJobStore::GetSweep(const std::string& id) {
-  absl::MutexLock lock(&mu_);
-  EnsureConnected();
-  if (!IsSweepId(id)) return absl::NotFoundError(absl::StrCat("no sweep \"", id, "\""));
-  PgResult s(Params().Text(id).Run(
-      conn_,
-      "SELECT name, axes, created_ms, seq, (w.row_sum IS NOT DISTINCT FROM cablesim_sweep_sum(w)) "
-      "FROM sweeps w WHERE pid = $1"));
-  if (!s.ok()) return s.status();
-  if (s.rows() == 0) return absl::NotFoundError(absl::StrCat("no sweep \"", id, "\""));
-  if (s.Int(0, 4) != 1) return DamagedRow("sweep", id);
-  v1::Sweep sweep;
-  sweep.ParseFromString(s.Bytes(0, 1));
-  sweep.set_id(id);
-  sweep.set_name(s.Bytes(0, 0));
-  sweep.set_created_unix_ms(s.Int(0, 2));
-  PgResult r(Params().Int(s.Int(0, 3)).Run(
-      conn_,
-      "SELECT pid, state, (j.row_sum IS NOT DISTINCT FROM cablesim_job_sum(j)) FROM jobs j "
-      "WHERE sweep_seq = $1::bigint ORDER BY sweep_index"));
-  if (!r.ok()) return r.status();
-  int finished = 0, failed = 0;
-  for (int i = 0; i < r.rows(); ++i) {
-    // A damaged item: the sweep's ids and counts cannot be served whole.
-    if (r.Int(i, 2) != 1) {
-      return absl::DataLossError(absl::StrCat("sweep ", id, ": the stored row of item ", i,
-                                              " fails its checksum (the database is damaged); "
-                                              "cablesim-server --check lists it"));
-    }
-    sweep.add_job_ids(r.Bytes(i, 0));
-    const auto state = static_cast<v1::JobState>(r.Int(i, 1));
-    if (IsFinished(state)) ++finished;
-    if (state == v1::FAILED || state == v1::CANCELLED) ++failed;
-  }
-  sweep.set_items(r.rows());
-  sweep.set_finished(finished);
-  sweep.set_failed(failed);
-  return sweep;
-}
-
-namespace {
-constexpr char kResultBytes[] = "octet_length(header) + octet_length(vals)";
-}  // namespace
-
-absl::StatusOr<int64_t> PostgresJobStore::DeleteJob(const std::string& id) {
-  absl::MutexLock lock(&mu_);
-  EnsureConnected();
-  Transaction tx(conn_);
-  if (!tx.begun().ok()) return tx.begun();
-  PgResult s(Params().Text(IsSweepId(id) ? std::string() : id).Run(
-      conn_, absl::StrCat("SELECT j.state, COALESCE(j.sweep_seq, 0), COALESCE((SELECT ",
-                          kResultBytes,
-                          " FROM results WHERE job_seq = j.seq), 0)::bigint, "
-                          "COALESCE((SELECT pid FROM sweeps WHERE sweeps.seq = j.sweep_seq), ''), "
-                          "j.seq FROM jobs j WHERE j.pid = $1 FOR UPDATE")));
-  if (!s.ok()) return (s.status());
-  if (s.rows() == 0) return (absl::NotFoundError(absl::StrCat("no job \"", id, "\"")));
-  const auto state = static_cast<v1::JobState>(s.Int(0, 0));
-  if (!IsFinished(state)) {
-    return (absl::FailedPreconditionError(absl::StrCat(
-        "job \"", id, "\" is ", v1::JobState_Name(state), "; cancel it before deleting it")));
-  }
-  if (s.Int(0, 1) > 0) {
-    return (absl::FailedPreconditionError(
-        absl::StrCat("job \"", id, "\" is an item of sweep \"", s.Bytes(0, 3),
-                     "\"; delete the sweep (DeleteSweep) instead")));
-  }
-  PgResult d(Params().Int(s.Int(0, 4)).Run(conn_, "DELETE FROM jobs WHERE seq = $1::bigint"));
-  if (!d.ok()) return (d.status());
-  Notify();
-  if (absl::Status st = tx.Commit(); !st.ok()) return st;
-  return s.Int(0, 2);
-}
-
-absl::StatusOr<int64_t> PostgresJobStore::DeleteSweep(const std::string& id) {
-  absl::MutexLock lock(&mu_);
-  EnsureConnected();
-  Transaction tx(conn_);
-  if (!tx.begun().ok()) return tx.begun();
-  PgResult s(Params().Text(IsSweepId(id) ? id : std::string()).Run(
-      conn_, "SELECT seq FROM sweeps WHERE pid = $1 FOR UPDATE"));
-  if (!s.ok()) return (s.status());
-  if (s.rows() == 0) return (absl::NotFoundError(absl::StrCat("no sweep \"", id, "\"")));
-  const int64_t seq = s.Int(0, 0);
-  PgResult c(Params().Int(seq).Run(
-      conn_, absl::StrCat("SELECT COUNT(*) FILTER (WHERE state NOT IN ", kFinishedStates,
-                          "), COALESCE(SUM((SELECT ", kResultBytes,
-                          " FROM results WHERE job_seq = jobs.seq)), 0)::bigint FROM jobs "
-                          "WHERE sweep_seq = $1::bigint")));
-  if (!c.ok()) return (c.status());
-  if (const int64_t unfinished = c.Int(0, 0); unfinished > 0) {
-    return (absl::FailedPreconditionError(
-        absl::StrCat("sweep \"", id, "\" has ", unfinished,
-                     " unfinished items; cancel them before deleting it")));
-  }
-  PgResult d(Params().Int(seq).Run(conn_,
-                                   "DELETE FROM jobs WHERE sweep_seq = $1::bigint"));
-  if (!d.ok()) return (d.status());
-  PgResult e(Params().Int(seq).Run(conn_, "DELETE FROM sweeps WHERE seq = $1::bigint"));
-  if (!e.ok()) return (e.status());
-  Notify();
-  if (absl::Status st = tx.Commit(); !st.ok()) return st;
-  return c.Int(0, 1);
-}
-
-absl::StatusOr<RetentionReport> PostgresJobStore::ApplyRetention(int64_t older_than_unix_ms,
-                                                                 int64_t max_bytes) {
-  absl::MutexLock lock(&mu_);
-  EnsureConnected();
-  PgResult t(Params().Run(
-      conn_, absl::StrCat("SELECT COALESCE(SUM(", kResultBytes, "), 0)::bigint FROM results")));
-  if (!t.ok()) return t.status();
-  int64_t total = t.Int(0, 0);
-  PgResult c(Params().Run(
-      conn_,
-      absl::StrCat("SELECT 0, seq, finished_ms, COALESCE((SELECT ", kResultBytes,
-                   " FROM results WHERE job_seq = jobs.seq), 0)::bigint FROM jobs "
-                   "WHERE sweep_seq IS NULL AND state IN ",
-                   kFinishedStates,
-                   " UNION ALL "
-                   "SELECT 1, sweep_seq, MAX(finished_ms), COALESCE(SUM((SELECT ",
-                   kResultBytes,
-                   " FROM results WHERE job_seq = jobs.seq)), 0)::bigint FROM jobs "
-                   "WHERE sweep_seq IS NOT NULL GROUP BY sweep_seq "
-                   "HAVING COUNT(*) FILTER (WHERE state NOT IN ",
-                   kFinishedStates, ") = 0 ORDER BY 3")));
-  if (!c.ok()) return c.status();
-  RetentionReport report;
-  for (int i = 0; i < c.rows(); ++i) {
-    const bool sweep = c.Int(i, 0) != 0;
-    const int64_t seq = c.Int(i, 1), finished_ms = c.Int(i, 2), bytes = c.Int(i, 3);
-    if (finished_ms >= older_than_unix_ms && total <= max_bytes) break;
-    Transaction tx(conn_);
-    if (!tx.begun().ok()) return tx.begun();
-    // Another server may have deleted it meanwhile: count what goes here.
-    PgResult d(Params().Int(seq).Run(
-        conn_, sweep ? "DELETE FROM jobs WHERE sweep_seq = $1::bigint"
-                     : absl::StrCat("DELETE FROM jobs WHERE seq = $1::bigint AND sweep_seq IS "
-                                    "NULL AND state IN ",
-                                    kFinishedStates)));
-    absl::Status st = d.status();
-    if (st.ok() && sweep) {
-      PgResult e(Params().Int(seq).Run(conn_, "DELETE FROM sweeps WHERE seq = $1::bigint"));
-      st = e.status();
-    }
-    if (st.ok()) st = tx.Commit();
-    if (!st.ok()) return st;
-    total -= bytes;
-    report.jobs += d.changed();
-    report.sweeps += sweep ? 1 : 0;
-    report.bytes += bytes;
-  }
-  if (report.jobs > 0) Notify();
-  return report;
 }
 
 }  // namespace cablesim

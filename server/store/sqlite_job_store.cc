@@ -14,6 +14,8 @@
 #include <cstring>
 #include <fstream>
 #include <utility>
+#include <variant>
+#include <vector>
 
 #include "absl/strings/escaping.h"
 #include "absl/strings/match.h"
@@ -224,53 +226,142 @@ std::string RowSumTriggers(absl::string_view table, absl::string_view columns) {
       ") BEGIN ", fresh);
 }
 
-// The last columns: bytes of the job's stored result (0 without one),
-// the id, the sweep's id, whether the row is intact.
+// The columns SqlStatements lists for a job row: progress is not stored
+// (one server runs its jobs and knows their progress), read as 0.
 const std::string& JobColumns() {
   static const std::string* sql = new std::string(absl::StrCat(
       "seq, state, name, created_ms, started_ms, finished_ms, attempts, end_time_s, summary, "
       "sweep_seq, sweep_index, "
       "(SELECT length(header) + length(vals) FROM results WHERE job_seq = jobs.seq), pid, "
-      "(SELECT pid FROM sweeps WHERE sweeps.seq = jobs.sweep_seq), ",
+      "(SELECT pid FROM sweeps WHERE sweeps.seq = jobs.sweep_seq), 0.0, ",
       JobIntact()));
   return *sql;
 }
-constexpr int kJobIntactColumn = 14;
 
-v1::Job JobFromRow(Stmt& s) {
-  v1::Job job;
-  job.set_id(s.Text(12));
-  job.set_state(static_cast<v1::JobState>(s.Int(1)));
-  job.set_name(s.Text(2));
-  job.set_created_unix_ms(s.Int(3));
-  job.set_started_unix_ms(s.Int(4));
-  job.set_finished_unix_ms(s.Int(5));
-  job.set_attempts(static_cast<int>(s.Int(6)));
-  job.set_end_time_s(s.Real(7));
-  const std::string summary = s.Blob(8);
-  if (!summary.empty()) job.mutable_summary()->ParseFromString(summary);
-  if (s.Int(9) > 0) {
-    job.set_sweep_id(s.Text(13));
-    job.set_sweep_index(static_cast<int>(s.Int(10)));
-  }
-  job.set_stored_bytes(s.Int(11));
-  return job;
+constexpr char kResultBytes[] = "length(header) + length(vals)";
+constexpr char kFinishedStates[] = "(@succeeded, @failed, @cancelled)";
+
+// SQLite's statements (SqlStatements): states are bound as the numbers
+// the jobs table stores; the time is this server's clock (@now_ms). One
+// connection and one server (the flock): a single UPDATE claims.
+const SqlStatements& Statements() {
+  static const SqlStatements* sql = new SqlStatements{
+      .begin = "BEGIN IMMEDIATE",
+      .requeue_running = "UPDATE jobs SET state = @queued WHERE state = @running",
+      .peer_lock = "",
+      .peer_unfinished =
+          "SELECT COUNT(*) FROM jobs WHERE peer = @peer AND state IN (@queued, @running)",
+      .insert_job = "INSERT INTO jobs (state, name, scene, end_time_s, created_ms, peer, tenant, "
+                    "pid) VALUES (@queued, @name, @scene, @end_time_s, @now_ms, @peer, @tenant, "
+                    "@id)",
+      .insert_sweep = "INSERT INTO sweeps (name, axes, created_ms, tenant, pid) VALUES (@name, "
+                      "@axes, @created_ms, @tenant, @id) RETURNING seq",
+      .insert_item = "INSERT INTO jobs (state, name, scene, end_time_s, created_ms, sweep_seq, "
+                     "sweep_index, peer, tenant, pid) VALUES (@queued, @name, @scene, "
+                     "@end_time_s, @created_ms, @sweep_seq, @sweep_index, @peer, @tenant, @id)",
+      .job_by_id = absl::StrCat("SELECT ", JobColumns(), " FROM jobs WHERE pid = @id"),
+      .scene_by_id = "SELECT scene FROM jobs WHERE pid = @id",
+      .sweep_seq_by_id = "SELECT seq FROM sweeps WHERE pid = @id",
+      .list_jobs = absl::StrCat(
+          "SELECT ", JobColumns(),
+          " FROM jobs WHERE (@any_state = 1 OR state = @state) AND (@sweep_seq = 0 OR "
+          "sweep_seq = @sweep_seq) AND seq < @before_seq AND (@any_tenant = 1 OR tenant = "
+          "@tenant) ORDER BY seq DESC LIMIT @limit"),
+      .tenant_of_job = absl::StrCat("SELECT tenant, ", JobIntact(), " FROM jobs WHERE pid = @id"),
+      .tenant_of_sweep =
+          absl::StrCat("SELECT tenant, ", SweepIntact(), " FROM sweeps WHERE pid = @id"),
+      .damaged_rows = absl::StrCat("SELECT 'job', seq, pid FROM jobs WHERE NOT ", JobIntact(),
+                                   " UNION ALL SELECT 'sweep', seq, pid FROM sweeps WHERE NOT ",
+                                   SweepIntact(), " ORDER BY 1, 2"),
+      .all_results = "SELECT job_seq, (SELECT pid FROM jobs WHERE seq = job_seq), header, vals, "
+                     "checksum, encoding FROM results ORDER BY job_seq",
+      .queued_ids = "SELECT pid FROM jobs WHERE state = @queued ORDER BY seq",
+      .claim_next = absl::StrCat(
+          "UPDATE jobs SET state = @running, started_ms = @now_ms, attempts = attempts + 1 "
+          "WHERE seq = (SELECT seq FROM jobs j WHERE state = @queued ORDER BY ",
+          kFairShareOrder, " LIMIT 1) AND state = @queued RETURNING pid, attempts"),
+      .mark_running = "UPDATE jobs SET state = @running, started_ms = @now_ms, attempts = "
+                      "attempts + 1 WHERE pid = @id AND state = @queued RETURNING seq",
+      .requeue = "UPDATE jobs SET state = @queued WHERE pid = @id AND state = @running AND "
+                 "(@attempt = 0 OR attempts = @attempt)",
+      .cancel_queued = "UPDATE jobs SET state = @cancelled, finished_ms = @now_ms WHERE pid = @id "
+                       "AND state = @queued RETURNING seq",
+      .finish = "UPDATE jobs SET state = @state, finished_ms = @now_ms, summary = @summary WHERE "
+                "pid = @id AND state = @running AND (@attempt = 0 OR attempts = @attempt) "
+                "RETURNING seq",
+      .store_result = "INSERT OR REPLACE INTO results (job_seq, header, vals, checksum, encoding) "
+                      "VALUES (@seq, @header, @vals, @checksum, @encoding)",
+      .result_by_id = "SELECT header, vals, checksum, encoding FROM results WHERE job_seq = "
+                      "(SELECT seq FROM jobs WHERE pid = @id)",
+      .sweep_by_id = absl::StrCat("SELECT name, axes, created_ms, seq, ", SweepIntact(),
+                                  " FROM sweeps WHERE pid = @id"),
+      .sweep_items = absl::StrCat("SELECT pid, state, ", JobIntact(),
+                                  " FROM jobs WHERE sweep_seq = @seq ORDER BY sweep_index"),
+      .job_for_delete = absl::StrCat(
+          "SELECT state, sweep_seq, (SELECT ", kResultBytes,
+          " FROM results WHERE job_seq = jobs.seq), (SELECT pid FROM sweeps WHERE sweeps.seq = "
+          "jobs.sweep_seq), seq FROM jobs WHERE pid = @id"),
+      .sweep_for_delete = "SELECT seq FROM sweeps WHERE pid = @id",
+      .sweep_unfinished = absl::StrCat(
+          "SELECT COALESCE(SUM(state NOT IN ", kFinishedStates, "), 0), COALESCE(SUM((SELECT ",
+          kResultBytes, " FROM results WHERE job_seq = jobs.seq)), 0) FROM jobs WHERE "
+          "sweep_seq = @seq"),
+      .delete_job_results = absl::StrCat(
+          "DELETE FROM results WHERE job_seq IN (SELECT seq FROM jobs WHERE seq = @seq AND "
+          "sweep_seq = 0 AND state IN ", kFinishedStates, ")"),
+      .delete_job = absl::StrCat("DELETE FROM jobs WHERE seq = @seq AND sweep_seq = 0 AND state IN ",
+                                 kFinishedStates),
+      .delete_sweep_results =
+          "DELETE FROM results WHERE job_seq IN (SELECT seq FROM jobs WHERE sweep_seq = @seq)",
+      .delete_sweep_jobs = "DELETE FROM jobs WHERE sweep_seq = @seq",
+      .delete_sweep = "DELETE FROM sweeps WHERE seq = @seq",
+      .results_bytes = absl::StrCat("SELECT COALESCE(SUM(", kResultBytes, "), 0) FROM results"),
+      .retention_candidates = absl::StrCat(
+          "SELECT 0, seq, finished_ms, COALESCE((SELECT ", kResultBytes,
+          " FROM results WHERE job_seq = jobs.seq), 0) FROM jobs WHERE sweep_seq = 0 AND state "
+          "IN ", kFinishedStates,
+          " UNION ALL SELECT 1, sweep_seq, MAX(finished_ms), COALESCE(SUM((SELECT ", kResultBytes,
+          " FROM results WHERE job_seq = jobs.seq)), 0) FROM jobs WHERE sweep_seq > 0 GROUP BY "
+          "sweep_seq HAVING SUM(state NOT IN ", kFinishedStates, ") = 0 ORDER BY 3"),
+  };
+  return *sql;
 }
 
+// The rows of one statement, each column a copy of its value (the
+// conversions of sqlite3_value_*, as sqlite3_column_* would make).
+class SqliteRows final : public SqlRows {
+ public:
+  SqliteRows(std::vector<sqlite3_value*> cells, int columns, int64_t changed)
+      : cells_(std::move(cells)), columns_(columns), changed_(changed) {}
+  ~SqliteRows() override {
+    for (sqlite3_value* v : cells_) sqlite3_value_free(v);
+  }
+  SqliteRows(const SqliteRows&) = delete;
+  SqliteRows& operator=(const SqliteRows&) = delete;
 
+  int size() const override {
+    return columns_ > 0 ? static_cast<int>(cells_.size()) / columns_ : 0;
+  }
+  int64_t Int(int row, int col) const override { return sqlite3_value_int64(cell(row, col)); }
+  double Real(int row, int col) const override { return sqlite3_value_double(cell(row, col)); }
+  std::string Bytes(int row, int col) const override {
+    sqlite3_value* v = cell(row, col);
+    const void* p = sqlite3_value_blob(v);
+    return p ? std::string(static_cast<const char*>(p), sqlite3_value_bytes(v)) : "";
+  }
+  int64_t changed() const override { return changed_; }
 
+ private:
+  sqlite3_value* cell(int row, int col) const { return cells_[row * columns_ + col]; }
+  std::vector<sqlite3_value*> cells_;
+  int columns_;
+  int64_t changed_;
+};
 }  // namespace
 
 
 
 
-
-int64_t SqliteJobStore::LookUpSeq(const std::string& id) {
-  Stmt s(db_, IsSweepId(id) ? "SELECT seq FROM sweeps WHERE pid = ?1"
-                            : "SELECT seq FROM jobs WHERE pid = ?1");
-  s.Bind(1, id);
-  return s.Step() == SQLITE_ROW ? s.Int(0) : -1;
-}
 
 absl::StatusOr<std::unique_ptr<SqliteJobStore>> SqliteJobStore::Open(const std::string& dir) {
   // A missing directory is created (0700; missing parents too, with the
@@ -535,484 +626,49 @@ absl::Status SqliteJobStore::Exec(const char* sql) {
   return absl::OkStatus();
 }
 
-absl::StatusOr<int> SqliteJobStore::RequeueRunning() {
-  absl::MutexLock lock(&mu_);
-  Stmt s(db_, "UPDATE jobs SET state = ?1 WHERE state = ?2");
-  s.Bind(1, int64_t{v1::QUEUED}).Bind(2, int64_t{v1::RUNNING});
-  if (absl::Status st = s.Done(); !st.ok()) return st;
-  return sqlite3_changes(db_);
-}
+SqliteJobStore::SqliteJobStore(sqlite3* db, int lock_fd, std::string dir)
+    : SqlJobStore(Statements()), db_(db), lock_fd_(lock_fd), dir_(std::move(dir)) {}
 
-absl::Status SqliteJobStore::CheckPeerRoom(const std::string& peer, int64_t adding,
-                                     int64_t max_unfinished) {
-  if (max_unfinished == std::numeric_limits<int64_t>::max()) return absl::OkStatus();
-  Stmt c(db_, "SELECT COUNT(*) FROM jobs WHERE peer = ?1 AND state IN (?2, ?3)");
-  c.Bind(1, peer).Bind(2, int64_t{v1::QUEUED}).Bind(3, int64_t{v1::RUNNING});
-  if (c.Step() != SQLITE_ROW) return SqlError(db_);
-  const int64_t unfinished = c.Int(0);
-  if (unfinished + adding > max_unfinished) {
-    return PeerLimitExceeded(peer, unfinished, adding, max_unfinished);
+absl::StatusOr<std::unique_ptr<SqlRows>> SqliteJobStore::Run(const std::string& sql,
+                                                             const SqlParams& params) {
+  sqlite3_stmt* stmt = nullptr;
+  if (sqlite3_prepare_v2(db_, sql.c_str(), -1, &stmt, nullptr) != SQLITE_OK) {
+    sqlite3_finalize(stmt);
+    return SqlError(db_);
   }
-  return absl::OkStatus();
-}
-
-absl::StatusOr<v1::Job> SqliteJobStore::InsertJob(const v1::Scene& scene, double end_time_s,
-                                            const std::string& peer, int64_t max_unfinished,
-                                            const std::string& tenant) {
-  absl::StatusOr<std::string> pid = NewPublicId('j');
-  if (!pid.ok()) return pid.status();
-  {
-    absl::MutexLock lock(&mu_);
-    if (absl::Status st = CheckPeerRoom(peer, 1, max_unfinished); !st.ok()) return st;
-    Stmt s(db_,
-           "INSERT INTO jobs (state, name, scene, end_time_s, created_ms, peer, tenant, pid) "
-           "VALUES (?1,?2,?3,?4,?5,?6,?7,?8)");
-    const std::string blob = scene.SerializeAsString();
-    s.Bind(1, int64_t{v1::QUEUED})
-        .Bind(2, scene.name())
-        .BindBlob(3, blob.data(), blob.size())
-        .Bind(4, end_time_s)
-        .Bind(5, NowUnixMs())
-        .Bind(6, peer)
-        .Bind(7, tenant)
-        .Bind(8, *pid);
-    if (absl::Status st = s.Done(); !st.ok()) return st;
-  }
-  return GetJob(*pid);
-}
-
-absl::StatusOr<v1::Sweep> SqliteJobStore::InsertSweep(const v1::SubmitSweepRequest& request,
-                                                const std::vector<v1::Scene>& items,
-                                                const std::vector<double>& end_times_s,
-                                                const std::string& peer,
-                                                int64_t max_unfinished,
-                                                const std::string& tenant) {
-  int64_t sweep_seq;
-  absl::StatusOr<std::string> sweep_pid;
-  {
-    absl::MutexLock lock(&mu_);
-    if (absl::Status st = CheckPeerRoom(peer, static_cast<int64_t>(items.size()), max_unfinished);
-        !st.ok()) {
-      return st;
+  for (const auto& [name, value] : params) {
+    const int i = sqlite3_bind_parameter_index(stmt, absl::StrCat("@", name).c_str());
+    if (i == 0) continue;  // a parameter this statement does not use
+    if (const auto* v = std::get_if<int64_t>(&value)) {
+      sqlite3_bind_int64(stmt, i, *v);
+    } else if (const auto* v = std::get_if<double>(&value)) {
+      sqlite3_bind_double(stmt, i, *v);
+    } else if (const auto* v = std::get_if<std::string>(&value)) {
+      sqlite3_bind_text(stmt, i, v->data(), static_cast<int>(v->size()), SQLITE_TRANSIENT);
+    } else if (const auto* v = std::get_if<SqlBytes>(&value)) {
+      // An empty blob, never NULL.
+      static const char kEmpty = 0;
+      sqlite3_bind_blob64(stmt, i, v->data.empty() ? &kEmpty : v->data.data(), v->data.size(),
+                          SQLITE_TRANSIENT);
+    } else {
+      // The state's number, as the jobs table stores it.
+      sqlite3_bind_int64(stmt, i, std::get<SqlState>(value).state);
     }
-    if (absl::Status st = Exec("BEGIN IMMEDIATE"); !st.ok()) return st;
-    auto rollback = [&](absl::Status st) {
-      Exec("ROLLBACK").IgnoreError();
-      return st;
-    };
-    sweep_pid = NewPublicId('s');
-    if (!sweep_pid.ok()) return rollback(sweep_pid.status());
-    v1::Sweep axes;
-    *axes.mutable_axes() = request.axes();
-    *axes.mutable_thresholds() = request.thresholds();  // kept with the axes
-    const std::string axes_blob = axes.SerializeAsString();
-    const int64_t now = NowUnixMs();
-    {
-      Stmt s(db_,
-             "INSERT INTO sweeps (name, axes, created_ms, tenant, pid) VALUES (?1,?2,?3,?4,?5)");
-      s.Bind(1, request.name())
-          .BindBlob(2, axes_blob.data(), axes_blob.size())
-          .Bind(3, now)
-          .Bind(4, tenant)
-          .Bind(5, *sweep_pid);
-      if (absl::Status st = s.Done(); !st.ok()) return rollback(st);
-      sweep_seq = sqlite3_last_insert_rowid(db_);
-    }
-    for (size_t i = 0; i < items.size(); ++i) {
-      Stmt s(db_,
-             "INSERT INTO jobs (state, name, scene, end_time_s, created_ms, sweep_seq, "
-             "sweep_index, peer, tenant, pid) VALUES (?1,?2,?3,?4,?5,?6,?7,?8,?9,?10)");
-      const std::string blob = items[i].SerializeAsString();
-      s.Bind(1, int64_t{v1::QUEUED})
-          .Bind(2, items[i].name())
-          .BindBlob(3, blob.data(), blob.size())
-          .Bind(4, end_times_s[i])
-          .Bind(5, now)
-          .Bind(6, sweep_seq)
-          .Bind(7, static_cast<int64_t>(i))
-          .Bind(8, peer)
-          .Bind(9, tenant);
-      absl::StatusOr<std::string> item_pid = NewPublicId('j');
-      if (!item_pid.ok()) return rollback(item_pid.status());
-      s.Bind(10, *item_pid);
-      if (absl::Status st = s.Done(); !st.ok()) return rollback(st);
-    }
-    if (absl::Status st = Exec("COMMIT"); !st.ok()) return rollback(st);
   }
-  (void)sweep_seq;
-  return GetSweep(*sweep_pid);
-}
-
-absl::StatusOr<v1::Job> SqliteJobStore::GetJob(const std::string& id) {
-  absl::MutexLock lock(&mu_);
-  Stmt s(db_, absl::StrCat("SELECT ", JobColumns(), " FROM jobs WHERE pid = ?1").c_str());
-  s.Bind(1, id);
-  const int rc = s.Step();
-  if (rc == SQLITE_ROW) {
-    if (s.Int(kJobIntactColumn) != 1) return DamagedRow("job", id);
-    return JobFromRow(s);
-  }
-  if (rc == SQLITE_DONE) return absl::NotFoundError(absl::StrCat("no job \"", id, "\""));
-  return SqlError(db_);
-}
-
-absl::StatusOr<v1::Scene> SqliteJobStore::GetScene(const std::string& id) {
-  absl::MutexLock lock(&mu_);
-  Stmt s(db_, "SELECT scene FROM jobs WHERE pid = ?1");
-  s.Bind(1, id);
-  const int rc = s.Step();
-  if (rc == SQLITE_DONE) return absl::NotFoundError(absl::StrCat("no job \"", id, "\""));
-  if (rc != SQLITE_ROW) return SqlError(db_);
-  v1::Scene scene;
-  if (!scene.ParseFromString(s.Blob(0))) return absl::DataLossError("stored scene unreadable");
-  return scene;
-}
-
-absl::StatusOr<std::vector<v1::Job>> SqliteJobStore::ListJobs(v1::JobState state,
-                                                              const std::string& sweep_id,
-                                                              int limit, int64_t after_key,
-                                                              const std::string* tenant,
-                                                              std::vector<int64_t>* keys) {
-  absl::MutexLock lock(&mu_);
-  Stmt s(db_, absl::StrCat("SELECT ", JobColumns(),
-                           " FROM jobs WHERE (?1 = 0 OR state = ?1) AND (?2 = 0 OR sweep_seq = ?2)"
-                           " AND seq < ?4 AND (?5 = 0 OR tenant = ?6) ORDER BY seq DESC LIMIT ?3")
-                  .c_str());
-  s.Bind(5, int64_t{tenant != nullptr}).Bind(6, tenant != nullptr ? *tenant : std::string());
-  s.Bind(1, int64_t{state})
-      .Bind(2, sweep_id.empty() ? 0 : (IsSweepId(sweep_id) ? LookUpSeq(sweep_id) : -1))
-      .Bind(3, int64_t{limit})
-      .Bind(4, after_key > 0 ? after_key : std::numeric_limits<int64_t>::max());
-  std::vector<v1::Job> jobs;
-  if (keys != nullptr) keys->clear();
+  const int columns = sqlite3_column_count(stmt);
+  std::vector<sqlite3_value*> cells;
   int rc;
-  while ((rc = s.Step()) == SQLITE_ROW) {
-    // A damaged row: a placeholder (JobStore::ListJobs).
-    jobs.push_back(s.Int(kJobIntactColumn) == 1 ? JobFromRow(s) : v1::Job());
-    if (keys != nullptr) keys->push_back(s.Int(0));
+  while ((rc = sqlite3_step(stmt)) == SQLITE_ROW) {
+    for (int c = 0; c < columns; ++c) cells.push_back(sqlite3_value_dup(sqlite3_column_value(stmt, c)));
   }
-  if (rc != SQLITE_DONE) return SqlError(db_);
-  return jobs;
-}
-
-absl::StatusOr<std::vector<std::string>> SqliteJobStore::QueuedJobIds() {
-  absl::MutexLock lock(&mu_);
-  Stmt s(db_, "SELECT pid FROM jobs WHERE state = ?1 ORDER BY seq");
-  s.Bind(1, int64_t{v1::QUEUED});
-  std::vector<std::string> ids;
-  int rc;
-  while ((rc = s.Step()) == SQLITE_ROW) ids.push_back(s.Text(0));
-  if (rc != SQLITE_DONE) return SqlError(db_);
-  return ids;
-}
-
-absl::StatusOr<bool> SqliteJobStore::MarkRunning(const std::string& id) {
-  absl::MutexLock lock(&mu_);
-  Stmt s(db_,
-         "UPDATE jobs SET state = ?1, started_ms = ?2, attempts = attempts + 1 "
-         "WHERE seq = ?3 AND state = ?4");
-  s.Bind(1, int64_t{v1::RUNNING})
-      .Bind(2, NowUnixMs())
-      .Bind(3, LookUpSeq(id))
-      .Bind(4, int64_t{v1::QUEUED});
-  if (absl::Status st = s.Done(); !st.ok()) return st;
-  return sqlite3_changes(db_) == 1;
-}
-
-absl::Status SqliteJobStore::Requeue(const std::string& id, int attempt) {
-  absl::MutexLock lock(&mu_);
-  Stmt s(db_,
-         "UPDATE jobs SET state = ?1 WHERE seq = ?2 AND state = ?3 AND (?4 = 0 OR attempts = ?4)");
-  s.Bind(1, int64_t{v1::QUEUED})
-      .Bind(2, LookUpSeq(id))
-      .Bind(3, int64_t{v1::RUNNING})
-      .Bind(4, int64_t{attempt});
-  return s.Done();
-}
-
-absl::StatusOr<std::optional<Claim>> SqliteJobStore::ClaimNext() {
-  absl::MutexLock lock(&mu_);
-  // One connection, one server (the flock): nothing else can claim
-  // between the look and the update.
-  Stmt s(db_, absl::StrCat("SELECT seq, pid, attempts FROM jobs j WHERE state = ?1 ORDER BY ",
-                          kFairShareOrder, " LIMIT 1")
-                 .c_str());
-  s.Bind(1, int64_t{v1::QUEUED});
-  const int rc = s.Step();
-  if (rc == SQLITE_DONE) return std::nullopt;
-  if (rc != SQLITE_ROW) return SqlError(db_);
-  Claim claim{s.Text(1), static_cast<int>(s.Int(2)) + 1};
-  Stmt u(db_,
-         "UPDATE jobs SET state = ?1, started_ms = ?2, attempts = attempts + 1 "
-         "WHERE seq = ?3 AND state = ?4");
-  u.Bind(1, int64_t{v1::RUNNING})
-      .Bind(2, NowUnixMs())
-      .Bind(3, s.Int(0))
-      .Bind(4, int64_t{v1::QUEUED});
-  if (absl::Status st = u.Done(); !st.ok()) return st;
-  if (sqlite3_changes(db_) != 1) return std::nullopt;
-  return claim;
-}
-
-absl::StatusOr<bool> SqliteJobStore::CancelQueued(const std::string& id) {
-  absl::MutexLock lock(&mu_);
-  Stmt s(db_, "UPDATE jobs SET state = ?1, finished_ms = ?2 WHERE seq = ?3 AND state = ?4");
-  s.Bind(1, int64_t{v1::CANCELLED})
-      .Bind(2, NowUnixMs())
-      .Bind(3, LookUpSeq(id))
-      .Bind(4, int64_t{v1::QUEUED});
-  if (absl::Status st = s.Done(); !st.ok()) return st;
-  return sqlite3_changes(db_) == 1;
-}
-
-absl::StatusOr<bool> SqliteJobStore::Finish(const std::string& id, v1::JobState state,
-                                            const v1::RunSummary& summary,
-                                            const StoredResult& result, int attempt) {
-  const std::string summary_blob = summary.SerializeAsString();
-  const std::string header_blob = result.header.SerializeAsString();
-  const EncodedValues vals = EncodeValues(result.values, result.header.columns_size());
-  absl::MutexLock lock(&mu_);
-  const int64_t seq = LookUpSeq(id);
-  if (absl::Status st = Exec("BEGIN IMMEDIATE"); !st.ok()) return st;
-  auto rollback = [&](absl::Status st) {
-    Exec("ROLLBACK").IgnoreError();
-    return st;
-  };
-  Stmt u(db_,
-         "UPDATE jobs SET state = ?1, finished_ms = ?2, summary = ?3 WHERE seq = ?4 AND "
-         "state = ?5 AND (?6 = 0 OR attempts = ?6)");
-  u.Bind(1, int64_t{state})
-      .Bind(2, NowUnixMs())
-      .BindBlob(3, summary_blob.data(), summary_blob.size())
-      .Bind(4, seq)
-      .Bind(5, int64_t{v1::RUNNING})
-      .Bind(6, int64_t{attempt});
-  if (absl::Status st = u.Done(); !st.ok()) return rollback(st);
-  if (sqlite3_changes(db_) != 1) {
-    Exec("ROLLBACK").IgnoreError();
-    return false;
+  std::unique_ptr<SqlRows> rows(new SqliteRows(std::move(cells), columns, sqlite3_changes(db_)));
+  if (rc != SQLITE_DONE) {
+    absl::Status error = SqlError(db_);
+    sqlite3_finalize(stmt);
+    return error;
   }
-  Stmt r(db_,
-         "INSERT OR REPLACE INTO results (job_seq, header, vals, checksum, encoding) VALUES "
-         "(?1,?2,?3,?4,?5)");
-  r.Bind(1, seq)
-      .BindBlob(2, header_blob.data(), header_blob.size())
-      .BindBlob(3, vals.blob.data(), vals.blob.size())
-      .Bind(4, ResultChecksum(header_blob.data(), header_blob.size(), vals.blob.data(),
-                              vals.blob.size()))
-      .Bind(5, vals.encoding);
-  if (absl::Status st = r.Done(); !st.ok()) return rollback(st);
-  if (absl::Status st = Exec("COMMIT"); !st.ok()) return rollback(st);
-  return true;
-}
-
-absl::StatusOr<StoredResult> SqliteJobStore::GetResult(const std::string& id) {
-  absl::MutexLock lock(&mu_);
-  Stmt s(db_, "SELECT header, vals, checksum, encoding FROM results WHERE job_seq = ?1");
-  s.Bind(1, LookUpSeq(id));
-  const int rc = s.Step();
-  if (rc == SQLITE_DONE) return absl::NotFoundError(absl::StrCat("job \"", id, "\" has no result"));
-  if (rc != SQLITE_ROW) return SqlError(db_);
-  const std::string header = s.Blob(0), vals = s.Blob(1);
-  // Never serve altered data: the checksum written with the result must
-  // still match.
-  return CheckedResult(id, header, vals, s.Int(2), s.Int(3));
-}
-
-absl::StatusOr<v1::Sweep> SqliteJobStore::GetSweep(const std::string& id) {
-  absl::MutexLock lock(&mu_);
-  const int64_t seq = IsSweepId(id) ? LookUpSeq(id) : -1;
-  v1::Sweep sweep;
-  {
-    Stmt s(db_, absl::StrCat("SELECT name, axes, created_ms, ", SweepIntact(),
-                             " FROM sweeps WHERE seq = ?1")
-                    .c_str());
-    s.Bind(1, seq);
-    const int rc = s.Step();
-    if (rc == SQLITE_DONE) return absl::NotFoundError(absl::StrCat("no sweep \"", id, "\""));
-    if (rc != SQLITE_ROW) return SqlError(db_);
-    if (s.Int(3) != 1) return DamagedRow("sweep", id);
-    sweep.ParseFromString(s.Blob(1));
-    sweep.set_id(id);
-    sweep.set_name(s.Text(0));
-    sweep.set_created_unix_ms(s.Int(2));
-  }
-  Stmt s(db_, absl::StrCat("SELECT pid, state, ", JobIntact(),
-                           " FROM jobs WHERE sweep_seq = ?1 ORDER BY sweep_index")
-                  .c_str());
-  s.Bind(1, seq);
-  int rc;
-  int items = 0, finished = 0, failed = 0;
-  while ((rc = s.Step()) == SQLITE_ROW) {
-    ++items;
-    // A damaged item: the sweep's ids and counts cannot be served whole.
-    if (s.Int(2) != 1) {
-      return absl::DataLossError(absl::StrCat("sweep ", id, ": the stored row of item ",
-                                              items - 1, " fails its checksum (the database "
-                                              "is damaged); cablesim-server --check lists it"));
-    }
-    sweep.add_job_ids(s.Text(0));
-    const auto state = static_cast<v1::JobState>(s.Int(1));
-    if (state == v1::SUCCEEDED || state == v1::FAILED || state == v1::CANCELLED) ++finished;
-    if (state == v1::FAILED || state == v1::CANCELLED) ++failed;
-  }
-  if (rc != SQLITE_DONE) return SqlError(db_);
-  sweep.set_items(items);
-  sweep.set_finished(finished);
-  sweep.set_failed(failed);
-  return sweep;
-}
-
-namespace {
-
-
-constexpr char kResultBytes[] = "length(header) + length(vals)";
-
-}  // namespace
-
-absl::Status SqliteJobStore::DeleteJobRows(const std::string& where, int64_t key) {
-  Stmt r(db_, absl::StrCat("DELETE FROM results WHERE job_seq IN (SELECT seq FROM jobs WHERE ",
-                           where, ")")
-                  .c_str());
-  if (absl::Status st = r.Bind(1, key).Done(); !st.ok()) return st;
-  Stmt j(db_, absl::StrCat("DELETE FROM jobs WHERE ", where).c_str());
-  return j.Bind(1, key).Done();
-}
-
-absl::StatusOr<int64_t> SqliteJobStore::DeleteJob(const std::string& id) {
-  absl::MutexLock lock(&mu_);
-  const int64_t seq = IsSweepId(id) ? -1 : LookUpSeq(id);
-  if (absl::Status st = Exec("BEGIN IMMEDIATE"); !st.ok()) return st;
-  auto rollback = [&](absl::Status st) {
-    Exec("ROLLBACK").IgnoreError();
-    return st;
-  };
-  Stmt s(db_, absl::StrCat("SELECT state, sweep_seq, (SELECT ", kResultBytes,
-                           " FROM results WHERE job_seq = jobs.seq), "
-                           "(SELECT pid FROM sweeps WHERE sweeps.seq = jobs.sweep_seq) "
-                           "FROM jobs WHERE seq = ?1")
-                  .c_str());
-  s.Bind(1, seq);
-  const int rc = s.Step();
-  if (rc == SQLITE_DONE) return rollback(absl::NotFoundError(absl::StrCat("no job \"", id, "\"")));
-  if (rc != SQLITE_ROW) return rollback(SqlError(db_));
-  const auto state = static_cast<v1::JobState>(s.Int(0));
-  const int64_t sweep_seq = s.Int(1), bytes = s.Int(2);
-  const std::string sweep_id = s.Text(3);
-  if (!IsFinished(state)) {
-    return rollback(absl::FailedPreconditionError(absl::StrCat(
-        "job \"", id, "\" is ", v1::JobState_Name(state), "; cancel it before deleting it")));
-  }
-  if (sweep_seq > 0) {
-    return rollback(absl::FailedPreconditionError(
-        absl::StrCat("job \"", id, "\" is an item of sweep \"", sweep_id,
-                     "\"; delete the sweep (DeleteSweep) instead")));
-  }
-  if (absl::Status st = DeleteJobRows("seq = ?1", seq); !st.ok()) return rollback(st);
-  if (absl::Status st = Exec("COMMIT"); !st.ok()) return rollback(st);
-  return bytes;
-}
-
-absl::StatusOr<int64_t> SqliteJobStore::DeleteSweep(const std::string& id) {
-  absl::MutexLock lock(&mu_);
-  const int64_t seq = IsSweepId(id) ? LookUpSeq(id) : -1;
-  if (absl::Status st = Exec("BEGIN IMMEDIATE"); !st.ok()) return st;
-  auto rollback = [&](absl::Status st) {
-    Exec("ROLLBACK").IgnoreError();
-    return st;
-  };
-  {
-    Stmt s(db_, "SELECT 1 FROM sweeps WHERE seq = ?1");
-    s.Bind(1, seq);
-    const int rc = s.Step();
-    if (rc == SQLITE_DONE) {
-      return rollback(absl::NotFoundError(absl::StrCat("no sweep \"", id, "\"")));
-    }
-    if (rc != SQLITE_ROW) return rollback(SqlError(db_));
-  }
-  int64_t bytes = 0, unfinished = 0;
-  {
-    Stmt s(db_, absl::StrCat("SELECT state, (SELECT ", kResultBytes,
-                             " FROM results WHERE job_seq = jobs.seq) FROM jobs WHERE "
-                             "sweep_seq = ?1")
-                    .c_str());
-    s.Bind(1, seq);
-    int rc;
-    while ((rc = s.Step()) == SQLITE_ROW) {
-      unfinished += IsFinished(static_cast<v1::JobState>(s.Int(0))) ? 0 : 1;
-      bytes += s.Int(1);
-    }
-    if (rc != SQLITE_DONE) return rollback(SqlError(db_));
-  }
-  if (unfinished > 0) {
-    return rollback(absl::FailedPreconditionError(
-        absl::StrCat("sweep \"", id, "\" has ", unfinished,
-                     " unfinished items; cancel them before deleting it")));
-  }
-  if (absl::Status st = DeleteJobRows("sweep_seq = ?1", seq); !st.ok()) return rollback(st);
-  Stmt d(db_, "DELETE FROM sweeps WHERE seq = ?1");
-  if (absl::Status st = d.Bind(1, seq).Done(); !st.ok()) return rollback(st);
-  if (absl::Status st = Exec("COMMIT"); !st.ok()) return rollback(st);
-  return bytes;
-}
-
-absl::StatusOr<RetentionReport> SqliteJobStore::ApplyRetention(int64_t older_than_unix_ms,
-                                                         int64_t max_bytes) {
-  // What can go: finished jobs outside sweeps, and sweeps whose items have
-  // all finished (a sweep goes as a whole), oldest finished first.
-  struct Candidate {
-    bool sweep;
-    int64_t seq, finished_ms, bytes;
-  };
-  std::vector<Candidate> candidates;
-  int64_t total = 0;
-  absl::MutexLock lock(&mu_);
-  {
-    Stmt t(db_, absl::StrCat("SELECT COALESCE(SUM(", kResultBytes, "), 0) FROM results").c_str());
-    if (t.Step() != SQLITE_ROW) return SqlError(db_);
-    total = t.Int(0);
-  }
-  {
-    Stmt s(db_, absl::StrCat(
-                    "SELECT 0, seq, finished_ms, COALESCE((SELECT ", kResultBytes,
-                    " FROM results WHERE job_seq = jobs.seq), 0) FROM jobs "
-                    "WHERE sweep_seq = 0 AND state IN (?1, ?2, ?3) "
-                    "UNION ALL "
-                    "SELECT 1, sweep_seq, MAX(finished_ms), COALESCE(SUM((SELECT ",
-                    kResultBytes,
-                    " FROM results WHERE job_seq = jobs.seq)), 0) FROM jobs "
-                    "WHERE sweep_seq > 0 GROUP BY sweep_seq "
-                    "HAVING SUM(state NOT IN (?1, ?2, ?3)) = 0 "
-                    "ORDER BY 3")
-                    .c_str());
-    s.Bind(1, int64_t{v1::SUCCEEDED}).Bind(2, int64_t{v1::FAILED}).Bind(3, int64_t{v1::CANCELLED});
-    int rc;
-    while ((rc = s.Step()) == SQLITE_ROW) {
-      candidates.push_back({s.Int(0) != 0, s.Int(1), s.Int(2), s.Int(3)});
-    }
-    if (rc != SQLITE_DONE) return SqlError(db_);
-  }
-  RetentionReport report;
-  for (const Candidate& c : candidates) {
-    if (c.finished_ms >= older_than_unix_ms && total <= max_bytes) break;
-    if (absl::Status st = Exec("BEGIN IMMEDIATE"); !st.ok()) return st;
-    absl::Status st = DeleteJobRows(c.sweep ? "sweep_seq = ?1" : "seq = ?1", c.seq);
-    int64_t jobs = sqlite3_changes(db_);
-    if (st.ok() && c.sweep) {
-      Stmt d(db_, "DELETE FROM sweeps WHERE seq = ?1");
-      st = d.Bind(1, c.seq).Done();
-    }
-    if (st.ok()) st = Exec("COMMIT");
-    if (!st.ok()) {
-      Exec("ROLLBACK").IgnoreError();
-      return st;
-    }
-    total -= c.bytes;
-    report.jobs += jobs;
-    report.sweeps += c.sweep ? 1 : 0;
-    report.bytes += c.bytes;
-  }
-  return report;
+  sqlite3_finalize(stmt);
+  return rows;
 }
 
 absl::StatusOr<bool> SqliteJobStore::ReclaimSpace() {
@@ -1037,56 +693,6 @@ absl::StatusOr<bool> SqliteJobStore::ReclaimSpace() {
   // the log is emptied.
   if (absl::Status s = Exec("PRAGMA wal_checkpoint(TRUNCATE)"); !s.ok()) return s;
   return false;
-}
-
-absl::StatusOr<std::string> SqliteJobStore::Tenant(const std::string& id) {
-  const bool sweep = IsSweepId(id);
-  absl::MutexLock lock(&mu_);
-  Stmt s(db_, absl::StrCat("SELECT tenant, ", sweep ? SweepIntact() : JobIntact(), " FROM ",
-                           sweep ? "sweeps" : "jobs", " WHERE pid = ?1")
-                  .c_str());
-  s.Bind(1, id);
-  const int rc = s.Step();
-  if (rc == SQLITE_ROW) {
-    // A damaged row's tenant cannot be trusted: DataLoss for everyone.
-    if (s.Int(1) != 1) return DamagedRow(sweep ? "sweep" : "job", id);
-    return s.Text(0);
-  }
-  if (rc == SQLITE_DONE) {
-    return absl::NotFoundError(absl::StrCat("no ", sweep ? "sweep" : "job", " \"", id, "\""));
-  }
-  return SqlError(db_);
-}
-
-absl::StatusOr<std::vector<std::string>> SqliteJobStore::CheckRows() {
-  absl::MutexLock lock(&mu_);
-  std::vector<std::string> damaged;
-  for (const auto& [table, kind, intact] : {std::tuple{"jobs", "job", &JobIntact()},
-                                            std::tuple{"sweeps", "sweep", &SweepIntact()}}) {
-    Stmt s(db_, absl::StrCat("SELECT seq, pid FROM ", table, " WHERE NOT ", *intact, " ORDER BY seq")
-                    .c_str());
-    int rc;
-    while ((rc = s.Step()) == SQLITE_ROW) {
-      damaged.push_back(absl::StrCat(kind, " ", s.Text(1), " (row ", s.Int(0),
-                                     "): the row fails its checksum"));
-    }
-    if (rc != SQLITE_DONE) return SqlError(db_);
-  }
-  Stmt r(db_,
-         "SELECT job_seq, (SELECT pid FROM jobs WHERE seq = job_seq), header, vals, checksum, "
-         "encoding FROM results ORDER BY job_seq");
-  int rc;
-  while ((rc = r.Step()) == SQLITE_ROW) {
-    const std::string id = r.Text(1);
-    absl::StatusOr<StoredResult> result =
-        CheckedResult(id, r.Blob(2), r.Blob(3), r.Int(4), r.Int(5));
-    if (!result.ok()) {
-      damaged.push_back(absl::StrCat("result of job ", id, " (row ", r.Int(0),
-                                     "): ", result.status().message()));
-    }
-  }
-  if (rc != SQLITE_DONE) return SqlError(db_);
-  return damaged;
 }
 
 }  // namespace cablesim
