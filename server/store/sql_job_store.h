@@ -70,7 +70,7 @@ struct SqlStatements {
   std::string begin;  // starts a write transaction (COMMIT and ROLLBACK end it)
   // -> changed; RUNNING jobs nobody runs any longer back to QUEUED.
   std::string requeue_running;
-  // -> count of @peer's unfinished jobs; peer_lock (may be null) first,
+  // -> count of @peer's unfinished jobs; peer_lock (may be empty) first,
   // in the same transaction.
   std::string peer_lock;
   std::string peer_unfinished;
