@@ -29,9 +29,9 @@ void AncfCableElement<D>::set_length(double length_m) {
 }
 
 template <int D>
-typename AncfCableElement<D>::Matrix AncfCableElement<D>::MassMatrix(
-    double mass_per_length_kg_m) const {
-  const double l = length_;
+Eigen::Matrix4d AncfCableElement<D>::ScalarMassMatrix(double length_m,
+                                                      double mass_per_length_kg_m) {
+  const double l = length_m;
   const double m = mass_per_length_kg_m * l;
   Eigen::Matrix4d c;
   c << 156, 22 * l, 54, -13 * l,
@@ -39,6 +39,13 @@ typename AncfCableElement<D>::Matrix AncfCableElement<D>::MassMatrix(
        54, 13 * l, 156, -22 * l,
        -13 * l, -3 * l * l, -22 * l, 4 * l * l;
   c *= m / 420;
+  return c;
+}
+
+template <int D>
+typename AncfCableElement<D>::Matrix AncfCableElement<D>::MassMatrix(
+    double mass_per_length_kg_m) const {
+  const Eigen::Matrix4d c = ScalarMassMatrix(length_, mass_per_length_kg_m);
   Matrix mass = Matrix::Zero();
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j)
@@ -47,9 +54,9 @@ typename AncfCableElement<D>::Matrix AncfCableElement<D>::MassMatrix(
 }
 
 template <int D>
-typename AncfCableElement<D>::Coords AncfCableElement<D>::GravityForce(
-    double mass_per_length_kg_m, const Point& g) const {
-  const double l = length_;
+typename AncfCableElement<D>::Coords AncfCableElement<D>::GravityForceOfLength(
+    double length_m, double mass_per_length_kg_m, const Point& g) {
+  const double l = length_m;
   const double m = mass_per_length_kg_m * l;
   Coords q;
   q.template segment<D>(0) = m * g / 2;
@@ -57,6 +64,12 @@ typename AncfCableElement<D>::Coords AncfCableElement<D>::GravityForce(
   q.template segment<D>(2 * D) = m * g / 2;
   q.template segment<D>(3 * D) = -m * l * g / 12;
   return q;
+}
+
+template <int D>
+typename AncfCableElement<D>::Coords AncfCableElement<D>::GravityForce(
+    double mass_per_length_kg_m, const Point& g) const {
+  return GravityForceOfLength(length_, mass_per_length_kg_m, g);
 }
 
 template <int D>

@@ -78,6 +78,14 @@ class AncfCableElement {
   // the element's gravitational potential is exactly -Q_g . e.
   Coords GravityForce(double mass_per_length_kg_m, const Point& g) const;
 
+  // The same two for an element of length `length_m` (what the members
+  // return at length()): the 4 x 4 scalar mass matrix mbar (M = mbar (x)
+  // I_D) and the gravity force. A winch cable's contributors evaluate them
+  // at L(t) / N without holding the element.
+  static Eigen::Matrix4d ScalarMassMatrix(double length_m, double mass_per_length_kg_m);
+  static Coords GravityForceOfLength(double length_m, double mass_per_length_kg_m,
+                                     const Point& g);
+
   // Position r(xi l) and slope r'(xi l) for xi in [0, 1].
   Point Position(const Coords& e, double xi) const;
   Point Slope(const Coords& e, double xi) const;

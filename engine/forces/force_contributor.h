@@ -28,7 +28,11 @@
 //    (-df/dqdot) into the matrix (its q-derivative is left out of Newton,
 //    as for damping) and the rounding and size as above.
 //  - StoredEnergy U(q) of the conservative parts [J], in the energy bucket
-//    bucket() (the loads' potential, or contact).
+//    bucket() (the loads' potential, or contact, or the potential alone
+//    for gravity, whose per-part shares AddEnergyParts reports).
+//  - AddEnergyParts: its share of the energy per cable and per body
+//    (EnergyParts, output/results.h), for a contributor whose energy is
+//    not all the loads' (gravity: per cable and body).
 //  - AddDissipatedPower: -f_d . qdot [W] of the dissipative part (the
 //    model's energy.damped integrates it); equals -f . qdot of
 //    AddDissipative.
@@ -57,6 +61,7 @@
 namespace cablesim {
 
 class WaveField;
+struct EnergyParts;
 
 // The state a contributor is evaluated at. `qdot` is null in the
 // position-only passes; `waves` the scene's wave field (null: none).
@@ -94,6 +99,9 @@ struct StepEnds {
 enum class EnergyBucket {
   kLoads,    // energy.potential and EnergyParts::loads
   kContact,  // energy.contact
+  // energy.potential alone; the contributor reports its EnergyParts shares
+  // itself (AddEnergyParts): gravity, per cable and per body.
+  kPotential,
 };
 
 class ForceContributor {
@@ -122,6 +130,13 @@ class ForceContributor {
   virtual double StoredEnergy(const ForceState& s) const {
     (void)s;
     return 0;
+  }
+  // Its shares of the energy parts at s (after the model has set the loads'
+  // sum: parts->loads is the kLoads contributors' energy minus the external
+  // work).
+  virtual void AddEnergyParts(const ForceState& s, EnergyParts* parts) const {
+    (void)s;
+    (void)parts;
   }
   // Adds its dissipated power -f_d . qdot [W] to *power (a running sum,
   // so that the model's total is summed term by term as before).

@@ -44,7 +44,24 @@
 
 #include <Eigen/Core>
 
+#include "engine/scene/time_function.h"
+
 namespace cablesim {
+
+// A winch's free length in time: L(t) = L(0) + int_0^t speed, with its
+// rate and acceleration (what the model's elements and the winch's
+// contributors evaluate at SetTime).
+struct WinchReel {
+  double length0 = 0;  // L(0) [m]
+  TimeFunction speed;  // Ldot(t) [m/s]
+  struct State {
+    double length = 0, rate = 0, accel = 0;  // L [m], Ldot [m/s], Lddot [m/s^2]
+  };
+  State At(double t) const {
+    const TimeFunction::Value v = speed.Evaluate(t);
+    return State{length0 + speed.Integral(t), v.f, v.df};
+  }
+};
 
 struct WinchElementInertia {
   Eigen::Matrix4d m, m_l;  // M and dM/dl

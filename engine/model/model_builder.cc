@@ -432,7 +432,6 @@ absl::Status ModelBuilder::CheckIntegratorFits() const {
 template <int D>
 void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* elements) {
   const double extent = q0_.lpNorm<Eigen::Infinity>();  // scene size [m]
-  const Eigen::Matrix<double, D, 1> g = scene_.gravity_m_s2.head<D>();
   const std::vector<int>& first_node = mesh_.first_node;
   model_.cable_element_begin_.assign(1, 0);
   for (int c = 0; c < static_cast<int>(scene_.cables.size()); ++c) {
@@ -463,7 +462,9 @@ void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* 
       model_.energy_roundoff_ += (ea + ei / (l * l)) * l * strain * strain;
       e.first_coord = NodeCoord(k);
       e.mass_per_length = mpl + cable.added_mass * displaced;
-      e.gravity = e.element.GravityForce(mpl - displaced, g);
+      // Gravity acts on the mass less the displaced fluid's (buoyancy).
+      element_weight_.push_back(mpl - displaced);
+      element_cable_.push_back(c);
       CableFluidLoad::Element fluid;
       fluid.drag_n = drag_n;
       fluid.drag_t = drag_t;
@@ -500,6 +501,8 @@ void ModelBuilder::BuildElements() {
       field.AddJonswap(j.significant_height_m, j.peak_period_s, j.peak_factor, j.direction,
                        j.components, j.seed);
     model_.wave_load_ = std::make_shared<const WaveLoad>(std::move(field), fluid.current_m_s);
+    model_.waves_ = &model_.wave_load_->field();
+    model_.wave_components_ = static_cast<int64_t>(model_.waves_->components().size());
   }
   if (model_.dim_ == 2) {
     BuildElementsOf<2>(&model_.elements2_);
@@ -607,55 +610,85 @@ void ModelBuilder::Winches() {
     w.cable = c;
     w.element_begin = m.cable_element_begin_[c];
     w.element_end = m.cable_element_begin_[c + 1];
-    w.length0 = w.length = cable.length_m;
-    w.speed = cable.winch.speed;
+    w.reel.length0 = w.length = cable.length_m;
+    w.reel.speed = cable.winch.speed;
     w.mass_per_length = cable.density_kg_m3 * cable.area_m2;
     w.ea = cable.youngs_modulus_pa * cable.area_m2;
-    w.axial_damping_s = cable.axial_damping_s;
-    w.alpha_1_s = cable.rayleigh_alpha_1_s;
     m.winches_.push_back(std::move(w));
   }
   if (m.winches_.empty()) return;
-  m.winch_slot_.assign(m.elements(), -1);
-  int elements = 0;
   for (const MultibodyModel::WinchData& w : m.winches_) {
     for (int k = w.element_begin; k < w.element_end; ++k) {
-      m.winch_slot_[k] = elements++;
-      // The winch damps the material motion instead (WinchDamping).
+      // The winch damps the material motion instead (WinchCables).
       if (cable_damping_) cable_damping_->ClearMaterialDamping(k);
     }
   }
-  for (auto* v : {&m.winch_cv_, &m.winch_ce_, &m.winch_mdot_, &m.winch_g_, &m.winch_h_})
-    v->assign(elements, Eigen::Matrix4d::Zero());
   m.has_damping_ = true;  // the convective terms ride on DampingForce
+}
+
+template <int D>
+void ModelBuilder::WinchContributor(const std::vector<MultibodyModel::ElementData<D>>& elements) {
+  constexpr int kN2 = 16 * D * D;
+  MultibodyModel& m = model_;
+  std::vector<typename WinchCables<D>::Winch> winches;
+  for (const MultibodyModel::WinchData& data : m.winches_) {
+    const CableSpec& cable = scene_.cables[data.cable];
+    typename WinchCables<D>::Winch w;
+    w.reel = data.reel;
+    w.mass_per_length = data.mass_per_length;
+    w.ea = data.ea;
+    w.axial_damping_s = cable.axial_damping_s;
+    w.alpha_1_s = cable.rayleigh_alpha_1_s;
+    for (int k = data.element_begin; k < data.element_end; ++k) {
+      typename WinchCables<D>::Element e;
+      e.first_coord = elements[k].first_coord;
+      e.slots.assign(&m.element_slots_[kN2 * k], &m.element_slots_[kN2 * k] + kN2);
+      e.factors.assign(&m.element_factors_[kN2 * k], &m.element_factors_[kN2 * k] + kN2);
+      w.elements.push_back(std::move(e));
+    }
+    winches.push_back(std::move(w));
+  }
+  // Last in the list: the model summed the winches' terms after every
+  // other contributor's.
+  if (auto c = MakeWinchCables<D>(std::move(winches))) m.contributors_.push_back(std::move(c));
 }
 
 void ModelBuilder::ConstantForces() {
   MultibodyModel& m = model_;
   const int D = m.dim_;
-  m.gravity_ = scene_.gravity_m_s2;
   for (const BodySpec& body : scene_.bodies) m.body_names_.push_back(body.name);
-  m.constant_force_ = VectorXd::Zero(q0_.size());
-  for (const auto& e : m.elements2_) m.constant_force_.segment<8>(e.first_coord) += e.gravity;
-  for (const auto& e : m.elements3_) m.constant_force_.segment<12>(e.first_coord) += e.gravity;
-  for (const MultibodyModel::BodyData& b : m.bodies_)
-    m.constant_force_.segment(b.coord, D) += b.mass * scene_.gravity_m_s2.head(D);
+  std::vector<int> first, body_coord;
+  std::vector<double> length, body_mass;
+  for (const auto& e : m.elements2_) {
+    first.push_back(e.first_coord);
+    length.push_back(e.element.length());
+  }
+  for (const auto& e : m.elements3_) {
+    first.push_back(e.first_coord);
+    length.push_back(e.element.length());
+  }
+  for (const MultibodyModel::BodyData& b : m.bodies_) {
+    body_coord.push_back(b.coord);
+    body_mass.push_back(b.mass);
+  }
   // A force F at a point r = sum_i a_i q_i + c does the work F . dr, so its
   // generalized force is sum_d F_d a_{d,i} on q_i (constant: the point is
   // linear in q).
-  if (!scene_.loads.empty()) m.load_force_ = VectorXd::Zero(q0_.size());
-  auto add_point_force = [&](const LinearVector& point, const Vector3d& force) {
-    for (int d = 0; d < D; ++d) {
-      for (const auto& [i, v] : point[d].terms) {
-        m.constant_force_(i) += v * force(d);
-        m.load_force_(i) += v * force(d);
-      }
-    }
-  };
+  std::vector<std::pair<int, double>> load_terms;
   for (const LoadSpec& load : scene_.loads) {
     const LinearVector point = PointOf(load.at);
-    add_point_force(point, load.force_n);
+    for (int d = 0; d < D; ++d)
+      for (const auto& [i, v] : point[d].terms) load_terms.push_back({i, v * load.force_n(d)});
   }
+  std::vector<std::pair<std::pair<int, int>, WinchReel>> winches;
+  for (const MultibodyModel::WinchData& w : m.winches_)
+    winches.push_back({{w.element_begin, w.element_end}, w.reel});
+  // First in the list: the applied loads are summed onto gravity.
+  if (auto gravity = MakeGravityLoads(D, scene_.gravity_m_s2, element_weight_, first, length,
+                                      element_cable_, body_coord, body_mass, load_terms,
+                                      !scene_.loads.empty(), winches,
+                                      static_cast<int>(q0_.size())))
+    m.contributors_.insert(m.contributors_.begin(), std::move(gravity));
 }
 
 void ModelBuilder::Probes() {
@@ -743,11 +776,9 @@ void ModelBuilder::WinchBases(const std::vector<MultibodyModel::ElementData<D>>&
   MultibodyModel& m = model_;
   constexpr int kN = 4 * D, kN2 = kN * kN;
   m.mass_base_.assign(m.mass_.values(), m.mass_.values() + m.mass_.stored());
-  m.constant_force_base_ = m.constant_force_;
   for (const MultibodyModel::WinchData& w : m.winches_) {
     for (int k = w.element_begin; k < w.element_end; ++k) {
       const MultibodyModel::ElementData<D>& e = elements[k];
-      m.constant_force_base_.segment<kN>(e.first_coord) -= e.gravity;
       const auto me = e.element.MassMatrix(e.mass_per_length);
       for (int t = 0; t < kN2; ++t) {
         const int slot = m.element_slots_[kN2 * k + t];
@@ -760,6 +791,15 @@ void ModelBuilder::WinchBases(const std::vector<MultibodyModel::ElementData<D>>&
 MultibodyModel ModelBuilder::Finish() {
   model_.scratch_full_ = VectorXd::Zero(q0_.size());
   model_.scratch_roundoff_ = VectorXd::Zero(q0_.size());
+  // The winches' contributor needs the element scatter tables
+  // (EnvelopeAndMass).
+  if (!model_.winches_.empty()) {
+    if (model_.dim_ == 2) {
+      WinchContributor(model_.elements2_);
+    } else {
+      WinchContributor(model_.elements3_);
+    }
+  }
   model_.time_dependent_ = false;
   for (const ConstraintFamily* f : model_.families_)
     if (f->time_dependent()) model_.time_dependent_ = true;

@@ -19,6 +19,8 @@
 #include "absl/status/statusor.h"
 #include "engine/forces/cable_damping.h"
 #include "engine/forces/cable_fluid_load.h"
+#include "engine/forces/gravity_loads.h"
+#include "engine/forces/winch_cables.h"
 #include "engine/model/multibody_model.h"
 #include "engine/constraints/quadratic_form.h"
 #include "engine/scene/scene.h"
@@ -190,10 +192,10 @@ class ModelBuilder {
   // ranges; the model then needs its damping pass (the convective terms).
   void Winches();
 
-  // The constant generalized force [N, or N m per unit slope]: element and
-  // body gravity and each load's force at its point (the loads' also
-  // apart, for the energy per part). Torques and time-varying forces are
-  // the applied-loads contributor's (Contributors).
+  // Gravity and the loads' constant forces as a contributor (GravityLoads,
+  // forces/gravity_loads.h), first in the list: element and body gravity
+  // and each load's force at its point. Torques and time-varying forces
+  // are the applied-loads contributor's (Contributors).
   void ConstantForces();
 
   // Each probe's point as a linear form of q (position [m] = const + sum
@@ -259,10 +261,13 @@ class ModelBuilder {
   void BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* elements);
   // The element scatter tables (per element, the (4D)^2 skyline slots
   // and factors s_a s_b) and the elements' share of the mass matrix.
-  // Finish's share for the winches: mass_base_ and constant_force_base_,
-  // the mass values and constant force without the winch elements.
+  // Finish's share for the winches: mass_base_, the mass values without
+  // the winch elements; and their contributor (WinchCables), which takes
+  // the winch elements' scatter tables.
   template <int D>
   void WinchBases(const std::vector<MultibodyModel::ElementData<D>>& elements);
+  template <int D>
+  void WinchContributor(const std::vector<MultibodyModel::ElementData<D>>& elements);
   template <int D>
   void SetupElementSlots(const std::vector<MultibodyModel::ElementData<D>>& elements);
 
@@ -280,6 +285,10 @@ class ModelBuilder {
   std::vector<CableDamping::Element> damping_elements_;
   std::vector<CableFluidLoad::Element> fluid_elements_;
   CableDamping* cable_damping_ = nullptr;
+  // Per element: the mass per length gravity acts on [kg/m] (less the
+  // displaced fluid's) and its cable, for GravityLoads (ConstantForces).
+  std::vector<double> element_weight_;
+  std::vector<int> element_cable_;
 };
 
 }  // namespace cablesim

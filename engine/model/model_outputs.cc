@@ -51,8 +51,6 @@ void MultibodyModel::ElementEnergy(const VectorXd& q, const VectorXd& qdot, Ener
     part->kinetic += kinetic;
     part->axial += se.axial;
     part->bending += se.bending;
-    // Element gravity is exactly -Q_g . e (MODEL.md section 2).
-    part->gravity -= e.gravity.dot(qe);
   }
 }
 
@@ -88,17 +86,15 @@ EnergySample MultibodyModel::Energy(const VectorXd& q, const VectorXd& qdot, dou
     if (parts != nullptr) {
       PartEnergy& part = parts->bodies[i];
       part.kinetic = kinetic;
-      part.gravity = -load_factor * b.mass * gravity_.head(D).dot(q.segment(b.coord, D));
     }
   }
-  // Gravity and point loads are constant forces on q: V = -F . q. Element
-  // gravity is exactly -Q_g . e (MODEL.md section 2).
-  en.potential = -load_factor * constant_force_.dot(q);
   // Torques, time-varying loads, moving supports: their work so far
-  // (AccumulateExternalWork).
-  en.potential -= external_work_;
-  // Contributors' stored energies, each in its bucket (the loads' part or
-  // contact).
+  // (AccumulateExternalWork). Subtracted first, so that with gravity's
+  // energy added next the sum is gravity's minus the work, as ever
+  // (a + b = b + a exactly).
+  en.potential = -external_work_;
+  // Contributors' stored energies, each in its bucket (the potential, also
+  // the loads' part, or contact).
   double loads_energy = 0;
   if (!contributors_.empty()) {
     const ForceState state = StateAt(q, &qdot, load_factor);
@@ -108,16 +104,18 @@ EnergySample MultibodyModel::Energy(const VectorXd& q, const VectorXd& qdot, dou
         en.contact += u;
       } else {
         en.potential += u;
-        loads_energy += u;
+        if (c->bucket() == EnergyBucket::kLoads) loads_energy += u;
       }
     }
   }
   en.total = en.kinetic + en.potential + en.axial + en.bending + en.contact;
   if (parts != nullptr) {
-    // The element gravity above is at load factor 1 (statics scales it).
-    for (PartEnergy& part : parts->cables) part.gravity *= load_factor;
     parts->loads = loads_energy - external_work_;
-    if (load_force_.size() > 0) parts->loads -= load_factor * load_force_.dot(q);
+    // Contributors' own shares of the parts (gravity per cable and body).
+    if (!contributors_.empty()) {
+      const ForceState state = StateAt(q, &qdot, load_factor);
+      for (const auto& c : contributors_) c->AddEnergyParts(state, parts);
+    }
   }
   return en;
 }

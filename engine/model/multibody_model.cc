@@ -10,7 +10,6 @@
 #include <Eigen/Geometry>
 
 #include "absl/status/status.h"
-#include "engine/forces/winch_inertia.h"
 #include "engine/elements/gauss_quadrature.h"
 #include "engine/elements/hermite_shape.h"
 #include "engine/linear/rounding.h"
@@ -206,9 +205,9 @@ double MultibodyModel::NetForce(const VectorXd& q, double load_factor, VectorXd*
                                 VectorXd* roundoff) {
   constexpr double kEps = std::numeric_limits<double>::epsilon();
   VectorXd& full = scratch_full_;
-  full = load_factor * constant_force_;
-  // Contributors' applied loads (time-varying loads, torques, body
-  // buoyancy), scaled as gravity.
+  full.setZero();
+  // Contributors' applied loads (gravity and constant loads first, then
+  // time-varying loads, torques, body buoyancy), scaled by the load factor.
   const ForceState state = StateAt(q, nullptr, load_factor);
   ForceOutput out{&full, nullptr, stiffness, stiffness_scale, Map()};
   for (const auto& c : contributors_) c->AddAppliedLoad(state, &out);
@@ -286,7 +285,7 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
   ForceOutput coupled{full, roundoff, tangent, tangent_scale, Map()};
   // Work per element for the stop poll: its Gauss points, each summing
   // every wave component.
-  const int64_t components = wave_load_ ? wave_load_->field().components().size() : 0;
+  const int64_t components = wave_components_;
   for (size_t k = 0; k < elements.size(); ++k) {
     const ElementData<D>& e = elements[k];
     if (StopNow(e.element.gauss_points() * (1 + components))) {  // set_stop_poll
@@ -340,12 +339,6 @@ double MultibodyModel::DampingForce(const VectorXd& q, const VectorXd& qdot, Vec
     for (const auto& c : contributors_) c->AddDissipative(state, &out);
     size = std::max(size, out.size);
   }
-  if (!winches_.empty()) {
-    size = std::max(size, dim_ == 2 ? WinchForces<2>(q, qdot, &full, tangent, tangent_scale,
-                                                     full_roundoff)
-                                    : WinchForces<3>(q, qdot, &full, tangent, tangent_scale,
-                                                     full_roundoff));
-  }
   const int n = coordinates();
   for (int i = 0; i < n; ++i) {
     if (j_[i] < 0) continue;
@@ -367,14 +360,6 @@ double MultibodyModel::DampingPower(const VectorXd& q, const VectorXd& qdot) con
   if (!contributors_.empty()) {
     const ForceState state = StateAt(q, &qdot, 1.0);
     for (const auto& c : contributors_) c->AddDissipatedPower(state, &power);
-  }
-  // A winch cable's damping (not its convective inertia, which dissipates
-  // nothing).
-  for (const WinchData& w : winches_) {
-    for (int index = w.element_begin; index < w.element_end; ++index) {
-      power += dim_ == 2 ? WinchDamping<2>(w, index, q, qdot, nullptr, nullptr)
-                         : WinchDamping<3>(w, index, q, qdot, nullptr, nullptr);
-    }
   }
   return power;
 }

@@ -59,6 +59,7 @@
 #include "engine/forces/seabed.h"
 #include "engine/forces/sheaves.h"
 #include "engine/forces/wave_load.h"
+#include "engine/forces/winch_inertia.h"
 #include "engine/constraints/constraint.h"
 #include "engine/constraints/joint_rows.h"
 #include "engine/constraints/prescribed_motion.h"
@@ -393,10 +394,12 @@ class MultibodyModel {
   // Winches (WinchSpec, docs/model.md "Winches"): an axially moving mesh
   // on each winch cable, whose N elements all have the length L(t) / N, so
   // the model's size is fixed while the free length L(t) changes. At
-  // SetTime the winch cables' elements, their mass matrices (in mass()),
-  // gravity and the convective inertia terms (forces/winch_inertia.h,
-  // added by DampingForce, which every stepper calls; not dissipation:
-  // DampingPower leaves them out) are evaluated at L(t). A scene without
+  // SetTime the winch cables' elements and their mass matrices (in
+  // mass()) are evaluated at L(t), and so are the contributors' gravity
+  // (forces/gravity_loads.h) and convective inertia and damping
+  // (forces/winch_cables.h: velocity-dependent, so DampingForce adds them,
+  // which every stepper calls; not dissipation: DampingPower leaves the
+  // inertia out). A scene without
   // winches holds none and pays nothing. The total energy of a winch
   // scene is not conserved (the winch does work that is not summed), so
   // the dynamic run's energy guard is off there.
@@ -433,7 +436,6 @@ class MultibodyModel {
     AncfCableElement<D> element;
     int first_coord = 0;  // full index of its first node's position
     double mass_per_length = 0;
-    Eigen::Matrix<double, 4 * D, 1> gravity;
     Eigen::Matrix4d mbar;  // scalar mass matrix: M = mbar (x) I_D
   };
   struct BodyData {
@@ -450,18 +452,17 @@ class MultibodyModel {
     int coord = 0;
     double coeff = 0;
   };
-  // A winch (WinchSpec) on a cable.
+  // A winch (WinchSpec) on a cable: what the model keeps of it, its
+  // elements' length and mass (the mass matrix, which the steppers factor,
+  // is the model's); its forces are contributors (forces/winch_cables.h,
+  // and its gravity forces/gravity_loads.h).
   struct WinchData {
     int cable = 0;
     int element_begin = 0, element_end = 0;  // the cable's elements
-    double length0 = 0;                      // L(0) [m]
-    TimeFunction speed;                      // Ldot(t) [m/s]
-    double length = 0, rate = 0, accel = 0;  // L, Ldot, Lddot at time_
+    WinchReel reel;
+    double length = 0;                       // L at time_ [m]
     double mass_per_length = 0;              // rho A [kg/m]
     double ea = 0;                           // [N]
-    // Damping on the material motion (WinchDamping); the elements' own
-    // damping is then 0.
-    double axial_damping_s = 0, alpha_1_s = 0;
   };
   template <int D>
   double ElementForces(const Eigen::VectorXd& q, Eigen::VectorXd* full, SkylineLdlt* stiffness,
@@ -500,33 +501,13 @@ class MultibodyModel {
   // The state contributors are evaluated at (time_ and the wave field).
   ForceState StateAt(const Eigen::VectorXd& q, const Eigen::VectorXd* qdot,
                      double load_factor) const {
-    return ForceState{&q, qdot, load_factor, time_, wave_field()};
+    return ForceState{&q, qdot, load_factor, time_, waves_};
   }
-  const WaveField* wave_field() const { return wave_load_ ? &wave_load_->field() : nullptr; }
   void ProjectInitialVelocity();
-  // SetTime's share for the winches: lengths, elements, mass, gravity and
-  // convective coefficients at time_.
+  // SetTime's share for the winches: their elements' length and mass at
+  // time_.
   template <int D>
   void UpdateWinches();
-  // DampingForce's share for the winches: the convective force
-  // -cv edot - ce e per element into `full`, tangent_scale * Mdot (the
-  // symmetric part of cv; the skew ldot (G - G^T) and the small position
-  // term are left out of the Newton matrix) into `tangent`. Returns the
-  // largest force entry.
-  template <int D>
-  double WinchForces(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, Eigen::VectorXd* full,
-                     SkylineLdlt* tangent, double tangent_scale, Eigen::VectorXd* roundoff) const;
-  // A winch cable element's damping on the material motion: Rayleigh
-  // alpha as -alpha int mu S^T v dx (v the material velocity, so a rigid
-  // reel-in is damped as any motion through still air would be) and
-  // Kelvin-Voigt axial damping on the material strain rate (WinchSlopeRateShape);
-  // adds the force to `fe` and its edot-derivative to `ce` (either may be
-  // null) and returns the dissipated power [W], >= 0. Bending damping is
-  // refused on winch cables (CheckWinches).
-  template <int D>
-  double WinchDamping(const WinchData& w, int index, const Eigen::VectorXd& q,
-                      const Eigen::VectorXd& qdot, typename AncfCableElement<D>::Coords* fe,
-                      typename AncfCableElement<D>::Matrix* ce) const;
   template <int D>
   Eigen::Vector3d WinchTension(const Eigen::VectorXd& q, int w) const;
   // The scene's rigid initial velocity at full configuration q (all nodes
@@ -562,12 +543,8 @@ class MultibodyModel {
   std::vector<ElementData<2>> elements2_;
   std::vector<ElementData<3>> elements3_;
   std::vector<BodyData> bodies_;
-  Eigen::VectorXd constant_force_;  // full: gravity and point loads
-  // Full: the point loads alone (empty without any), for EnergyParts::loads.
-  Eigen::VectorXd load_force_;
   // Per cable, its first element; one more entry, the element count.
   std::vector<int> cable_element_begin_;
-  Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();  // [m/s^2]
   std::vector<std::string> cable_names_, body_names_;
   // The cable nodes of ModelInfo: per distinct node its position's first
   // full coordinate; per cable the count; per node its arc length [m].
@@ -608,8 +585,12 @@ class MultibodyModel {
   // The sheaves' typed view (null without sheaves).
   const Sheaves* sheaves_ = nullptr;
   // Only in a scene whose fluid has waves (then it carries the current
-  // too); shared with the cables' fluid load (CableFluidLoad).
+  // too); shared with the cables' fluid load (CableFluidLoad). For the
+  // outputs (wave_load()); the assembly passes the field (waves_) in
+  // ForceState and counts its components for the stop poll.
   std::shared_ptr<const WaveLoad> wave_load_;
+  const WaveField* waves_ = nullptr;
+  int64_t wave_components_ = 0;
   StopPoll* stop_poll_ = nullptr;
   // Counts `units` of work on the stop poll; true when the run should stop.
   bool StopNow(int64_t units) const { return stop_poll_ != nullptr && stop_poll_->Poll(units); }
@@ -663,14 +644,8 @@ class MultibodyModel {
   double external_work_ = 0;
   // Winches (empty in most scenes: then nothing is evaluated).
   std::vector<WinchData> winches_;
-  // Per winch element (winch by winch, along each cable): the convective
-  // coefficients cv, ce and Mdot = ldot dM/dl (4 x 4 per component) at time_.
-  std::vector<Eigen::Matrix4d> winch_cv_, winch_ce_, winch_mdot_, winch_g_, winch_h_;
-  // Per element: its index into those (-1: not on a winch cable).
-  std::vector<int> winch_slot_;
-  // mass_'s values and constant_force_ without the winch elements' shares.
+  // mass_'s values without the winch elements' shares.
   std::vector<double> mass_base_;
-  Eigen::VectorXd constant_force_base_;
   // Per probe: the winch at whose end it sits (ProbeForces), or -1.
   std::vector<int> probe_winch_;
   // Scratch (full size) for DampingForce (sized only when has_damping_).

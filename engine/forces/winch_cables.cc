@@ -1,0 +1,183 @@
+#include "engine/forces/winch_cables.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "engine/elements/ancf_cable_element.h"
+#include "engine/elements/gauss_quadrature.h"
+#include "engine/elements/hermite_shape.h"
+#include "engine/linear/rounding.h"
+
+namespace cablesim {
+
+using Eigen::VectorXd;
+
+template <int D>
+WinchCables<D>::WinchCables(std::vector<Winch> winches) : winches_(std::move(winches)) {
+  size_t elements = 0;
+  for (const Winch& w : winches_) elements += w.elements.size();
+  state_.resize(winches_.size());
+  now_.resize(elements);
+  SetTime(0);
+}
+
+template <int D>
+void WinchCables<D>::SetTime(double t) {
+  size_t slot = 0;
+  for (size_t i = 0; i < winches_.size(); ++i) {
+    const Winch& w = winches_[i];
+    state_[i] = w.reel.At(t);
+    const int n = static_cast<int>(w.elements.size());
+    const double l = state_[i].length / n, ldot = state_[i].rate / n,
+                 lddot = state_[i].accel / n;
+    for (int k = 0; k < n; ++k, ++slot) {
+      Now& at = now_[slot];
+      at.mbar = AncfCableElement<D>::ScalarMassMatrix(l, w.mass_per_length);
+      const WinchElementInertia in = ComputeWinchElementInertia(w.mass_per_length, l, k);
+      WinchConvectiveCoefficients(in, ldot, lddot, &at.cv, &at.ce);
+      at.mdot = ldot * in.m_l;
+      at.g = in.g;
+      at.h = in.h;
+    }
+  }
+}
+
+template <int D>
+double WinchCables<D>::Damping(const Winch& w, const WinchReel::State& now, int k, const Now& at,
+                               const VectorXd& q, const VectorXd& qdot, Coords* fe,
+                               Matrix* ce) const {
+  if (w.alpha_1_s == 0 && w.axial_damping_s == 0) return 0;
+  const int first = w.elements[k].first_coord;
+  const auto qe = q.segment<kN>(first);
+  const auto ve = qdot.segment<kN>(first);
+  const int n = static_cast<int>(w.elements.size());
+  const double l = now.length / n, ldot = now.rate / n;
+  double power = 0;
+  if (w.alpha_1_s != 0) {
+    // -alpha int mu S^T v dx with the material velocity v = S edot + ldot W e.
+    const Eigen::Matrix4d& g = at.g;
+    for (int a = 0; a < 4; ++a) {
+      for (int d = 0; d < D; ++d) {
+        double p = 0;
+        for (int b = 0; b < 4; ++b)
+          p += at.mbar(a, b) * ve(D * b + d) + ldot * g(a, b) * qe(D * b + d);
+        if (fe) (*fe)(D * a + d) -= w.alpha_1_s * p;
+        power += w.alpha_1_s * p * ve(D * a + d);
+        if (ce)
+          for (int b = 0; b < 4; ++b) (*ce)(D * a + d, D * b + d) += w.alpha_1_s * at.mbar(a, b);
+      }
+    }
+    // The power is alpha int mu |v|^2 = 2 alpha T: add ldot e^T G^T edot +
+    // ldot^2 e^T H e to the edot . (M edot + ldot G e) summed above.
+    const Eigen::Matrix4d& h = at.h;
+    for (int d = 0; d < D; ++d) {
+      for (int a = 0; a < 4; ++a) {
+        for (int b = 0; b < 4; ++b) {
+          power += w.alpha_1_s * ldot * qe(D * a + d) *
+                   (g(b, a) * ve(D * b + d) + ldot * h(a, b) * qe(D * b + d));
+        }
+      }
+    }
+  }
+  if (w.axial_damping_s != 0) {
+    // Kelvin-Voigt on the material strain rate u . d(r_s)/dt|_s.
+    static const GaussRule rule = MakeGaussRule(AncfCableElement<D>::kDefaultGaussPoints);
+    const double c = w.ea * w.axial_damping_s;
+    for (int gp = 0; gp < rule.n; ++gp) {
+      double d1[4], wd[4];
+      HermiteShapeD1(rule.xi[gp], l, d1);
+      WinchSlopeRateShape(rule.xi[gp], l, k, wd);
+      Eigen::Matrix<double, D, 1> u = Eigen::Matrix<double, D, 1>::Zero(), udot = u;
+      for (int a = 0; a < 4; ++a) {
+        u += d1[a] * qe.template segment<D>(D * a);
+        udot += d1[a] * ve.template segment<D>(D * a) + ldot * wd[a] * qe.template segment<D>(D * a);
+      }
+      const double wl = rule.weight[gp] * l, rate = u.dot(udot);
+      power += wl * c * rate * rate;
+      if (fe)
+        for (int a = 0; a < 4; ++a) fe->template segment<D>(D * a) -= (wl * c * rate * d1[a]) * u;
+      if (ce) {
+        const Eigen::Matrix<double, D, D> uu = u * u.transpose();
+        for (int a = 0; a < 4; ++a)
+          for (int b = 0; b < 4; ++b)
+            ce->template block<D, D>(D * a, D * b) += (wl * c * d1[a] * d1[b]) * uu;
+      }
+    }
+  }
+  return power;
+}
+
+template <int D>
+void WinchCables<D>::AddDissipative(const ForceState& s, ForceOutput* out) const {
+  const VectorXd& q = *s.q;
+  const VectorXd& qdot = *s.qdot;
+  VectorXd* full = out->full;
+  VectorXd* roundoff = out->roundoff;
+  SkylineLdlt* tangent = out->matrix;
+  Coords fe;
+  Matrix ce;
+  size_t slot = 0;
+  for (size_t i = 0; i < winches_.size(); ++i) {
+    const Winch& w = winches_[i];
+    for (int k = 0; k < static_cast<int>(w.elements.size()); ++k, ++slot) {
+      const Element& e = w.elements[k];
+      const Now& at = now_[slot];
+      const auto qe = q.segment<kN>(e.first_coord);
+      const auto ve = qdot.segment<kN>(e.first_coord);
+      // The convective force -cv edot - ce e; Newton takes Mdot (the
+      // symmetric part of cv).
+      fe.setZero();
+      ce.setZero();
+      for (int a = 0; a < 4; ++a) {
+        for (int d = 0; d < D; ++d) {
+          double f = 0, abs_sum = 0;
+          for (int b = 0; b < 4; ++b) {
+            const double tv = at.cv(a, b) * ve(D * b + d), te = at.ce(a, b) * qe(D * b + d);
+            f -= tv + te;
+            abs_sum += std::abs(tv) + std::abs(te);
+            ce(D * a + d, D * b + d) = at.mdot(a, b);
+          }
+          fe(D * a + d) = f;
+          if (roundoff) (*roundoff)(e.first_coord + D * a + d) += kSumRounding * abs_sum;
+        }
+      }
+      Damping(w, state_[i], k, at, q, qdot, &fe, tangent ? &ce : nullptr);
+      full->segment<kN>(e.first_coord) += fe;
+      out->size = std::max(out->size, fe.template lpNorm<Eigen::Infinity>());
+      if (roundoff)
+        roundoff->segment<kN>(e.first_coord).noalias() += kSumRounding * fe.cwiseAbs();
+      if (!tangent) continue;
+      const int* slots = e.slots.data();
+      const double* factors = e.factors.data();
+      for (int t = 0; t < kN2; ++t)
+        if (slots[t] >= 0)
+          tangent->values()[slots[t]] += out->scale * factors[t] * ce(t / kN, t % kN);
+    }
+  }
+}
+
+template <int D>
+void WinchCables<D>::AddDissipatedPower(const ForceState& s, double* power) const {
+  // The damping only: the convective inertia dissipates nothing.
+  size_t slot = 0;
+  for (size_t i = 0; i < winches_.size(); ++i) {
+    const Winch& w = winches_[i];
+    for (int k = 0; k < static_cast<int>(w.elements.size()); ++k, ++slot)
+      *power += Damping(w, state_[i], k, now_[slot], *s.q, *s.qdot, nullptr, nullptr);
+  }
+}
+
+template <int D>
+std::unique_ptr<ForceContributor> MakeWinchCables(
+    std::vector<typename WinchCables<D>::Winch> winches) {
+  if (winches.empty()) return nullptr;
+  return std::make_unique<WinchCables<D>>(std::move(winches));
+}
+
+template class WinchCables<2>;
+template class WinchCables<3>;
+template std::unique_ptr<ForceContributor> MakeWinchCables<2>(std::vector<WinchCables<2>::Winch>);
+template std::unique_ptr<ForceContributor> MakeWinchCables<3>(std::vector<WinchCables<3>::Winch>);
+
+}  // namespace cablesim

@@ -1,0 +1,94 @@
+#ifndef CABLESIM_ENGINE_FORCES_WINCH_CABLES_H_
+#define CABLESIM_ENGINE_FORCES_WINCH_CABLES_H_
+
+// A winch cable's forces beyond its elements' own (docs/model.md,
+// "Winches"), as one ForceContributor over every winch of a scene:
+//
+//  - the convective inertia of the axially moving mesh (winch_inertia.h):
+//    Q = -cv edot - ce e per element, cv = ldot (dM/dl + G - G^T),
+//    ce = lddot G + ldot^2 (dG/dl - H), evaluated at L(t) / N (SetTime).
+//    It is not dissipation (AddDissipatedPower leaves it out), but it
+//    depends on the rates, so it rides with the velocity-dependent forces
+//    (AddDissipative, which every stepper calls). Its rate tangent in the
+//    Newton matrix is Mdot = ldot dM/dl, the symmetric part of cv; the skew
+//    ldot (G - G^T) and the small position term ce are left out;
+//  - damping on the material motion: Rayleigh alpha as
+//    -alpha int mu S^T v dx (v = S edot + ldot W e the material velocity,
+//    so a rigid reel-in is damped as any motion through still air would
+//    be), and Kelvin-Voigt axial damping on the material strain rate
+//    (WinchSlopeRateShape); its power alpha int mu |v|^2 + int c rate^2
+//    >= 0. Bending damping is refused on winch cables (the model
+//    builder's CheckWinches), and the elements' own damping cleared there.
+//
+// What stays in the model: the winch cables' elements (their length
+// L(t) / N) and their mass matrices in the model's mass matrix, which
+// every stepper factors (a mass that changes with time is the model's,
+// not a force); their gravity is GravityLoads' (gravity_loads.h).
+
+#include <memory>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "engine/forces/force_contributor.h"
+#include "engine/forces/winch_inertia.h"
+
+namespace cablesim {
+
+template <int D>
+class WinchCables : public ForceContributor {
+ public:
+  static constexpr int kN = 4 * D, kN2 = kN * kN;
+  using Coords = Eigen::Matrix<double, kN, 1>;
+  using Matrix = Eigen::Matrix<double, kN, kN>;
+  // An element of a winch cable: its first full coordinate and where its
+  // (4D)^2 entries go in the Newton matrix (slot or -1, factor s_a s_b:
+  // the model's element scatter).
+  struct Element {
+    int first_coord = 0;
+    std::vector<int> slots;
+    std::vector<double> factors;
+  };
+  struct Winch {
+    WinchReel reel;
+    double mass_per_length = 0;  // rho A [kg/m]
+    double ea = 0;               // [N]
+    double axial_damping_s = 0, alpha_1_s = 0;
+    std::vector<Element> elements;  // from the payload end (k = 0)
+  };
+
+  explicit WinchCables(std::vector<Winch> winches);
+
+  std::string_view name() const override { return "winch_cables"; }
+  bool time_dependent() const override { return true; }
+  void SetTime(double t) override;
+  bool dissipates() const override { return true; }
+  void AddDissipative(const ForceState& s, ForceOutput* out) const override;
+  void AddDissipatedPower(const ForceState& s, double* power) const override;
+
+ private:
+  // Per element at the time of SetTime: the scalar mass matrix and the
+  // convective coefficients (4 x 4 per component).
+  struct Now {
+    Eigen::Matrix4d mbar, cv, ce, mdot, g, h;
+  };
+  // Element k of winch w's damping on the material motion: adds the force
+  // to `fe` and its edot-derivative to `ce` (either may be null); returns
+  // the dissipated power [W], >= 0.
+  double Damping(const Winch& w, const WinchReel::State& now, int k, const Now& at,
+                 const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, Coords* fe,
+                 Matrix* ce) const;
+
+  std::vector<Winch> winches_;
+  std::vector<WinchReel::State> state_;  // per winch
+  std::vector<Now> now_;                  // per element, winch by winch
+};
+
+// The contributor, or null without winches.
+template <int D>
+std::unique_ptr<ForceContributor> MakeWinchCables(std::vector<typename WinchCables<D>::Winch> winches);
+
+}  // namespace cablesim
+
+#endif  // CABLESIM_ENGINE_FORCES_WINCH_CABLES_H_
