@@ -148,11 +148,21 @@ void WinchCables<D>::AddDissipative(const ForceState& s, ForceOutput* out) const
       if (roundoff)
         roundoff->segment<kN>(e.first_coord).noalias() += kSumRounding * fe.cwiseAbs();
       if (!tangent) continue;
-      const int* slots = e.slots.data();
-      const double* factors = e.factors.data();
-      for (int t = 0; t < kN2; ++t)
-        if (slots[t] >= 0)
-          tangent->values()[slots[t]] += out->scale * factors[t] * ce(t / kN, t % kN);
+      // The element's matrix onto z, entry by entry in the order (and with
+      // the factor s_a s_b) of the model's element scatter: pairs with
+      // j_a > j_b once, j_a == j_b all.
+      const CoordinateMap& map = out->map;
+      double* values = tangent->values();
+      for (int a = 0; a < kN; ++a) {
+        const int ia = e.first_coord + a, ja = map.j[ia];
+        if (ja < 0) continue;
+        for (int b = 0; b < kN; ++b) {
+          const int ib = e.first_coord + b, jb = map.j[ib];
+          if (jb < 0 || jb > ja) continue;
+          const int slot = tangent->Slot(ja, jb);
+          if (slot >= 0) values[slot] += out->scale * (map.s[ia] * map.s[ib]) * ce(a, b);
+        }
+      }
     }
   }
 }

@@ -39,16 +39,12 @@ namespace cablesim {
 template <int D>
 class WinchCables : public ForceContributor {
  public:
-  static constexpr int kN = 4 * D, kN2 = kN * kN;
+  static constexpr int kN = 4 * D;
   using Coords = Eigen::Matrix<double, kN, 1>;
   using Matrix = Eigen::Matrix<double, kN, kN>;
-  // An element of a winch cable: its first full coordinate and where its
-  // (4D)^2 entries go in the Newton matrix (slot or -1, factor s_a s_b:
-  // the model's element scatter).
+  // An element of a winch cable: its first full coordinate.
   struct Element {
     int first_coord = 0;
-    std::vector<int> slots;
-    std::vector<double> factors;
   };
   struct Winch {
     WinchReel reel;

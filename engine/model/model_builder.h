@@ -232,6 +232,9 @@ class ModelBuilder {
  private:
   using Row = JointRows::Row;
 
+  // Relative tolerance for matching arc lengths to nodes.
+  static constexpr double kSnap = 1e-9;
+
   // Full index of a node's position, of a body's centre of mass.
   int NodeCoord(int node) const { return model_.node_stride_ * node; }
   int BodyCoord(int body) const;
@@ -262,8 +265,8 @@ class ModelBuilder {
   // The element scatter tables (per element, the (4D)^2 skyline slots
   // and factors s_a s_b) and the elements' share of the mass matrix.
   // Finish's share for the winches: mass_base_, the mass values without
-  // the winch elements; and their contributor (WinchCables), which takes
-  // the winch elements' scatter tables.
+  // the winch elements; and their contributor (WinchCables), last in the
+  // contributors' list.
   template <int D>
   void WinchBases(const std::vector<MultibodyModel::ElementData<D>>& elements);
   template <int D>
