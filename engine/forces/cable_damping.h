@@ -9,7 +9,7 @@
 // the derivative of C(q) edot in q (MultibodyModel::DampingForce).
 //
 // A winch cable's elements carry none: the winch damps the material motion
-// instead (ClearMaterialDamping; MultibodyModel::WinchDamping).
+// instead (ClearMaterialDamping; WinchCables, forces/winch_cables.h).
 
 #include <memory>
 #include <string_view>
