@@ -3,7 +3,7 @@
 
 // The scene's loads that are not constant generalized forces, as one
 // ForceContributor (the constant ones, gravity and the loads' constant
-// forces, stay the model's constant vector: V = -F . q):
+// forces, are GravityLoads', gravity_loads.h: V = -F . q):
 //
 //  - a time-varying force F(t) at a point x linear in q (a cable point or
 //    a body point): the generalized force sum_d F_d a_{d,i} on q_i; its

@@ -186,7 +186,7 @@ void ModelBuilder::BuildElements() {
                        j.components, j.seed);
     model_.wave_load_ = std::make_shared<const WaveLoad>(std::move(field), fluid.current_m_s);
     model_.waves_ = &model_.wave_load_->field();
-    model_.wave_components_ = static_cast<int64_t>(model_.waves_->components().size());
+    model_.damping_point_cost_ = 1 + static_cast<int64_t>(model_.waves_->components().size());
   }
   if (model_.dim_ == 2) {
     BuildElementsOf<2>(&model_.elements2_);

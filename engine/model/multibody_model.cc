@@ -283,12 +283,11 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
   const bool terms = !element_dissipates_.empty();
   // Where terms that couple an element with other coordinates add those.
   ForceOutput coupled{full, roundoff, tangent, tangent_scale, Map()};
-  // Work per element for the stop poll: its Gauss points, each summing
-  // every wave component.
-  const int64_t components = wave_components_;
+  // Work per element for the stop poll: its Gauss points, each at the
+  // builder's cost per point.
   for (size_t k = 0; k < elements.size(); ++k) {
     const ElementData<D>& e = elements[k];
-    if (StopNow(e.element.gauss_points() * (1 + components))) {  // set_stop_poll
+    if (StopNow(e.element.gauss_points() * damping_point_cost_)) {  // set_stop_poll
       if (full) full->setConstant(std::numeric_limits<double>::quiet_NaN());
       if (power) *power = std::numeric_limits<double>::quiet_NaN();
       return std::numeric_limits<double>::quiet_NaN();

@@ -586,11 +586,13 @@ class MultibodyModel {
   const Sheaves* sheaves_ = nullptr;
   // Only in a scene whose fluid has waves (then it carries the current
   // too); shared with the cables' fluid load (CableFluidLoad). For the
-  // outputs (wave_load()); the assembly passes the field (waves_) in
-  // ForceState and counts its components for the stop poll.
+  // outputs (wave_load()); the assembly only passes the field (waves_,
+  // null without waves) to the contributors in ForceState.
   std::shared_ptr<const WaveLoad> wave_load_;
   const WaveField* waves_ = nullptr;
-  int64_t wave_components_ = 0;
+  // The stop poll's units of work per Gauss point in the damping pass: 1,
+  // plus one per wave component the fluid's load sums there.
+  int64_t damping_point_cost_ = 1;
   StopPoll* stop_poll_ = nullptr;
   // Counts `units` of work on the stop poll; true when the run should stop.
   bool StopNow(int64_t units) const { return stop_poll_ != nullptr && stop_poll_->Poll(units); }
