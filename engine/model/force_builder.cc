@@ -147,7 +147,7 @@ void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* 
       e.first_coord = NodeCoord(k);
       e.mass_per_length = mpl + cable.added_mass * displaced;
       // Gravity acts on the mass less the displaced fluid's (buoyancy).
-      element_weight_.push_back(mpl - displaced);
+      e.weight_per_length = mpl - displaced;
       element_cable_.push_back(c);
       CableFluidLoad::Element fluid;
       fluid.drag_n = drag_n;
@@ -335,16 +335,16 @@ void ModelBuilder::ConstantForces() {
   MultibodyModel& m = model_;
   const int D = m.dim_;
   for (const BodySpec& body : scene_.bodies) m.body_names_.push_back(body.name);
+  m.gravity_ = scene_.gravity_m_s2;
   std::vector<int> first, body_coord;
-  std::vector<double> length, body_mass;
-  for (const auto& e : m.elements2_) {
+  std::vector<double> weight, length, body_mass;
+  auto element = [&](const auto& e) {
     first.push_back(e.first_coord);
+    weight.push_back(e.weight_per_length);
     length.push_back(e.element.length());
-  }
-  for (const auto& e : m.elements3_) {
-    first.push_back(e.first_coord);
-    length.push_back(e.element.length());
-  }
+  };
+  for (const auto& e : m.elements2_) element(e);
+  for (const auto& e : m.elements3_) element(e);
   for (const MultibodyModel::BodyData& b : m.bodies_) {
     body_coord.push_back(b.coord);
     body_mass.push_back(b.mass);
@@ -362,7 +362,7 @@ void ModelBuilder::ConstantForces() {
   for (const MultibodyModel::WinchData& w : m.winches_)
     winches.push_back({{w.element_begin, w.element_end}, w.reel});
   // First in the list: the applied loads are summed onto gravity.
-  if (auto gravity = MakeGravityLoads(D, scene_.gravity_m_s2, element_weight_, first, length,
+  if (auto gravity = MakeGravityLoads(D, scene_.gravity_m_s2, weight, first, length,
                                       element_cable_, body_coord, body_mass, load_terms,
                                       !scene_.loads.empty(), winches,
                                       static_cast<int>(q0_.size())))

@@ -288,9 +288,7 @@ class ModelBuilder {
   std::vector<CableDamping::Element> damping_elements_;
   std::vector<CableFluidLoad::Element> fluid_elements_;
   CableDamping* cable_damping_ = nullptr;
-  // Per element: the mass per length gravity acts on [kg/m] (less the
-  // displaced fluid's) and its cable, for GravityLoads (ConstantForces).
-  std::vector<double> element_weight_;
+  // Per element: its cable, for GravityLoads (ConstantForces).
   std::vector<int> element_cable_;
 };
 

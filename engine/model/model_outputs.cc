@@ -301,7 +301,8 @@ void MultibodyModel::ElementEndForces(const VectorXd& q, int k, double load_fact
   const ElementData<D>& e = Elements<D>()[k];
   Eigen::Matrix<double, kN, 1> f = Eigen::Matrix<double, kN, 1>::Zero();  // ElasticForce adds
   e.element.ElasticForce(q.segment<kN>(e.first_coord), &f, nullptr);
-  f -= load_factor * e.gravity;
+  f -= load_factor * AncfCableElement<D>::GravityForceOfLength(
+                         e.element.length(), e.weight_per_length, gravity_.head<D>());
   start->setZero();
   end->setZero();
   // Rows of the end positions (r_i, r_j) in the element's coordinates

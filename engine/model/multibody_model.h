@@ -436,6 +436,10 @@ class MultibodyModel {
     AncfCableElement<D> element;
     int first_coord = 0;  // full index of its first node's position
     double mass_per_length = 0;
+    // The mass per length its weight acts on [kg/m] (less the displaced
+    // fluid's): output.tension's section forces take its weight off
+    // (ElementEndForces); the force itself is GravityLoads'.
+    double weight_per_length = 0;
     Eigen::Matrix4d mbar;  // scalar mass matrix: M = mbar (x) I_D
   };
   struct BodyData {
@@ -546,6 +550,7 @@ class MultibodyModel {
   // Per cable, its first element; one more entry, the element count.
   std::vector<int> cable_element_begin_;
   std::vector<std::string> cable_names_, body_names_;
+  Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();  // [m/s^2], for the outputs
   // The cable nodes of ModelInfo: per distinct node its position's first
   // full coordinate; per cable the count; per node its arc length [m].
   bool shape_ = false;
