@@ -301,8 +301,7 @@ void MultibodyModel::ElementEndForces(const VectorXd& q, int k, double load_fact
   const ElementData<D>& e = Elements<D>()[k];
   Eigen::Matrix<double, kN, 1> f = Eigen::Matrix<double, kN, 1>::Zero();  // ElasticForce adds
   e.element.ElasticForce(q.segment<kN>(e.first_coord), &f, nullptr);
-  f -= load_factor * AncfCableElement<D>::GravityForceOfLength(
-                         e.element.length(), e.weight_per_length, gravity_.head<D>());
+  f -= load_factor * ElementWeight(e);
   start->setZero();
   end->setZero();
   // Rows of the end positions (r_i, r_j) in the element's coordinates
@@ -398,7 +397,7 @@ Vector3d MultibodyModel::BendingMomentOf(const VectorXd& q, int cable, double s,
     const ElementData<D>& el = elements[e];
     Eigen::Matrix<double, kN, 1> f = Eigen::Matrix<double, kN, 1>::Zero();  // ElasticForce adds
     el.element.ElasticForce(q.segment<kN>(el.first_coord), &f, nullptr);
-    f -= load_factor * el.gravity;
+    f -= load_factor * ElementWeight(el);
     const int row = at_end ? 3 * D : D;  // (r_i, u_i, r_j, u_j)
     Vector3d u = Vector3d::Zero(), g = Vector3d::Zero();
     u.head<D>() = q.segment<D>(el.first_coord + row);

@@ -502,6 +502,13 @@ class MultibodyModel {
   template <int D>
   Eigen::Vector3d ElementAngularMomentum(const Eigen::VectorXd& q,
                                          const Eigen::VectorXd& qdot) const;
+  // An element's gravity force [N] at its current length, for the
+  // outputs' section forces (the same numbers GravityLoads sums).
+  template <int D>
+  typename AncfCableElement<D>::Coords ElementWeight(const ElementData<D>& e) const {
+    return AncfCableElement<D>::GravityForceOfLength(e.element.length(), e.weight_per_length,
+                                                     gravity_.head<D>());
+  }
   // The state contributors are evaluated at (time_ and the wave field).
   ForceState StateAt(const Eigen::VectorXd& q, const Eigen::VectorXd* qdot,
                      double load_factor) const {
