@@ -112,8 +112,50 @@ size_t FirstInvalidUtf8(absl::string_view text) {
   return absl::string_view::npos;
 }
 
+// One byte at a time through JSON text, telling which bytes are inside
+// strings: the scans below look at the nesting outside strings (and at
+// keys), which the full parser only reaches after recursing into it.
+class JsonStringTracker {
+ public:
+  enum class Byte {
+    kOutside,   // outside any string, not a quote
+    kOpen,      // the quote that opens a string
+    kContent,   // an unescaped byte inside a string
+    kEscape,    // a backslash inside a string, or the byte it escapes
+    kClose,     // the quote that closes a string
+  };
+
+  Byte Next(char c) {
+    if (!in_string_) {
+      if (c != '"') return Byte::kOutside;
+      in_string_ = true;
+      return Byte::kOpen;
+    }
+    if (escaped_) {
+      escaped_ = false;
+      return Byte::kEscape;
+    }
+    if (c == '\\') {
+      escaped_ = true;
+      return Byte::kEscape;
+    }
+    if (c == '"') {
+      in_string_ = false;
+      return Byte::kClose;
+    }
+    return Byte::kContent;
+  }
+
+  bool in_string() const { return in_string_; }
+
+ private:
+  bool in_string_ = false;
+  bool escaped_ = false;
+};
+
 // The field path (`cables[0].name`) of the JSON value, or key, that
 // contains byte `offset` of `json`: a small scan of the nesting up to it.
+// A key's escaped characters are left out of it.
 std::string JsonPathAt(absl::string_view json, size_t offset) {
   struct Frame {
     bool array;
@@ -122,28 +164,28 @@ std::string JsonPathAt(absl::string_view json, size_t offset) {
     bool expecting_key = true;
   };
   std::vector<Frame> stack;
-  bool in_string = false, escaped = false, string_is_key = false;
+  JsonStringTracker strings;
+  bool string_is_key = false;
   std::string current;
   for (size_t i = 0; i < offset && i < json.size(); ++i) {
     const char c = json[i];
-    if (in_string) {
-      if (escaped) {
-        escaped = false;
-      } else if (c == '\\') {
-        escaped = true;
-      } else if (c == '"') {
-        in_string = false;
+    switch (strings.Next(c)) {
+      case JsonStringTracker::Byte::kOpen:
+        string_is_key = !stack.empty() && !stack.back().array && stack.back().expecting_key;
+        current.clear();
+        continue;
+      case JsonStringTracker::Byte::kContent:
+        if (string_is_key) current += c;
+        continue;
+      case JsonStringTracker::Byte::kEscape:
+        continue;
+      case JsonStringTracker::Byte::kClose:
         if (string_is_key && !stack.empty()) stack.back().key = current;
-      } else if (string_is_key) {
-        current += c;
-      }
-      continue;
+        continue;
+      case JsonStringTracker::Byte::kOutside:
+        break;
     }
-    if (c == '"') {
-      in_string = true;
-      string_is_key = !stack.empty() && !stack.back().array && stack.back().expecting_key;
-      current.clear();
-    } else if (c == '{' || c == '[') {
+    if (c == '{' || c == '[') {
       stack.push_back(Frame{c == '['});
     } else if ((c == '}' || c == ']') && !stack.empty()) {
       stack.pop_back();
@@ -158,7 +200,7 @@ std::string JsonPathAt(absl::string_view json, size_t offset) {
       }
     }
   }
-  if (in_string && string_is_key && !stack.empty()) stack.back().key = current;
+  if (strings.in_string() && string_is_key && !stack.empty()) stack.back().key = current;
   std::string path;
   for (const Frame& f : stack) {
     if (f.array) {
@@ -222,20 +264,11 @@ absl::Status CheckSize(absl::string_view text, absl::string_view what) {
 // parser recurses into it.
 absl::Status CheckJsonNesting(absl::string_view json, absl::string_view what) {
   int depth = 0;
-  bool in_string = false, escaped = false;
+  JsonStringTracker strings;
   for (size_t i = 0; i < json.size(); ++i) {
     const char c = json[i];
-    if (in_string) {
-      if (escaped) {
-        escaped = false;
-      } else if (c == '\\') {
-        escaped = true;
-      } else if (c == '"') {
-        in_string = false;
-      }
-    } else if (c == '"') {
-      in_string = true;
-    } else if (c == '[' || c == '{') {
+    if (strings.Next(c) != JsonStringTracker::Byte::kOutside) continue;
+    if (c == '[' || c == '{') {
       if (++depth > kMaxSceneNesting) {
         return absl::InvalidArgumentError(absl::StrCat(what, ": nested deeper than ",
                                                        kMaxSceneNesting, " levels (at byte ", i,

@@ -65,6 +65,22 @@ TEST(StrictParseTest, DeepNestingIsRefusedBeforeParsing) {
   EXPECT_TRUE(named.ok()) << named.status();
 }
 
+// The nesting check and the UTF-8 error's field path share one reading of
+// JSON strings (convert/scene_file.cc, JsonStringTracker): an escaped
+// quote does not end a string, so brackets, commas and colons after it
+// are text, not structure.
+TEST(StrictParseTest, EscapedQuotesDoNotEndStrings) {
+  const absl::StatusOr<v1::Scene> named = ParseSceneJson(
+      absl::StrCat(R"({"name": "say \"hi\" )", std::string(40, '['), R"("})"));
+  EXPECT_TRUE(named.ok()) << named.status();
+  EXPECT_EQ(named->name(), absl::StrCat("say \"hi\" ", std::string(40, '[')));
+  EXPECT_EQ(ParseError("{\"name\": \"a\\\"],[{,:\", \"cables\": [{\"name\": \"b\xff\"}]}"),
+            "invalid JSON scene: cables[0].name: not valid UTF-8 (byte 44 is 0xff)");
+  // A key's escaped characters are left out of the path.
+  EXPECT_THAT(ParseError("{\"cables\": [{\"n\\\"a\xffme\": \"c\"}]}"),
+              HasSubstr("cables[0].na: not valid UTF-8"));
+}
+
 TEST(StrictParseTest, TextFormatNestingIsBounded) {
   std::string deep;
   for (int i = 0; i < 1000; ++i) deep += "solver {";

@@ -1,0 +1,225 @@
+#include "convert/scene/sections.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "convert/scene_from_proto.h"
+
+namespace cablesim::scene_convert {
+namespace {
+
+constexpr int kDefaultElements = 10;
+constexpr int kMaxElements = 100000;
+
+// The polyline's corner at points[corner], between the segment from the
+// point before it and the segment to `next`, must not fold the cable back.
+absl::Status CheckCorner(absl::string_view cable_path, int corner,
+                         const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& next) {
+  const Eigen::Vector3d in = points[corner] - points[corner - 1];
+  const Eigen::Vector3d out = next - points[corner];
+  const double cosine = in.dot(out) / (in.norm() * out.norm());
+  const double turn_degrees = std::acos(std::clamp(cosine, -1.0, 1.0)) * 180 / kPi;
+  if (!(turn_degrees <= plausible::kMaxCornerTurnDegrees)) {
+    return Invalid(Indexed(cable_path, "points", corner),
+                   absl::StrFormat("the polyline folds back at this corner (turns by %.1f "
+                                   "degrees; at most %g)",
+                                   turn_degrees, plausible::kMaxCornerTurnDegrees));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status ConvertCable(ConversionState* state, int i, CableSpec* cable) {
+  const v1::Cable& c = state->proto.cables(i);
+  const std::string path = Indexed("", "cables", i);
+  CABLESIM_RETURN_IF_ERROR(
+      RegisterName(Sub(path, "name"), "cables", c.name(), i, &state->cable_index));
+  cable->name = c.name();
+
+  cable->elements = c.has_elements() ? c.elements() : kDefaultElements;
+  CABLESIM_RETURN_IF_ERROR(CheckIntRange(Sub(path, "elements"), cable->elements, 1, kMaxElements));
+
+  // Geometry: a polyline, or start + direction * length.
+  if (c.points_size() > 0) {
+    if (c.has_start()) return Invalid(Sub(path, "start"), "give either start/direction or points");
+    if (c.has_direction()) {
+      return Invalid(Sub(path, "direction"), "give either start/direction or points");
+    }
+    if (c.points_size() < 2) {
+      return Invalid(Sub(path, "points"),
+                     absl::StrCat("needs at least 2 points (got ", c.points_size(), ")"));
+    }
+    double polyline_length = 0;
+    for (int j = 0; j < c.points_size(); ++j) {
+      const std::string point_path = Indexed(path, "points", j);
+      CABLESIM_ASSIGN_OR_RETURN(const Eigen::Vector3d p,
+                                VectorInRange(point_path, c.points(j), plausible::kCoordinate));
+      if (j > 0) {
+        const Eigen::Vector3d& previous = cable->points.back();
+        const double segment = (p - previous).norm();
+        const double scale = std::max(p.norm(), previous.norm());
+        if (!(segment > 1e-12 * scale) || segment == 0) {
+          return Invalid(point_path, absl::StrCat("same as points[", j - 1,
+                                                  "] (consecutive points must differ)"));
+        }
+        if (j > 1) CABLESIM_RETURN_IF_ERROR(CheckCorner(path, j - 1, cable->points, p));
+        polyline_length += segment;
+      }
+      cable->points.push_back(p);
+    }
+    if (!(polyline_length >= plausible::kCableLength.lo &&
+          polyline_length <= plausible::kCableLength.hi)) {
+      return Invalid(
+          Sub(path, "points"),
+          absl::StrCat("polyline length must be in [", Num(plausible::kCableLength.lo), ", ",
+                       Num(plausible::kCableLength.hi), "] m (got ", Num(polyline_length), ")"));
+    }
+    if (c.has_length()) {
+      CABLESIM_RETURN_IF_ERROR(
+          CheckPositiveInRange(Sub(path, "length"), c.length(), plausible::kCableLength));
+      cable->length_m = c.length();
+    } else {
+      cable->length_m = polyline_length;
+    }
+  } else {
+    CABLESIM_ASSIGN_OR_RETURN(const Eigen::Vector3d start,
+                              VectorInRange(Sub(path, "start"), c.start(), plausible::kCoordinate));
+    Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
+    if (c.has_direction()) {
+      CABLESIM_ASSIGN_OR_RETURN(direction, Direction(Sub(path, "direction"), c.direction()));
+    }
+    if (!c.has_length()) return Invalid(Sub(path, "length"), "required (or give points)");
+    CABLESIM_RETURN_IF_ERROR(
+        CheckPositiveInRange(Sub(path, "length"), c.length(), plausible::kCableLength));
+    cable->length_m = c.length();
+    cable->points = {start, Eigen::Vector3d(start + direction * cable->length_m)};
+  }
+
+  CABLESIM_RETURN_IF_ERROR(
+      CheckPositiveInRange(Sub(path, "density"), c.density(), plausible::kDensity));
+  cable->density_kg_m3 = c.density();
+  CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange(Sub(path, "youngs_modulus"), c.youngs_modulus(),
+                                                plausible::kYoungsModulus));
+  cable->youngs_modulus_pa = c.youngs_modulus();
+
+  if (c.has_diameter()) {
+    CABLESIM_RETURN_IF_ERROR(
+        CheckPositiveInRange(Sub(path, "diameter"), c.diameter(), plausible::kSize));
+  }
+  const double d = c.diameter();
+  if (c.has_area()) {
+    CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange(Sub(path, "area"), c.area(), plausible::kArea));
+    cable->area_m2 = c.area();
+  } else if (c.has_diameter()) {
+    cable->area_m2 = kPi * d * d / 4;
+  } else {
+    return Invalid(Sub(path, "area"), "required (give area or diameter)");
+  }
+
+  CABLESIM_ASSIGN_OR_RETURN(cable->bending, BendingFromProto(c.bending(), Sub(path, "bending")));
+  const bool no_bending = cable->bending == BendingModel::kNone;
+  if (c.has_second_moment()) {
+    const std::string moment_path = Sub(path, "second_moment");
+    CABLESIM_RETURN_IF_ERROR(no_bending ? CheckNonNegative(moment_path, c.second_moment())
+                                        : CheckPositive(moment_path, c.second_moment()));
+    if (c.second_moment() != 0) {
+      CABLESIM_RETURN_IF_ERROR(
+          CheckRange(moment_path, c.second_moment(), plausible::kSecondMoment));
+    }
+    cable->second_moment_m4 = c.second_moment();
+  } else if (c.has_diameter()) {
+    cable->second_moment_m4 = kPi * d * d * d * d / 64;
+  } else if (no_bending) {
+    cable->second_moment_m4 = 0;
+  } else {
+    return Invalid(Sub(path, "second_moment"),
+                   "required unless bending is NONE (give second_moment or diameter)");
+  }
+  if (!std::isfinite(cable->area_m2) || !(cable->area_m2 > 0) ||
+      !std::isfinite(cable->second_moment_m4)) {
+    return Invalid(Sub(path, "diameter"), "section properties out of range");
+  }
+  if (c.has_hydrodynamics()) {
+    const v1::Hydrodynamics& h = c.hydrodynamics();
+    const std::string hydro_path = Sub(path, "hydrodynamics");
+    if (!(state->proto.fluid().density() > 0)) {
+      return Invalid(hydro_path, "needs a fluid around the cables (fluid.density > 0)");
+    }
+    for (const auto& [name, value, out] :
+         {std::tuple{"normal_drag", h.normal_drag(), &cable->normal_drag},
+          std::tuple{"tangential_drag", h.tangential_drag(), &cable->tangential_drag},
+          std::tuple{"added_mass", h.added_mass(), &cable->added_mass}}) {
+      CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(hydro_path, name), value));
+      CABLESIM_RETURN_IF_ERROR(
+          CheckRange(Sub(hydro_path, name), value, plausible::kHydroCoefficient));
+      *out = value;
+    }
+    if (h.has_diameter()) {
+      CABLESIM_RETURN_IF_ERROR(
+          CheckPositiveInRange(Sub(hydro_path, "diameter"), h.diameter(), plausible::kSize));
+      cable->hydro_diameter_m = h.diameter();
+    }
+  }
+  switch (c.axial_law()) {
+    case v1::AXIAL_LAW_UNSPECIFIED:
+    case v1::GREEN_LAGRANGE:
+      cable->axial_law = AxialLaw::kGreenLagrange;
+      break;
+    case v1::ENGINEERING:
+      cable->axial_law = AxialLaw::kEngineering;
+      break;
+    default:
+      return Invalid(Sub(path, "axial_law"),
+                     absl::StrCat("unknown value ", c.axial_law(),
+                                  " (must be GREEN_LAGRANGE or ENGINEERING)"));
+  }
+  if (c.has_winch()) {
+    if (cable->axial_law == AxialLaw::kEngineering) {
+      return Invalid(Sub(path, "axial_law"),
+                     "ENGINEERING is not available on a cable with a winch (its line tension "
+                     "is the Green-Lagrange law's)");
+    }
+    cable->winch.enabled = true;
+    CABLESIM_ASSIGN_OR_RETURN(
+        cable->winch.speed, ConvertTimeFunction(Sub(Sub(path, "winch"), "speed"), c.winch().speed(),
+                                                plausible::kVelocity));
+  }
+  if (c.has_damping()) {
+    const v1::CableDamping& d = c.damping();
+    const std::string damping_path = Sub(path, "damping");
+    for (const auto& [name, value, out, range] :
+         {std::tuple{"axial_time", d.axial_time(), &cable->axial_damping_s,
+                     &plausible::kDampingTime},
+          std::tuple{"bending_time", d.bending_time(), &cable->bending_damping_s,
+                     &plausible::kDampingTime},
+          std::tuple{"rayleigh_alpha", d.rayleigh_alpha(), &cable->rayleigh_alpha_1_s,
+                     &plausible::kRayleighAlpha},
+          std::tuple{"rayleigh_beta", d.rayleigh_beta(), &cable->rayleigh_beta_s,
+                     &plausible::kDampingTime}}) {
+      CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(damping_path, name), value));
+      CABLESIM_RETURN_IF_ERROR(CheckRange(Sub(damping_path, name), value, *range));
+      *out = value;
+    }
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::Status ConvertCables(ConversionState* state) {
+  const v1::Scene& proto = state->proto;
+  if (proto.cables_size() == 0 && proto.bodies_size() == 0) {
+    return Invalid("cables", "a scene needs at least one cable or body");
+  }
+  state->scene.cables.resize(proto.cables_size());
+  for (int i = 0; i < proto.cables_size(); ++i) {
+    CABLESIM_RETURN_IF_ERROR(ConvertCable(state, i, &state->scene.cables[i]));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace cablesim::scene_convert

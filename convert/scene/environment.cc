@@ -1,0 +1,211 @@
+#include "convert/scene/sections.h"
+
+#include <cmath>
+#include <cstdint>
+#include <string>
+
+#include "absl/strings/str_cat.h"
+
+namespace cablesim::scene_convert {
+namespace {
+
+// JONSWAP components per sea (each costs a few exponentials per Gauss
+// point per force evaluation).
+constexpr int kMaxWaveComponents = 1000;
+
+// A wave's direction of travel: its part normal to gravity, normalised.
+// Omitted: x (y when gravity is along x).
+absl::StatusOr<Eigen::Vector3d> WaveDirection(const ConversionState& state, absl::string_view path,
+                                              bool given, const v1::Vec3& v) {
+  const Eigen::Vector3d up = -state.scene.gravity_m_s2.normalized();
+  Eigen::Vector3d d = Eigen::Vector3d::UnitX();
+  if (given) {
+    CABLESIM_ASSIGN_OR_RETURN(d, Direction(path, v));
+  } else if (std::abs(up.x()) > 0.99) {
+    d = Eigen::Vector3d::UnitY();
+  }
+  const Eigen::Vector3d horizontal = d - up.dot(d) * up;
+  if (!(horizontal.norm() >= 1e-6)) {
+    return Invalid(path, "must have a horizontal part (it is along gravity)");
+  }
+  return Eigen::Vector3d(horizontal.normalized());
+}
+
+absl::Status ConvertWaves(ConversionState* state) {
+  const v1::Fluid& f = state->proto.fluid();
+  if (!f.has_waves()) return absl::OkStatus();
+  const v1::Waves& w = f.waves();
+  WavesSpec& spec = state->scene.fluid.waves;
+  CABLESIM_RETURN_IF_ERROR(CheckNonNegative("fluid.waves.ramp_time", w.ramp_time()));
+  CABLESIM_RETURN_IF_ERROR(
+      CheckRange("fluid.waves.ramp_time", w.ramp_time(), plausible::kDuration));
+  spec.ramp_s = w.ramp_time();
+  if (w.regular_size() == 0 && w.jonswap_size() == 0) return absl::OkStatus();
+  if (!(f.density() > 0)) return Invalid("fluid.waves", "needs a fluid (fluid.density > 0)");
+  if (!(f.water_depth() > 0)) {
+    return Invalid("fluid.water_depth", "must be > 0 with waves (their kinematics depend on it)");
+  }
+  if (!(state->scene.gravity_m_s2.norm() > 0)) {
+    return Invalid("fluid.waves", "needs gravity (it sets the vertical and the waves' speed)");
+  }
+  for (int i = 0; i < w.regular_size(); ++i) {
+    const v1::Waves::Regular& r = w.regular(i);
+    const std::string path = Indexed("fluid.waves", "regular", i);
+    RegularWaveSpec out;
+    CABLESIM_RETURN_IF_ERROR(
+        CheckPositiveInRange(Sub(path, "height"), r.height(), plausible::kSize));
+    out.height_m = r.height();
+    CABLESIM_RETURN_IF_ERROR(
+        CheckPositiveInRange(Sub(path, "period"), r.period(), plausible::kWavePeriod));
+    out.period_s = r.period();
+    CABLESIM_ASSIGN_OR_RETURN(out.direction, WaveDirection(*state, Sub(path, "direction"),
+                                                           r.has_direction(), r.direction()));
+    CABLESIM_RETURN_IF_ERROR(CheckRange(Sub(path, "phase"), r.phase(), plausible::kPhase));
+    out.phase_rad = r.phase();
+    spec.regular.push_back(out);
+  }
+  for (int i = 0; i < w.jonswap_size(); ++i) {
+    const v1::Waves::Jonswap& j = w.jonswap(i);
+    const std::string path = Indexed("fluid.waves", "jonswap", i);
+    JonswapSpec out;
+    CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange(Sub(path, "significant_height"),
+                                                  j.significant_height(), plausible::kSize));
+    out.significant_height_m = j.significant_height();
+    CABLESIM_RETURN_IF_ERROR(
+        CheckPositiveInRange(Sub(path, "peak_period"), j.peak_period(), plausible::kWavePeriod));
+    out.peak_period_s = j.peak_period();
+    if (j.peak_factor() != 0) {
+      CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(path, "peak_factor"), j.peak_factor()));
+      if (!(j.peak_factor() >= 1 && j.peak_factor() <= 100)) {
+        return Invalid(Sub(path, "peak_factor"),
+                       absl::StrCat("must be >= 1 and <= 100 (got ", Num(j.peak_factor()), ")"));
+      }
+      out.peak_factor = j.peak_factor();
+    }
+    out.seed = j.seed();
+    if (j.components() != 0) {
+      CABLESIM_RETURN_IF_ERROR(
+          CheckIntRange(Sub(path, "components"), j.components(), 1, kMaxWaveComponents));
+      out.components = j.components();
+    }
+    CABLESIM_ASSIGN_OR_RETURN(out.direction, WaveDirection(*state, Sub(path, "direction"),
+                                                           j.has_direction(), j.direction()));
+    spec.jonswap.push_back(out);
+  }
+  return absl::OkStatus();
+}
+
+// The grid replaces the plane: depth 0, the normal a coordinate axis.
+absl::Status ConvertBathymetry(ConversionState* state, const v1::Seabed& b) {
+  const v1::Bathymetry& g = b.bathymetry();
+  BathymetrySpec& spec = state->scene.seabed.bathymetry;
+  constexpr int kMaxNodes = 10000000;
+  if (b.depth() != 0)
+    return Invalid("seabed.depth", "must be 0 with a bathymetry grid (the grid gives the depths)");
+  const Eigen::Vector3d& n = state->scene.seabed.normal;
+  if (n.cwiseAbs().maxCoeff() != 1.0)
+    return Invalid("seabed.normal",
+                   "must be along a coordinate axis with a bathymetry grid (the grid's up)");
+  CABLESIM_RETURN_IF_ERROR(CheckIntRange("seabed.bathymetry.nx", g.nx(), 1, kMaxNodes));
+  CABLESIM_RETURN_IF_ERROR(CheckIntRange("seabed.bathymetry.ny", g.ny(), 1, kMaxNodes));
+  const int64_t count = static_cast<int64_t>(g.nx()) * g.ny();
+  if (count > kMaxNodes)
+    return Invalid("seabed.bathymetry",
+                   absl::StrCat("at most ", kMaxNodes, " nodes (got nx*ny = ", count, ")"));
+  CABLESIM_RETURN_IF_ERROR(
+      CheckRange("seabed.bathymetry.origin_x", g.origin_x(), plausible::kCoordinate));
+  CABLESIM_RETURN_IF_ERROR(
+      CheckRange("seabed.bathymetry.origin_y", g.origin_y(), plausible::kCoordinate));
+  if (g.nx() > 1) {
+    CABLESIM_RETURN_IF_ERROR(
+        CheckPositiveInRange("seabed.bathymetry.dx", g.dx(), plausible::kCableLength));
+  }
+  if (g.ny() > 1) {
+    CABLESIM_RETURN_IF_ERROR(
+        CheckPositiveInRange("seabed.bathymetry.dy", g.dy(), plausible::kCableLength));
+  }
+  if (g.depths_size() != count)
+    return Invalid("seabed.bathymetry.depths",
+                   absl::StrCat("expected nx*ny = ", count, " values, got ", g.depths_size()));
+  spec.depths_m.resize(count);
+  for (int i = 0; i < g.depths_size(); ++i) {
+    CABLESIM_RETURN_IF_ERROR(CheckRange(absl::StrCat("seabed.bathymetry.depths[", i, "]"),
+                                        g.depths(i), plausible::kCoordinate));
+    spec.depths_m[i] = g.depths(i);
+  }
+  spec.enabled = true;
+  spec.origin_x_m = g.origin_x();
+  spec.origin_y_m = g.origin_y();
+  spec.dx_m = g.nx() > 1 ? g.dx() : 1.0;
+  spec.dy_m = g.ny() > 1 ? g.dy() : 1.0;
+  spec.nx = g.nx();
+  spec.ny = g.ny();
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::Status ConvertFluid(ConversionState* state) {
+  const v1::Fluid& f = state->proto.fluid();
+  CABLESIM_RETURN_IF_ERROR(CheckNonNegative("fluid.density", f.density()));
+  if (f.density() != 0)
+    CABLESIM_RETURN_IF_ERROR(CheckRange("fluid.density", f.density(), plausible::kDensity));
+  state->scene.fluid.density_kg_m3 = f.density();
+  CABLESIM_ASSIGN_OR_RETURN(state->scene.fluid.current_m_s,
+                            VectorInRange("fluid.current", f.current(), plausible::kVelocity));
+  CABLESIM_RETURN_IF_ERROR(
+      CheckRange("fluid.still_water_level", f.still_water_level(), plausible::kCoordinate));
+  state->scene.fluid.still_water_level_m = f.still_water_level();
+  CABLESIM_RETURN_IF_ERROR(CheckNonNegative("fluid.water_depth", f.water_depth()));
+  if (f.water_depth() != 0) {
+    CABLESIM_RETURN_IF_ERROR(
+        CheckRange("fluid.water_depth", f.water_depth(), plausible::kCableLength));
+  }
+  state->scene.fluid.water_depth_m = f.water_depth();
+  return ConvertWaves(state);
+}
+
+absl::Status ConvertSeabed(ConversionState* state) {
+  if (!state->proto.has_seabed()) return absl::OkStatus();
+  const v1::Seabed& b = state->proto.seabed();
+  SeabedSpec& spec = state->scene.seabed;
+  spec.enabled = true;
+  CABLESIM_RETURN_IF_ERROR(CheckRange("seabed.depth", b.depth(), plausible::kCoordinate));
+  spec.depth_m = b.depth();
+  if (b.has_normal()) {
+    CABLESIM_ASSIGN_OR_RETURN(spec.normal, Direction("seabed.normal", b.normal()));
+  } else if (state->scene.gravity_m_s2.norm() > 0) {
+    spec.normal = -state->scene.gravity_m_s2.normalized();
+  } else {
+    return Invalid("seabed.normal", "must be given when gravity is zero");
+  }
+  CABLESIM_RETURN_IF_ERROR(
+      CheckPositiveInRange("seabed.stiffness", b.stiffness(), plausible::kStiffness));
+  spec.stiffness_n_m2 = b.stiffness();
+  CABLESIM_RETURN_IF_ERROR(CheckNonNegative("seabed.damping", b.damping()));
+  CABLESIM_RETURN_IF_ERROR(
+      CheckRange("seabed.damping", b.damping(), plausible::kDampingCoefficient));
+  spec.damping_n_s_m2 = b.damping();
+  CABLESIM_RETURN_IF_ERROR(CheckNonNegative("seabed.friction_axial", b.friction_axial()));
+  CABLESIM_RETURN_IF_ERROR(
+      CheckRange("seabed.friction_axial", b.friction_axial(), plausible::kFrictionCoefficient));
+  spec.friction_axial = b.friction_axial();
+  CABLESIM_RETURN_IF_ERROR(CheckNonNegative("seabed.friction_transverse", b.friction_transverse()));
+  CABLESIM_RETURN_IF_ERROR(CheckRange("seabed.friction_transverse", b.friction_transverse(),
+                                      plausible::kFrictionCoefficient));
+  spec.friction_transverse = b.friction_transverse();
+  if (b.friction_speed() != 0) {
+    CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange("seabed.friction_speed", b.friction_speed(),
+                                                  plausible::kFrictionSpeed));
+    spec.friction_speed_m_s = b.friction_speed();
+  }
+  if (b.friction_length() != 0) {
+    CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange("seabed.friction_length", b.friction_length(),
+                                                  plausible::kFrictionLength));
+    spec.friction_length_m = b.friction_length();
+  }
+  if (b.has_bathymetry()) CABLESIM_RETURN_IF_ERROR(ConvertBathymetry(state, b));
+  return absl::OkStatus();
+}
+
+}  // namespace cablesim::scene_convert
