@@ -117,15 +117,7 @@ double EnergyMomentumStepper::EvaluateResidual(bool assemble, bool with_floor) {
   model_->Constraints(q1_, &phi_, &jac1_);
   model_->Constraints(qm_, &phim_, &jacm_);
   // R_v = M (v1 - v0) - h f + Phi_z(zm)^T (h lambda).
-  mdv_ = v1_ - v_;
-  model_->mass().Multiply(mdv_.data(), rhs_.data());
-  auto rv = rhs_.head(n_);
-  bt_mu_.setZero();
-  jacm_.AddTransposeMultiply(lambda1_.data(), bt_mu_.data());
-  bt_mu_ *= h;
-  const double scale = std::max({rv.lpNorm<Eigen::Infinity>(), h * force_size,
-                                 bt_mu_.lpNorm<Eigen::Infinity>(), 1e-300});
-  rv += bt_mu_ - h * f_;
+  const double scale = VelocityResidual(v1_, f_, force_size, jacm_, h, &mdv_, &bt_mu_);
   if (m_ > 0) rhs_.tail(m_) = phi_ * (2 / h);
   return scale;
 }
@@ -133,11 +125,7 @@ double EnergyMomentumStepper::EvaluateResidual(bool assemble, bool with_floor) {
 void EnergyMomentumStepper::ComputeFloor(bool with_floor) {
   const double h = h_;
   if (!with_floor) Forces(h, &f_floor_, nullptr, &floor_);
-  abs_terms_.setZero();
-  model_->mass().AddAbsMultiply(v1_.data(), abs_terms_.data());
-  model_->mass().AddAbsMultiply(v_.data(), abs_terms_.data());
-  jacm_.AddAbsTransposeMultiply(lambda1_.data(), abs_terms_.data(), h);
-  floor_ = h * floor_ + kSumRounding * abs_terms_;
+  VelocityResidualFloor(v1_, jacm_, h);
 }
 
 bool EnergyMomentumStepper::FactorMatrix(bool assembled, StepStats* st) {

@@ -85,15 +85,7 @@ double ImplicitEulerStepper::EvaluateResidual(bool assemble, bool with_floor) {
                                      : Forces(v1_, &f_, nullptr, h, with_floor ? &floor_ : nullptr);
   model_->Constraints(q_, &phi_, &solver_.b());
   // R_v = M (v1 - v0) - h f + Phi_z^T (h lambda).
-  mdv_ = v1_ - v_;
-  model_->mass().Multiply(mdv_.data(), rhs_.data());
-  auto rv = rhs_.head(n_);
-  bt_mu_.setZero();
-  solver_.b().AddTransposeMultiply(lambda1_.data(), bt_mu_.data());
-  bt_mu_ *= h;
-  const double scale = std::max({rv.lpNorm<Eigen::Infinity>(), h * force_size,
-                                 bt_mu_.lpNorm<Eigen::Infinity>(), 1e-300});
-  rv += bt_mu_ - h * f_;
+  const double scale = VelocityResidual(v1_, f_, force_size, solver_.b(), h, &mdv_, &bt_mu_);
   if (m_ > 0) rhs_.tail(m_) = phi_ / h;
   return scale;
 }
@@ -104,11 +96,7 @@ void ImplicitEulerStepper::ComputeFloor(bool with_floor) {
   // (M v1, M v0 and h Phi_z^T lambda); the forces once more, for their
   // bound, only where it matters, unless it came with them.
   if (!with_floor) Forces(v1_, &f_floor_, nullptr, h, &floor_);
-  abs_terms_.setZero();
-  model_->mass().AddAbsMultiply(v1_.data(), abs_terms_.data());
-  model_->mass().AddAbsMultiply(v_.data(), abs_terms_.data());
-  solver_.b().AddAbsTransposeMultiply(lambda1_.data(), abs_terms_.data(), h);
-  floor_ = h * floor_ + kSumRounding * abs_terms_;
+  VelocityResidualFloor(v1_, solver_.b(), h);
 }
 
 bool ImplicitEulerStepper::FactorMatrix(bool assembled, StepStats* st) {

@@ -124,4 +124,28 @@ Stepper::StepStats ImplicitStepper::Newton(bool fresh, bool reuse) {
   return st;  // not reached: the last iteration returns above
 }
 
+double ImplicitStepper::VelocityResidual(const Eigen::VectorXd& v1, const Eigen::VectorXd& f,
+                                         double force_size, const SparseRows& jac, double h,
+                                         Eigen::VectorXd* mdv, Eigen::VectorXd* bt_mu) {
+  *mdv = v1 - v_;
+  model_->mass().Multiply(mdv->data(), rhs_.data());
+  auto rv = rhs_.head(n_);
+  bt_mu->setZero();
+  jac.AddTransposeMultiply(lambda1_.data(), bt_mu->data());
+  *bt_mu *= h;
+  const double scale = std::max({rv.lpNorm<Eigen::Infinity>(), h * force_size,
+                                 bt_mu->lpNorm<Eigen::Infinity>(), 1e-300});
+  rv += *bt_mu - h * f;
+  return scale;
+}
+
+void ImplicitStepper::VelocityResidualFloor(const Eigen::VectorXd& v1, const SparseRows& jac,
+                                            double h) {
+  abs_terms_.setZero();
+  model_->mass().AddAbsMultiply(v1.data(), abs_terms_.data());
+  model_->mass().AddAbsMultiply(v_.data(), abs_terms_.data());
+  jac.AddAbsTransposeMultiply(lambda1_.data(), abs_terms_.data(), h);
+  floor_ = h * floor_ + kSumRounding * abs_terms_;
+}
+
 }  // namespace cablesim

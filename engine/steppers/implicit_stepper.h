@@ -27,6 +27,7 @@
 #include <Eigen/Core>
 
 #include "engine/linear/saddle_point_solver.h"
+#include "engine/linear/sparse_rows.h"
 #include "engine/model/multibody_model.h"
 #include "engine/scene/scene.h"
 #include "engine/steppers/stepper.h"
@@ -89,6 +90,18 @@ class ImplicitStepper : public Stepper {
   // last one (not a checking iteration) also takes the forces' rounding
   // bound in the force pass (generalized-alpha does).
   bool floor_with_forces_when_judged_ = false;
+
+  // The momentum residual of the schemes on (v1, mu = h lambda1), backward
+  // Euler and energy-momentum: R_v = M (v1 - v0) - h f + jac^T (h lambda1)
+  // into rhs_.head(n_) (mdv and bt_mu are scratch); returns its scale, the
+  // largest of its terms (force_size: f's, NetForce).
+  double VelocityResidual(const Eigen::VectorXd& v1, const Eigen::VectorXd& f, double force_size,
+                          const SparseRows& jac, double h, Eigen::VectorXd* mdv,
+                          Eigen::VectorXd* bt_mu);
+  // Its rounding floor: floor_ (holding the forces' rounding bound) becomes
+  // h floor_ + the rounding of the other terms summed into R_v (M v1, M v0
+  // and h jac^T lambda1).
+  void VelocityResidualFloor(const Eigen::VectorXd& v1, const SparseRows& jac, double h);
 
   MultibodyModel* model_;
   SolverSettings settings_;
