@@ -4,6 +4,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "engine/scene/integrator_traits.h"
 #include "engine/steppers/make_stepper.h"
 
 namespace cablesim {
@@ -31,22 +32,26 @@ std::string ImplicitNeed(const MultibodyModel& model, const Scene& scene) {
   return "";
 }
 
+// Chooses `chosen`: the reason is its name (integrator_traits.h) and why.
+Integrator Choose(Integrator chosen, const std::string& why, std::string* reason) {
+  *reason = absl::StrCat(std::string(IntegratorName(chosen)), ": ", why);
+  return chosen;
+}
+
 }  // namespace
 
 Integrator ChooseIntegrator(MultibodyModel* model, const Scene& scene, std::string* reason) {
   const SolverSettings& s = scene.solver;
-  if (const std::string need = ImplicitNeed(*model, scene); !need.empty()) {
-    *reason = absl::StrCat("HHT: ", need);
-    return Integrator::kHht;
-  }
+  if (const std::string need = ImplicitNeed(*model, scene); !need.empty())
+    return Choose(Integrator::kHht, need, reason);
   if (s.adaptive) {
     // Measured (docs/honest-runs.md): adaptive DORMAND_PRINCE is held to
     // its stable step (six force evaluations a step) and was 2-7 times
     // slower than adaptive CENTRAL_DIFFERENCE on the two pendulums.
-    *reason =
-        "CENTRAL_DIFFERENCE: no constraint rows, winch, contact or fluid; adaptive steps hold "
-        "its error (and its stability: a growing mode's error is rejected)";
-    return Integrator::kCentralDifference;
+    return Choose(Integrator::kCentralDifference,
+                  "no constraint rows, winch, contact or fluid; adaptive steps hold its error "
+                  "(and its stability: a growing mode's error is rejected)",
+                  reason);
   }
   SolverSettings trial = s;
   trial.integrator = Integrator::kCentralDifference;
@@ -55,14 +60,15 @@ Integrator ChooseIntegrator(MultibodyModel* model, const Scene& scene, std::stri
   const bool fits = stepper->Initialize(&why);
   model->SetTime(0);
   if (!fits) {
-    *reason = absl::StrCat("HHT: CENTRAL_DIFFERENCE does not fit: ", why);
-    return Integrator::kHht;
+    return Choose(Integrator::kHht,
+                  absl::StrCat(std::string(IntegratorName(trial.integrator)), " does not fit: ", why), reason);
   }
-  *reason = absl::StrFormat(
-      "CENTRAL_DIFFERENCE: no constraint rows, winch, contact or fluid, and solver.step (%g s) "
-      "is within its stable step at the initial state (h omega_max < 2)",
-      s.step_s);
-  return Integrator::kCentralDifference;
+  return Choose(Integrator::kCentralDifference,
+                absl::StrFormat("no constraint rows, winch, contact or fluid, and solver.step "
+                                "(%g s) is within its stable step at the initial state "
+                                "(h omega_max < 2)",
+                                s.step_s),
+                reason);
 }
 
 }  // namespace cablesim

@@ -13,9 +13,7 @@ EnergyMomentumStepper::EnergyMomentumStepper(MultibodyModel* model,
     : ImplicitStepper(model, settings) {
   jac1_ = model->jacobian_pattern();
   jacm_ = model->jacobian_pattern();
-  for (Eigen::VectorXd* x : {&abar_, &z1_, &v1_, &f_, &mdv_, &bt_mu_}) x->setZero(n_);
-  lambda1_.setZero(m_);
-  phi_.setZero(m_);
+  for (Eigen::VectorXd* x : {&abar_, &v1_, &f_, &mdv_, &bt_mu_}) x->setZero(n_);
   phim_.setZero(m_);
   for (Eigen::VectorXd* x : {&q0_, &q1_, &qm_, &qd_}) x->setZero(model->coordinates());
   abar_old_ = abar_;
@@ -76,99 +74,15 @@ Stepper::StepStats EnergyMomentumStepper::Step(double h) {
 }
 
 Stepper::StepStats EnergyMomentumStepper::Solve(double h, bool fresh) {
-  StepStats st;
-  const double tol = settings_.newton_tolerance;
-  const bool reuse = settings_.reuse_factorization;
-  const double c = 0.25 * h * h;
-  if (kept_.Stale(c)) fresh = true;
+  h_ = h;
+  c_ = 0.25 * h * h;
+  if (kept_.Stale(c_)) fresh = true;
   // Predictor: the mean acceleration of the last step.
   v1_ = v_ + h * abar_;
   lambda1_ = lambda_;
   model_->ToFull(z_, &q0_);
-  double last_increment = 0, previous_increment = 0;
-  bool previous_at_floor = false;
-  SkylineLdlt& a = solver_.a();
-  for (int it = 0; it <= settings_.max_newton_iterations; ++it) {
-    z1_ = z_ + (0.5 * h) * (v_ + v1_);
-    model_->ToFull(z1_, &q1_);
-    qm_ = 0.5 * (q0_ + q1_);
-    const bool checking = it > 0 && last_increment <= tol * (1 + z1_.lpNorm<Eigen::Infinity>());
-    const bool judge = checking || it == settings_.max_newton_iterations;
-    const bool have_floor = checking && floor_expected_;
-    const bool assemble = fresh && !checking;
-    if (assemble) LoadMass();
-    const double force_size = Forces(h, &f_, assemble ? &a : nullptr,
-                                     have_floor ? &floor_ : nullptr);
-    // Phi(z1, t + h) (jac1_ only as its scratch), and Phi_z(zm).
-    model_->SetTime(t_ + h);
-    model_->Constraints(q1_, &phi_, &jac1_);
-    model_->Constraints(qm_, &phim_, &jacm_);
-    // R_v = M (v1 - v0) - h f + Phi_z(zm)^T (h lambda).
-    mdv_ = v1_ - v_;
-    model_->mass().Multiply(mdv_.data(), rhs_.data());
-    auto rv = rhs_.head(n_);
-    bt_mu_.setZero();
-    jacm_.AddTransposeMultiply(lambda1_.data(), bt_mu_.data());
-    bt_mu_ *= h;
-    const double scale = std::max({rv.lpNorm<Eigen::Infinity>(), h * force_size,
-                                   bt_mu_.lpNorm<Eigen::Infinity>(), 1e-300});
-    rv += bt_mu_ - h * f_;
-    if (m_ > 0) rhs_.tail(m_) = phi_ * (2 / h);
-    NewtonIterate iterate;
-    if (!BeginIterate(rv, scale, phi_, z1_, last_increment, previous_increment,
-                      previous_at_floor, &iterate)) {
-      st.reason = kNotFiniteResidual;
-      return st;
-    }
-    previous_at_floor = false;
-    const bool plain = iterate.residual <= tol && iterate.violation <= tol * iterate.zscale;
-    if (judge && !(checking && plain)) {
-      if (!have_floor) Forces(h, &f_floor_, nullptr, &floor_);
-      abs_terms_.setZero();
-      model_->mass().AddAbsMultiply(v1_.data(), abs_terms_.data());
-      model_->mass().AddAbsMultiply(v_.data(), abs_terms_.data());
-      jacm_.AddAbsTransposeMultiply(lambda1_.data(), abs_terms_.data(), h);
-      floor_ = h * floor_ + kSumRounding * abs_terms_;
-      MeasureResidual(rv, floor_, scale, &iterate);
-      previous_at_floor = iterate.excess <= tol;
-    }
-    if (checking && NewtonConverged(iterate, tol)) {
-      floor_expected_ = !plain;
-      AcceptIterate(iterate, &st);
-      break;
-    }
-    if (it == settings_.max_newton_iterations) {
-      st.reason = NewtonFailure(it, iterate);
-      if (reuse) kept_.refresh = true;
-      return st;
-    }
-    if (fresh) {
-      if (!assemble) {
-        LoadMass();
-        Forces(h, &f_floor_, &a, nullptr);
-      }
-      if (m_ > 0) model_->AddConstraintHessian(qm_, lambda1_, c, &a);
-      if (!FactorNewtonMatrix(&solver_, jacm_, c, &kept_, &st)) return st;
-      // Keep this matrix for the next iterations only when asked to.
-      fresh = !reuse;
-    }
-    if (!SolveNewtonSystem(&solver_, settings_, &rhs_, &dx_, &st)) {
-      if (reuse) kept_.refresh = true;
-      return st;
-    }
-    v1_ += dx_.head(n_);
-    if (m_ > 0) lambda1_ += dx_.tail(m_) / h;
-    const double increment = 0.5 * h * dx_.head(n_).lpNorm<Eigen::Infinity>();
-    if (!std::isfinite(increment) || increment > 1e6 * iterate.zscale) {
-      st.reason = "Newton diverged";
-      if (reuse) kept_.refresh = true;
-      return st;
-    }
-    // Safeguard of the kept matrix: slow contraction asks for a fresh one.
-    if (reuse && it > 0 && increment > 0.5 * last_increment) fresh = true;
-    previous_increment = last_increment;
-    last_increment = increment;
-  }
+  StepStats st = Newton(fresh, settings_.reuse_factorization);
+  if (!st.converged) return st;
   KeepPreviousState();
   abar_old_.swap(abar_);
   z_.swap(z1_);
@@ -185,6 +99,49 @@ Stepper::StepStats EnergyMomentumStepper::Solve(double h, bool fresh) {
   t_ += h;
   model_->SetTime(t_);
   return st;
+}
+
+void EnergyMomentumStepper::PlaceIterate() {
+  z1_ = z_ + (0.5 * h_) * (v_ + v1_);
+  model_->ToFull(z1_, &q1_);
+  qm_ = 0.5 * (q0_ + q1_);
+}
+
+double EnergyMomentumStepper::EvaluateResidual(bool assemble, bool with_floor) {
+  const double h = h_;
+  if (assemble) LoadMass();
+  const double force_size =
+      Forces(h, &f_, assemble ? &solver_.a() : nullptr, with_floor ? &floor_ : nullptr);
+  // Phi(z1, t + h) (jac1_ only as its scratch), and Phi_z(zm).
+  model_->SetTime(t_ + h);
+  model_->Constraints(q1_, &phi_, &jac1_);
+  model_->Constraints(qm_, &phim_, &jacm_);
+  // R_v = M (v1 - v0) - h f + Phi_z(zm)^T (h lambda).
+  const double scale = VelocityResidual(v1_, f_, force_size, jacm_, h, &mdv_, &bt_mu_);
+  if (m_ > 0) rhs_.tail(m_) = phi_ * (2 / h);
+  return scale;
+}
+
+void EnergyMomentumStepper::ComputeFloor(bool with_floor) {
+  const double h = h_;
+  if (!with_floor) Forces(h, &f_floor_, nullptr, &floor_);
+  VelocityResidualFloor(v1_, jacm_, h);
+}
+
+bool EnergyMomentumStepper::FactorMatrix(bool assembled, StepStats* st) {
+  SkylineLdlt& a = solver_.a();
+  if (!assembled) {
+    LoadMass();
+    Forces(h_, &f_floor_, &a, nullptr);
+  }
+  if (m_ > 0) model_->AddConstraintHessian(qm_, lambda1_, c_, &a);
+  return FactorNewtonMatrix(&solver_, jacm_, c_, &kept_, st);
+}
+
+double EnergyMomentumStepper::ApplyCorrection() {
+  v1_ += dx_.head(n_);
+  if (m_ > 0) lambda1_ += dx_.tail(m_) / h_;
+  return 0.5 * h_ * dx_.head(n_).lpNorm<Eigen::Infinity>();
 }
 
 }  // namespace cablesim

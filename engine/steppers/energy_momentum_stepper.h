@@ -89,6 +89,13 @@ class EnergyMomentumStepper final : public ImplicitStepper {
   // One Newton solve of the step; `fresh`: assemble and factor the Newton
   // matrix at the first iteration rather than keep the last one.
   StepStats Solve(double h, bool fresh);
+  // Newton's hooks (ImplicitStepper::Newton): the unknowns are v1_ and
+  // mu = h lambda1_.
+  void PlaceIterate() override;
+  double EvaluateResidual(bool assemble, bool with_floor) override;
+  void ComputeFloor(bool with_floor) override;
+  bool FactorMatrix(bool assembled, StepStats* st) override;
+  double ApplyCorrection() override;
 
   SparseRows jac1_;  // Phi_z(z1) (its values unused; Constraints fills it with Phi)
   SparseRows jacm_;  // Phi_z(zm), copied into the solver when it factors
@@ -97,7 +104,8 @@ class EnergyMomentumStepper final : public ImplicitStepper {
   // c = h^2 / 4.
   Eigen::VectorXd abar_, abar_old_;
   // Newton work vectors.
-  Eigen::VectorXd z1_, v1_, lambda1_, q0_, q1_, qm_, qd_, f_, phi_, phim_, mdv_, bt_mu_;
+  Eigen::VectorXd v1_, q0_, q1_, qm_, qd_, f_, phim_, mdv_, bt_mu_;
+  double h_ = 0, c_ = 0;  // the step being taken [s] and c = h^2 / 4
 };
 
 }  // namespace cablesim

@@ -7,11 +7,6 @@
 #include "engine/steppers/newton_convergence.h"
 
 namespace cablesim {
-namespace {
-// A Newton correction below this times (1 + |z|_inf) changes z only in its
-// last few bits (16 machine epsilons).
-}  // namespace
-
 GeneralizedAlphaStepper::GeneralizedAlphaStepper(MultibodyModel* model,
                                                  const SolverSettings& settings, Variant variant)
     : ImplicitStepper(model, settings), variant_(variant) {
@@ -32,14 +27,13 @@ GeneralizedAlphaStepper::GeneralizedAlphaStepper(MultibodyModel* model,
   acc_.setZero(n_);
   acc_h_.setZero(n_);
   g_.setZero(n_);
-  for (Eigen::VectorXd* x : {&z_pred_, &v_pred_, &z1_, &zdd1_, &f_, &bt_lambda_}) x->setZero(n_);
-  lambda1_.setZero(m_);
-  phi_.setZero(m_);
+  for (Eigen::VectorXd* x : {&z_pred_, &v_pred_, &zdd1_, &f_, &bt_lambda_}) x->setZero(n_);
   q_.setZero(model->coordinates());
   qd_.setZero(model->coordinates());
   v1_.setZero(n_);
   acc_old_ = acc_;
   g_old_ = g_;
+  floor_with_forces_when_judged_ = true;
 }
 
 double GeneralizedAlphaStepper::Forces(const Eigen::VectorXd& v, Eigen::VectorXd* f,
@@ -111,12 +105,8 @@ Stepper::StepStats GeneralizedAlphaStepper::Step(double h) {
 }
 
 Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
-  StepStats st;
-  const double tol = settings_.newton_tolerance;
-  const bool reuse = settings_.reuse_factorization;
   const bool ga = variant_ == Variant::kGeneralizedAlpha;
   // Predictors: everything in z_{n+1}, v_{n+1} except s a_{n+1}.
-  double s, sv;
   if (ga) {
     const double k = 1 / (1 - alpha_m_);
     // Variable steps: a_n approximates zdd(t_n + (alpha_m - alpha_f) h)
@@ -129,134 +119,34 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
     bt_lambda_ = k * (alpha_f_ * a_ - alpha_m_ * acc_h_);  // scratch: known part of a_{n+1}
     z_pred_ = z_ + h * v_ + (h * h * (0.5 - beta_)) * acc_h_ + (h * h * beta_) * bt_lambda_;
     v_pred_ = v_ + (h * (1 - gamma_)) * acc_h_ + (h * gamma_) * bt_lambda_;
-    s = h * h * beta_ * k * (1 - alpha_f_);
-    sv = h * gamma_ * k * (1 - alpha_f_);
+    s_ = h * h * beta_ * k * (1 - alpha_f_);
+    sv_ = h * gamma_ * k * (1 - alpha_f_);
   } else {
     z_pred_ = z_ + h * v_ + (h * h * (0.5 - beta_)) * a_;
     v_pred_ = v_ + (h * (1 - gamma_)) * a_;
-    s = h * h * beta_;
-    sv = h * gamma_;
+    s_ = h * h * beta_;
+    sv_ = h * gamma_;
   }
-  const double c = w_ * s;
+  c_ = w_ * s_;
   // The damping's share of the Newton matrix: d v_{n+1} / d zdd = s_v.
-  const double cd = w_ * sv;
-  const bool damping = model_->has_damping();
+  cd_ = w_ * sv_;
   // A kept matrix serves while c is within 20 % of its own (the last steps
   // shortened to end on the duration, or resized by the error controller): Newton
-  // then still contracts by about that fraction, and the safeguard below
+  // then still contracts by about that fraction, and Newton()'s safeguard
   // catches it when it does not.
-  if (kept_.Stale(c)) fresh = true;
+  if (kept_.Stale(c_)) fresh = true;
   // Predictor: the acceleration extrapolated linearly from the last two
   // steps (constant on the first step and after Restore()).
   zdd1_ = a_;
   if (h_last_ > 0) zdd1_ += (h / h_last_) * (a_ - a_old_);
   lambda1_ = lambda_;
-  double last_increment = 0, previous_increment = 0;
-  bool previous_at_floor = false;
-  SkylineLdlt& a = solver_.a();
-  for (int it = 0; it <= settings_.max_newton_iterations; ++it) {
-    z1_ = z_pred_ + s * zdd1_;
-    model_->ToFull(z1_, &q_);
-    if (damping) v1_ = v_pred_ + sv * zdd1_;
-    const bool checking = it > 0 && last_increment <= tol * (1 + z1_.lpNorm<Eigen::Infinity>());
-    // The rounding floor is needed where convergence is judged (and for the
-    // message of the last iteration), unless the residual is below tol.
-    const bool judge = checking || it == settings_.max_newton_iterations;
-    // Assemble the Newton matrix with the forces when this iteration will
-    // need a fresh one and is not expected to be the converged one.
-    bool assembled = false, have_floor = false;
-    double force_size;
-    if (fresh && !checking) {
-      LoadMass();
-      force_size = Forces(v1_, &f_, &a, c, cd, nullptr);
-      assembled = true;
-    } else {
-      // The forces' rounding bound in the same pass when the last step was
-      // accepted at its floor: this one most likely will be too.
-      have_floor = judge && floor_expected_;
-      force_size = Forces(v1_, &f_, nullptr, 0, 0, have_floor ? &floor_ : nullptr);
-    }
-    model_->Constraints(q_, &phi_, &jac_);
-    // R = M zdd + w (Phi_z^T lambda - f) + (1 - w) g_n.
-    auto r = rhs_.head(n_);
-    if (have_floor) {
-      abs_terms_.setZero();
-      model_->mass().MultiplyWithAbs(zdd1_.data(), r.data(), abs_terms_.data());
-    } else {
-      model_->mass().Multiply(zdd1_.data(), r.data());
-    }
-    const double inertia = r.lpNorm<Eigen::Infinity>();
-    bt_lambda_.setZero();
-    jac_.AddTransposeMultiply(lambda1_.data(), bt_lambda_.data());
-    const double scale =
-        std::max({inertia, w_ * force_size, w_ * bt_lambda_.lpNorm<Eigen::Infinity>(),
-                  (1 - w_) * g_.lpNorm<Eigen::Infinity>(), 1e-300});
-    r += w_ * (bt_lambda_ - f_);
-    if (w_ != 1) r += (1 - w_) * g_;
-    if (m_ > 0) rhs_.tail(m_) = phi_ / s;
-    NewtonIterate iterate;
-    if (!BeginIterate(r, scale, phi_, z1_, last_increment, previous_increment,
-                      previous_at_floor, &iterate)) {
-      st.reason = kNotFiniteResidual;
-      return st;
-    }
-    previous_at_floor = false;
-    const bool plain = iterate.residual <= tol && iterate.violation <= tol * iterate.zscale;
-    if (judge && !(checking && plain)) {
-      // floor = w roundoff(f) + rounding of the other terms summed into R
-      // (the forces once more for their bound, unless it came with them).
-      if (!have_floor) {
-        Forces(v1_, &f_floor_, nullptr, 0, 0, &floor_);
-        abs_terms_.setZero();
-        model_->mass().AddAbsMultiply(zdd1_.data(), abs_terms_.data());
-      }
-      jac_.AddAbsTransposeMultiply(lambda1_.data(), abs_terms_.data(), w_);
-      floor_ = w_ * floor_ + kSumRounding * (abs_terms_ + (1 - w_) * g_.cwiseAbs());
-      MeasureResidual(r, floor_, scale, &iterate);
-      previous_at_floor = iterate.excess <= tol;
-    }
-    if (checking && NewtonConverged(iterate, tol)) {
-      floor_expected_ = !plain;
-      AcceptIterate(iterate, &st);
-      break;
-    }
-    if (it == settings_.max_newton_iterations) {
-      st.reason = NewtonFailure(it, iterate);
-      if (reuse) kept_.refresh = true;
-      return st;
-    }
-    if (fresh) {
-      if (!assembled) {
-        LoadMass();
-        Forces(v1_, &f_, &a, c, cd, nullptr);
-      }
-      if (m_ > 0) model_->AddConstraintHessian(q_, lambda1_, c, &a);
-      if (!FactorNewtonMatrix(&solver_, jac_, c, &kept_, &st)) return st;
-      // Keep this matrix for the next iterations only when asked to.
-      fresh = !reuse;
-    }
-    if (!SolveNewtonSystem(&solver_, settings_, &rhs_, &dx_, &st)) {
-      if (reuse) kept_.refresh = true;
-      return st;
-    }
-    zdd1_ += dx_.head(n_);
-    if (m_ > 0) lambda1_ += dx_.tail(m_) / w_;
-    const double increment = s * dx_.head(n_).lpNorm<Eigen::Infinity>();
-    if (!std::isfinite(increment) || increment > 1e6 * iterate.zscale) {
-      st.reason = "Newton diverged";
-      if (reuse) kept_.refresh = true;
-      return st;
-    }
-    // Safeguard of the kept matrix: slow contraction asks for a fresh one.
-    if (reuse && it > 0 && increment > 0.5 * last_increment) fresh = true;
-    previous_increment = last_increment;
-    last_increment = increment;
-  }
+  StepStats st = Newton(fresh, settings_.reuse_factorization);
+  if (!st.converged) return st;
   KeepPreviousState();
   acc_old_.swap(acc_);
   g_old_.swap(g_);
   z_ = z1_;
-  v_ = v_pred_ + sv * zdd1_;
+  v_ = v_pred_ + sv_ * zdd1_;
   if (ga) {
     const double k = 1 / (1 - alpha_m_);
     acc_ = k * (alpha_f_ * a_old_ - alpha_m_ * acc_h_ + (1 - alpha_f_) * zdd1_);
@@ -272,6 +162,69 @@ Stepper::StepStats GeneralizedAlphaStepper::Solve(double h, bool fresh) {
   t_old_ = t_;
   t_ += h;
   return st;
+}
+
+void GeneralizedAlphaStepper::PlaceIterate() {
+  z1_ = z_pred_ + s_ * zdd1_;
+  model_->ToFull(z1_, &q_);
+  if (model_->has_damping()) v1_ = v_pred_ + sv_ * zdd1_;
+}
+
+double GeneralizedAlphaStepper::EvaluateResidual(bool assemble, bool with_floor) {
+  double force_size;
+  if (assemble) {
+    LoadMass();
+    force_size = Forces(v1_, &f_, &solver_.a(), c_, cd_, nullptr);
+  } else {
+    force_size = Forces(v1_, &f_, nullptr, 0, 0, with_floor ? &floor_ : nullptr);
+  }
+  model_->Constraints(q_, &phi_, &jac_);
+  // R = M zdd + w (Phi_z^T lambda - f) + (1 - w) g_n.
+  auto r = rhs_.head(n_);
+  if (with_floor) {
+    abs_terms_.setZero();
+    model_->mass().MultiplyWithAbs(zdd1_.data(), r.data(), abs_terms_.data());
+  } else {
+    model_->mass().Multiply(zdd1_.data(), r.data());
+  }
+  const double inertia = r.lpNorm<Eigen::Infinity>();
+  bt_lambda_.setZero();
+  jac_.AddTransposeMultiply(lambda1_.data(), bt_lambda_.data());
+  const double scale =
+      std::max({inertia, w_ * force_size, w_ * bt_lambda_.lpNorm<Eigen::Infinity>(),
+                (1 - w_) * g_.lpNorm<Eigen::Infinity>(), 1e-300});
+  r += w_ * (bt_lambda_ - f_);
+  if (w_ != 1) r += (1 - w_) * g_;
+  if (m_ > 0) rhs_.tail(m_) = phi_ / s_;
+  return scale;
+}
+
+void GeneralizedAlphaStepper::ComputeFloor(bool with_floor) {
+  // floor = w roundoff(f) + rounding of the other terms summed into R
+  // (the forces once more for their bound, unless it came with them).
+  if (!with_floor) {
+    Forces(v1_, &f_floor_, nullptr, 0, 0, &floor_);
+    abs_terms_.setZero();
+    model_->mass().AddAbsMultiply(zdd1_.data(), abs_terms_.data());
+  }
+  jac_.AddAbsTransposeMultiply(lambda1_.data(), abs_terms_.data(), w_);
+  floor_ = w_ * floor_ + kSumRounding * (abs_terms_ + (1 - w_) * g_.cwiseAbs());
+}
+
+bool GeneralizedAlphaStepper::FactorMatrix(bool assembled, StepStats* st) {
+  SkylineLdlt& a = solver_.a();
+  if (!assembled) {
+    LoadMass();
+    Forces(v1_, &f_, &a, c_, cd_, nullptr);
+  }
+  if (m_ > 0) model_->AddConstraintHessian(q_, lambda1_, c_, &a);
+  return FactorNewtonMatrix(&solver_, jac_, c_, &kept_, st);
+}
+
+double GeneralizedAlphaStepper::ApplyCorrection() {
+  zdd1_ += dx_.head(n_);
+  if (m_ > 0) lambda1_ += dx_.tail(m_) / w_;
+  return s_ * dx_.head(n_).lpNorm<Eigen::Infinity>();
 }
 
 }  // namespace cablesim

@@ -116,6 +116,14 @@ class GeneralizedAlphaStepper final : public ImplicitStepper {
   double Forces(const Eigen::VectorXd& v, Eigen::VectorXd* f, SkylineLdlt* a, double c,
                 double cd, Eigen::VectorXd* roundoff);
 
+  // Newton's hooks (ImplicitStepper::Newton): the unknowns are zdd1_ and
+  // lambda1_ (scaled by w in the matrix).
+  void PlaceIterate() override;
+  double EvaluateResidual(bool assemble, bool with_floor) override;
+  void ComputeFloor(bool with_floor) override;
+  bool FactorMatrix(bool assembled, StepStats* st) override;
+  double ApplyCorrection() override;
+
   Variant variant_;
   double alpha_m_ = 0, alpha_f_ = 0, beta_ = 0.25, gamma_ = 0.5, w_ = 1;
   SparseRows jac_;  // Phi_z at the current iterate (solver_.b() holds the factored one)
@@ -131,7 +139,11 @@ class GeneralizedAlphaStepper final : public ImplicitStepper {
   Eigen::VectorXd acc_old_, g_old_;
   // Newton work vectors.
   // v1_ and qd_: the iterate's velocity, with damping only.
-  Eigen::VectorXd z_pred_, v_pred_, z1_, v1_, zdd1_, lambda1_, q_, qd_, f_, phi_, bt_lambda_;
+  Eigen::VectorXd z_pred_, v_pred_, v1_, zdd1_, q_, qd_, f_, bt_lambda_;
+  // The step's coefficients: z_{n+1} = z_pred + s zdd_{n+1}, v_{n+1} =
+  // v_pred + sv zdd_{n+1}, and the Newton matrix's c = w s (of K_T) and
+  // cd = w sv (of the damping matrix).
+  double s_ = 0, sv_ = 0, c_ = 0, cd_ = 0;
 };
 
 }  // namespace cablesim

@@ -9,9 +9,7 @@ namespace cablesim {
 
 ImplicitEulerStepper::ImplicitEulerStepper(MultibodyModel* model, const SolverSettings& settings)
     : ImplicitStepper(model, settings) {
-  for (Eigen::VectorXd* x : {&z1_, &v1_, &f_, &mdv_, &bt_mu_}) x->setZero(n_);
-  lambda1_.setZero(m_);
-  phi_.setZero(m_);
+  for (Eigen::VectorXd* x : {&v1_, &f_, &mdv_, &bt_mu_}) x->setZero(n_);
   q_.setZero(model->coordinates());
   qd_.setZero(model->coordinates());
 }
@@ -55,88 +53,13 @@ double ImplicitEulerStepper::AssembleForces(double h) {
 }
 
 ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
-  StepStats st;
-  const double tol = settings_.newton_tolerance;
+  h_ = h;
   model_->SetTime(t_ + h);
   v1_ = v_ + h * a_;
   lambda1_ = lambda_;
-  double last_increment = 0, previous_increment = 0;
-  bool previous_at_floor = false;
-  SkylineLdlt& a = solver_.a();
-  for (int it = 0; it <= settings_.max_newton_iterations; ++it) {
-    z1_ = z_ + h * v1_;
-    model_->ToFull(z1_, &q_);
-    // Newton matrix M + h^2 (K_T + H_lambda), assembled with the forces
-    // unless this evaluation is expected to be the converged one.
-    const bool checking = it > 0 && last_increment <= tol * (1 + z1_.lpNorm<Eigen::Infinity>());
-    // The rounding floor is needed where convergence is judged (and for the
-    // message of the last iteration).
-    const bool judge = checking || it == settings_.max_newton_iterations;
-    // The forces' rounding bound in the same pass when the last step was
-    // accepted at its floor: this one most likely will be too.
-    const bool have_floor = checking && floor_expected_;
-    const double force_size =
-        checking ? Forces(v1_, &f_, nullptr, h, have_floor ? &floor_ : nullptr)
-                 : AssembleForces(h);
-    model_->Constraints(q_, &phi_, &solver_.b());
-    // R_v = M (v1 - v0) - h f + Phi_z^T (h lambda).
-    mdv_ = v1_ - v_;
-    model_->mass().Multiply(mdv_.data(), rhs_.data());
-    auto rv = rhs_.head(n_);
-    bt_mu_.setZero();
-    solver_.b().AddTransposeMultiply(lambda1_.data(), bt_mu_.data());
-    bt_mu_ *= h;
-    const double scale = std::max({rv.lpNorm<Eigen::Infinity>(), h * force_size,
-                                   bt_mu_.lpNorm<Eigen::Infinity>(), 1e-300});
-    rv += bt_mu_ - h * f_;
-    if (m_ > 0) rhs_.tail(m_) = phi_ / h;
-    NewtonIterate iterate;
-    if (!BeginIterate(rv, scale, phi_, z1_, last_increment, previous_increment,
-                      previous_at_floor, &iterate)) {
-      st.reason = kNotFiniteResidual;
-      return st;
-    }
-    previous_at_floor = false;
-    const bool plain = iterate.residual <= tol && iterate.violation <= tol * iterate.zscale;
-    if (judge && !(checking && plain)) {
-      // floor = h roundoff(f) + rounding of the other terms summed into R_v
-      // (M v1, M v0 and h Phi_z^T lambda); the forces once more, for their
-      // bound, only where it matters, unless it came with them.
-      if (!have_floor) Forces(v1_, &f_floor_, nullptr, h, &floor_);
-      abs_terms_.setZero();
-      model_->mass().AddAbsMultiply(v1_.data(), abs_terms_.data());
-      model_->mass().AddAbsMultiply(v_.data(), abs_terms_.data());
-      solver_.b().AddAbsTransposeMultiply(lambda1_.data(), abs_terms_.data(), h);
-      floor_ = h * floor_ + kSumRounding * abs_terms_;
-      MeasureResidual(rv, floor_, scale, &iterate);
-      previous_at_floor = iterate.excess <= tol;
-    }
-    if (checking && NewtonConverged(iterate, tol)) {
-      floor_expected_ = !plain;
-      AcceptIterate(iterate, &st);
-      break;
-    }
-    if (it == settings_.max_newton_iterations) {
-      st.reason = NewtonFailure(it, iterate);
-      return st;
-    }
-    if (checking) AssembleForces(h);
-    if (m_ > 0) model_->AddConstraintHessian(q_, lambda1_, h * h, &a);
-    if (!solver_.Prepare()) {
-      st.reason = "the Newton matrix has a non-finite pivot";
-      return st;
-    }
-    ++st.factorizations;
-    if (!SolveNewtonSystem(&solver_, settings_, &rhs_, &dx_, &st)) return st;
-    v1_ += dx_.head(n_);
-    if (m_ > 0) lambda1_ += dx_.tail(m_) / h;
-    previous_increment = last_increment;
-    last_increment = h * dx_.head(n_).lpNorm<Eigen::Infinity>();
-    if (!std::isfinite(last_increment) || last_increment > 1e6 * iterate.zscale) {
-      st.reason = "Newton diverged";
-      return st;
-    }
-  }
+  // A fresh Newton matrix every iteration.
+  StepStats st = Newton(/*fresh=*/true, /*reuse=*/false);
+  if (!st.converged) return st;
   // Keep the previous state for Restore() (swaps, no copies: z1_, v1_ and
   // lambda1_ are rewritten at the start of every step).
   KeepPreviousState();
@@ -147,6 +70,50 @@ ImplicitEulerStepper::StepStats ImplicitEulerStepper::Step(double h) {
   t_old_ = t_;
   t_ += h;
   return st;
+}
+
+void ImplicitEulerStepper::PlaceIterate() {
+  z1_ = z_ + h_ * v1_;
+  model_->ToFull(z1_, &q_);
+}
+
+double ImplicitEulerStepper::EvaluateResidual(bool assemble, bool with_floor) {
+  const double h = h_;
+  // Newton matrix M + h^2 (K_T + H_lambda), assembled with the forces
+  // unless this evaluation is expected to be the converged one.
+  const double force_size = assemble ? AssembleForces(h)
+                                     : Forces(v1_, &f_, nullptr, h, with_floor ? &floor_ : nullptr);
+  model_->Constraints(q_, &phi_, &solver_.b());
+  // R_v = M (v1 - v0) - h f + Phi_z^T (h lambda).
+  const double scale = VelocityResidual(v1_, f_, force_size, solver_.b(), h, &mdv_, &bt_mu_);
+  if (m_ > 0) rhs_.tail(m_) = phi_ / h;
+  return scale;
+}
+
+void ImplicitEulerStepper::ComputeFloor(bool with_floor) {
+  const double h = h_;
+  // floor = h roundoff(f) + rounding of the other terms summed into R_v
+  // (M v1, M v0 and h Phi_z^T lambda); the forces once more, for their
+  // bound, only where it matters, unless it came with them.
+  if (!with_floor) Forces(v1_, &f_floor_, nullptr, h, &floor_);
+  VelocityResidualFloor(v1_, solver_.b(), h);
+}
+
+bool ImplicitEulerStepper::FactorMatrix(bool assembled, StepStats* st) {
+  if (!assembled) AssembleForces(h_);
+  if (m_ > 0) model_->AddConstraintHessian(q_, lambda1_, h_ * h_, &solver_.a());
+  if (!solver_.Prepare()) {
+    st->reason = "the Newton matrix has a non-finite pivot";
+    return false;
+  }
+  ++st->factorizations;
+  return true;
+}
+
+double ImplicitEulerStepper::ApplyCorrection() {
+  v1_ += dx_.head(n_);
+  if (m_ > 0) lambda1_ += dx_.tail(m_) / h_;
+  return h_ * dx_.head(n_).lpNorm<Eigen::Infinity>();
 }
 
 }  // namespace cablesim

@@ -64,11 +64,20 @@ class ImplicitEulerStepper final : public ImplicitStepper {
   // force size.
   double AssembleForces(double h);
 
+  // Newton's hooks (ImplicitStepper::Newton): the unknowns are v1_ and
+  // mu = h lambda1_.
+  void PlaceIterate() override;
+  double EvaluateResidual(bool assemble, bool with_floor) override;
+  void ComputeFloor(bool with_floor) override;
+  bool FactorMatrix(bool assembled, StepStats* st) override;
+  double ApplyCorrection() override;
+
   // Newton work vectors (the state and the rounding floor's are
   // ImplicitStepper's). Each step sets the model's time to its end
   // (prescribed motions and varying loads at t_{n+1}, where backward Euler
   // imposes Phi(z_{n+1}, t_{n+1}) = 0).
-  Eigen::VectorXd z1_, v1_, lambda1_, q_, qd_, f_, phi_, mdv_, bt_mu_;
+  Eigen::VectorXd v1_, q_, qd_, f_, mdv_, bt_mu_;
+  double h_ = 0;  // the step being taken [s]
 };
 
 }  // namespace cablesim

@@ -11,15 +11,23 @@
 // its own history (generalized-alpha's a_n and g_n, energy-momentum's mean
 // acceleration) and restores it in RestoreScheme().
 //
-// The Newton helpers shared with the schemes (SolveInitialAcceleration,
-// FactorNewtonMatrix, SolveNewtonSystem, SolveWithFreshRetry) are in
-// stepper.h.
+// Newton's iteration is written once, Newton() below: each iteration
+// places the iterate (PlaceIterate), evaluates the residual and, when it
+// starts a fresh matrix, assembles it in the same pass (EvaluateResidual),
+// judges convergence against the residual's rounding floor (ComputeFloor,
+// newton_convergence.h), assembles and factors the Newton matrix when it is
+// not kept (FactorMatrix), solves and applies the correction
+// (ApplyCorrection), and refuses a diverging one. A scheme supplies those
+// hooks, its predictor before Newton() and its update after it. The other
+// Newton helpers (SolveInitialAcceleration, FactorNewtonMatrix,
+// SolveNewtonSystem, SolveWithFreshRetry) are in stepper.h.
 
 #include <string>
 
 #include <Eigen/Core>
 
 #include "engine/linear/saddle_point_solver.h"
+#include "engine/linear/sparse_rows.h"
 #include "engine/model/multibody_model.h"
 #include "engine/scene/scene.h"
 #include "engine/steppers/stepper.h"
@@ -50,6 +58,51 @@ class ImplicitStepper : public Stepper {
   // The scheme's own history back to before the last step (Restore()).
   virtual void RestoreScheme() {}
 
+  // One Newton solve from the scheme's predictor: iterates until
+  // NewtonConverged (st.converged, the iterate left in the scheme's
+  // unknowns) or fails (st.reason). `fresh`: assemble and factor the Newton
+  // matrix at the first iteration; `reuse` (solver.reuse_factorization):
+  // keep it across iterations, refreshed when an increment shrinks by less
+  // than half, and mark kept_ for refresh when the solve fails.
+  StepStats Newton(bool fresh, bool reuse);
+
+  // Newton's hooks, called in this order each iteration.
+  // Sets z1_ (and the full coordinates the residual needs) from the
+  // scheme's unknowns.
+  virtual void PlaceIterate() = 0;
+  // The residual: its momentum rows into rhs_.head(n_), the constraint rows
+  // into rhs_.tail(m_) and Phi into phi_; returns the residual's scale (its
+  // largest term). `assemble`: also load the Newton matrix's mass and force
+  // parts into solver_.a() in the same pass; `with_floor`: also the forces'
+  // rounding bound into floor_ (ComputeFloor then completes it).
+  virtual double EvaluateResidual(bool assemble, bool with_floor) = 0;
+  // The residual's rounding floor per unknown into floor_; `with_floor`: the
+  // forces' part is already there (from EvaluateResidual).
+  virtual void ComputeFloor(bool with_floor) = 0;
+  // Completes the Newton matrix (its mass and force parts too unless
+  // `assembled` by EvaluateResidual) and factors it, counted in `st`; false
+  // with st->reason on a non-finite pivot.
+  virtual bool FactorMatrix(bool assembled, StepStats* st) = 0;
+  // Applies the correction dx_ to the unknowns; returns the position
+  // increment |dz|_inf it makes [m].
+  virtual double ApplyCorrection() = 0;
+  // Whether an iteration that judges convergence only because it is the
+  // last one (not a checking iteration) also takes the forces' rounding
+  // bound in the force pass (generalized-alpha does).
+  bool floor_with_forces_when_judged_ = false;
+
+  // The momentum residual of the schemes on (v1, mu = h lambda1), backward
+  // Euler and energy-momentum: R_v = M (v1 - v0) - h f + jac^T (h lambda1)
+  // into rhs_.head(n_) (mdv and bt_mu are scratch); returns its scale, the
+  // largest of its terms (force_size: f's, NetForce).
+  double VelocityResidual(const Eigen::VectorXd& v1, const Eigen::VectorXd& f, double force_size,
+                          const SparseRows& jac, double h, Eigen::VectorXd* mdv,
+                          Eigen::VectorXd* bt_mu);
+  // Its rounding floor: floor_ (holding the forces' rounding bound) becomes
+  // h floor_ + the rounding of the other terms summed into R_v (M v1, M v0
+  // and h jac^T lambda1).
+  void VelocityResidualFloor(const Eigen::VectorXd& v1, const SparseRows& jac, double h);
+
   MultibodyModel* model_;
   SolverSettings settings_;
   SaddlePointSolver solver_;
@@ -69,6 +122,8 @@ class ImplicitStepper : public Stepper {
   // rounding in the same pass as the forces.
   bool floor_expected_ = false;
   KeptNewtonMatrix kept_;
+  // The Newton iterate's positions z_{n+1}, multipliers and Phi(z_{n+1}).
+  Eigen::VectorXd z1_, lambda1_, phi_;
 };
 
 }  // namespace cablesim
