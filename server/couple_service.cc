@@ -154,7 +154,9 @@ grpc::Status CablesimServiceImpl::Couple(
   if (!request.has_open()) {
     return Invalid("open: the first message of a coupling session opens it (CoupleRequest.open)");
   }
+  // (`request` is read into again: what the session keeps of it is copied.)
   const v1::CoupleOpen& open = request.open();
+  const bool lines = open.lines();
   absl::StatusOr<v1::Scene> scene = SceneOrDeckOfRequest(open.has_scene(), open.scene(),
                                                          open.scene_json(), open.scene_moordyn());
   if (!scene.ok()) return ToGrpcStatus(scene.status());
@@ -194,7 +196,7 @@ grpc::Status CablesimServiceImpl::Couple(
   }
   reply.set_max_jump_m(session->max_jump_m());
   reply.set_end_time_s(end_time_s);
-  SetState(*session, open.lines(), &reply);
+  SetState(*session, lines, &reply);
   if (!TimedWrite(stream, reply, slot.watch())) {
     return grpc::Status(grpc::StatusCode::CANCELLED, "the client went away");
   }
@@ -243,7 +245,7 @@ grpc::Status CablesimServiceImpl::Couple(
       }
     }
     if (!refused.ok()) SetError(refused, &reply);
-    SetState(*session, open.lines(), &reply);
+    SetState(*session, lines, &reply);
     if (!TimedWrite(stream, reply, slot.watch())) {
       return grpc::Status(grpc::StatusCode::CANCELLED, "the client went away");
     }
