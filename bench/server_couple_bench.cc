@@ -2,20 +2,21 @@
 // "What a coupling step costs"): the three-line buoy
 // (scenes/mooring-three-line-buoy.json) with its buoy replaced by the host
 // (the three fairleads coupled supports), driven 1 m in surge and heave
-// over 10 s at a coupling step of 0.05 s (one scene step inside each).
+// over 10 s at a coupling step of 0.05 s (one scene step inside each): the
+// scene and motion of bench/couple_bench.cc, whose CPU time per iteration
+// is the physics alone (CouplingSession::Step in the benchmark's thread).
 //
-//   Couple/InProcessEngine: CouplingSession::Step, the physics alone.
-//   Couple/ServerLoopback:  one Couple message and its reply through
-//                           cablesim-server's service over TCP on
-//                           127.0.0.1 (the client blocking on each reply,
-//                           as a host does).
-//   The difference is the gRPC cost per coupling step; the ratio says what
-//   share of a step the service takes. The counter process_cpu_us is the
-//   whole process's CPU time per step (the server's threads are in the
-//   process too): on a busy machine the wall time says little, the CPU
-//   time difference is the service's work (client and server together).
+//   Couple/ServerLoopback: one Couple message and its reply through
+//                          cablesim-server's service over TCP on 127.0.0.1
+//                          (the client blocking on each reply, as a host
+//                          does). The counter process_cpu_us is the whole
+//                          process's CPU time per step (the server's
+//                          threads are in the process too): on a busy
+//                          machine the wall time says little; this minus
+//                          couple_bench's CPU time is the service's work
+//                          (client and server together).
 //
-// Run with --benchmark_repetitions=5 and read the medians.
+// Run both with --benchmark_repetitions=5 and read the medians.
 
 #include <benchmark/benchmark.h>
 
@@ -77,37 +78,6 @@ void CountProcessCpu(benchmark::State& state, double start) {
 // The fairlead's displacement and velocity at time t.
 Eigen::Vector3d Offset(double t) { return Eigen::Vector3d(1, 0, 1) * std::sin(kOmega * t); }
 Eigen::Vector3d Rate(double t) { return Eigen::Vector3d(1, 0, 1) * kOmega * std::cos(kOmega * t); }
-
-void BM_CoupleInProcessEngine(benchmark::State& state) {
-  auto session = CouplingSession::Open(*SceneFromProto(CoupledBuoy()));
-  if (!session.ok()) {
-    state.SkipWithError(std::string(session.status().message()).c_str());
-    return;
-  }
-  CouplingSession& s = **session;
-  const int n = s.coupled_points();
-  std::vector<Eigen::Vector3d> x(n), v(n, Eigen::Vector3d::Zero());
-  for (int i = 0; i < n; ++i) x[i] = s.scene_position(i);
-  if (!s.Initialize(x, v).ok()) {
-    state.SkipWithError("Initialize");
-    return;
-  }
-  long k = 0;
-  const double cpu = ProcessCpuSeconds();
-  for (auto _ : state) {
-    const double t = kStep * static_cast<double>(++k);
-    for (int i = 0; i < n; ++i) {
-      x[i] = s.scene_position(i) + Offset(t);
-      v[i] = Rate(t);
-    }
-    if (absl::Status st = s.Step(t, x, v); !st.ok()) {
-      state.SkipWithError(std::string(st.message()).c_str());
-      return;
-    }
-  }
-  CountProcessCpu(state, cpu);
-}
-BENCHMARK(BM_CoupleInProcessEngine)->Unit(benchmark::kMicrosecond)->MinTime(3);
 
 void SetPoint(const Eigen::Vector3d& x, const Eigen::Vector3d& v, v1::CoupledPoint* p) {
   p->mutable_position()->set_x(x.x());

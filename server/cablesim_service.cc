@@ -323,18 +323,7 @@ grpc::Status CablesimServiceImpl::Validate(grpc::ServerContext* context,
     return ToGrpc(checked.status());
   }
   response->set_valid(false);
-  const std::string message(checked.status().message());
-  v1::FieldError* error = response->add_errors();
-  error->set_code(code == absl::StatusCode::kInvalidArgument ? "INVALID_ARGUMENT"
-                                                             : "RESOURCE_EXHAUSTED");
-  // Messages read `path: rule` (convert/scene_from_proto.h).
-  const size_t colon = message.find(": ");
-  if (colon != std::string::npos && message.find(' ') >= colon) {
-    error->set_path(message.substr(0, colon));
-    error->set_message(message.substr(colon + 2));
-  } else {
-    error->set_message(message);
-  }
+  SetFieldError(checked.status(), response->add_errors());
   return grpc::Status::OK;
 }
 

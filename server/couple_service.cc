@@ -102,20 +102,6 @@ std::string FieldsOfMessage(absl::string_view message) {
   return std::string(message);
 }
 
-// A refused message's reply: `path: rule` split as in ValidateResponse.
-void SetError(const absl::Status& status, v1::CoupleResponse* reply) {
-  const std::string message = FieldsOfMessage(status.message());
-  v1::FieldError* error = reply->mutable_error();
-  error->set_code(absl::StatusCodeToString(status.code()));
-  const size_t colon = message.find(": ");
-  if (colon != std::string::npos && message.find(' ') >= colon) {
-    error->set_path(message.substr(0, colon));
-    error->set_message(message.substr(colon + 2));
-  } else {
-    error->set_message(message);
-  }
-}
-
 // The session's state after a message: time, forces, steps, lines.
 void SetState(const CouplingSession& session, bool lines, v1::CoupleResponse* reply) {
   reply->set_time_s(session.time());
@@ -244,7 +230,10 @@ grpc::Status CablesimServiceImpl::Couple(
         refused = stepped;
       }
     }
-    if (!refused.ok()) SetError(refused, &reply);
+    if (!refused.ok()) {
+      SetFieldError(absl::Status(refused.code(), FieldsOfMessage(refused.message())),
+                    reply.mutable_error());
+    }
     SetState(*session, lines, &reply);
     if (!TimedWrite(stream, reply, slot.watch())) {
       return grpc::Status(grpc::StatusCode::CANCELLED, "the client went away");
