@@ -64,6 +64,15 @@ struct Line {
   int segments = 0;
 };
 
+// A line end's tension channel (OUTPUTS): the probe's name (as the deck
+// spells it), the line's id, which end (B: s = length), the deck's line.
+struct TensionChannel {
+  std::string name;
+  int line_id = 0;
+  bool end_b = false;
+  int line = 0;
+};
+
 struct Option {
   double value = 0;
   int line = 0;
@@ -462,11 +471,11 @@ class DeckReader {
     for (absl::string_view channel : w) {
       for (absl::string_view c : absl::StrSplit(channel, ',', absl::SkipEmpty())) {
         const std::string lower = absl::AsciiStrToLower(c);
-        if (absl::StartsWith(lower, "fairten") || absl::StartsWith(lower, "anchten") ||
-            absl::StrContains(lower, "ten")) {
-          return Error(n, absl::StrCat("OUTPUTS ", c),
-                       "tension channels cannot be expressed yet (cablesim reports a support's "
-                       "force only where it moves: docs/moordyn-files.md)");
+        // A line end's tension: FairTen<n> (= Line<n>TenB, end B) and
+        // AnchTen<n> (= Line<n>TenA, end A), MoorDyn's own names.
+        if (std::optional<TensionChannel> t = LineEndTension(lower, n, c)) {
+          tension_channels_.push_back(*t);
+          continue;
         }
         // Point<n> position channels: Point<n>Px, PointnPy, PointnPz.
         absl::string_view rest = c;
@@ -487,10 +496,36 @@ class DeckReader {
           }
         }
         return Error(n, absl::StrCat("OUTPUTS ", c),
-                     "only point positions (Point<n>Px, Py, Pz) are translated (as probes)");
+                     "only point positions (Point<n>Px, Py, Pz) and line-end tensions "
+                     "(FairTen<n>, AnchTen<n>, Line<n>TenA, Line<n>TenB) are translated (as "
+                     "probes)");
       }
     }
     return absl::OkStatus();
+  }
+
+  // `lower`: the channel in lower case; nullopt unless it names a line
+  // end's tension.
+  static std::optional<TensionChannel> LineEndTension(absl::string_view lower, int n,
+                                                      absl::string_view channel) {
+    absl::string_view rest = lower;
+    bool end_b = false;
+    if (absl::ConsumePrefix(&rest, "fairten")) {
+      end_b = true;
+    } else if (!absl::ConsumePrefix(&rest, "anchten")) {
+      if (!absl::ConsumePrefix(&rest, "line")) return std::nullopt;
+      if (absl::ConsumeSuffix(&rest, "tenb")) {
+        end_b = true;
+      } else if (!absl::ConsumeSuffix(&rest, "tena")) {
+        return std::nullopt;
+      }
+    }
+    int id = 0;
+    if (rest.empty() || rest.find_first_not_of("0123456789") != absl::string_view::npos ||
+        !absl::SimpleAtoi(rest, &id)) {
+      return std::nullopt;
+    }
+    return TensionChannel{std::string(channel), id, end_b, n};
   }
 
   double OptionOr(const std::string& key, double fallback) const {
@@ -715,10 +750,15 @@ class DeckReader {
       for (const auto& [end, pid] : {std::pair{0.0, l.a}, std::pair{l.length, l.b}}) {
         const Point& p = points_.at(pid);
         if (p.kind != PointKind::kFree) {
+          // Named by the point, so that the reactions' columns and a
+          // coupling host (couple/moordyn/MoorDyn2.h) find it; a Vessel
+          // point is a coupled support (held where it is in a run).
           v1::Joint* j = scene.add_joints();
+          j->set_name(absl::StrCat("point", pid));
           j->set_type(v1::PIN);
           j->mutable_a()->set_cable(name);
           j->mutable_a()->set_s(end);
+          if (p.kind == PointKind::kCoupled) j->set_coupled(true);
           continue;
         }
         if (const auto body = body_of.find(pid); body != body_of.end()) {
@@ -766,6 +806,19 @@ class DeckReader {
                      absl::StrCat("point ", id, " has an output channel but no line"));
       }
     }
+    for (const TensionChannel& t : tension_channels_) {
+      const auto line = std::find_if(lines_.begin(), lines_.end(),
+                                     [&](const Line& l) { return l.id == t.line_id; });
+      if (line == lines_.end()) {
+        return Error(t.line, absl::StrCat("OUTPUTS ", t.name),
+                     absl::StrCat("line ", t.line_id, " does not exist"));
+      }
+      v1::Probe* probe = scene.add_probes();
+      probe->set_name(t.name);
+      probe->set_cable(absl::StrCat("line", t.line_id));
+      probe->set_s(t.end_b ? line->length : 0.0);
+      scene.mutable_output()->set_tension(true);
+    }
     return scene;
   }
 
@@ -776,6 +829,7 @@ class DeckReader {
   std::vector<Line> lines_;
   std::map<std::string, Option> options_;
   std::vector<int> probe_points_;
+  std::vector<TensionChannel> tension_channels_;
   // The POINTS row of each body Build made, in scene order (for Located).
   mutable std::vector<int> body_points_;
 };

@@ -25,6 +25,8 @@ v1::ModelInfo ModelInfoToProto(const ModelInfo& info) {
   for (const std::string& name : info.tension_probe_names) p.add_tension_probe_names(name);
   p.set_node_tension(info.node_tension);
   p.set_body_orientation(info.body_orientation);
+  for (const std::string& name : info.bending_moment_probe_names)
+    p.add_bending_moment_probe_names(name);
   return p;
 }
 
@@ -50,6 +52,8 @@ ModelInfo ModelInfoFromProto(const v1::ModelInfo& p) {
   info.tension_probe_names.assign(p.tension_probe_names().begin(), p.tension_probe_names().end());
   info.node_tension = p.node_tension();
   info.body_orientation = p.body_orientation();
+  info.bending_moment_probe_names.assign(p.bending_moment_probe_names().begin(),
+                                         p.bending_moment_probe_names().end());
   return info;
 }
 

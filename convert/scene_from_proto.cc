@@ -342,6 +342,7 @@ class SceneConverter {
     scene_.output.statistics = proto_.output().statistics();
     scene_.output.reactions = proto_.output().reactions();
     scene_.output.tension = proto_.output().tension();
+    scene_.output.bending_moment = proto_.output().bending_moment();
     scene_.output.orientation = proto_.output().orientation();
     {
       const v1::Rainflow& r = proto_.output().rainflow();

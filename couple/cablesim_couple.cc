@@ -15,6 +15,7 @@
 #include "absl/strings/str_format.h"
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
+#include "couple/couple_internal.h"
 #include "engine/run/coupling.h"
 
 struct CableSimSystemImpl {
@@ -78,6 +79,32 @@ int CheckNode(unsigned int node, unsigned int line, size_t nodes) {
 
 }  // namespace
 
+namespace cablesim::couple {
+
+CableSimSystem CreateFromProto(const v1::Scene& proto, const std::string& source) {
+  try {
+    absl::StatusOr<Scene> scene = SceneFromProto(proto);
+    if (!scene.ok()) {
+      Error(CABLESIM_INVALID_SCENE, absl::StrCat(source, ": ", scene.status().message()));
+      return nullptr;
+    }
+    auto session = CouplingSession::Open(*scene);
+    if (!session.ok()) {
+      Error(CABLESIM_INVALID_SCENE, absl::StrCat(source, ": ", session.status().message()));
+      return nullptr;
+    }
+    last_error.clear();
+    return new CableSimSystemImpl{std::move(*session)};
+  } catch (const std::exception& e) {
+    Error(CABLESIM_INVALID_SCENE, absl::StrCat(source, ": ", e.what()));
+    return nullptr;
+  }
+}
+
+void SetError(const std::string& message) { last_error = message; }
+
+}  // namespace cablesim::couple
+
 extern "C" {
 
 CableSimSystem CableSim_Create(const char* scene_file) {
@@ -91,18 +118,7 @@ CableSimSystem CableSim_Create(const char* scene_file) {
       Error(CABLESIM_INVALID_SCENE, std::string(proto.status().message()));
       return nullptr;
     }
-    absl::StatusOr<cablesim::Scene> scene = cablesim::SceneFromProto(*proto);
-    if (!scene.ok()) {
-      Error(CABLESIM_INVALID_SCENE, absl::StrCat(scene_file, ": ", scene.status().message()));
-      return nullptr;
-    }
-    auto session = cablesim::CouplingSession::Open(*scene);
-    if (!session.ok()) {
-      Error(CABLESIM_INVALID_SCENE, absl::StrCat(scene_file, ": ", session.status().message()));
-      return nullptr;
-    }
-    last_error.clear();
-    return new CableSimSystemImpl{std::move(*session)};
+    return cablesim::couple::CreateFromProto(*proto, scene_file);
   } catch (const std::exception& e) {
     Error(CABLESIM_INVALID_SCENE, absl::StrCat(scene_file, ": ", e.what()));
     return nullptr;

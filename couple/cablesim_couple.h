@@ -26,7 +26,10 @@
  * names the argument ("x[1].z: must be finite (got nan)"). An input error
  * leaves the system as it was. A step that fails (the lines' Newton
  * iterations do not converge even at the smallest sub-step) returns
- * CABLESIM_STEP_FAILED and the system refuses further steps. */
+ * CABLESIM_STEP_FAILED and the system refuses further steps.
+ *
+ * A host written against MoorDyn v2's C function names can keep them:
+ * couple/moordyn/MoorDyn2.h declares them over this library. */
 
 #ifdef __cplusplus
 extern "C" {
@@ -75,8 +78,9 @@ int CableSim_GetNumberLines(CableSimSystem sys, unsigned int* n);
 int CableSim_GetLineNumberNodes(CableSimSystem sys, unsigned int line, unsigned int* n);
 int CableSim_GetLineNodePos(CableSimSystem sys, unsigned int line, unsigned int node,
                             double pos[3]);
-/* The tension [N] at node `node`: EA (|r'| - 1) from the cable's slope r'
- * there (negative in compression). */
+/* The tension [N] at node `node`: the axial force, the section force the
+ * elements hold there under the cable's own axial law (negative in
+ * compression; docs/reference/output.md, "Tension along a line"). */
 int CableSim_GetLineTension(CableSimSystem sys, unsigned int line, unsigned int node,
                             double* tension);
 /* The system's time [s]. */

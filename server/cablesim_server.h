@@ -17,7 +17,7 @@
 #include "absl/time/time.h"
 #include "server/cablesim_service.h"
 #include "server/job_manager.h"
-#include "server/job_store.h"
+#include "server/store/job_store.h"
 #include "server/request_checks.h"
 
 namespace cablesim {

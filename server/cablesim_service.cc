@@ -15,7 +15,7 @@
 #include "convert/run_proto.h"
 #include "convert/scene_file.h"
 #include "server/energy_report.h"
-#include "server/job_store.h"
+#include "server/store/job_store.h"
 #include "server/stream_slot.h"
 
 namespace cablesim {

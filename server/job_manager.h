@@ -32,7 +32,7 @@
 #include "absl/status/statusor.h"
 #include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
-#include "server/job_store.h"
+#include "server/store/job_store.h"
 #include "server/request_checks.h"
 
 namespace cablesim {

@@ -251,9 +251,11 @@ absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimi
     for (const JointSpec& joint : checked.scene.joints)
       force_values += joint.type == JointType::kSlide ? 0 : joint.type == JointType::kFixed ? 6 : 3;
   }
-  // output.tension adds NAME.tension per probe on a cable, and
-  // output.orientation 10 values per body, to every row.
-  if (checked.scene.output.tension) {
+  // output.tension adds NAME.tension and output.bending_moment
+  // NAME.bending_moment per probe on a cable, and output.orientation 10
+  // values per body, to every row.
+  for (const bool on : {checked.scene.output.tension, checked.scene.output.bending_moment}) {
+    if (!on) continue;
     for (const ProbeSpec& probe : checked.scene.probes) force_values += probe.at.cable >= 0 ? 1 : 0;
   }
   if (checked.scene.output.orientation)

@@ -269,6 +269,57 @@ TEST(CableStaticsTest, TwoThousandElementChainStretchesUnderItsWeight) {
   EXPECT_EQ(s.rejected_steps, 0);
 }
 
+// What a mooring engineer reads: the forces at the anchor and at the
+// fairlead (output.reactions) and the line tension (output.tension),
+// against the same elastic catenary between supports at different heights.
+// The support at s = 0 holds the cable with (-H, V0), the one at s = L with
+// (H, w L - V0); the tension at s is T(s) = sqrt(H^2 + (V0 - w s)^2).
+// Tolerance 2e-3 of the largest tension, the bound the sag is held to above:
+// H and V0 follow the shape, so a shape within it gives forces within it
+// (a reaction read at the wrong end, or a tension with its sign or stretch
+// factor wrong, is off by tens of percent). The vertical reactions balance
+// the weight exactly (statics), to 1e-9 of it.
+TEST(CableStaticsTest, SupportsCarryTheCatenaryEndForcesAndTheLineItsTension) {
+  // Bending NONE: with the scenes' EI of 2e-3 N m^2 the bending length
+  // sqrt(EI / T) is 2.6 cm, half an element, and the supports' boundary
+  // layers move H by 0.5 %: physics the catenary leaves out, not an error.
+  {
+    const char pts[] = R"([{"x": 0, "y": 0}, {"x": 0.4, "y": -0.3}, {"x": 1, "y": 0.3}])";
+    std::string json = CableScene(24, "NONE", pts, 1.2);
+    const std::string solver = R"("solver": {"analysis": "STATIC"})";
+    json.replace(json.find(solver), solver.size(),
+                 R"("output": {"reactions": true, "tension": true, "shape": true}, )" + solver);
+    CollectingSink sink;
+    RunOk(SceneFromJson(json), &sink);
+    ASSERT_FALSE(sink.frames().empty());
+    const Frame& f = sink.frames().back();
+    Catenary cat{1.2, kEa, kW, {}, {}};
+    double h, v0;
+    cat.Solve(1.0, 0.3, &h, &v0);
+    const double w_total = kW * 1.2;
+    const double t_max = std::max(std::hypot(h, v0), std::hypot(h, w_total - v0));
+    const double tol = 2e-3 * t_max;
+    ASSERT_EQ(f.reactions.size(), 2u);
+    const Eigen::Vector3d anchor = f.reactions[0].force, fairlead = f.reactions[1].force;
+    std::printf("H %.9g N, V0 %.9g N; anchor (%.9g, %.9g), fairlead (%.9g, %.9g)\n", h, v0,
+                anchor.x(), anchor.y(), fairlead.x(), fairlead.y());
+    EXPECT_NEAR(anchor.x(), -h, tol);
+    EXPECT_NEAR(anchor.y(), v0, tol);
+    EXPECT_NEAR(fairlead.x(), h, tol);
+    EXPECT_NEAR(fairlead.y(), w_total - v0, tol);
+    EXPECT_NEAR(anchor.y() + fairlead.y(), w_total, 1e-9 * w_total);
+    // The probe at mid-length.
+    ASSERT_EQ(f.probe_tensions.size(), 1u);
+    EXPECT_NEAR(f.probe_tensions[0], std::hypot(h, v0 - kW * 0.6), tol);
+    // Along the line, node by node (the shape's tension).
+    const std::vector<double>& node_s = sink.info().node_s;
+    ASSERT_EQ(f.node_tensions.size(), node_s.size());
+    for (size_t k = 0; k < node_s.size(); ++k) {
+      EXPECT_NEAR(f.node_tensions[k], std::hypot(h, v0 - kW * node_s[k]), tol) << node_s[k];
+    }
+  }
+}
+
 TEST(CableStaticsTest, AFreeCableHasNoEquilibriumAndSaysSo) {
   CollectingSink sink;
   auto summary = RunScene(SceneFromJson(R"({

@@ -35,6 +35,7 @@
 #include <string.h>
 
 #include "couple/cablesim_couple.h"
+#include "tests/c_expect.h"
 
 #define MAX_FRAMES 1000
 /* The frames compared: up to 5 s (see main). */
@@ -42,16 +43,6 @@ static const double kCompareUntil = 5.0;
 static const double kMass = 20000.0, kDamping = 20000.0, kRho = 1025.0, kG = 9.81;
 static const double kDiameter = 4.0, kHeight = 4.0;
 
-static int failures = 0;
-#define EXPECT(cond, ...)                                  \
-  do {                                                     \
-    if (!(cond)) {                                         \
-      ++failures;                                          \
-      fprintf(stderr, "FAILED %s:%d: ", __FILE__, __LINE__); \
-      fprintf(stderr, __VA_ARGS__);                        \
-      fprintf(stderr, "\n");                               \
-    }                                                      \
-  } while (0)
 
 /* The reference: t, x, y, z of probe "floater" per frame. */
 static int frames = 0;

@@ -8,7 +8,7 @@
 // several PostgreSQL stores share one queue, leases expire and a stale
 // claim stores nothing, migrations are versioned.
 
-#include "server/job_store.h"
+#include "server/store/job_store.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -27,8 +27,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
-#include "server/postgres_job_store.h"
-#include "server/sqlite_job_store.h"
+#include "server/store/postgres_job_store.h"
+#include "server/store/sqlite_job_store.h"
 #include "server/result_codec.h"
 #include "tests/postgres_test_util.h"
 
@@ -567,6 +567,57 @@ TEST(PostgresJobStoreTest, MigrationsAreVersionedAndANewerSchemaIsRefused) {
   const absl::StatusOr<std::unique_ptr<JobStore>> refused = JobStore::Open(url);
   EXPECT_EQ(refused.status().code(), absl::StatusCode::kFailedPrecondition);
   EXPECT_THAT(refused.status().message(), ::testing::HasSubstr("schema is version 999"));
+  PQfinish(conn);
+}
+
+TEST(PostgresJobStoreTest, StatesAreBoundByNameAndStoredRowsKeepTheirNumbers) {
+  CABLESIM_POSTGRES_URL_OR_SKIP(url, "states");
+  std::string done, waiting;
+  {
+    auto store = OpenPostgres(url, 10'000);
+    ASSERT_NE(store, nullptr);
+    done = store->InsertJob(Named("done"), 1)->id();
+    waiting = store->InsertJob(Named("waiting"), 1)->id();
+    const Claim claim = **store->ClaimNext();
+    ASSERT_EQ(claim.id, done);
+    ASSERT_TRUE(*store->Finish(done, v1::SUCCEEDED, {}, TwoRows(), claim.attempt));
+  }
+  PGconn* conn = PQconnectdb(url.c_str());
+  ASSERT_EQ(PQstatus(conn), CONNECTION_OK);
+  auto one = [&](const std::string& sql) {
+    PGresult* r = PQexec(conn, sql.c_str());
+    std::string v = "(no row)";
+    if (PQntuples(r) == 1) v = PQgetvalue(r, 0, 0);
+    PQclear(r);
+    return v;
+  };
+  // The stored format is the contract's number (what servers before named
+  // states wrote and read).
+  EXPECT_EQ(one(absl::StrCat("SELECT state FROM jobs WHERE pid = '", done, "'")), "3");
+  EXPECT_EQ(one(absl::StrCat("SELECT state FROM jobs WHERE pid = '", waiting, "'")), "1");
+  // The database's name-to-number map agrees with service.proto for every
+  // state.
+  const google::protobuf::EnumDescriptor* states = v1::JobState_descriptor();
+  for (int i = 0; i < states->value_count(); ++i) {
+    EXPECT_EQ(one(absl::StrCat("SELECT cablesim_state('", states->value(i)->name(), "')")),
+              absl::StrCat(states->value(i)->number()))
+        << states->value(i)->name();
+  }
+  // A database of schema version 5 (before the map) is upgraded at Open and
+  // serves its rows as before.
+  PQclear(PQexec(conn, "DROP FUNCTION cablesim_state(TEXT); "
+                       "DELETE FROM schema_migrations WHERE version >= 6"));
+  ASSERT_EQ(one("SELECT MAX(version) FROM schema_migrations"), "5");
+  auto store = OpenPostgres(url, 10'000);
+  ASSERT_NE(store, nullptr);
+  EXPECT_EQ(one("SELECT MAX(version) FROM schema_migrations"),
+            absl::StrCat(PostgresJobStore::LatestSchemaVersion()));
+  EXPECT_EQ(store->GetJob(done)->state(), v1::SUCCEEDED);
+  EXPECT_EQ(store->GetResult(done)->values, TwoRows().values);
+  EXPECT_EQ(*store->QueuedJobIds(), std::vector<std::string>{waiting});
+  const std::vector<v1::Job> succeeded = *store->ListJobs(v1::SUCCEEDED, "", 10);
+  ASSERT_EQ(succeeded.size(), 1u);
+  EXPECT_EQ(succeeded[0].id(), done);
   PQfinish(conn);
 }
 

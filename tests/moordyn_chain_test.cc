@@ -7,10 +7,12 @@
 // tolerance MoorDyn's tests state for statics).
 //
 // Each deck is read by the MoorDyn reader (convert/moordyn_deck.h) and
-// solved by STATIC. The fairlead's tension is the force its support exerts:
-// cablesim reports it for a moving support's probe, so the test gives the
-// fairlead a motion that is zero at t = 0 (statics solve at t = 0, so the
-// equilibrium is unchanged). The decks keep MoorDyn's seabed friction
+// solved by STATIC. The fairlead's tension is read as a MoorDyn user asks
+// for it, the deck's FairTen1 channel (the column FairTen1.tension), and
+// checked against the force the fairlead's support exerts (the deck's
+// Vessel point is a coupled support, whose probe reads its force): in
+// statics under weight the line's end tension is that force to the Newton
+// tolerance (1e-6 of it here; the chain has no bending, so no shear). The decks keep MoorDyn's seabed friction
 // (0.5): without it the part of the chain laid on the bed has no stiffness
 // across the line at the first load increment (no tension yet), and the
 // 600 m case's statics failed there (measured); statics regularise it over
@@ -59,6 +61,8 @@ ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
 %g                   WtrDpth              water depth (m)
 100.0                TmaxIC               max time for ic gen (s)
 0.5                  FrictionCoefficient  general bottom friction coefficient (-)
+---------------------- OUTPUTS -----------------------------------------
+FairTen1
 ------------------------- need this line --------------------------------------
 )",
                          c.depth_m, static_cast<int>(c.depth_m), c.anchor_x_m, -c.depth_m,
@@ -69,20 +73,14 @@ double FairleadTensionKn(const ChainCase& c) {
   absl::StatusOr<v1::Scene> proto = SceneFromMoorDyn(ChainDeck(c), "chain.dat");
   EXPECT_TRUE(proto.ok()) << proto.status();
   if (!proto.ok()) return NAN;
-  // The fairlead's joint (line 1 at s = L) as a moving support, still at t = 0.
+  // The fairlead (the deck's Vessel point) is a coupled support, held in
+  // place in a run, whose force a probe there reads: the deck's FairTen1
+  // probe.
   bool found = false;
-  for (v1::Joint& j : *proto->mutable_joints()) {
-    if (j.a().cable() != "line1" || j.a().s() != c.length_m) continue;
-    v1::TimeFunction::Ramp* r = j.mutable_motion()->mutable_x()->mutable_ramp();
-    r->set_slope(1e-3);
-    r->set_start(1);
-    found = true;
+  for (const v1::Joint& j : proto->joints()) {
+    found |= j.a().cable() == "line1" && j.a().s() == c.length_m && j.coupled();
   }
   EXPECT_TRUE(found);
-  v1::Probe* p = proto->add_probes();
-  p->set_name("fairlead");
-  p->set_cable("line1");
-  p->set_s(c.length_m);
   absl::StatusOr<Scene> scene = SceneFromProto(*proto);
   EXPECT_TRUE(scene.ok()) << scene.status();
   if (!scene.ok()) return NAN;
@@ -92,7 +90,15 @@ double FairleadTensionKn(const ChainCase& c) {
     ADD_FAILURE() << "no fairlead force";
     return NAN;
   }
-  const double t = sink.frames().back().support_forces[0].norm() / 1e3;
+  const Frame& last = sink.frames().back();
+  EXPECT_EQ(sink.info().tension_probe_names, std::vector<std::string>{"FairTen1"});
+  if (last.probe_tensions.size() != 1) {
+    ADD_FAILURE() << "no FairTen1 tension";
+    return NAN;
+  }
+  const double support = last.support_forces[0].norm() / 1e3;
+  const double t = last.probe_tensions[0] / 1e3;
+  EXPECT_NEAR(t, support, 1e-6 * support);
   std::printf("depth %g m: fairlead tension %.1f kN (OrcaFlex %.1f kN, %+.2f %%), %lld Newton "
               "iterations, %.2f s\n",
               c.depth_m, t, c.orcaflex_kn, 100 * (t / c.orcaflex_kn - 1),

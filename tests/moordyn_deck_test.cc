@@ -12,6 +12,7 @@
 #include <numbers>
 #include <sstream>
 #include <string>
+#include <tuple>
 
 #include <gtest/gtest.h>
 
@@ -200,6 +201,27 @@ TEST(MoorDynDeckTest, PointsBecomeSupportsBodiesAndPins) {
   EXPECT_TRUE(scene.ok()) << scene.status();
 }
 
+// MoorDyn's line-end tension channels become probes at the line's end
+// with output.tension: FairTen<n> and Line<n>TenB at end B (s = length),
+// AnchTen<n> and Line<n>TenA at end A, named as the deck spells them
+// (columns FAIRTEN1.tension ...).
+TEST(MoorDynDeckTest, LineEndTensionChannelsBecomeTensionProbes) {
+  const v1::Scene s = Read(Edited("Point2Px Point2Pz", "FAIRTEN1 anchten1\nLine4TenB Line2TenA"));
+  EXPECT_TRUE(s.output().tension());
+  ASSERT_EQ(s.probes_size(), 5);
+  const std::vector<std::tuple<std::string, std::string, double>> expected = {
+      {"FAIRTEN1", "line1", 450}, {"anchten1", "line1", 0}, {"Line4TenB", "line4", 110},
+      {"Line2TenA", "line2", 0}};
+  for (size_t k = 0; k < expected.size(); ++k) {
+    const v1::Probe& p = s.probes(static_cast<int>(k) + 1);
+    EXPECT_EQ(p.name(), std::get<0>(expected[k]));
+    EXPECT_EQ(p.cable(), std::get<1>(expected[k]));
+    EXPECT_DOUBLE_EQ(p.s(), std::get<2>(expected[k]));
+  }
+  const absl::StatusOr<Scene> scene = SceneFromProto(s);
+  EXPECT_TRUE(scene.ok()) << scene.status();
+}
+
 TEST(MoorDynDeckTest, SlackLinesAreLaidAlongTheirLengthAboveTheBed) {
   const v1::Scene s = Read(kDeck);
   for (const v1::Cable& c : s.cables()) {
@@ -238,7 +260,8 @@ TEST(MoorDynDeckTest, RefusalsNameTheLineAndField) {
       {"100        1.0e9", "-100       1.0e9", "bad.dat:6: LINE TYPES Mass/m: must be > 0"},
       {"0.001         dtM", "0.001         dtM\n7             NotAnOption",
        "bad.dat:25: OPTIONS NotAnOption"},
-      {"Point4Pz", "FairTen1", "bad.dat:33: OUTPUTS FairTen1: tension channels"},
+      {"Point4Pz", "Line1N3T", "bad.dat:33: OUTPUTS Line1N3T: only point positions (Point<n>Px, Py, Pz) and line-end tensions"},
+      {"Point4Pz", "FairTen7", "bad.dat:33: OUTPUTS FairTen7: line 7 does not exist"},
       {"rope       0.1 ", "rope       0.2 ",
        "OPTIONS kBot: line types \"chain\" and \"rope\" differ"},
       {"100           WtrDpth       water depth (m)\n", "", "OPTIONS WtrDpth: required"},

@@ -22,8 +22,8 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "server/job_store.h"
-#include "server/sqlite_job_store.h"
+#include "server/store/job_store.h"
+#include "server/store/sqlite_job_store.h"
 #include "tests/postgres_test_util.h"
 
 namespace cablesim {

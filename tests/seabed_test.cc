@@ -284,6 +284,64 @@ TEST(SeabedTest, MooringStaticsWithFrictionMatchesTheCatenaryWithCB) {
   }
 }
 
+// What a mooring engineer reads off the same statics (C_B = 0.1): the
+// anchor's and the fairlead's forces (output.reactions) and the tension
+// along the line (output.tension with the shape), against the closed form:
+// the fairlead holds (H, V), the anchor pulls with the grounded line's
+// tension there, T(s) = H - C_B w (L_B - s) on the bed and
+// sqrt(H^2 + (w (s - L_B))^2) above it. Tolerances as above: 1e-4 of H
+// (the mesh), the anchor's plus twice the short friction there. The
+// anchor's node tension also leaves out its element's share of the bed's
+// friction, C_B w l / 2 = 24 N (model_outputs.cc, Tensions: a cable's end
+// node reads one element; the anchor's reaction is exact). Nodes within
+// 2 m of the touchdown point are left out: the closed form's tension has a
+// kink there (the bed's support ends) that the mesh rounds over an element
+// or two.
+TEST(SeabedTest, AnchorAndFairleadForcesAndTheTensionAlongTheLine) {
+  const double cb = 0.1;
+  SeabedCatenary ref;
+  ref.cb = cb;
+  ASSERT_TRUE(ref.Solve(kXf, kZf + kW / kStiffness));
+  const std::string bed = absl::StrFormat(
+      R"("seabed": {"depth": 0, "stiffness": %.17g, "friction_axial": %.17g,
+         "friction_transverse": %.17g},
+         "output": {"reactions": true, "tension": true, "shape": true},)",
+      kStiffness, cb, cb);
+  CollectingSink sink;
+  RunOk(SceneFromJson(MooringScene(160, "STATIC", bed)), &sink);
+  ASSERT_FALSE(sink.frames().empty());
+  const Frame& f = sink.frames().back();
+  ASSERT_EQ(f.reactions.size(), 2u);
+  const double tol = 1e-4 * ref.h;
+  const double anchor = ref.GroundTension(0);
+  const double short_friction = cb * kW * kEa * 1e-5 / anchor;
+  std::printf("anchor force (%.3f, %.3f) N, closed form (%.3f, 0); fairlead (%.3f, %.3f) N, "
+              "closed form (%.3f, %.3f)\n",
+              f.reactions[0].force.x(), f.reactions[0].force.y(), -anchor,
+              f.reactions[1].force.x(), f.reactions[1].force.y(), ref.h, ref.v);
+  EXPECT_NEAR(f.reactions[0].force.x(), -anchor, tol + 2 * short_friction);
+  EXPECT_NEAR(f.reactions[1].force.x(), ref.h, tol);
+  EXPECT_NEAR(f.reactions[1].force.y(), ref.v, tol);
+  ASSERT_EQ(f.probe_tensions.size(), 1u);
+  EXPECT_NEAR(f.probe_tensions[0], std::hypot(ref.h, ref.v), tol);
+  const std::vector<double>& node_s = sink.info().node_s;
+  ASSERT_EQ(f.node_tensions.size(), node_s.size());
+  double worst = 0;
+  int checked = 0;
+  for (size_t k = 0; k < node_s.size(); ++k) {
+    const double s = node_s[k];
+    if (std::abs(s - ref.Lb()) < 2) continue;
+    const double expected = s < ref.Lb() ? ref.GroundTension(s)
+                                         : std::hypot(ref.h, kW * (s - ref.Lb()));
+    const double end_share = cb * kW * (kLength / 160) / 2;
+    const double allowed = tol + (s == 0 ? 2 * short_friction + end_share : 0);
+    EXPECT_NEAR(f.node_tensions[k], expected, allowed) << "s = " << s;
+    worst = std::max(worst, std::abs(f.node_tensions[k] - expected));
+    ++checked;
+  }
+  std::printf("%d nodes: largest tension error %.3f N (H %.1f N)\n", checked, worst, ref.h);
+}
+
 // A 10 m chain laid flat 0.1 m above the bed falls, bounces on the damped
 // bed and comes to rest sunk by w / k, where its weight balances the bed.
 // Generalized-alpha with rho_inf = 1 (the trapezoidal rule, which

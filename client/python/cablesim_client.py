@@ -73,10 +73,11 @@ def job_result(stub, job_id):
     return result_from_events(stub.GetJobResult(service_pb2.GetJobResultRequest(id=job_id)))
 
 
-def plot(result, png_path, probe=None):
-    """Plots the path of `probe` (default: the first) and the energy
-    components against time to `png_path`."""
-    result.plot(png_path, probe)
+def plot(result, png_path, probe=None, view="xy", tension=None):
+    """Plots the path of `probe` (default: the first) in the plane `view`,
+    the energy components and, with `tension`, the tensions against time to
+    `png_path` (Result.plot)."""
+    result.plot(png_path, probe, view=view, tension=tension)
 
 
 def main(argv):

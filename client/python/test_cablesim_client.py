@@ -148,6 +148,59 @@ class ClientTest(unittest.TestCase):
         with self.assertRaises(ValueError):
             plain.cable_nodes(0)
 
+    def test_views_tensions_shape_csv_and_scene_overlays(self):
+        """A mooring read as its engineer reads it: the path in the x-z
+        plane with the fairlead tensions beside it; the CLI's CSV and shape
+        CSV loaded into the same Result as the service streams (every
+        number identical); the animation with the buoy, the seabed and the
+        water line."""
+        import cablesim
+        from cablesim.animation import scene_overlays
+        from google.protobuf import json_format
+        scene = cablesim_client.load_scene(
+            os.path.join(SOURCE, "scenes", "mooring-three-line-buoy.json"))
+        scene.solver.duration = 0.5
+        scene.solver.output_interval = 0.1
+        scene.output.shape = True
+        scene.output.tension = True
+        result = cablesim_client.run(self.stub, scene)
+        self.assertEqual(result.summary.status, "ok")
+        scene_path = os.path.join(self.tmp.name, "buoy.json")
+        csv_path = os.path.join(self.tmp.name, "buoy.csv")
+        shape_path = os.path.join(self.tmp.name, "buoy.shape.csv")
+        with open(scene_path, "w") as f:
+            f.write(json_format.MessageToJson(scene, preserving_proto_field_name=True))
+        subprocess.run([os.path.join(BIN, "cablesim"), "run", scene_path, "--out", csv_path,
+                        "--shape", shape_path], check=True, stdout=subprocess.DEVNULL)
+        loaded = cablesim.load_csv(csv_path, shape=shape_path)
+        self.assertEqual(loaded.columns, result.columns)
+        np.testing.assert_array_equal(loaded.data, result.data)
+        np.testing.assert_array_equal(loaded.cable_nodes(2), result.cable_nodes(2))
+        self.assertEqual(loaded.info.cable_names, ["cables[0]", "cables[1]", "cables[2]"])
+        with self.assertRaises(ValueError):  # not a shape CSV
+            cablesim.load_csv(csv_path, shape=csv_path)
+        # The overlays from the scene: gravity along z, the bed 50 m below
+        # the still water level 0, the buoy at its probe.
+        overlays = scene_overlays(scene_path, "xz")
+        self.assertEqual((overlays["up"], overlays["seabed"], overlays["water"]), ("z", -50.0, 0.0))
+        self.assertEqual(overlays["bodies"], [("buoy", "buoy")])
+        self.assertEqual(scene_overlays(scene, ("x", "y"))["seabed"], None)
+        try:
+            from PIL import Image
+            import matplotlib  # noqa: F401
+        except ImportError as e:
+            self.skipTest("plots need Debian's python3-matplotlib and python3-pil: %s" % e)
+        png = os.path.join(self.tmp.name, "buoy.png")
+        loaded.plot(png, probe="buoy", view="xz", tension=True)
+        with open(png, "rb") as f:
+            self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
+        with self.assertRaises(ValueError):
+            loaded.plot(png, view="xx")
+        gif = os.path.join(self.tmp.name, "buoy.gif")
+        self.assertEqual(cablesim.animate(loaded, gif, plane="xz", scene=scene_path), 6)
+        with Image.open(gif) as image:
+            self.assertEqual(image.n_frames, 6)
+
     def test_shape_animates_to_an_mp4_with_ffmpeg(self):
         import shutil
         if shutil.which("ffmpeg") is None:

@@ -681,8 +681,10 @@ void ModelBuilder::Probes() {
     m.node_cable_.insert(m.node_cable_.end(), count, static_cast<int>(c));
   }
   m.tension_ = scene_.output.tension;
+  m.bending_moment_ = scene_.output.bending_moment;
   m.orientation_ = scene_.output.orientation;
-  if (m.tension_) {
+  // The probes on a cable, for their tension and bending moment.
+  if (m.tension_ || m.bending_moment_) {
     for (const CableSpec& cable : scene_.cables) {
       m.cable_ea_.push_back(cable.youngs_modulus_pa * cable.area_m2);
       m.cable_engineering_.push_back(cable.axial_law == AxialLaw::kEngineering);

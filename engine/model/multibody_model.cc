@@ -138,9 +138,14 @@ ModelInfo MultibodyModel::Info() const {
   info.contact = has_contact();
   info.joint_names = joint_names_;
   info.joint_reaction_values = joint_reaction_values_;
-  for (int p : tension_probe_) info.tension_probe_names.push_back(probe_names_[p]);
+  if (tension_) {
+    for (int p : tension_probe_) info.tension_probe_names.push_back(probe_names_[p]);
+  }
   info.node_tension = tension_ && shape_;
   info.body_orientation = orientation_;
+  if (bending_moment_) {
+    for (int p : tension_probe_) info.bending_moment_probe_names.push_back(probe_names_[p]);
+  }
   return info;
 }
 

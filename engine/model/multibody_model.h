@@ -338,14 +338,26 @@ class MultibodyModel {
                  std::vector<JointReaction>* out) const;
   // With output.tension (tension()): the cable's axial force [N] at every
   // probe on a cable (ModelInfo::tension_probe_names) and, with shape,
-  // at every node of NodePositions, from full positions q: EA eps |r_s|,
-  // eps = (r_s . r_s - 1) / 2 (Green-Lagrange, the element's strain), the
-  // component along the tangent of the section force EA eps r_s that the
-  // element's internal force holds (AncfCableElement). `probes` and
-  // `nodes` are resized (no allocation once they have the size).
+  // at every node of NodePositions, from full positions q at load factor
+  // `load_factor` (1 but in statics' load steps): the section force that
+  // the elements' equations hold at the nodes (model_outputs.cc, Tensions,
+  // says how and what it leaves out), its component along the tangent;
+  // compression negative. `probes` and `nodes` are resized.
   bool tension() const { return tension_; }
-  void Tensions(const Eigen::VectorXd& q, std::vector<double>* probes,
+  void Tensions(const Eigen::VectorXd& q, double load_factor, std::vector<double>* probes,
                 std::vector<double>* nodes) const;
+  // With output.bending_moment (bending_moment()): the bending moment [N m]
+  // at every probe on a cable (ModelInfo::bending_moment_probe_names), from
+  // the elements' slope rows as Tensions reads their position rows: the
+  // moment u x Q_u the cable beyond the probe exerts on the cable before
+  // it, averaged over the two elements at a node; planar: about z,
+  // spatial: its size. `out` is resized.
+  bool bending_moment() const { return bending_moment_; }
+  void BendingMoments(const Eigen::VectorXd& q, double load_factor,
+                      std::vector<double>* out) const;
+  // The same at each node of cable `cable` (its elements' ends, in order).
+  std::vector<double> CableNodeTensions(const Eigen::VectorXd& q, int cable,
+                                        double load_factor) const;
   // With output.orientation (orientation()): per body 10 values
   // (Frame::body_orientation) from full q and qdot. The body's axes are its
   // natural coordinates (e1 = u, e2 = v, e3 = w, the columns of R), so
@@ -464,6 +476,21 @@ class MultibodyModel {
   template <int D>
   void ElementEnergy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, EnergySample* en,
                      EnergyParts* parts) const;
+  // Tensions' parts: the section force at element k's two ends (its
+  // internal force's end-position rows less its weight's share), the
+  // tension at (cable, s), and at every node of a cable into out.
+  template <int D>
+  void ElementEndForces(const Eigen::VectorXd& q, int k, double load_factor,
+                        Eigen::Vector3d* start, Eigen::Vector3d* end) const;
+  template <int D>
+  double TensionOf(const Eigen::VectorXd& q, int cable, double s, double load_factor) const;
+  // The bending moment vector at (cable, s) (model_outputs.cc).
+  template <int D>
+  Eigen::Vector3d BendingMomentOf(const Eigen::VectorXd& q, int cable, double s,
+                                  double load_factor) const;
+  template <int D>
+  void CableNodeTensionsOf(const Eigen::VectorXd& q, int cable, double load_factor,
+                           double* out) const;
   template <int D>
   Eigen::Vector3d CablePositionOf(const Eigen::VectorXd& q, int cable, double s,
                                   Eigen::Vector3d* slope) const;
@@ -552,6 +579,7 @@ class MultibodyModel {
   // output.tension: per probe on a cable, its probe, cable and arc length;
   // per cable its EA [N]; per shape node, its cable.
   bool tension_ = false;
+  bool bending_moment_ = false;
   std::vector<int> tension_probe_, tension_cable_;
   std::vector<double> tension_s_, cable_ea_;
   std::vector<bool> cable_engineering_;  // per cable: AxialLaw::kEngineering

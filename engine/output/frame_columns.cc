@@ -48,6 +48,9 @@ std::vector<std::string> FrameColumns(const ModelInfo& info, bool with_nodes) {
       }
     }
   }
+  for (const std::string& name : info.bending_moment_probe_names) {
+    columns.push_back(name + ".bending_moment");
+  }
   if (!info.shape || !with_nodes) return columns;
   for (size_t i = 0; i < info.cable_nodes.size(); ++i) {
     for (int k = 0; k < info.cable_nodes[i]; ++k) {
@@ -84,7 +87,8 @@ FrameReader::FrameReader(const ModelInfo& info, absl::Span<const std::string> co
       tension_probes_(static_cast<int>(info.tension_probe_names.size())),
       node_tension_(info.shape && info.node_tension),
       orientation_values_(info.body_orientation ? 10 * static_cast<int>(info.body_names.size())
-                                                : 0) {
+                                                : 0),
+      bending_moment_probes_(static_cast<int>(info.bending_moment_probe_names.size())) {
   absl::flat_hash_map<std::string_view, int> column;
   for (size_t i = 0; i < columns.size(); ++i) column.emplace(columns[i], static_cast<int>(i));
   for (const std::string& name : FrameColumns(info)) {
@@ -103,6 +107,7 @@ void FrameReader::Read(absl::Span<const double> row, Frame* frame) const {
   frame->probe_tensions.resize(tension_probes_);
   frame->node_tensions.resize(node_tension_ ? nodes_ : 0);
   frame->body_orientation.resize(orientation_values_);
+  frame->probe_bending_moments.resize(bending_moment_probes_);
   frame->reactions.resize(reaction_values_.size());
   for (size_t j = 0; j < reaction_values_.size(); ++j)
     frame->reactions[j].values = reaction_values_[j];

@@ -55,6 +55,9 @@ struct ModelInfo {
   // With output.orientation: every frame carries each body's orientation
   // (Frame::body_orientation).
   bool body_orientation = false;
+  // With output.bending_moment: the probes on a cable (scene order), each
+  // with a column NAME.bending_moment.
+  std::vector<std::string> bending_moment_probe_names;
 };
 
 // The force [N] a joint exerts on its side a (a joint to ground: on what it
@@ -155,6 +158,10 @@ struct Frame {
   // yaw [rad] (R = Rz(yaw) Ry(pitch) Rx(roll)) and the angular velocity
   // wx, wy, wz [rad/s] in world axes.
   std::vector<double> body_orientation;
+  // With output.bending_moment, per probe of
+  // ModelInfo::bending_moment_probe_names the cable's bending moment there
+  // [N m] (planar: about z; spatial: its size).
+  std::vector<double> probe_bending_moments;
 };
 
 class FrameSink {

@@ -292,14 +292,10 @@ std::vector<Eigen::Vector3d> CouplingSession::NodePositions(int c) const {
 std::vector<double> CouplingSession::NodeTensions(int c) const {
   Eigen::VectorXd q(s_->model.coordinates());
   s_->model.ToFull(stepper_ ? stepper_->z() : s_->model.initial_z(), &q);
-  const CableSpec& cable = s_->scene.cables[c];
-  const double ea = cable.youngs_modulus_pa * cable.area_m2;
-  std::vector<double> tension;
-  for (int k = 0; k < s_->info.cable_nodes[c]; ++k) {
-    Eigen::Vector3d slope;
-    s_->model.CablePosition(q, c, s_->info.node_s[s_->first_node[c] + k], &slope);
-    tension.push_back(ea * (slope.norm() - 1));
-  }
+  // The model's own tension (its axial law, its section force at the
+  // nodes: MultibodyModel::Tensions), one per node of the cable.
+  std::vector<double> tension = s_->model.CableNodeTensions(q, c, 1.0);
+  tension.resize(s_->info.cable_nodes[c]);
   return tension;
 }
 

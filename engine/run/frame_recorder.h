@@ -44,8 +44,13 @@ class FrameRecorder {
       frame_.support_forces.assign(model_->force_probe_count(), Eigen::Vector3d::Zero());
     }
     if (model_->reactions()) model_->Reactions(q_, lambda, &frame_.reactions);
-    if (model_->tension()) model_->Tensions(q_, &frame_.probe_tensions, &frame_.node_tensions);
+    if (model_->tension()) {
+      model_->Tensions(q_, load_factor, &frame_.probe_tensions, &frame_.node_tensions);
+    }
     if (model_->orientation()) model_->Orientations(q_, qd_, &frame_.body_orientation);
+    if (model_->bending_moment()) {
+      model_->BendingMoments(q_, load_factor, &frame_.probe_bending_moments);
+    }
     if (model_->shape()) model_->NodePositions(q_, &frame_.nodes);
     frame_.energy = model_->Energy(q_, qd_, load_factor, &frame_.energy_parts);
     frame_.energy.damped = Damped(t);

@@ -384,6 +384,9 @@ struct OutputSpec {
   // Every body's orientation (a unit quaternion and roll, pitch, yaw) and
   // angular velocity in every frame (Frame::body_orientation).
   bool orientation = false;
+  // The bending moment at every cable probe in every frame
+  // (NAME.bending_moment, Frame::probe_bending_moments).
+  bool bending_moment = false;
 };
 
 struct Scene {

@@ -116,6 +116,12 @@ class Result:
         `output.tension: true`; compression is negative)."""
         return self.column(probe + ".tension")
 
+    def bending_moment(self, probe: str) -> np.ndarray:
+        """The bending moment [N m] at a cable probe (NAME.bending_moment,
+        with `output.bending_moment: true`; planar: about z, spatial: its
+        size)."""
+        return self.column(probe + ".bending_moment")
+
     def cable_nodes(self, cable: int) -> np.ndarray:
         """The positions [m] of cable `cable`'s nodes (its index in the scene)
         in every frame, frames x nodes x 3: the columns cables[i].nodes[k].x,
@@ -131,19 +137,34 @@ class Result:
                            self.columns.index(self.columns[i][:-1] + "z")] for i in first])
         return self.data[:, index]
 
-    def plot(self, png_path: str, probe: Optional[str] = None) -> None:
-        """Plots the path of `probe` (default: the first) and the energy
-        components against time to `png_path` (matplotlib, Agg)."""
+    def plot(self, png_path: str, probe: Optional[str] = None, view: str = "xy",
+             tension=None) -> None:
+        """Plots the path of `probe` (default: the first) in the plane
+        `view` names ("xy", "xz", "yz": the horizontal axis first; a
+        mooring whose gravity is along z reads best in "xz"), the energy
+        components against time, and with `tension` (True: every
+        NAME.tension column; or a list of probe names) the tensions against
+        time, to `png_path` (matplotlib, Agg)."""
         import matplotlib
 
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
 
-        probe = probe or self.info.probe_names[0]
-        fig, (path_ax, energy_ax) = plt.subplots(1, 2, figsize=(11, 4.5))
-        path_ax.plot(self.column(probe + ".x"), self.column(probe + ".y"))
-        path_ax.set_xlabel("x [m]")
-        path_ax.set_ylabel("y [m]")
+        if len(view) != 2 or any(c not in "xyz" for c in view) or view[0] == view[1]:
+            raise ValueError('view: two different axes of "xyz", e.g. "xz" (got %r)' % (view,))
+        if tension is True:
+            tension = [c[:-len(".tension")] for c in self.columns
+                       if c.endswith(".tension") and not c.startswith("cables[")]
+        tension = list(tension or [])
+        if probe is None:
+            names = getattr(self.info, "probe_names", None) or [self.columns[1].rsplit(".", 1)[0]]
+            probe = names[0]
+        panels = 3 if tension else 2
+        fig, axes = plt.subplots(1, panels, figsize=(5.5 * panels, 4.5))
+        path_ax, energy_ax = axes[0], axes[1]
+        path_ax.plot(self.column(probe + "." + view[0]), self.column(probe + "." + view[1]))
+        path_ax.set_xlabel(view[0] + " [m]")
+        path_ax.set_ylabel(view[1] + " [m]")
         path_ax.set_title("path of " + probe)
         path_ax.set_aspect("equal", adjustable="datalim")
         for name in ("kinetic", "potential", "axial", "bending", "total"):
@@ -152,16 +173,29 @@ class Result:
         energy_ax.set_ylabel("energy [J]")
         energy_ax.legend()
         energy_ax.set_title("energy")
+        if tension:
+            tension_ax = axes[2]
+            for name in tension:
+                tension_ax.plot(self.t, self.tension(name), label=name)
+            tension_ax.set_xlabel("t [s]")
+            tension_ax.set_ylabel("tension [N]")
+            tension_ax.legend()
+            tension_ax.set_title("tension")
         fig.tight_layout()
         fig.savefig(png_path, dpi=100)
         plt.close(fig)
 
 
-def load_csv(path: str) -> Result:
+def load_csv(path: str, shape: Optional[str] = None) -> Result:
     """Reads the CSV of `cablesim run SCENE --out FILE.csv` (or `watch
     --out`) into a Result with the same columns and numbers as the service
-    streams them (17 significant digits read back exactly). `info` and
-    `summary` are empty: the CSV carries the frames only."""
+    streams them (17 significant digits read back exactly). With `shape`,
+    the shape CSV of the same run (`--shape FILE`, or FILE.shape.csv beside
+    the output; rows t, cable, node, s, x, y, z[, tension]) adds the nodes'
+    columns cables[i].nodes[k].x, .y, .z (and .tension) as the service's
+    rows carry them, so that cable_nodes() and animate() work on it.
+    `info` holds the cables' names as cables[i] and the nodes' arc lengths
+    then; `summary` is empty: the CSVs carry the frames only."""
     with open(path) as f:
         columns = f.readline().strip().split(",")
     if columns == [""]:
@@ -172,7 +206,44 @@ def load_csv(path: str) -> Result:
     if data.shape[1] != len(columns):
         raise ValueError("%s: %d columns in the header, %d in the rows"
                          % (path, len(columns), data.shape[1]))
-    return Result(columns=columns, data=data, info=Record(), summary=Record())
+    info = Record()
+    if shape is not None:
+        columns, data, info = _with_shape(path, columns, data, shape)
+    return Result(columns=columns, data=data, info=info, summary=Record())
+
+
+def _with_shape(path, columns, data, shape):
+    """The frames' columns and rows with the shape CSV's nodes appended."""
+    with open(shape) as f:
+        header = f.readline().strip().split(",")
+    if header[:7] != ["t", "cable", "node", "s", "x", "y", "z"]:
+        raise ValueError("%s: not a cablesim shape CSV (its header is %s)"
+                         % (shape, ",".join(header)))
+    rows = np.loadtxt(shape, delimiter=",", skiprows=1, ndmin=2)
+    with_tension = len(header) > 7 and header[7] == "tension"
+    nodes = sorted({(int(c), int(k)) for c, k in rows[:, 1:3]}) if rows.size else []
+    index = {node: i for i, node in enumerate(nodes)}
+    per_node = 4 if with_tension else 3
+    times = np.unique(rows[:, 0]) if rows.size else np.zeros(0)
+    if len(times) != data.shape[0] or (len(times) and not np.array_equal(times, data[:, 0])):
+        raise ValueError("%s: its %d times are not the %d frames of %s"
+                         % (shape, len(times), data.shape[0], path))
+    extra = np.zeros((data.shape[0], per_node * len(nodes)))
+    frame_of = {t: i for i, t in enumerate(data[:, 0])}
+    s = {}
+    for row in rows:
+        i, n = frame_of[row[0]], index[(int(row[1]), int(row[2]))]
+        extra[i, 3 * n:3 * n + 3] = row[4:7]
+        if with_tension:
+            extra[i, 3 * len(nodes) + n] = row[7]
+        s[n] = row[3]
+    names = ["cables[%d].nodes[%d].%s" % (c, k, a) for c, k in nodes for a in "xyz"]
+    if with_tension:
+        names += ["cables[%d].nodes[%d].tension" % (c, k) for c, k in nodes]
+    cables = sorted({c for c, _ in nodes})
+    info = Record(cable_names=["cables[%d]" % c for c in cables],
+                  node_s=[s[n] for n in range(len(nodes))])
+    return columns + names, np.hstack([data, extra]), info
 
 
 def result_from_events(events, on_time=None) -> Result:

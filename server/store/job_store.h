@@ -1,5 +1,5 @@
-#ifndef CABLESIM_SERVER_JOB_STORE_H_
-#define CABLESIM_SERVER_JOB_STORE_H_
+#ifndef CABLESIM_SERVER_STORE_JOB_STORE_H_
+#define CABLESIM_SERVER_STORE_JOB_STORE_H_
 
 // Durable jobs, sweeps and results: the interface of the job stores
 // (SqliteJobStore, one server's embedded database, the default;
@@ -252,4 +252,4 @@ absl::Status CreateDataDir(const std::string& dir);
 
 }  // namespace cablesim
 
-#endif  // CABLESIM_SERVER_JOB_STORE_H_
+#endif  // CABLESIM_SERVER_STORE_JOB_STORE_H_

@@ -1,5 +1,5 @@
-#ifndef CABLESIM_SERVER_POSTGRES_JOB_STORE_H_
-#define CABLESIM_SERVER_POSTGRES_JOB_STORE_H_
+#ifndef CABLESIM_SERVER_STORE_POSTGRES_JOB_STORE_H_
+#define CABLESIM_SERVER_STORE_POSTGRES_JOB_STORE_H_
 
 // The shared job store: one PostgreSQL database (libpq) that any number
 // of servers use at once, as one queue.
@@ -41,13 +41,13 @@
 #include <vector>
 
 #include "absl/synchronization/mutex.h"
-#include "server/job_store.h"
+#include "server/store/sql_job_store.h"
 
 typedef struct pg_conn PGconn;
 
 namespace cablesim {
 
-class PostgresJobStore final : public JobStore {
+class PostgresJobStore final : public SqlJobStore {
  public:
   // `url`: a libpq connection URL (postgresql://user@host:port/db).
   static absl::StatusOr<std::unique_ptr<PostgresJobStore>> Open(const std::string& url,
@@ -61,41 +61,17 @@ class PostgresJobStore final : public JobStore {
   // The schema version after Open's migrations.
   static int LatestSchemaVersion();
 
-  absl::StatusOr<int> RequeueRunning() override;
-  absl::StatusOr<v1::Job> InsertJob(const v1::Scene& scene, double end_time_s,
-                                    const std::string& peer, int64_t max_unfinished,
-                                    const std::string& tenant) override;
-  absl::StatusOr<v1::Sweep> InsertSweep(const v1::SubmitSweepRequest& request,
-                                        const std::vector<v1::Scene>& items,
-                                        const std::vector<double>& end_times_s,
-                                        const std::string& peer, int64_t max_unfinished,
-                                        const std::string& tenant) override;
-  absl::StatusOr<v1::Job> GetJob(const std::string& id) override;
-  absl::StatusOr<v1::Scene> GetScene(const std::string& id) override;
-  absl::StatusOr<std::vector<v1::Job>> ListJobs(v1::JobState state, const std::string& sweep_id,
-                                                int limit, int64_t after_key,
-                                                const std::string* tenant,
-                                                std::vector<int64_t>* keys) override;
-  const std::string& page_token_secret() const override { return page_token_secret_; }
-  absl::StatusOr<std::string> Tenant(const std::string& id) override;
-  absl::StatusOr<std::vector<std::string>> CheckRows() override;
-  absl::StatusOr<std::vector<std::string>> QueuedJobIds() override;
-  absl::StatusOr<std::optional<Claim>> ClaimNext() override;
-  absl::StatusOr<bool> MarkRunning(const std::string& id) override;
-  absl::Status Requeue(const std::string& id, int attempt) override;
-  absl::StatusOr<bool> CancelQueued(const std::string& id) override;
   absl::Status RequestCancel(const std::string& id) override;
   absl::StatusOr<HeartbeatReply> Heartbeat(const std::vector<RunningJob>& running) override;
-  absl::StatusOr<bool> Finish(const std::string& id, v1::JobState state,
-                              const v1::RunSummary& summary, const StoredResult& result,
-                              int attempt) override;
-  absl::StatusOr<StoredResult> GetResult(const std::string& id) override;
-  absl::StatusOr<v1::Sweep> GetSweep(const std::string& id) override;
-  absl::StatusOr<int64_t> DeleteJob(const std::string& id) override;
-  absl::StatusOr<int64_t> DeleteSweep(const std::string& id) override;
-  absl::StatusOr<RetentionReport> ApplyRetention(int64_t older_than_unix_ms,
-                                                 int64_t max_bytes) override;
   void SetChangeListener(std::function<void()> listener) override;
+
+ protected:
+  absl::StatusOr<std::unique_ptr<SqlRows>> Run(const std::string& sql,
+                                               const SqlParams& params) override;
+  void Ready() override { EnsureConnected(); }
+  void Changed() override { Notify(); }
+  std::string owner_param() const override { return owner_; }
+  int64_t lease_ms_param() const override { return options_.lease_ms; }
 
  private:
   PostgresJobStore(PGconn* conn, std::string url, const StoreOptions& options);
@@ -105,8 +81,6 @@ class PostgresJobStore final : public JobStore {
   void EnsureConnected();
   // Runs `sql` (several statements allowed, no parameters); mu_ held.
   absl::Status Exec(const std::string& sql);
-  // ResourceExhausted as SqliteJobStore; in the caller's transaction.
-  absl::Status CheckPeerRoom(const std::string& peer, int64_t adding, int64_t max_unfinished);
   // NOTIFY the other servers (payload: owner_); mu_ held.
   void Notify();
   void Listen();
@@ -116,7 +90,6 @@ class PostgresJobStore final : public JobStore {
   const StoreOptions options_;
   std::string owner_;
   std::string describe_;
-  absl::Mutex mu_;
   PGconn* conn_ ABSL_GUARDED_BY(mu_);
   // Set and called under listener_mu_, so that clearing it (a manager
   // shutting down) waits for a call under way.
@@ -124,10 +97,8 @@ class PostgresJobStore final : public JobStore {
   std::function<void()> listener_ ABSL_GUARDED_BY(listener_mu_);
   std::atomic<bool> stop_{false};
   std::thread listen_thread_;
-  std::string page_token_secret_;  // set by Open
-
 };
 
 }  // namespace cablesim
 
-#endif  // CABLESIM_SERVER_POSTGRES_JOB_STORE_H_
+#endif  // CABLESIM_SERVER_STORE_POSTGRES_JOB_STORE_H_

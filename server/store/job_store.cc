@@ -1,4 +1,4 @@
-#include "server/job_store.h"
+#include "server/store/job_store.h"
 
 #include <sys/random.h>
 #include <sys/stat.h>
@@ -13,9 +13,9 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "server/postgres_job_store.h"
+#include "server/store/postgres_job_store.h"
 #include "server/result_codec.h"
-#include "server/sqlite_job_store.h"
+#include "server/store/sqlite_job_store.h"
 
 namespace cablesim {
 
