@@ -16,93 +16,9 @@
 #include "convert/scene_file.h"
 #include "server/energy_report.h"
 #include "server/store/job_store.h"
+#include "server/stream_slot.h"
 
 namespace cablesim {
-
-namespace {
-int64_t NowNs();
-}  // namespace
-
-// Holds one of the limited stream slots and registers the stream with the
-// stall watchdog.
-class StreamSlot {
- public:
-  // `counted`: the stream takes one of the max_streams slots (runs do;
-  // watchers and result downloads only register with the watchdog).
-  // A counted stream also takes one of its client's max_streams_per_peer
-  // slots (`client`: ClientKey), so that one client cannot hold every slot.
-  StreamSlot(CablesimServiceImpl* service, grpc::ServerContext* context, bool counted = true,
-             const std::string& client = "")
-      : service_(service), watch_{context}, counted_(counted) {
-    watch_.counted = counted_;
-    if (counted_) peer_ = client.empty() ? PeerOf(context) : client;
-    absl::MutexLock lock(&service_->mu_);
-    if (counted_) {
-      const ServerLimits& limits = service_->limits_;
-      int& mine = service_->peer_streams_[peer_];
-      // Streams whose clients stopped reading count against those clients
-      // only (CablesimServiceImpl::kStalledAfterNs).
-      int stalled = 0;
-      const int64_t now = NowNs();
-      for (const auto& [watch, unused] : service_->watched_) {
-        const int64_t started = watch->write_started_ns.load();
-        stalled += watch->counted && started != 0 &&
-                   now - started > CablesimServiceImpl::kStalledAfterNs;
-      }
-      // The client's own share first: a client that holds it (reading or
-      // not) is told so.
-      if (mine >= limits.max_streams_per_peer) {
-        refusal_ = absl::StrCat("this client (", peer_, ") already runs ", mine,
-                                " streams, the server's limit is ", limits.max_streams_per_peer,
-                                " (max_streams_per_peer); try again later");
-      } else if (service_->streams_ - stalled >= limits.max_streams ||
-                 service_->streams_ >= 2 * static_cast<int64_t>(limits.max_streams)) {
-        refusal_ = absl::StrCat("the server already runs ", limits.max_streams,
-                                " streams (max_streams); try again later");
-      }
-      acquired_ = refusal_.empty();
-      if (acquired_) {
-        ++service_->streams_;
-        ++mine;
-      } else if (mine == 0) {
-        service_->peer_streams_.erase(peer_);
-      }
-    } else {
-      acquired_ = true;
-    }
-    service_->watched_[&watch_] = true;
-  }
-  ~StreamSlot() {
-    absl::MutexLock lock(&service_->mu_);
-    if (counted_ && acquired_) {
-      --service_->streams_;
-      if (--service_->peer_streams_[peer_] == 0) service_->peer_streams_.erase(peer_);
-    }
-    service_->watched_.erase(&watch_);
-  }
-  bool acquired() const { return acquired_; }
-  // Why not acquired (names the limit).
-  const std::string& refusal() const { return refusal_; }
-
-  // "ipv4:127.0.0.1:5555" -> "ipv4:127.0.0.1", "ipv6:[::1]:5555" -> "ipv6:[::1]".
-  static std::string PeerOf(const grpc::ServerContext* context) {
-    std::string peer = context->peer();
-    const size_t colon = peer.rfind(':');
-    if ((peer.rfind("ipv4:", 0) == 0 || peer.rfind("ipv6:", 0) == 0) && colon > 5) {
-      peer.resize(colon);
-    }
-    return peer;
-  }
-  CablesimServiceImpl::StreamWatch* watch() { return &watch_; }
-
- private:
-  CablesimServiceImpl* service_;
-  CablesimServiceImpl::StreamWatch watch_;
-  const bool counted_;
-  bool acquired_ = false;
-  std::string peer_;
-  std::string refusal_;
-};
 
 // Holds one scene-carrying unary call's place (ServerLimits::
 // max_unary_calls, max_unary_calls_per_peer) and its estimated memory
@@ -170,12 +86,6 @@ class UnarySlot {
 
 namespace {
 
-int64_t NowNs() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
-
 grpc::Status ToGrpc(const absl::Status& s) {
   if (s.ok()) return grpc::Status::OK;
   return grpc::Status(static_cast<grpc::StatusCode>(s.code()), std::string(s.message()));
@@ -190,16 +100,6 @@ int BatchSize(int requested) {
 
 bool Finished(v1::JobState s) {
   return s == v1::SUCCEEDED || s == v1::FAILED || s == v1::CANCELLED;
-}
-
-// Writes `event`, recording the wait for the watchdog.
-template <typename Message>
-bool TimedWrite(grpc::ServerWriterInterface<Message>* writer, const Message& event,
-                CablesimServiceImpl::StreamWatch* watch) {
-  watch->write_started_ns = NowNs();
-  const bool ok = writer->Write(event);
-  watch->write_started_ns = 0;
-  return ok;
 }
 
 // Streams a run: header, batches of frame rows, (the caller writes the
@@ -423,18 +323,7 @@ grpc::Status CablesimServiceImpl::Validate(grpc::ServerContext* context,
     return ToGrpc(checked.status());
   }
   response->set_valid(false);
-  const std::string message(checked.status().message());
-  v1::FieldError* error = response->add_errors();
-  error->set_code(code == absl::StatusCode::kInvalidArgument ? "INVALID_ARGUMENT"
-                                                             : "RESOURCE_EXHAUSTED");
-  // Messages read `path: rule` (convert/scene_from_proto.h).
-  const size_t colon = message.find(": ");
-  if (colon != std::string::npos && message.find(' ') >= colon) {
-    error->set_path(message.substr(0, colon));
-    error->set_message(message.substr(colon + 2));
-  } else {
-    error->set_message(message);
-  }
+  SetFieldError(checked.status(), response->add_errors());
   return grpc::Status::OK;
 }
 

@@ -75,6 +75,10 @@ class CablesimServiceImpl final : public v1::CablesimService::Service {
   grpc::Status GetServerInfo(grpc::ServerContext* context,
                              const v1::GetServerInfoRequest* request,
                              v1::ServerInfo* response) override;
+  // A coupling session (server/couple_service.cc).
+  grpc::Status Couple(grpc::ServerContext* context,
+                      grpc::ServerReaderWriter<v1::CoupleResponse, v1::CoupleRequest>* stream)
+      override;
 
   // Tracks one stream's writes for the stall watchdog.
   struct StreamWatch {

@@ -347,6 +347,18 @@ absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimi
   return checked;
 }
 
+void SetFieldError(const absl::Status& status, v1::FieldError* error) {
+  const std::string message(status.message());
+  error->set_code(absl::StatusCodeToString(status.code()));
+  const size_t colon = message.find(": ");
+  if (colon != std::string::npos && message.find(' ') >= colon) {
+    error->set_path(message.substr(0, colon));
+    error->set_message(message.substr(colon + 2));
+  } else {
+    error->set_message(message);
+  }
+}
+
 std::vector<double> SweepAxisValues(const google::protobuf::RepeatedPtrField<v1::SweepAxis>& axes,
                                     int64_t index) {
   std::vector<double> values(axes.size());

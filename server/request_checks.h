@@ -146,6 +146,11 @@ std::vector<std::string> ThresholdFailures(
     const google::protobuf::RepeatedPtrField<v1::SweepThreshold>& thresholds,
     const v1::RunSummary& summary);
 
+// `error` from a refusal whose message reads `path: rule`
+// (convert/scene_from_proto.h; a message without such a path: all of it
+// the rule), its code's name ("INVALID_ARGUMENT", "RESOURCE_EXHAUSTED").
+void SetFieldError(const absl::Status& status, v1::FieldError* error);
+
 // The items of a sweep (cartesian product, last axis fastest), each
 // checked with CheckScene; `end_times_s` receives each item's end time.
 absl::StatusOr<std::vector<v1::Scene>> ExpandSweep(const v1::SubmitSweepRequest& request,

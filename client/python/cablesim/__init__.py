@@ -6,6 +6,8 @@
         job_id = client.submit({"name": "x", ...})            # a dict scene
         client.wait(job_id).state                             # "SUCCEEDED"
         table = client.sweep(scene, {"solver.step": [1e-4, 5e-5]})
+    with cablesim.couple("127.0.0.1:50051", "floater.json", x0) as session:
+        forces = session.step(0.05, x1, v1)                   # a coupling step
 
 The gRPC modules (cablesim.v1.scene_pb2, service_pb2, service_pb2_grpc) are
 generated from proto/cablesim/v1 when the package is built (setup.py).
@@ -22,6 +24,7 @@ __version__ = "0.15.0"
 _LAZY = {
     "animate": "cablesim.animation",
     "Client": "cablesim.client", "open_channel": "cablesim.client", "read_token": "cablesim.client",
+    "couple": "cablesim.coupling", "CoupleSession": "cablesim.coupling",
     "Energy": "cablesim.results", "Job": "cablesim.results", "Record": "cablesim.results",
     "Result": "cablesim.results", "SweepResult": "cablesim.results", "load_csv": "cablesim.results",
     "load_scene": "cablesim.scenes", "scene_to_dict": "cablesim.scenes",
@@ -40,5 +43,5 @@ def __getattr__(name):
     return value
 
 
-__all__ = ["animate", "Client", "Energy", "Error", "Job", "Record", "Result", "SceneError",
-           "SweepResult", "load_csv", "load_scene", "open_channel", "read_token", "scene_to_dict"]
+__all__ = ["animate", "Client", "couple", "CoupleSession", "Energy", "Error", "Job", "Record",
+           "Result", "SceneError", "SweepResult", "load_csv", "load_scene", "open_channel", "read_token", "scene_to_dict"]

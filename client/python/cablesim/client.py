@@ -31,7 +31,8 @@ class _CallDetails(collections.namedtuple(
     pass
 
 
-class _BearerToken(grpc.UnaryUnaryClientInterceptor, grpc.UnaryStreamClientInterceptor):
+class _BearerToken(grpc.UnaryUnaryClientInterceptor, grpc.UnaryStreamClientInterceptor,
+                   grpc.StreamStreamClientInterceptor):
     """Adds `authorization: Bearer TOKEN` to every call (an interceptor, not
     call credentials, so that it also works on a loopback channel without
     TLS)."""
@@ -50,6 +51,9 @@ class _BearerToken(grpc.UnaryUnaryClientInterceptor, grpc.UnaryStreamClientInter
 
     def intercept_unary_stream(self, continuation, details, request):
         return continuation(self._details(details), request)
+
+    def intercept_stream_stream(self, continuation, details, request_iterator):
+        return continuation(self._details(details), request_iterator)
 
 
 def read_token(path: str) -> str:
@@ -229,6 +233,14 @@ class Client:
             if reporter is not None:
                 reporter.close()
         return self.sweep_results(sweep_id)
+
+    def couple(self, scene: SceneLike, positions, velocities=None, *, lines: bool = False,
+               strict: bool = False, timeout: Optional[float] = None):
+        """A coupling session of `scene` (cablesim.couple(), on this
+        client's channel): step(dt, positions, velocities) -> forces."""
+        from cablesim.coupling import couple
+        return couple(self, scene, positions, velocities, lines=lines, strict=strict,
+                      timeout=timeout)
 
     def sweep(self, base: SceneLike, axes: Axes, name: str = "",
               timeout: Optional[float] = None, progress: Progress = None) -> SweepResult:

@@ -1,0 +1,222 @@
+// The Couple stream (server/couple_service.cc) in the process: a session
+// opens, steps and reports forces; each bad step message gets an error
+// reply naming the field and leaves the session as it was; the stream's
+// own errors (no open first, a step the lines cannot take, the per-client
+// limit) end it with a status. The coupled floater's accuracy is tested
+// from Python (client/python/test_couple.py) and C (couple_floater_test).
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <string>
+
+#include "cablesim/v1/service.grpc.pb.h"
+#include "server/cablesim_server.h"
+
+namespace cablesim {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+// A 1 m string in 4 elements along x, pinned at s = 0, its end (1, 0, 0)
+// a coupled support; it starts as given (no statics), so the host starts
+// at the scene's point.
+constexpr char kString[] = R"({"gravity": {"z": -9.81},
+  "cables": [{"name": "c", "length": 1, "elements": 4, "direction": {"x": 1},
+    "density": 1000, "youngs_modulus": 1e7, "diameter": 0.01}],
+  "joints": [{"type": "PIN", "a": {"cable": "c", "s": 0}},
+             {"type": "PIN", "a": {"cable": "c", "s": 1}, "coupled": true}],
+  "solver": {"duration": 1, "step": 0.005}})";
+
+using Stream = grpc::ClientReaderWriter<v1::CoupleRequest, v1::CoupleResponse>;
+
+class CoupleServiceTest : public ::testing::Test {
+ protected:
+  void Start(int max_streams_per_peer = std::numeric_limits<int>::max()) {
+    ServerOptions options;
+    options.log = false;
+    options.limits.max_streams_per_peer = max_streams_per_peer;
+    absl::StatusOr<std::unique_ptr<CablesimServer>> server = CablesimServer::Start(options);
+    ASSERT_TRUE(server.ok()) << server.status();
+    server_ = std::move(*server);
+    stub_ = v1::CablesimService::NewStub(server_->InProcessChannel());
+  }
+  void SetUp() override { Start(); }
+
+  static v1::CoupleRequest Open(const std::string& scene_json) {
+    v1::CoupleRequest request;
+    request.mutable_open()->set_scene_json(scene_json);
+    request.mutable_open()->add_points()->mutable_position()->set_x(1);
+    return request;
+  }
+  static v1::CoupleRequest Step(double dt, double x) {
+    v1::CoupleRequest request;
+    request.mutable_step()->set_dt_s(dt);
+    request.mutable_step()->add_points()->mutable_position()->set_x(x);
+    return request;
+  }
+  // Sends `request` and reads its reply.
+  static v1::CoupleResponse Exchange(Stream* stream, const v1::CoupleRequest& request) {
+    v1::CoupleResponse reply;
+    EXPECT_TRUE(stream->Write(request));
+    EXPECT_TRUE(stream->Read(&reply));
+    return reply;
+  }
+
+  std::unique_ptr<CablesimServer> server_;
+  std::unique_ptr<v1::CablesimService::Stub> stub_;
+};
+
+TEST_F(CoupleServiceTest, StepsAndRefusesBadStepsWithoutLosingTheSession) {
+  grpc::ClientContext context;
+  std::unique_ptr<Stream> stream = stub_->Couple(&context);
+  v1::CoupleResponse reply = Exchange(stream.get(), Open(kString));
+  ASSERT_FALSE(reply.has_error());
+  ASSERT_EQ(reply.forces_size(), 1);
+  EXPECT_EQ(reply.coupled_joints(0), 1);
+  EXPECT_EQ(reply.scene_positions(0).x(), 1);
+  EXPECT_DOUBLE_EQ(reply.max_jump_m(), 0.25);
+  EXPECT_EQ(reply.end_time_s(), 1);
+  EXPECT_EQ(reply.time_s(), 0);
+
+  reply = Exchange(stream.get(), Step(0.01, 1.001));
+  ASSERT_FALSE(reply.has_error()) << reply.error().message();
+  EXPECT_DOUBLE_EQ(reply.time_s(), 0.01);
+  EXPECT_EQ(reply.steps(), 2);  // 0.01 s in steps of 0.005 s
+  // The string pulled 1 mm (1e-3 strain): it pulls the end back with about
+  // EA e = 1e7 x 7.85e-5 x 1e-3 = 0.8 N, its weight (7.85e-2 kg) hanging.
+  EXPECT_LT(reply.end_forces(0).x(), -0.3);
+  EXPECT_LT(reply.end_forces(0).z(), 0);
+  const v1::CoupleResponse good = reply;
+
+  struct Bad {
+    v1::CoupleRequest request;
+    std::string path, says;
+  };
+  std::vector<Bad> bad;
+  bad.push_back({Step(-0.01, 1.001), "dt_s", "must be > 0"});
+  bad.push_back({Step(0, 1.001), "dt_s", "must be > 0"});
+  bad.push_back({Step(std::nan(""), 1.001), "dt_s", "must be > 0"});
+  bad.push_back({Step(2, 1.001), "dt_s", "solver.duration"});
+  bad.push_back({Step(0.01, std::nan("")), "points[0].position.x", "must be finite"});
+  {
+    v1::CoupleRequest r = Step(0.01, 1.001);
+    r.mutable_step()->mutable_points(0)->mutable_velocity()->set_z(
+        std::numeric_limits<double>::infinity());
+    bad.push_back({r, "points[0].velocity.z", "must be finite"});
+    r = Step(0.01, 1.001);
+    *r.mutable_step()->add_points() = r.step().points(0);  // a point the scene has not
+    bad.push_back({r, "points", "2 coupled points given, the scene has 1"});
+    r = Step(0.01, 1.001);
+    r.mutable_step()->clear_points();
+    bad.push_back({r, "points", "0 coupled points given"});
+  }
+  bad.push_back({Step(0.01, 1.5), "points[0].position", "more than the 0.25 m allowed"});
+  bad.push_back({Open(kString), "open", "open already"});
+  bad.push_back({v1::CoupleRequest(), "step", "a message after open is a step"});
+  for (const Bad& b : bad) {
+    SCOPED_TRACE(b.path);
+    reply = Exchange(stream.get(), b.request);
+    ASSERT_TRUE(reply.has_error());
+    EXPECT_EQ(reply.error().code(), "INVALID_ARGUMENT");
+    EXPECT_EQ(reply.error().path(), b.path);
+    EXPECT_THAT(reply.error().message(), HasSubstr(b.says));
+    // The session as it was.
+    EXPECT_EQ(reply.time_s(), good.time_s());
+    EXPECT_EQ(reply.steps(), good.steps());
+    EXPECT_EQ(reply.forces(0).x(), good.forces(0).x());
+  }
+  reply = Exchange(stream.get(), Step(0.01, 1.002));
+  ASSERT_FALSE(reply.has_error()) << reply.error().message();
+  EXPECT_DOUBLE_EQ(reply.time_s(), 0.02);
+  EXPECT_EQ(reply.steps(), 4);
+  stream->WritesDone();
+  EXPECT_TRUE(stream->Finish().ok());
+}
+
+TEST_F(CoupleServiceTest, TheFirstMessageOpensAndABadOpenEndsTheStream) {
+  struct Case {
+    v1::CoupleRequest request;
+    grpc::StatusCode code;
+    std::string starts;
+  };
+  std::vector<Case> cases;
+  cases.push_back({Step(0.01, 1), grpc::StatusCode::INVALID_ARGUMENT, "open:"});
+  v1::CoupleRequest r = Open(kString);
+  r.mutable_open()->clear_points();
+  cases.push_back({r, grpc::StatusCode::INVALID_ARGUMENT, "points: 0 coupled points given"});
+  r = Open(kString);
+  r.mutable_open()->mutable_points(0)->mutable_position()->set_y(std::nan(""));
+  cases.push_back({r, grpc::StatusCode::INVALID_ARGUMENT, "points[0].position.y: must be finite"});
+  r = Open(kString);
+  r.mutable_open()->mutable_points(0)->mutable_position()->set_x(1.1);
+  cases.push_back({r, grpc::StatusCode::INVALID_ARGUMENT, "points[0].position: 0.1 m from"});
+  std::string uncoupled = kString;
+  const std::string coupled = ", \"coupled\": true";
+  uncoupled.replace(uncoupled.find(coupled), coupled.size(), "");
+  cases.push_back({Open(uncoupled), grpc::StatusCode::INVALID_ARGUMENT, "joints: no coupled"});
+  std::string bad_length = kString;
+  bad_length.replace(bad_length.find("\"length\": 1"), 11, "\"length\": -1");
+  cases.push_back(
+      {Open(bad_length), grpc::StatusCode::INVALID_ARGUMENT, "cables[0].length: must be > 0"});
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.starts);
+    grpc::ClientContext context;
+    std::unique_ptr<Stream> stream = stub_->Couple(&context);
+    ASSERT_TRUE(stream->Write(c.request));
+    v1::CoupleResponse reply;
+    EXPECT_FALSE(stream->Read(&reply));
+    const grpc::Status status = stream->Finish();
+    EXPECT_EQ(status.error_code(), c.code);
+    EXPECT_THAT(status.error_message(), StartsWith(c.starts));
+  }
+}
+
+TEST_F(CoupleServiceTest, AStepTheLinesCannotTakeEndsTheSession) {
+  // One Newton iteration and no halving: a stretch of the string fails.
+  std::string brittle = kString;
+  brittle.replace(brittle.find("\"step\": 0.005"), 13,
+                  "\"step\": 0.005, \"max_newton_iterations\": 1, \"max_step_halvings\": 0");
+  grpc::ClientContext context;
+  std::unique_ptr<Stream> stream = stub_->Couple(&context);
+  ASSERT_FALSE(Exchange(stream.get(), Open(brittle)).has_error());
+  ASSERT_TRUE(stream->Write(Step(0.01, 1.2)));
+  v1::CoupleResponse reply;
+  EXPECT_FALSE(stream->Read(&reply));
+  const grpc::Status status = stream->Finish();
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::ABORTED);
+  EXPECT_THAT(status.error_message(), HasSubstr("the lines could not be advanced"));
+  EXPECT_THAT(status.error_message(), HasSubstr("t = 0"));
+}
+
+TEST_F(CoupleServiceTest, ASessionHoldsOneOfTheClientsStreams) {
+  Start(/*max_streams_per_peer=*/1);
+  grpc::ClientContext first_context;
+  std::unique_ptr<Stream> first = stub_->Couple(&first_context);
+  ASSERT_FALSE(Exchange(first.get(), Open(kString)).has_error());
+  {
+    grpc::ClientContext context;
+    std::unique_ptr<Stream> second = stub_->Couple(&context);
+    second->Write(Open(kString));
+    v1::CoupleResponse reply;
+    EXPECT_FALSE(second->Read(&reply));
+    const grpc::Status status = second->Finish();
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+    EXPECT_THAT(status.error_message(), HasSubstr("max_streams_per_peer"));
+  }
+  first->WritesDone();
+  EXPECT_TRUE(first->Finish().ok());
+  // Freed: a new session opens.
+  grpc::ClientContext context;
+  std::unique_ptr<Stream> again = stub_->Couple(&context);
+  EXPECT_FALSE(Exchange(again.get(), Open(kString)).has_error());
+  again->WritesDone();
+  EXPECT_TRUE(again->Finish().ok());
+}
+
+}  // namespace
+}  // namespace cablesim
