@@ -100,6 +100,18 @@ std::string SummaryToJson(const RunSummary& summary) {
     json.Add("local_error_estimate_m", summary.local_error_estimate_m)
         .Add("error_tolerance_m", summary.error_tolerance_m)
         .Add("warnings", summary.warnings);
+    // The joints that let go (Joint.release), an empty list when none did.
+    std::vector<std::string> releases;
+    for (const JointReleaseEvent& e : summary.releases) {
+      JsonLine item;
+      item.Add("joint", e.joint)
+          .Add("name", e.name)
+          .Add("time_s", e.time_s)
+          .Add("force_n", e.force_n)
+          .Add("cause", e.cause);
+      releases.push_back(item.ToString());
+    }
+    json.AddJson("releases", absl::StrCat("[", absl::StrJoin(releases, ","), "]"));
     if (summary.has_error_estimate) {
       if (summary.error_estimate_m >= 0) json.Add("error_estimate_m", summary.error_estimate_m);
       json.Add("error_estimate_method", summary.error_estimate_method)

@@ -111,10 +111,22 @@ class MultibodyModel {
   // static equilibrium, say): the scene's rigid initial velocity is taken
   // at that configuration and projected onto the joints as in Build.
   void SetInitialState(const Eigen::VectorXd& z);
+  // Starts the motion from unknowns z with rates v as they are (a model
+  // rebuilt mid-run, JointRelease), and with the external work done so far.
+  void SetInitialState(const Eigen::VectorXd& z, const Eigen::VectorXd& v, double external_work) {
+    z0_ = z;
+    v0_ = v;
+    initial_velocity_correction_ = 0;
+    external_work_ = external_work;
+  }
 
   // q = c + S z, and qdot = S zdot.
   void ToFull(const Eigen::VectorXd& z, Eigen::VectorXd* q) const;
   void RateToFull(const Eigen::VectorXd& zdot, Eigen::VectorXd* qdot) const;
+  // Unknowns from a full vector, by least squares through q = c + S z
+  // (exact for a full vector the map can produce; c is ignored, so this is
+  // for rates and for positions whose fixed coordinates are c).
+  Eigen::VectorXd Reduce(const Eigen::VectorXd& full) const;
 
   // The skyline envelope of the Newton matrix on z (mass, stiffness and
   // constraint Hessians all fit in it).
@@ -276,6 +288,7 @@ class MultibodyModel {
   // forces: once it says stop, the forces still to be computed are
   // not-a-number (the step fails at once; the run says "cancelled").
   void set_stop_poll(StopPoll* poll) { stop_poll_ = poll; }
+  StopPoll* stop_poll() const { return stop_poll_; }
   bool stop_requested() const { return stop_poll_ != nullptr && stop_poll_->stopped(); }
 
   // The fluid's loads on bodies (engine/forces/body_fluid_load.h): the
@@ -519,10 +532,6 @@ class MultibodyModel {
   // The scene's rigid initial velocity at full configuration q (all nodes
   // and bodies; fixed coordinates are dropped by Reduce).
   void RigidVelocity(const Eigen::VectorXd& q, Eigen::VectorXd* qdot) const;
-  // Unknowns from a full vector, by least squares through q = c + S z
-  // (exact for a full vector the map can produce; c is ignored, so this is
-  // for rates and for positions whose fixed coordinates are c).
-  Eigen::VectorXd Reduce(const Eigen::VectorXd& full) const;
   template <int D>
   const std::vector<ElementData<D>>& Elements() const {
     if constexpr (D == 2) {
