@@ -111,14 +111,19 @@ class MultibodyModel {
   // static equilibrium, say): the scene's rigid initial velocity is taken
   // at that configuration and projected onto the joints as in Build.
   void SetInitialState(const Eigen::VectorXd& z);
-  // Starts the motion from unknowns z with rates v as they are (a model
-  // rebuilt mid-run, JointRelease), and with the external work done so far.
-  void SetInitialState(const Eigen::VectorXd& z, const Eigen::VectorXd& v, double external_work) {
+  // Starts the motion at time t [s] from unknowns z with rates v as they
+  // are (a model rebuilt mid-run, JointRelease), and with the external
+  // work done so far; a stepper made then starts its clock at t.
+  void SetInitialState(const Eigen::VectorXd& z, const Eigen::VectorXd& v, double external_work,
+                       double t) {
     z0_ = z;
     v0_ = v;
     initial_velocity_correction_ = 0;
     external_work_ = external_work;
+    initial_time_ = t;
   }
+  // The time [s] the motion starts at (0 but after the call above).
+  double initial_time() const { return initial_time_; }
 
   // q = c + S z, and qdot = S zdot.
   void ToFull(const Eigen::VectorXd& z, Eigen::VectorXd* q) const;
@@ -656,6 +661,7 @@ class MultibodyModel {
   bool time_dependent_ = false;
   // Work done by torques, time-varying loads and moving supports so far [J].
   double external_work_ = 0;
+  double initial_time_ = 0;  // SetInitialState(z, v, work, t)
   // Winches (empty in most scenes: then nothing is evaluated).
   std::vector<WinchData> winches_;
   // Per winch element (winch by winch, along each cable): the convective

@@ -28,7 +28,7 @@ absl::Status JointRelease::Start(MultibodyModel* model) {
   StopPoll* poll = model->stop_poll();
   *model = std::move(*built);
   model->set_stop_poll(poll);
-  model->SetInitialState(z0_, v0_, 0);
+  model->SetInitialState(z0_, v0_, 0, 0);
   rebuilt_ = false;
   return absl::OkStatus();
 }
@@ -92,7 +92,7 @@ absl::StatusOr<bool> JointRelease::LetGo(MultibodyModel* model, double t, double
   *model = std::move(*built);
   model->set_stop_poll(poll);
   model->SetTime(t);
-  model->SetInitialState(model->Reduce(q_), model->Reduce(qdot_), work);
+  model->SetInitialState(model->Reduce(q_), model->Reduce(qdot_), work, t);
   rebuilt_ = true;
   return true;
 }
