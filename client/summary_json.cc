@@ -8,12 +8,16 @@
 #include "client/json_line.h"
 
 namespace cablesim {
+namespace {
+
+// A JSON array of objects already written.
+std::string JsonArray(const std::vector<std::string>& objects) {
+  return absl::StrCat("[", absl::StrJoin(objects, ","), "]");
+}
+
+}  // namespace
 
 std::string StatisticsToJson(const RunStatistics& statistics) {
-  // A JSON array of objects already written.
-  auto array = [](const std::vector<std::string>& objects) {
-    return absl::StrCat("[", absl::StrJoin(objects, ","), "]");
-  };
   std::vector<std::string> columns;
   for (const ColumnStatistics& c : statistics.columns) {
     JsonLine item;
@@ -38,11 +42,11 @@ std::string StatisticsToJson(const RunStatistics& statistics) {
     rainflow.push_back(item.ToString());
   }
   JsonLine json;
-  json.AddJson("columns", array(columns));
+  json.AddJson("columns", JsonArray(columns));
   if (!statistics.rainflow.empty()) {
     json.Add("sn_slope", statistics.sn_slope)
         .Add("equivalent_cycles", statistics.equivalent_cycles)
-        .AddJson("rainflow", array(rainflow));
+        .AddJson("rainflow", JsonArray(rainflow));
   }
   return json.ToString();
 }
@@ -100,6 +104,18 @@ std::string SummaryToJson(const RunSummary& summary) {
     json.Add("local_error_estimate_m", summary.local_error_estimate_m)
         .Add("error_tolerance_m", summary.error_tolerance_m)
         .Add("warnings", summary.warnings);
+    // The joints that let go (Joint.release), an empty list when none did.
+    std::vector<std::string> releases;
+    for (const JointReleaseEvent& e : summary.releases) {
+      JsonLine item;
+      item.Add("joint", e.joint)
+          .Add("name", e.name)
+          .Add("time_s", e.time_s)
+          .Add("force_n", e.force_n)
+          .Add("cause", e.cause);
+      releases.push_back(item.ToString());
+    }
+    json.AddJson("releases", JsonArray(releases));
     if (summary.has_error_estimate) {
       if (summary.error_estimate_m >= 0) json.Add("error_estimate_m", summary.error_estimate_m);
       json.Add("error_estimate_method", summary.error_estimate_method)

@@ -143,6 +143,14 @@ v1::RunSummary SummaryToProto(const RunSummary& s) {
   for (const std::string& w : s.warnings) p.add_warnings(w);
   p.set_integrator_requested(s.integrator_requested);
   p.set_integrator_reason(s.integrator_reason);
+  for (const JointReleaseEvent& e : s.releases) {
+    v1::JointRelease* r = p.add_releases();
+    r->set_joint(e.joint);
+    r->set_name(e.name);
+    r->set_time_s(e.time_s);
+    r->set_force_n(e.force_n);
+    r->set_cause(e.cause);
+  }
   return p;
 }
 
@@ -192,6 +200,8 @@ RunSummary SummaryFromProto(const v1::RunSummary& p) {
   s.warnings.assign(p.warnings().begin(), p.warnings().end());
   s.integrator_requested = p.integrator_requested();
   s.integrator_reason = p.integrator_reason();
+  for (const v1::JointRelease& r : p.releases())
+    s.releases.push_back({r.joint(), r.name(), r.time_s(), r.force_n(), r.cause()});
   return s;
 }
 

@@ -70,12 +70,17 @@ RunSummary EveryFieldSet() {
   s.local_error_estimate_m = 0.036;
   s.error_tolerance_m = 0.037;
   s.warnings = {"one", "two \"quoted\""};
+  s.releases = {{1, "fairlead", 10.5, 1234.5, "time"}, {3, "", 12.25, 98.5, "breaking_load"}};
   return s;
 }
 
 TEST(RunProtoTest, SummaryRoundTripKeepsEveryKeyOfTheSummaryLine) {
   RunSummary s = EveryFieldSet();
   EXPECT_EQ(SummaryToJson(SummaryFromProto(SummaryToProto(s))), SummaryToJson(s));
+  // (The summary line prints the releases.)
+  EXPECT_NE(SummaryToJson(s).find(R"("releases":[{"joint":1,"name":"fairlead","time_s":10.5,)"),
+            std::string::npos)
+      << SummaryToJson(s);
   s.analysis = "MODAL";  // frequencies_hz is printed for MODAL only
   EXPECT_EQ(SummaryToJson(SummaryFromProto(SummaryToProto(s))), SummaryToJson(s));
   EXPECT_NE(SummaryToJson(s).find(

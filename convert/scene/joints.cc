@@ -37,6 +37,41 @@ absl::Status ConvertSlide(const std::string& path, const v1::Joint& j, JointSpec
   return absl::OkStatus();
 }
 
+// Joint.release (line failure): a PIN or FIXED joint whose force is its
+// rows' multipliers, not a moving, turning or coupled support (their
+// force columns and work belong to the support), nor a winch's end.
+absl::Status ConvertRelease(const ConversionState& state, const std::string& path,
+                            const v1::Joint& j, JointSpec* joint) {
+  if (!j.has_release()) return absl::OkStatus();
+  const std::string release = Sub(path, "release");
+  const v1::Release& r = j.release();
+  if (!r.has_time() && !r.has_breaking_load())
+    return Invalid(release, "needs time or breaking_load");
+  if (joint->type == JointType::kSlide)
+    return Invalid(release, "not with type SLIDE (only a PIN or FIXED joint lets go)");
+  if (joint->HasMotion() || joint->HasRotation())
+    return Invalid(release, "not on a moving or turning support");
+  for (const Attachment* at : {&joint->a, &joint->b}) {
+    if (at->cable < 0 || !state.scene.cables[at->cable].winch.enabled) continue;
+    const double length = state.scene.cables[at->cable].length_m;
+    if (std::abs(at->s_m - length) <= kArcLengthTolerance * length)
+      return Invalid(release, "not at a winch's end (the winch holds the line)");
+  }
+  if (r.has_time()) {
+    if (!(r.time() >= 0) || !std::isfinite(r.time()))
+      return Invalid(Sub(release, "time"),
+                     absl::StrCat("must be >= 0 and finite (got ", Num(r.time()), ")"));
+    joint->release_time_s = r.time();
+  }
+  if (r.has_breaking_load()) {
+    if (!(r.breaking_load() > 0) || !std::isfinite(r.breaking_load()))
+      return Invalid(Sub(release, "breaking_load"),
+                     absl::StrCat("must be > 0 and finite (got ", Num(r.breaking_load()), ")"));
+    joint->breaking_load_n = r.breaking_load();
+  }
+  return absl::OkStatus();
+}
+
 absl::Status ConvertJoint(const ConversionState& state, int i, JointSpec* joint) {
   const v1::Joint& j = state.proto.joints(i);
   const std::string path = Indexed("", "joints", i);
@@ -107,7 +142,7 @@ absl::Status ConvertJoint(const ConversionState& state, int i, JointSpec* joint)
     if (!j.has_rotation()) return Invalid(axis, "only with rotation");
     CABLESIM_ASSIGN_OR_RETURN(joint->rotation_axis, Direction(axis, j.rotation_axis()));
   }
-  return absl::OkStatus();
+  return ConvertRelease(state, path, j, joint);
 }
 
 }  // namespace

@@ -38,6 +38,7 @@ absl::Status ModelBuilder::Joints() {
       }
       continue;
     }
+    if (joint.released) continue;  // let go (JointRelease): no rows, its reaction reads 0
     Attachment a = joint.a, b = joint.b;
     if (a.IsGround()) std::swap(a, b);
     if (a.IsGround()) {
@@ -45,7 +46,8 @@ absl::Status ModelBuilder::Joints() {
           absl::StrCat("joints[", ji, "].a: a joint needs a cable or a body on one side"));
     }
     const bool fixed = joint.type == JointType::kFixed;
-    const bool reactions = scene_.output.reactions;
+    // A joint that may let go keeps its rows: their multipliers are its force.
+    const bool reactions = scene_.output.reactions || joint.HasRelease();
     if (b.IsGround() && (joint.HasMotion() || joint.HasRotation() || reactions)) {
       // A moving support: its point stays as rows (below); FIXED keeps the
       // orientation by elimination, as a fixed support does, or, when the

@@ -112,10 +112,27 @@ class MultibodyModel {
   // static equilibrium, say): the scene's rigid initial velocity is taken
   // at that configuration and projected onto the joints as in Build.
   void SetInitialState(const Eigen::VectorXd& z);
+  // Starts the motion at time t [s] from unknowns z with rates v as they
+  // are (a model rebuilt mid-run, JointRelease), and with the external
+  // work done so far; a stepper made then starts its clock at t.
+  void SetInitialState(const Eigen::VectorXd& z, const Eigen::VectorXd& v, double external_work,
+                       double t) {
+    z0_ = z;
+    v0_ = v;
+    initial_velocity_correction_ = 0;
+    external_work_ = external_work;
+    initial_time_ = t;
+  }
+  // The time [s] the motion starts at (0 but after the call above).
+  double initial_time() const { return initial_time_; }
 
   // q = c + S z, and qdot = S zdot.
   void ToFull(const Eigen::VectorXd& z, Eigen::VectorXd* q) const;
   void RateToFull(const Eigen::VectorXd& zdot, Eigen::VectorXd* qdot) const;
+  // Unknowns from a full vector, by least squares through q = c + S z
+  // (exact for a full vector the map can produce; c is ignored, so this is
+  // for rates and for positions whose fixed coordinates are c).
+  Eigen::VectorXd Reduce(const Eigen::VectorXd& full) const;
 
   // The skyline envelope of the Newton matrix on z (mass, stiffness and
   // constraint Hessians all fit in it).
@@ -277,6 +294,7 @@ class MultibodyModel {
   // forces: once it says stop, the forces still to be computed are
   // not-a-number (the step fails at once; the run says "cancelled").
   void set_stop_poll(StopPoll* poll) { stop_poll_ = poll; }
+  StopPoll* stop_poll() const { return stop_poll_; }
   bool stop_requested() const { return stop_poll_ != nullptr && stop_poll_->stopped(); }
 
   // The fluid's loads on bodies (engine/forces/body_fluid_load.h): the
@@ -524,10 +542,6 @@ class MultibodyModel {
   // The scene's rigid initial velocity at full configuration q (all nodes
   // and bodies; fixed coordinates are dropped by Reduce).
   void RigidVelocity(const Eigen::VectorXd& q, Eigen::VectorXd* qdot) const;
-  // Unknowns from a full vector, by least squares through q = c + S z
-  // (exact for a full vector the map can produce; c is ignored, so this is
-  // for rates and for positions whose fixed coordinates are c).
-  Eigen::VectorXd Reduce(const Eigen::VectorXd& full) const;
   template <int D>
   const std::vector<ElementData<D>>& Elements() const {
     if constexpr (D == 2) {
@@ -656,6 +670,7 @@ class MultibodyModel {
   bool time_dependent_ = false;
   // Work done by torques, time-varying loads and moving supports so far [J].
   double external_work_ = 0;
+  double initial_time_ = 0;  // SetInitialState(z, v, work, t)
   // Winches (empty in most scenes: then nothing is evaluated).
   std::vector<WinchData> winches_;
   // mass_'s values without the winch elements' shares.

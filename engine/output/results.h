@@ -202,6 +202,16 @@ struct RunStatistics {
   std::vector<RainflowStatistics> rainflow;  // in output.rainflow.columns order
 };
 
+// A joint that let go during a dynamic run (JointSpec::release_time_s,
+// breaking_load_n; engine/run/joint_release.h).
+struct JointReleaseEvent {
+  int joint = -1;       // scene index
+  std::string name;     // JointSpec::name
+  double time_s = 0;    // when it let go
+  double force_n = 0;   // |force| it carried then [N]
+  std::string cause;    // "time" or "breaking_load"
+};
+
 struct RunSummary {
   std::string status = "ok";  // "ok", "failed" or "cancelled"
   std::string error;          // why, when not ok (with the time)
@@ -262,6 +272,8 @@ struct RunSummary {
   double error_estimate_m = -1;
   std::string error_estimate_method;
   double error_estimate_seconds = 0;  // wall time of the companion run
+  // DYNAMIC: the joints that let go, in the order they did.
+  std::vector<JointReleaseEvent> releases;
   // output.statistics or output.rainflow: what the frames say.
   bool has_statistics = false;
   RunStatistics statistics;

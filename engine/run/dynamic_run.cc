@@ -19,18 +19,23 @@
 namespace cablesim {
 
 void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const RunControl& control,
-                FrameRecorder* rec, RunSummary* summary) {
-  std::unique_ptr<Stepper> stepper_owner = MakeStepper(model, settings);
-  Stepper& stepper = *stepper_owner;
+                FrameRecorder* rec, RunSummary* summary, JointRelease* release) {
+  if (release != nullptr) {
+    if (absl::Status s = release->Start(model); !s.ok()) {
+      Fail(summary, 0, std::string(s.message()));
+      return;
+    }
+  }
+  std::unique_ptr<Stepper> stepper = MakeStepper(model, settings);
   std::string reason;
-  if (!stepper.Initialize(&reason)) {
+  if (!stepper->Initialize(&reason)) {
     Fail(summary, 0, reason);
     return;
   }
   ExternalWork external_work(model);
   model->SetTime(0);
-  rec->AdvanceDamping(0, stepper.z(), stepper.v());
-  if (absl::Status s = rec->Emit(0, 1, stepper.z(), &stepper.v(), &stepper.a(), &stepper.lambda());
+  rec->AdvanceDamping(0, stepper->z(), stepper->v());
+  if (absl::Status s = rec->Emit(0, 1, stepper->z(), &stepper->v(), &stepper->a(), &stepper->lambda());
       !s.ok()) {
     summary->status = "cancelled";
     summary->error = std::string(s.message());
@@ -61,7 +66,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   // Steps of h (the last one or two shortened to end on the duration);
   // frames between step ends are interpolated (DenseOutput). A frame's
   // energies and constraint violation are those of that interpolated state.
-  DenseOutput dense(stepper);
+  DenseOutput dense(*stepper);
   auto frame_time = [&](long k) { return std::min(duration, k * interval); };
   // The energy guard on a state the stepper reached (a step's end): false
   // (with the summary failed) when its energy rose beyond the limit.
@@ -97,12 +102,40 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     }
     return true;
   };
+  // Line failure (JointRelease): at a state the run reached, the joints
+  // whose time has come or whose force exceeds their breaking load let go;
+  // the stepper restarts on the rebuilt model from that state. False (the
+  // summary failed) when it cannot.
+  auto LetGo = [&](double t_state) {
+    if (release == nullptr) return true;
+    absl::StatusOr<bool> let = release->LetGo(model, t_state, 1e-9 * h_nominal, stepper->z(),
+                                              stepper->v(), stepper->lambda(),
+                                              &summary->releases);
+    if (!let.ok()) {
+      Fail(summary, t_state, std::string(let.status().message()));
+      return false;
+    }
+    if (!*let) return true;
+    stepper = MakeStepper(model, settings);
+    std::string why;
+    if (!stepper->Initialize(&why)) {
+      Fail(summary, t_state,
+           absl::StrFormat("after a joint let go at t = %.9g s: %s", t_state, why));
+      return false;
+    }
+    return true;
+  };
+  if (!LetGo(0)) return;
+  // A step cut to end on a release time leaves the fixed steps' grid; the
+  // step after it ends where the uncut step would have (grid_end), so that
+  // the frames on the grid stay step ends.
+  double grid_end = -1;
   long next_frame = 1;
   while (next_frame <= frames) {
     // A frame already reached (a duration within rounding of the last).
     if (const double tf = frame_time(next_frame); tf - t <= 1e-12 * std::max(1.0, tf)) {
       model->SetTime(tf);
-      rec->Evaluate(tf, 1, stepper.z(), &stepper.v(), &stepper.a(), &stepper.lambda());
+      rec->Evaluate(tf, 1, stepper->z(), &stepper->v(), &stepper->a(), &stepper->lambda());
       if (!CheckAndDeliver(tf)) return;
       ++next_frame;
       continue;
@@ -115,13 +148,20 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     const double left = remaining / h;
     const bool whole =
         left >= 0.5 && std::abs(left - std::round(left)) <= 1e-9 * std::max(1.0, left);
-    const double h_try =
-        remaining < 2 * h && !whole ? remaining / std::ceil(left - 1e-9) : h;
-    dense.BeginStep(stepper);
-    external_work.Before(stepper.z(), t, stepper.lambda());
-    const auto st = stepper.Step(h_try);
+    double h_try = remaining < 2 * h && !whole ? remaining / std::ceil(left - 1e-9) : h;
+    const double h_step = h_try;  // a failed step halves this, not a cut
+    if (release != nullptr) {
+      if (grid_end > t && grid_end - t < h_try) h_try = grid_end - t;
+      if (const double until = release->NextTime() - t; until < h_try * (1 - 1e-9)) {
+        if (!settings.adaptive) grid_end = t + h_try;
+        h_try = until;
+      }
+    }
+    dense.BeginStep(*stepper);
+    external_work.Before(stepper->z(), t, stepper->lambda());
+    const auto st = stepper->Step(h_try);
     if (model->stop_requested()) {  // the step was cut short (StopPoll)
-      stepper.Restore();
+      stepper->Restore();
       summary->status = "cancelled";
       summary->error = absl::StrFormat("stopped by the caller during the step from t = %.9g", t);
       return;
@@ -138,12 +178,12 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       // A step Newton found hard may have landed on a spurious root (an
       // element folded through itself: Green-Lagrange strain does not see
       // it); its energy says so. Take it back and halve the step.
-      const EnergySample e = rec->StateEnergy(t + h_try, stepper.z(), stepper.v());
+      const EnergySample e = rec->StateEnergy(t + h_try, stepper->z(), stepper->v());
       if (guard.Fails(e, rec->energy_scale())) {
-        stepper.Restore();
+        stepper->Restore();
         ++summary->rejected_steps;
         successes = 0;
-        h = h_try / 2;
+        h = h_step / 2;
         summary->smallest_cut_step_s = std::min(summary->smallest_cut_step_s, h);
         if (h < h_min * (1 - 1e-12)) {
           Fail(summary, t + h_try,
@@ -159,11 +199,11 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     if (st.converged && settings.adaptive) {
       // Adaptive steps: accept when the local error estimate meets the
       // tolerance, and choose the next step from it either way.
-      const double err = stepper.LocalErrorNorm(h_try, settings.tolerance_m,
+      const double err = stepper->LocalErrorNorm(h_try, settings.tolerance_m,
                                                 settings.relative_tolerance);
       const double factor = StepFactor(err, TraitsOf(settings.integrator).local_error_order);
       if (!(err <= 1)) {
-        stepper.Restore();
+        stepper->Restore();
         ++summary->rejected_steps;
         h = h_try * factor;
         if (h < h_min * (1 - 1e-12)) {
@@ -176,7 +216,8 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
         }
         continue;
       }
-      h = std::min(h_try * factor, stepper.stable_step());
+      // (A step cut to end on a release time keeps the step planned before.)
+      h = std::min(h_try < h_step ? h_step : h_try * factor, stepper->stable_step());
     }
     if (st.converged) {
       const double t0 = t;
@@ -188,14 +229,14 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
         t_anchor = t;
         tick_anchor = tick;
       }
-      external_work.After(stepper.z(), t, stepper.lambda(), 1);
+      external_work.After(stepper->z(), t, stepper->lambda(), 1);
       // Every run's error estimate: the stepper's embedded local error
       // (one pass over the unknowns), absolute and against the tolerance.
       summary->local_error_estimate_m =
-          std::max(summary->local_error_estimate_m, stepper.LocalErrorNorm(h_try, 1, 0));
+          std::max(summary->local_error_estimate_m, stepper->LocalErrorNorm(h_try, 1, 0));
       summary->local_error_ratio =
           std::max(summary->local_error_ratio,
-                   stepper.LocalErrorNorm(h_try, settings.error_tolerance_m,
+                   stepper->LocalErrorNorm(h_try, settings.error_tolerance_m,
                                           settings.relative_tolerance));
       ++summary->steps;
       summary->min_step_s = std::min(summary->min_step_s, h_try);
@@ -225,30 +266,32 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
           t_anchor = tf;
           tick_anchor = tick;
           model->SetTime(tf);
-          rec->Evaluate(tf, 1, stepper.z(), &stepper.v(), &stepper.a(), &stepper.lambda());
+          rec->Evaluate(tf, 1, stepper->z(), &stepper->v(), &stepper->a(), &stepper->lambda());
         } else {
           // The step's end is guarded before any frame inside it goes out.
           if (!end_checked) {
             model->SetTime(t);
-            const EnergySample end = rec->StateEnergy(t, stepper.z(), stepper.v());
+            const EnergySample end = rec->StateEnergy(t, stepper->z(), stepper->v());
             if (!EnergyHolds(end, t)) return;
             rec->NoteReachedState(end);
             end_checked = true;
           }
-          dense.Interpolate((tf - t0) / h_try, h_try, stepper);
+          dense.Interpolate((tf - t0) / h_try, h_try, *stepper);
           model->SetTime(tf);
           rec->Evaluate(tf, 1, dense.z(), &dense.v(), &dense.a(), &dense.lambda());
         }
         if (!CheckAndDeliver(tf, /*guard=*/at_end)) return;
         ++next_frame;
       }
-      rec->AdvanceDamping(t, stepper.z(), stepper.v());
+      rec->AdvanceDamping(t, stepper->z(), stepper->v());
       summary->end_time_s = t;
+      if (grid_end >= 0 && t >= grid_end - 1e-9 * h_nominal) grid_end = -1;
+      if (!LetGo(t)) return;
       continue;
     }
     ++summary->rejected_steps;
     successes = 0;
-    h = h_try / 2;
+    h = h_step / 2;
     summary->smallest_cut_step_s = std::min(summary->smallest_cut_step_s, h);
     if (h < h_min * (1 - 1e-12)) {
       Fail(summary, t + h_try,

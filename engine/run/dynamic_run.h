@@ -10,13 +10,16 @@
 #include "engine/model/multibody_model.h"
 #include "engine/output/results.h"
 #include "engine/run/frame_recorder.h"
+#include "engine/run/joint_release.h"
 #include "engine/scene/run_control.h"
 #include "engine/scene/scene.h"
 
 namespace cablesim {
 
+// `release` (null: no joint of the scene lets go): line failure, see
+// joint_release.h; the model may be replaced in place by a rebuilt one.
 void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const RunControl& control,
-                FrameRecorder* rec, RunSummary* summary);
+                FrameRecorder* rec, RunSummary* summary, JointRelease* release = nullptr);
 
 }  // namespace cablesim
 

@@ -17,7 +17,7 @@ using Clock = std::chrono::steady_clock;
 
 void EstimateError(MultibodyModel* model, const SolverSettings& settings,
                    const RunControl& control, const ProbeRecordingSink& main,
-                   RunSummary* summary) {
+                   RunSummary* summary, JointRelease* release) {
   const auto start = Clock::now();
   summary->has_error_estimate = true;
   SolverSettings companion = settings;
@@ -44,7 +44,7 @@ void EstimateError(MultibodyModel* model, const SolverSettings& settings,
   RunSummary companion_summary;
   FrameRecorder recorder(model, &recorded, &companion_summary);
   // The caller's stop request and step limit apply to the companion too.
-  RunDynamic(model, companion, control, &recorder, &companion_summary);
+  RunDynamic(model, companion, control, &recorder, &companion_summary, release);
   summary->error_estimate_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   if (companion_summary.status != "ok") {
     summary->error_estimate_method += " (the companion run failed: " + companion_summary.error + ")";

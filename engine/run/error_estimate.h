@@ -12,6 +12,7 @@
 
 #include "absl/status/status.h"
 #include "engine/model/multibody_model.h"
+#include "engine/run/joint_release.h"
 #include "engine/output/results.h"
 #include "engine/scene/run_control.h"
 #include "engine/scene/scene.h"
@@ -46,9 +47,11 @@ class ProbeRecordingSink : public FrameSink {
 // Fixed steps: Richardson extrapolation for a method of order p,
 // e(h) ~ |x_h - x_{h/2}| 2^p / (2^p - 1). Adaptive: the companion is much
 // more accurate, so the difference itself is the estimate.
+// `release`: the main run's line failures (joint_release.h), which the
+// companion run repeats from the scene's own model (null: none).
 void EstimateError(MultibodyModel* model, const SolverSettings& settings,
                    const RunControl& control, const ProbeRecordingSink& main,
-                   RunSummary* summary);
+                   RunSummary* summary, JointRelease* release = nullptr);
 
 }  // namespace cablesim
 

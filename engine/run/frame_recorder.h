@@ -56,6 +56,8 @@ class FrameRecorder {
     frame_.energy.damped = Damped(t);
     frame_.has_contact = model_->has_contact();
     frame_.angular_momentum = model_->AngularMomentum(q_, qd_);
+    // (A joint that let go, JointRelease, leaves the model fewer rows.)
+    if (phi_.size() != model_->multipliers()) phi_.setZero(model_->multipliers());
     model_->Constraints(q_, &phi_, nullptr);
     frame_.constraint_violation = phi_.size() ? phi_.lpNorm<Eigen::Infinity>() : 0.0;
   }

@@ -13,6 +13,7 @@
 #include "engine/run/dynamic_run.h"
 #include "engine/run/error_estimate.h"
 #include "engine/run/frame_recorder.h"
+#include "engine/run/joint_release.h"
 #include "engine/run/run_warnings.h"
 #include "engine/run/static_run.h"
 #include "engine/scene/integrator_traits.h"
@@ -137,11 +138,14 @@ absl::StatusOr<RunSummary> RunPrepared(PreparedRun* prepared, FrameSink* sink,
              !StartFromEquilibrium(&model, settings, control, &summary)) {
     // The summary says why; no frame was delivered.
   } else {
-    RunDynamic(&model, settings, control, &recorder, &summary);
+    // Line failure: only a scene that asks for it holds a JointRelease.
+    std::unique_ptr<JointRelease> release;
+    if (JointRelease::Wanted(scene)) release = std::make_unique<JointRelease>(scene);
+    RunDynamic(&model, settings, control, &recorder, &summary, release.get());
     if (!std::isfinite(summary.min_step_s)) summary.min_step_s = 0;
     if (estimate) {
       if (summary.status == "ok") {
-        EstimateError(&model, settings, control, recording, &summary);
+        EstimateError(&model, settings, control, recording, &summary, release.get());
       } else {
         summary.has_error_estimate = true;
         summary.error_estimate_method = "none: the run did not finish";

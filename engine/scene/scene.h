@@ -175,6 +175,16 @@ struct JointSpec {
   bool HasRotation() const { return !rotation.IsZero(); }
   // Free text naming the joint in the outputs (ModelInfo::joint_names).
   std::string name;
+  // Line failure (PIN and FIXED only, not at a winch's end or coupled):
+  // the joint lets go at release_time_s [s] or at the end of the first
+  // step whose reaction force |F| exceeds breaking_load_n [N], whichever
+  // comes first (engine/run/joint_release.h). Negative: not asked.
+  double release_time_s = -1;
+  double breaking_load_n = -1;
+  bool HasRelease() const { return release_time_s >= 0 || breaking_load_n > 0; }
+  // Set by the dynamic run once the joint has let go (never by the input):
+  // the model is then built without its rows (its reaction reads 0).
+  bool released = false;
 };
 
 struct LoadSpec {

@@ -7,6 +7,7 @@ ExplicitStepper::ExplicitStepper(MultibodyModel* model, const SolverSettings& se
   n_ = model->dofs();
   z_ = model->initial_z();
   v_ = model->initial_v();
+  t_ = t_old_ = model->initial_time();  // 0 but after a joint let go (JointRelease)
   a_.setZero(n_);
   lambda_.resize(0);
   z_old_ = z_;

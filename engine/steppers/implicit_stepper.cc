@@ -15,6 +15,7 @@ ImplicitStepper::ImplicitStepper(MultibodyModel* model, const SolverSettings& se
   solver_.Configure(settings.preconditioner, settings.accept_inexact_solves);
   z_ = model->initial_z();
   v_ = model->initial_v();
+  t_ = t_old_ = model->initial_time();  // 0 but after a joint let go (JointRelease)
   a_.setZero(n_);
   lambda_.setZero(m_);
   for (Eigen::VectorXd* x : {&floor_, &abs_terms_, &f_floor_}) x->setZero(n_);
