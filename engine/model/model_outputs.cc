@@ -16,6 +16,24 @@ namespace cablesim {
 using Eigen::Vector3d;
 using Eigen::VectorXd;
 
+namespace {
+
+// The element k in [begin, end) of a cable that holds arc length s [m],
+// and s's place in it, xi in [0, 1] (a node: the element before it).
+template <class Elements>
+void LocateOnCable(const Elements& elements, int begin, int end, double s, int* k, double* xi) {
+  double start = 0;
+  *k = begin;
+  for (; *k + 1 < end; ++*k) {
+    const double l = elements[*k].element.length();
+    if (s <= start + l) break;
+    start += l;
+  }
+  *xi = std::clamp((s - start) / elements[*k].element.length(), 0.0, 1.0);
+}
+
+}  // namespace
+
 template <int D>
 void MultibodyModel::ElementEnergy(const VectorXd& q, const VectorXd& qdot, EnergySample* en,
                                    EnergyParts* parts) const {
@@ -315,14 +333,9 @@ double MultibodyModel::TensionOf(const VectorXd& q, int cable, double s,
                                  double load_factor) const {
   const auto& elements = Elements<D>();
   const int begin = cable_element_begin_[cable], end = cable_element_begin_[cable + 1];
-  int k = begin;
-  double start = 0;
-  for (; k + 1 < end; ++k) {
-    const double l = elements[k].element.length();
-    if (s <= start + l) break;
-    start += l;
-  }
-  const double xi = std::clamp((s - start) / elements[k].element.length(), 0.0, 1.0);
+  int k = 0;
+  double xi = 0;
+  LocateOnCable(elements, begin, end, s, &k, &xi);
   // The section force at each end of element k, averaged with the
   // neighbour's at a shared node.
   Vector3d at_start, at_end, other, unused;
@@ -382,14 +395,9 @@ Vector3d MultibodyModel::BendingMomentOf(const VectorXd& q, int cable, double s,
   constexpr int kN = 4 * D;
   const auto& elements = Elements<D>();
   const int begin = cable_element_begin_[cable], end = cable_element_begin_[cable + 1];
-  int k = begin;
-  double start = 0;
-  for (; k + 1 < end; ++k) {
-    const double l = elements[k].element.length();
-    if (s <= start + l) break;
-    start += l;
-  }
-  const double xi = std::clamp((s - start) / elements[k].element.length(), 0.0, 1.0);
+  int k = 0;
+  double xi = 0;
+  LocateOnCable(elements, begin, end, s, &k, &xi);
   // The moment at an end of element e, u x (Q_e - lf G_e)[u rows]: at its
   // end (the cable beyond acting on e) and, negated, at its start (e acting
   // on the cable before it).
