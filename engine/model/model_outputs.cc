@@ -314,7 +314,8 @@ void MultibodyModel::Orientations(const VectorXd& q, const VectorXd& qdot,
 
 template <int D>
 void MultibodyModel::ElementEndForces(const VectorXd& q, int k, double load_factor,
-                                      Vector3d* start, Vector3d* end) const {
+                                      Vector3d* start, Vector3d* end, Vector3d* moment_start,
+                                      Vector3d* moment_end) const {
   constexpr int kN = 4 * D;
   const ElementData<D>& e = Elements<D>()[k];
   Eigen::Matrix<double, kN, 1> f = Eigen::Matrix<double, kN, 1>::Zero();  // ElasticForce adds
@@ -326,6 +327,17 @@ void MultibodyModel::ElementEndForces(const VectorXd& q, int k, double load_fact
   // (r_i, r_s,i, r_j, r_s,j): the force the element needs at each end.
   start->head<D>() = -f.template segment<D>(0);
   end->head<D>() = f.template segment<D>(2 * D);
+  if (moment_start == nullptr) return;
+  // The slope rows (u_i, u_j): u x Q_u at its end (the cable beyond acting
+  // on the element) and, negated, at its start (the element acting on the
+  // cable before it).
+  Vector3d u = Vector3d::Zero(), g = Vector3d::Zero();
+  u.head<D>() = q.segment<D>(e.first_coord + D);
+  g.head<D>() = f.template segment<D>(D);
+  *moment_start = -u.cross(g);
+  u.head<D>() = q.segment<D>(e.first_coord + 3 * D);
+  g.head<D>() = f.template segment<D>(3 * D);
+  *moment_end = u.cross(g);
 }
 
 template <int D>
@@ -392,29 +404,23 @@ void MultibodyModel::CableNodeTensionsOf(const VectorXd& q, int cable, double lo
 template <int D>
 Vector3d MultibodyModel::BendingMomentOf(const VectorXd& q, int cable, double s,
                                          double load_factor) const {
-  constexpr int kN = 4 * D;
   const auto& elements = Elements<D>();
   const int begin = cable_element_begin_[cable], end = cable_element_begin_[cable + 1];
   int k = 0;
   double xi = 0;
   LocateOnCable(elements, begin, end, s, &k, &xi);
-  // The moment at an end of element e, u x (Q_e - lf G_e)[u rows]: at its
-  // end (the cable beyond acting on e) and, negated, at its start (e acting
-  // on the cable before it).
-  auto at = [&](int e, bool at_end) {
-    const ElementData<D>& el = elements[e];
-    Eigen::Matrix<double, kN, 1> f = Eigen::Matrix<double, kN, 1>::Zero();  // ElasticForce adds
-    el.element.ElasticForce(q.segment<kN>(el.first_coord), &f, nullptr);
-    f -= load_factor * ElementWeight(el);
-    const int row = at_end ? 3 * D : D;  // (r_i, u_i, r_j, u_j)
-    Vector3d u = Vector3d::Zero(), g = Vector3d::Zero();
-    u.head<D>() = q.segment<D>(el.first_coord + row);
-    g.head<D>() = f.template segment<D>(row);
-    return at_end ? Vector3d(u.cross(g)) : Vector3d(-u.cross(g));
-  };
-  Vector3d m_start = at(k, false), m_end = at(k, true);
-  if (k > begin) m_start = 0.5 * (m_start + at(k - 1, true));
-  if (k + 1 < end) m_end = 0.5 * (m_end + at(k + 1, false));
+  // The moment at each end of element k (ElementEndForces), averaged with
+  // the neighbour's at a shared node.
+  Vector3d m_start, m_end, other, unused;
+  ElementEndForces<D>(q, k, load_factor, &unused, &unused, &m_start, &m_end);
+  if (k > begin) {
+    ElementEndForces<D>(q, k - 1, load_factor, &unused, &unused, &unused, &other);
+    m_start = 0.5 * (m_start + other);
+  }
+  if (k + 1 < end) {
+    ElementEndForces<D>(q, k + 1, load_factor, &unused, &unused, &other, &unused);
+    m_end = 0.5 * (m_end + other);
+  }
   return (1 - xi) * m_start + xi * m_end;
 }
 

@@ -499,12 +499,16 @@ class MultibodyModel {
   template <int D>
   void ElementEnergy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, EnergySample* en,
                      EnergyParts* parts) const;
-  // Tensions' parts: the section force at element k's two ends (its
-  // internal force's end-position rows less its weight's share), the
-  // tension at (cable, s), and at every node of a cable into out.
+  // Tensions' and BendingMoments' parts: the section force at element k's
+  // two ends (its internal force's end-position rows less its weight's
+  // share) and, when asked for, the moment u x Q_u of its end-slope rows
+  // (the same force vector, computed once); the tension at (cable, s), and
+  // at every node of a cable into out.
   template <int D>
   void ElementEndForces(const Eigen::VectorXd& q, int k, double load_factor,
-                        Eigen::Vector3d* start, Eigen::Vector3d* end) const;
+                        Eigen::Vector3d* start, Eigen::Vector3d* end,
+                        Eigen::Vector3d* moment_start = nullptr,
+                        Eigen::Vector3d* moment_end = nullptr) const;
   template <int D>
   double TensionOf(const Eigen::VectorXd& q, int cable, double s, double load_factor) const;
   // The bending moment vector at (cable, s) (model_outputs.cc).
