@@ -625,6 +625,8 @@ class MultibodyModel {
   int64_t damping_point_cost_ = 1;
   StopPoll* stop_poll_ = nullptr;
   // Counts `units` of work on the stop poll; true when the run should stop.
+  // Element loops ask the stop poll once per this many elements.
+  static constexpr int64_t kPollElements = 64;
   bool StopNow(int64_t units) const { return stop_poll_ != nullptr && stop_poll_->Poll(units); }
   // The force contributors the scene uses (none in most scenes), summed in
   // this order; and typed views of some of them for the accessors above.

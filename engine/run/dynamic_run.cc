@@ -232,12 +232,17 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       external_work.After(stepper->z(), t, stepper->lambda(), 1);
       // Every run's error estimate: the stepper's embedded local error
       // (one pass over the unknowns), absolute and against the tolerance.
-      summary->local_error_estimate_m =
-          std::max(summary->local_error_estimate_m, stepper->LocalErrorNorm(h_try, 1, 0));
-      summary->local_error_ratio =
-          std::max(summary->local_error_ratio,
-                   stepper->LocalErrorNorm(h_try, settings.error_tolerance_m,
-                                          settings.relative_tolerance));
+      // Without a relative tolerance the ratio is the estimate over the
+      // tolerance, to the last bit (a division by a positive constant is
+      // monotone), so one pass serves both.
+      const double error_m = stepper->LocalErrorNorm(h_try, 1, 0);
+      summary->local_error_estimate_m = std::max(summary->local_error_estimate_m, error_m);
+      summary->local_error_ratio = std::max(
+          summary->local_error_ratio,
+          settings.relative_tolerance == 0
+              ? error_m / settings.error_tolerance_m
+              : stepper->LocalErrorNorm(h_try, settings.error_tolerance_m,
+                                        settings.relative_tolerance));
       ++summary->steps;
       summary->min_step_s = std::min(summary->min_step_s, h_try);
       summary->max_step_s = std::max(summary->max_step_s, h_try);

@@ -40,11 +40,7 @@ Stepper::StepStats CentralDifferenceStepper::Step(double h) {
 }
 
 double CentralDifferenceStepper::LocalErrorNorm(double h, double atol, double rtol) const {
-  double worst = 0;
-  const double k = h * h / 6;
-  for (int i = 0; i < n_; ++i)
-    worst = std::max(worst, k * std::abs(a_(i) - a_old_(i)) / (atol + rtol * std::abs(z_(i))));
-  return worst;
+  return WeightedMaxNorm(h * h / 6, a_ - a_old_, z_, n_, atol, rtol);
 }
 
 }  // namespace cablesim

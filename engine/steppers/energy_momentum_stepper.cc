@@ -45,12 +45,7 @@ bool EnergyMomentumStepper::Initialize(std::string* reason) {
 void EnergyMomentumStepper::RestoreScheme() { abar_ = abar_old_; }
 
 double EnergyMomentumStepper::LocalErrorNorm(double h, double atol, double rtol) const {
-  const double k = h * h / (6 * (1 + h_old_ / h));
-  double worst = 0;
-  for (int i = 0; i < n_; ++i)
-    worst = std::max(worst, k * std::abs(abar_(i) - abar_old_(i)) /
-                                (atol + rtol * std::abs(z_(i))));
-  return worst;
+  return WeightedMaxNorm(h * h / (6 * (1 + h_old_ / h)), abar_ - abar_old_, z_, n_, atol, rtol);
 }
 
 double EnergyMomentumStepper::Forces(double h, Eigen::VectorXd* f, SkylineLdlt* a,

@@ -89,13 +89,7 @@ void GeneralizedAlphaStepper::RestoreScheme() {
 }
 
 double GeneralizedAlphaStepper::LocalErrorNorm(double h, double atol, double rtol) const {
-  const double k = h * h * std::abs(beta_ - 1.0 / 6);
-  double worst = 0;
-  for (int i = 0; i < n_; ++i) {
-    worst = std::max(worst,
-                     k * std::abs(a_(i) - a_old_(i)) / (atol + rtol * std::abs(z_(i))));
-  }
-  return worst;
+  return WeightedMaxNorm(h * h * std::abs(beta_ - 1.0 / 6), a_ - a_old_, z_, n_, atol, rtol);
 }
 
 Stepper::StepStats GeneralizedAlphaStepper::Step(double h) {

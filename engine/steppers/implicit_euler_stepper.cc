@@ -15,10 +15,7 @@ ImplicitEulerStepper::ImplicitEulerStepper(MultibodyModel* model, const SolverSe
 }
 
 double ImplicitEulerStepper::LocalErrorNorm(double h, double atol, double rtol) const {
-  double worst = 0;
-  for (int i = 0; i < n_; ++i)
-    worst = std::max(worst, 0.5 * h * h * std::abs(a_(i)) / (atol + rtol * std::abs(z_(i))));
-  return worst;
+  return WeightedMaxNorm(0.5 * h * h, a_, z_, n_, atol, rtol);
 }
 
 bool ImplicitEulerStepper::Initialize(std::string* reason) {

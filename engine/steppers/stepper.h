@@ -16,6 +16,7 @@
 // (midpoint rule with a discrete gradient). Step() allocates
 // nothing.
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -30,6 +31,26 @@
 namespace cablesim {
 
 class MultibodyModel;
+
+// The weighted max norm of an error estimate e = k d (k >= 0 a scalar, d a
+// vector expression over the first n unknowns): max_i k |d_i| / (atol +
+// rtol |z_i|), NaN entries skipped. With rtol = 0 (the default) it is
+// k max_i |d_i| / atol, one vectorised pass with no division per unknown,
+// and the same number to the last bit: rounding is monotone, so the largest
+// |d_i| gives the largest quotient.
+template <typename Diff>
+double WeightedMaxNorm(double k, const Eigen::MatrixBase<Diff>& d, const Eigen::VectorXd& z,
+                       int n, double atol, double rtol) {
+  if (n == 0) return 0;
+  if (rtol == 0) {
+    const double m = d.head(n).cwiseAbs().template maxCoeff<Eigen::PropagateNumbers>();
+    return m > 0 ? k * m / atol : 0;
+  }
+  double worst = 0;
+  for (int i = 0; i < n; ++i)
+    worst = std::max(worst, k * std::abs(d(i)) / (atol + rtol * std::abs(z(i))));
+  return worst;
+}
 
 class Stepper {
  public:
