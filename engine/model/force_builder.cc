@@ -101,14 +101,6 @@ absl::Status ModelBuilder::CheckWinches() const {
           "loads on an axially moving mesh are not built)",
           c));
     }
-    if (scene_.solver.integrator == Integrator::kEnergyMomentum &&
-        scene_.solver.analysis == Analysis::kDynamic) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "solver.integrator: ENERGY_MOMENTUM does not take winches (cables[%d].winch): its "
-          "energy statement needs a constant mass; use HHT, GENERALIZED_ALPHA or "
-          "IMPLICIT_EULER",
-          c));
-    }
   }
   return absl::OkStatus();
 }

@@ -306,11 +306,13 @@ void ModelBuilder::OrderUnknowns() {
 }
 
 absl::Status ModelBuilder::CheckIntegratorFits() const {
-  if (!TraitsOf(scene_.solver.integrator).is_explicit || scene_.solver.analysis != Analysis::kDynamic)
-    return absl::OkStatus();
-  const std::string name(IntegratorName(scene_.solver.integrator));
+  // What the integrator takes is read from its traits (integrator_traits.h),
+  // and so are the alternatives the messages offer.
+  const IntegratorTraits& traits = TraitsOf(scene_.solver.integrator);
+  if (scene_.solver.analysis != Analysis::kDynamic) return absl::OkStatus();
+  const std::string name(traits.name);
   const MultibodyModel& m = model_;
-  if (m.joint_rows_->size() > 0) {
+  if (traits.is_explicit && m.joint_rows_->size() > 0) {
     const JointRows::Row& r = m.joint_rows_->row(0);
     const std::string what = r.joint >= 0
                                  ? absl::StrFormat("joints[%d] is kept as constraint rows", r.joint)
@@ -318,15 +320,18 @@ absl::Status ModelBuilder::CheckIntegratorFits() const {
     return absl::InvalidArgumentError(absl::StrFormat(
         "solver.integrator: %s is explicit and integrates unconstrained motion "
         "only, and this scene has %d constraint rows (%s; only joints to fixed ground "
-        "points are eliminated): use HHT, GENERALIZED_ALPHA, ENERGY_MOMENTUM or IMPLICIT_EULER",
-        name, m.multipliers(), what));
+        "points are eliminated): use %s",
+        name, m.multipliers(), what,
+        IntegratorNames([](const IntegratorTraits& t) { return !t.is_explicit; })));
   }
+  if (traits.takes_winches) return absl::OkStatus();
   for (int c = 0; c < static_cast<int>(scene_.cables.size()); ++c) {
     if (scene_.cables[c].winch.enabled) {
       return absl::InvalidArgumentError(absl::StrFormat(
-          "solver.integrator: %s does not take winches (cables[%d].winch): it "
-          "factors the mass matrix once; use HHT, GENERALIZED_ALPHA or IMPLICIT_EULER",
-          name, c));
+          "solver.integrator: %s does not take winches (cables[%d].winch): %s; use %s", name, c,
+          traits.is_explicit ? "it factors the mass matrix once"
+                             : "its energy statement needs a constant mass",
+          IntegratorNames([](const IntegratorTraits& t) { return t.takes_winches; })));
     }
   }
   return absl::OkStatus();

@@ -12,7 +12,9 @@
 // run loop all read it; none of them may include the steppers.
 
 #include <array>
+#include <string>
 #include <string_view>
+#include <vector>
 
 #include "engine/scene/scene.h"
 
@@ -78,6 +80,21 @@ constexpr const IntegratorTraits& TraitsOf(Integrator integrator) {
 // The scene-file spelling, e.g. "HHT" (what the summary reports).
 constexpr std::string_view IntegratorName(Integrator integrator) {
   return TraitsOf(integrator).name;
+}
+
+// The names of the integrators whose row satisfies `pred`, in the table's
+// order, as "A, B or C" (the alternatives an error message offers).
+template <typename Pred>
+std::string IntegratorNames(Pred pred) {
+  std::vector<std::string_view> names;
+  for (const IntegratorTraits& t : kIntegratorTraits)
+    if (pred(t)) names.push_back(t.name);
+  std::string out;
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (i > 0) out += i + 1 == names.size() ? " or " : ", ";
+    out += names[i];
+  }
+  return out;
 }
 
 }  // namespace cablesim
