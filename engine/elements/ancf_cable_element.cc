@@ -129,8 +129,9 @@ typename AncfCableElement<D>::Energy AncfCableElement<D>::StrainEnergy(const Coo
 }
 
 template <int D>
-void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* tangent,
-                                       Coords* roundoff) const {
+template <AxialLaw kLaw>
+void AncfCableElement<D>::ElasticForceWith(const Coords& e, Coords* force, Matrix* tangent,
+                                           Coords* roundoff) const {
   using Id = Eigen::Matrix<double, D, D>;
   constexpr double kEps = std::numeric_limits<double>::epsilon();
   // For `roundoff`: |e_k| per node (once per element), and per node the
@@ -154,7 +155,7 @@ void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* t
     // Gradient (gu, gw) and Hessian blocks of psi with respect to (u, w).
     Point gu = Point::Zero(), gw = Point::Zero();
     Block huu = Block::Zero(), huw = Block::Zero(), hww = Block::Zero();
-    if (axial_law_ == AxialLaw::kEngineering) {
+    if constexpr (kLaw == AxialLaw::kEngineering) {
       // psi_a = EA/2 (s - 1)^2, s = |u|: gradient EA (1 - 1/s) u, Hessian
       // EA ((1 - 1/s) I + u u^T / s^3) (eigenvalues 1 - 1/s and 1).
       const double s = std::sqrt(a);
@@ -225,6 +226,16 @@ void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* t
   if (roundoff)
     for (int k = 0; k < 4; ++k) roundoff->template segment<D>(k * D).array() += node_bound[k];
   if (tangent) MirrorUpperBlocks(tangent);
+}
+
+template <int D>
+void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* tangent,
+                                       Coords* roundoff) const {
+  // The law chosen once per element, not per Gauss point (the hot loop).
+  if (axial_law_ == AxialLaw::kEngineering)
+    ElasticForceWith<AxialLaw::kEngineering>(e, force, tangent, roundoff);
+  else
+    ElasticForceWith<AxialLaw::kGreenLagrange>(e, force, tangent, roundoff);
 }
 
 template <int D>

@@ -203,6 +203,11 @@ class AncfCableElement {
                   Coords* force, Matrix* c) const;
 
  private:
+  // ElasticForce for one axial law (the law a template argument, so the
+  // Gauss-point loop does not branch on it).
+  template <AxialLaw kLaw>
+  void ElasticForceWith(const Coords& e, Coords* force, Matrix* tangent, Coords* roundoff) const;
+
   // B maps e to (u, w) at Gauss point g: rows 0..D-1 are S', rows D..2D-1
   // are S''.
   using BMatrix = Eigen::Matrix<double, 2 * D, kCoords>;
