@@ -34,16 +34,16 @@ class MultibodyModel;
 
 // The weighted max norm of an error estimate e = k d (k >= 0 a scalar, d a
 // vector expression over the first n unknowns): max_i k |d_i| / (atol +
-// rtol |z_i|), NaN entries skipped. With rtol = 0 (the default) it is
-// k max_i |d_i| / atol, one vectorised pass with no division per unknown,
-// and the same number to the last bit: rounding is monotone, so the largest
-// |d_i| gives the largest quotient.
+// rtol |z_i|). With rtol = 0 (the default) it is k max_i |d_i| / atol, one
+// vectorised pass with no division per unknown, and the same number to the
+// last bit: rounding is monotone, so the largest |d_i| gives the largest
+// quotient. (d is finite: an accepted step's accelerations are.)
 template <typename Diff>
 double WeightedMaxNorm(double k, const Eigen::MatrixBase<Diff>& d, const Eigen::VectorXd& z,
                        int n, double atol, double rtol) {
   if (n == 0) return 0;
   if (rtol == 0) {
-    const double m = d.head(n).cwiseAbs().template maxCoeff<Eigen::PropagateNumbers>();
+    const double m = d.head(n).cwiseAbs().maxCoeff();
     return m > 0 ? k * m / atol : 0;
   }
   double worst = 0;
