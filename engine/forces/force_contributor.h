@@ -119,6 +119,13 @@ class ForceContributor {
     (void)s;
     (void)out;
   }
+  // The applied load over the full coordinates [N] when it is the same at
+  // every q and t (gravity without winches, constant point loads), else
+  // nullptr. The model sums such loads once when it is built, and its force
+  // starts from load_factor times that sum in one pass; AddAppliedLoad is
+  // then not called for this contributor in the step loop (it must add the
+  // same load, scaled, for callers that assemble by hand).
+  virtual const Eigen::VectorXd* ConstantAppliedLoad() const { return nullptr; }
   virtual void AddConservative(const ForceState& s, ForceOutput* out) const {
     (void)s;
     (void)out;

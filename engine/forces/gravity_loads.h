@@ -67,6 +67,9 @@ class GravityLoads : public ForceContributor {
   std::string_view name() const override { return "gravity_loads"; }
   EnergyBucket bucket() const override { return EnergyBucket::kPotential; }
   bool time_dependent() const override { return !winches_.empty(); }
+  const Eigen::VectorXd* ConstantAppliedLoad() const override {
+    return winches_.empty() ? &force_ : nullptr;
+  }
   void SetTime(double t) override;
   void AddAppliedLoad(const ForceState& s, ForceOutput* out) const override;
   double StoredEnergy(const ForceState& s) const override;

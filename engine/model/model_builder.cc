@@ -445,6 +445,23 @@ MultibodyModel ModelBuilder::Finish() {
       WinchContributor(model_.elements3_);
     }
   }
+  // Constant applied loads summed once (NetForce starts from them); the
+  // others called in the step loop, in the list's order. The constant ones
+  // come first in the list (gravity and point loads), so the order of the
+  // sum is unchanged.
+  model_.constant_applied_.resize(0);
+  model_.varying_applied_.clear();
+  for (const auto& c : model_.contributors_) {
+    if (const Eigen::VectorXd* f = c->ConstantAppliedLoad()) {
+      if (model_.constant_applied_.size() == 0) {
+        model_.constant_applied_ = *f;
+      } else {
+        model_.constant_applied_ += *f;
+      }
+    } else {
+      model_.varying_applied_.push_back(c.get());
+    }
+  }
   model_.time_dependent_ = false;
   for (const ConstraintFamily* f : model_.families_)
     if (f->time_dependent()) model_.time_dependent_ = true;

@@ -174,7 +174,8 @@ double MultibodyModel::ElementForces(const VectorXd& q, VectorXd* full, SkylineL
     const ElementData<D>& e = elements[k];
     // The stop poll once per kPollElements elements, counting their Gauss
     // points (set_stop_poll): a check per element cost 1 % on small cables.
-    if (k % kPollElements == 0 && StopNow(kPollElements * e.element.gauss_points())) {
+    if (k % kPollElements == 0 &&
+        StopNow(ChunkOf(k, elements.size()) * e.element.gauss_points())) {
       full->setConstant(std::numeric_limits<double>::quiet_NaN());
       return std::numeric_limits<double>::quiet_NaN();
     }
@@ -207,12 +208,17 @@ double MultibodyModel::NetForce(const VectorXd& q, double load_factor, VectorXd*
                                 VectorXd* roundoff) {
   constexpr double kEps = std::numeric_limits<double>::epsilon();
   VectorXd& full = scratch_full_;
-  full.setZero();
-  // Contributors' applied loads (gravity and constant loads first, then
-  // time-varying loads, torques, body buoyancy), scaled by the load factor.
+  // Contributors' applied loads (gravity and constant loads first, in one
+  // pass, then time-varying loads, torques, body buoyancy), scaled by the
+  // load factor.
+  if (constant_applied_.size() > 0) {
+    full = load_factor * constant_applied_;
+  } else {
+    full.setZero();
+  }
   const ForceState state = StateAt(q, nullptr, load_factor);
   ForceOutput out{&full, nullptr, stiffness, stiffness_scale, Map()};
-  for (const auto& c : contributors_) c->AddAppliedLoad(state, &out);
+  for (const ForceContributor* c : varying_applied_) c->AddAppliedLoad(state, &out);
   // The size of the applied terms counts only coordinates that move: a
   // heavy body welded to ground must not loosen the tolerance elsewhere.
   double size = 0;
@@ -290,7 +296,8 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
   for (size_t k = 0; k < elements.size(); ++k) {
     const ElementData<D>& e = elements[k];
     if (k % kPollElements == 0 &&
-        StopNow(kPollElements * e.element.gauss_points() * damping_point_cost_)) {  // set_stop_poll
+        StopNow(ChunkOf(k, elements.size()) * e.element.gauss_points() *
+                damping_point_cost_)) {  // set_stop_poll
       if (full) full->setConstant(std::numeric_limits<double>::quiet_NaN());
       if (power) *power = std::numeric_limits<double>::quiet_NaN();
       return std::numeric_limits<double>::quiet_NaN();

@@ -38,6 +38,7 @@
 //
 // All vectors of size dofs() are "reduced"; of size coordinates() "full".
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -627,10 +628,20 @@ class MultibodyModel {
   // Counts `units` of work on the stop poll; true when the run should stop.
   // Element loops ask the stop poll once per this many elements.
   static constexpr int64_t kPollElements = 64;
+  // The elements from k to the end of its chunk (the work one poll counts,
+  // the same units as one poll per element).
+  static int64_t ChunkOf(size_t k, size_t count) {
+    return std::min<int64_t>(kPollElements, static_cast<int64_t>(count - k));
+  }
   bool StopNow(int64_t units) const { return stop_poll_ != nullptr && stop_poll_->Poll(units); }
   // The force contributors the scene uses (none in most scenes), summed in
   // this order; and typed views of some of them for the accessors above.
   std::vector<std::unique_ptr<ForceContributor>> contributors_;
+  // NetForce's applied loads: the sum of the contributors' constant ones
+  // (empty if none) and the contributors whose applied load varies, in the
+  // list's order (ModelBuilder::Contributors).
+  Eigen::VectorXd constant_applied_;
+  std::vector<const ForceContributor*> varying_applied_;
   const BodyFluidForces* body_fluid_ = nullptr;
   const BodySeabedContact* body_contact_ = nullptr;
   const SlidingJoints* sliders_ = nullptr;
