@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "engine/steppers/newton_convergence.h"
 
@@ -116,7 +117,9 @@ StaticSolver::IncrementStats StaticSolver::Solve(double alpha, double tolerance)
     iterate.violation = m_ > 0 ? phi_.lpNorm<Eigen::Infinity>() : 0.0;
     MeasureResidual(r, floor_, scale, &iterate);
     if (!std::isfinite(iterate.residual) || !std::isfinite(iterate.violation)) {
-      st.reason = "the residual is not finite";
+      const std::string where = model_->DescribeNonFinite(q_, nullptr, alpha);
+      st.reason = where.empty() ? std::string("the residual is not finite")
+                                : absl::StrCat("the residual is not finite: ", where);
       return st;
     }
     if (it > 0 && last_increment <= tol * iterate.zscale && NewtonConverged(iterate, tol)) {
