@@ -78,6 +78,9 @@ std::string MultibodyModel::DescribeNonFiniteElements(const Eigen::VectorXd& q,
 
 std::string MultibodyModel::DescribeNonFinite(const Eigen::VectorXd& q, const Eigen::VectorXd* qdot,
                                               double load_factor) const {
+  // A stop request fills the forces with NaN on purpose (set_stop_poll):
+  // nothing to name, and no evaluation (it may be costly) once stopping.
+  if (stop_requested()) return "";
   const auto first_bad = [](const Eigen::VectorXd& x) {
     for (int i = 0; i < x.size(); ++i)
       if (!std::isfinite(x(i))) return i;

@@ -412,7 +412,8 @@ class MultibodyModel {
   // terms, the contributors), the first one with a non-finite entry and
   // where ("non-finite force from contributor 'seabed' (cables[1] node
   // 7)", "elastic force, cables[0] element 3"); empty when every term is
-  // finite. Only on a failure path: it allocates.
+  // finite, or once a stop was requested (set_stop_poll's NaN). Only on a
+  // failure path: it allocates.
   std::string DescribeNonFinite(const Eigen::VectorXd& q, const Eigen::VectorXd* qdot,
                                 double load_factor) const;
   // Full coordinate i as a scene place: "cables[c] node n", "bodies[b]".
