@@ -4,12 +4,17 @@
 #include <cmath>
 #include <limits>
 
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "engine/steppers/newton_convergence.h"
 
 namespace cablesim {
 namespace {
 constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
+// Newton iterations of a load increment after which a matrix with
+// negative pivots under constraint rows gets the flipped step rather than
+// only the shift (see Solve).
+constexpr int kShiftOnlyIterations = 100;
 }  // namespace
 
 StaticSolver::StaticSolver(MultibodyModel* model, const SolverSettings& settings)
@@ -116,7 +121,9 @@ StaticSolver::IncrementStats StaticSolver::Solve(double alpha, double tolerance)
     iterate.violation = m_ > 0 ? phi_.lpNorm<Eigen::Infinity>() : 0.0;
     MeasureResidual(r, floor_, scale, &iterate);
     if (!std::isfinite(iterate.residual) || !std::isfinite(iterate.violation)) {
-      st.reason = "the residual is not finite";
+      const std::string where = model_->DescribeNonFinite(q_, nullptr, alpha);
+      st.reason = where.empty() ? std::string("the residual is not finite")
+                                : absl::StrCat("the residual is not finite: ", where);
       return st;
     }
     if (it > 0 && last_increment <= tol * iterate.zscale && NewtonConverged(iterate, tol)) {
@@ -191,13 +198,27 @@ StaticSolver::IncrementStats StaticSolver::Solve(double alpha, double tolerance)
       // r / |k|, so the short wavelengths that the shift would amplify
       // most (sigma M - |K| is smallest for them) move least, and the cable
       // leaves the unstable straight branch in its long, sagging shape
-      // rather than crumpled. With constraints left (m_ > 0) the saddle
-      // point has no such factor: the shift only.
+      // rather than crumpled. With constraints left (m_ > 0) the same by
+      // block elimination with (L|D|L^T)^{-1} (SaddlePointSolver::SolveAbs:
+      // the constraints' linearisation still met): without it the shift
+      // alone stays at about the most negative curvature up to the
+      // solution and Newton converges only linearly there (a compressed
+      // line lying exactly in a coordinate plane, held by coupled
+      // supports' rows, took over 500 iterations). Only after
+      // kShiftOnlyIterations of the shift: the scenes that converge with
+      // it take the path (and reach the digits) they always did.
       const bool flipped = a.negative_pivots() > 0;
       if (flipped) {
-        if (m_ > 0) continue;
-        dx_.head(n_) = -r;
-        a.SolveAbs(dx_.data());
+        if (m_ > 0 && it < kShiftOnlyIterations) continue;
+        if (m_ == 0) {
+          dx_.head(n_) = -r;
+          a.SolveAbs(dx_.data());
+        } else {
+          rhs_ = -rhs_;
+          const bool solved = solver_.SolveAbs(rhs_, &dx_);
+          rhs_ = -rhs_;
+          if (!solved) continue;
+        }
       } else {
         rhs_ = -rhs_;
         const auto ls = solver_.Solve(settings_.linear_solver, rhs_, settings_.linear_tolerance,

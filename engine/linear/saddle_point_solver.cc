@@ -161,11 +161,16 @@ void SaddlePointSolver::Precondition(const Eigen::VectorXd& r, Eigen::VectorXd& 
   }
 }
 
-void SaddlePointSolver::SolveDirect(const Eigen::VectorXd& rhs, Eigen::VectorXd* x) {
+void SaddlePointSolver::SolveDirect(const Eigen::VectorXd& rhs, Eigen::VectorXd* x, bool abs) {
   const int n = a_.size(), m = b_.rows();
-  // x1 <- A^{-1} r1.
+  // x1 <- A^{-1} r1 (y_ and the Schur complement are formed with
+  // (L|D|L^T)^{-1}, the same as A^{-1} when every pivot is positive).
   x->head(n) = rhs.head(n);
-  a_.Solve(x->data());
+  if (abs) {
+    a_.SolveAbs(x->data());
+  } else {
+    a_.Solve(x->data());
+  }
   if (m == 0) return;
   // x2 <- S^{-1} (B A^{-1} r1 - r2).
   auto x2 = x->segment(n, m);
@@ -183,6 +188,19 @@ void SaddlePointSolver::SolveDirect(const Eigen::VectorXd& rhs, Eigen::VectorXd*
   }
   // x1 <- A^{-1} r1 - (A^{-1} B^T) x2.
   x->head(n).noalias() -= y_ * x2;
+}
+
+bool SaddlePointSolver::SolveAbs(const Eigen::VectorXd& rhs, Eigen::VectorXd* x) {
+  if (b_.rows() > 0 && !schur_dense_) return false;
+  if (gamma_ != 0 && b_.rows() > 0) {
+    augmented_rhs_ = rhs;
+    tmp_.head(b_.rows()) = gamma_ * rhs.tail(b_.rows());
+    b_.AddTransposeMultiply(tmp_.data(), augmented_rhs_.data());
+    SolveDirect(augmented_rhs_, x, true);
+  } else {
+    SolveDirect(rhs, x, true);
+  }
+  return true;
 }
 
 SaddlePointSolver::Stats SaddlePointSolver::Solve(LinearSolverKind kind_in,

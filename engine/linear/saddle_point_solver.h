@@ -92,6 +92,12 @@ class SaddlePointSolver {
   Stats Solve(LinearSolverKind kind, const Eigen::VectorXd& rhs, double tolerance,
               int max_iterations, Eigen::VectorXd* x);
 
+  // The modified step of an indefinite A (its pivots' signs flipped, as
+  // SkylineLdlt::SolveAbs): block elimination with (L|D|L^T)^{-1} in place
+  // of A^{-1}, so that B x1 = r2 still holds exactly. False (x untouched)
+  // without the dense Schur complement Prepare forms when it fits.
+  bool SolveAbs(const Eigen::VectorXd& rhs, Eigen::VectorXd* x);
+
   // y = K x.
   void Multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
 
@@ -104,7 +110,7 @@ class SaddlePointSolver {
 
  private:
   // Block elimination (see the class comment); x must not alias rhs.
-  void SolveDirect(const Eigen::VectorXd& rhs, Eigen::VectorXd* x);
+  void SolveDirect(const Eigen::VectorXd& rhs, Eigen::VectorXd* x, bool abs = false);
 
   void Precondition(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
 

@@ -38,6 +38,12 @@ const ForceContributor* MultibodyModel::FindContributor(std::string_view name) c
   return nullptr;
 }
 
+void MultibodyModel::AddContributor(std::unique_ptr<ForceContributor> c) {
+  if (c->dissipates()) has_damping_ = true;
+  if (c->time_dependent()) time_dependent_ = true;
+  contributors_.push_back(std::move(c));
+}
+
 VectorXd MultibodyModel::Reduce(const VectorXd& full) const {
   VectorXd z = VectorXd::Zero(dofs_), norm2 = VectorXd::Zero(dofs_);
   for (int i = 0; i < coordinates(); ++i) {

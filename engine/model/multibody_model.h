@@ -407,6 +407,21 @@ class MultibodyModel {
   const std::vector<std::unique_ptr<ElementTerm>>& element_terms() const {
     return element_terms_;
   }
+  // What made a non-finite force at q (qdot null: positions only), for
+  // a failure message: each term evaluated on its own, in the model's
+  // order (a non-finite state, the elements' elastic force, the element
+  // terms, the contributors), the first one with a non-finite entry and
+  // where ("non-finite force from contributor 'seabed' (cables[1] node
+  // 7)", "elastic force, cables[0] element 3"); empty when every term is
+  // finite, or once a stop was requested (set_stop_poll's NaN). Only on a
+  // failure path: it allocates.
+  std::string DescribeNonFinite(const Eigen::VectorXd& q, const Eigen::VectorXd* qdot,
+                                double load_factor) const;
+  // Full coordinate i as a scene place: "cables[c] node n", "bodies[b]".
+  std::string DescribeCoordinate(int i) const;
+  // Appends a force contributor after the scene's (summed last): a
+  // caller's own force on a built model (the tests inject one this way).
+  void AddContributor(std::unique_ptr<ForceContributor> c);
   // The contributor called `name`, or null.
   const ForceContributor* FindContributor(std::string_view name) const;
 
@@ -490,6 +505,9 @@ class MultibodyModel {
   template <int D>
   double ElementForces(const Eigen::VectorXd& q, Eigen::VectorXd* full, SkylineLdlt* stiffness,
                        double stiffness_scale, Eigen::VectorXd* roundoff) const;
+  template <int D>
+  std::string DescribeNonFiniteElements(const Eigen::VectorXd& q,
+                                        const Eigen::VectorXd* qdot) const;
   template <int D>
   void ElementDiscreteGradientCorrection(const Eigen::VectorXd& q0, const Eigen::VectorXd& q1,
                                          Eigen::VectorXd* full) const;

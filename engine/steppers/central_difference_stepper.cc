@@ -26,11 +26,11 @@ Stepper::StepStats CentralDifferenceStepper::Step(double h) {
   z1_ = z_ + h * v1_;
   if (model_->has_damping()) v_pred_ = v_ + h * a_;
   if (!acceleration_.Evaluate(t_ + h, z1_, v_pred_, &a1_)) {
-    model_->SetTime(t_);
     st.reason = absl::StrFormat(
         "the acceleration after the explicit step is not finite (h = %.3g s: likely beyond "
-        "CENTRAL_DIFFERENCE's stability limit, 2 / omega_max)",
-        h);
+        "CENTRAL_DIFFERENCE's stability limit, 2 / omega_max)%s",
+        h, acceleration_.NotFiniteSource());
+    model_->SetTime(t_);
     return st;
   }
   v1_ += (0.5 * h) * a1_;

@@ -62,11 +62,11 @@ Stepper::StepStats DormandPrinceStepper::Step(double h) {
       vs_[i] += w * as_[j];
     }
     if (!acceleration_.Evaluate(t_ + kC[i] * h, zs_, vs_[i], &as_[i])) {
-      model_->SetTime(t_);
       st.reason = absl::StrFormat(
           "the acceleration at stage %d of the explicit step is not finite (h = %.3g s: likely "
-          "beyond DORMAND_PRINCE's stability limit, 1 to 1.7 / omega_max for undamped modes)",
-          i + 1, h);
+          "beyond DORMAND_PRINCE's stability limit, 1 to 1.7 / omega_max for undamped modes)%s",
+          i + 1, h, acceleration_.NotFiniteSource());
+      model_->SetTime(t_);
       return st;
     }
   }

@@ -96,6 +96,7 @@ class EnergyMomentumStepper final : public ImplicitStepper {
   void ComputeFloor(bool with_floor) override;
   bool FactorMatrix(bool assembled, StepStats* st) override;
   double ApplyCorrection() override;
+  const Eigen::VectorXd& IterateVelocity() const override { return v1_; }
 
   SparseRows jac1_;  // Phi_z(z1) (its values unused; Constraints fills it with Phi)
   SparseRows jacm_;  // Phi_z(zm), copied into the solver when it factors

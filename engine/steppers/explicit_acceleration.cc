@@ -100,4 +100,10 @@ bool ExplicitAcceleration::Evaluate(double t, const Eigen::VectorXd& z,
   return acc->allFinite();
 }
 
+std::string ExplicitAcceleration::NotFiniteSource() const {
+  const std::string where =
+      model_->DescribeNonFinite(q_, model_->has_damping() ? &qd_ : nullptr, 1.0);
+  return where.empty() ? std::string() : absl::StrCat(": ", where);
+}
+
 }  // namespace cablesim

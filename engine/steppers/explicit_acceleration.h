@@ -49,6 +49,10 @@ class ExplicitAcceleration {
   // acc = M^-1 f(t, z, v); false when it is not finite.
   bool Evaluate(double t, const Eigen::VectorXd& z, const Eigen::VectorXd& v,
                 Eigen::VectorXd* acc);
+  // After Evaluate returned false: ": " and the force term and place the
+  // non-finite value came from (MultibodyModel::DescribeNonFinite), or
+  // nothing when every term is finite (the mass solve overflowed).
+  std::string NotFiniteSource() const;
 
  private:
   void StartVector();

@@ -1,5 +1,7 @@
 #include "engine/steppers/explicit_stepper.h"
 
+#include "absl/strings/str_cat.h"
+
 namespace cablesim {
 
 ExplicitStepper::ExplicitStepper(MultibodyModel* model, const SolverSettings& settings)
@@ -20,7 +22,8 @@ bool ExplicitStepper::Start(const char* stepper, double limit, const char* limit
   if (!acceleration_.Prepare(stepper, settings_, z_, limit, limit_text, omega_max, reason))
     return false;
   if (!acceleration_.Evaluate(t_, z_, v_, &a_)) {
-    *reason = "the initial acceleration is not finite";
+    *reason = absl::StrCat("the initial acceleration is not finite",
+                           acceleration_.NotFiniteSource());
     return false;
   }
   a_old_ = a_;

@@ -123,6 +123,7 @@ class GeneralizedAlphaStepper final : public ImplicitStepper {
   void ComputeFloor(bool with_floor) override;
   bool FactorMatrix(bool assembled, StepStats* st) override;
   double ApplyCorrection() override;
+  const Eigen::VectorXd& IterateVelocity() const override { return v1_; }
 
   Variant variant_;
   double alpha_m_ = 0, alpha_f_ = 0, beta_ = 0.25, gamma_ = 0.5, w_ = 1;

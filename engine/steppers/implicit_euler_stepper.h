@@ -71,6 +71,7 @@ class ImplicitEulerStepper final : public ImplicitStepper {
   void ComputeFloor(bool with_floor) override;
   bool FactorMatrix(bool assembled, StepStats* st) override;
   double ApplyCorrection() override;
+  const Eigen::VectorXd& IterateVelocity() const override { return v1_; }
 
   // Newton work vectors (the state and the rounding floor's are
   // ImplicitStepper's). Each step sets the model's time to its end

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+
+#include "absl/strings/str_cat.h"
 
 #include "engine/steppers/newton_convergence.h"
 
@@ -82,7 +85,7 @@ Stepper::StepStats ImplicitStepper::Newton(bool fresh, bool reuse) {
     NewtonIterate iterate;
     if (!BeginIterate(r, scale, phi_, z1_, last_increment, previous_increment,
                       previous_at_floor, &iterate)) {
-      st.reason = kNotFiniteResidual;
+      st.reason = NotFiniteReason();
       return st;
     }
     previous_at_floor = false;
@@ -123,6 +126,16 @@ Stepper::StepStats ImplicitStepper::Newton(bool fresh, bool reuse) {
     last_increment = increment;
   }
   return st;  // not reached: the last iteration returns above
+}
+
+std::string ImplicitStepper::NotFiniteReason() const {
+  Eigen::VectorXd q(model_->coordinates()), qdot(model_->coordinates());
+  model_->ToFull(z1_, &q);
+  model_->RateToFull(IterateVelocity(), &qdot);
+  const std::string where =
+      model_->DescribeNonFinite(q, model_->has_damping() ? &qdot : nullptr, 1.0);
+  return where.empty() ? std::string(kNotFiniteResidual)
+                       : absl::StrCat(kNotFiniteResidual, ": ", where);
 }
 
 double ImplicitStepper::VelocityResidual(const Eigen::VectorXd& v1, const Eigen::VectorXd& f,

@@ -86,6 +86,13 @@ class ImplicitStepper : public Stepper {
   // Applies the correction dx_ to the unknowns; returns the position
   // increment |dz|_inf it makes [m].
   virtual double ApplyCorrection() = 0;
+  // The velocity the forces of the iterate were evaluated with (for the
+  // failure message of a non-finite residual only).
+  virtual const Eigen::VectorXd& IterateVelocity() const { return v_; }
+  // kNotFiniteResidual, with the force term and the place the non-finite
+  // value came from (MultibodyModel::DescribeNonFinite at the iterate):
+  // evaluated on this failure path only.
+  std::string NotFiniteReason() const;
   // Whether an iteration that judges convergence only because it is the
   // last one (not a checking iteration) also takes the forces' rounding
   // bound in the force pass (generalized-alpha does).
