@@ -27,6 +27,7 @@ v1::ModelInfo ModelInfoToProto(const ModelInfo& info) {
   p.set_body_orientation(info.body_orientation);
   for (const std::string& name : info.bending_moment_probe_names)
     p.add_bending_moment_probe_names(name);
+  for (const int j : info.release_joints) p.add_release_joints(j);
   return p;
 }
 
@@ -54,6 +55,7 @@ ModelInfo ModelInfoFromProto(const v1::ModelInfo& p) {
   info.body_orientation = p.body_orientation();
   info.bending_moment_probe_names.assign(p.bending_moment_probe_names().begin(),
                                          p.bending_moment_probe_names().end());
+  info.release_joints.assign(p.release_joints().begin(), p.release_joints().end());
   return info;
 }
 

@@ -275,6 +275,32 @@ TEST(CliTest, RunWritesSummaryAndCsv) {
   std::remove(scene.c_str());
 }
 
+// Line failure in the CSV: the tiny scene's support lets go at t = 0.01 s;
+// its column joints[0].released ends the frame columns, 0 at t = 0 and at
+// the release (that frame still shows it holding), 1 after; the scene
+// without the release has no such column (the CSV above).
+TEST(CliTest, RunCsvMarksAReleasedJoint) {
+  std::string json = kTinyScene;
+  const std::string pin = R"("a": {"cable": "c", "s": 0})";
+  json.insert(json.find(pin) + pin.size(), R"(, "release": {"time": 0.01})");
+  const std::string scene = WriteTempFile("tiny_release.json", json);
+  const std::string csv =
+      absl::StrCat(::testing::TempDir(), "/cli_test_", ::getpid(), "_tiny_release.csv");
+  const CliResult r = Cli({"run", scene, "--out", csv});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr(R"("releases":[{"joint":0,)"));
+  const std::vector<std::string> lines = ReadLines(csv);
+  ASSERT_EQ(lines.size(), 4);  // header and t = 0, 0.01, 0.02
+  EXPECT_EQ(lines[0], CsvWriter::Header(OneCable({"end"})) + ",joints[0].released");
+  const std::vector<std::string> expected = {"0", "0", "1"};
+  for (int k = 1; k <= 3; ++k) {
+    const std::vector<std::string> cells = absl::StrSplit(lines[k], ',');
+    EXPECT_EQ(cells.back(), expected[k - 1]) << lines[k];
+  }
+  std::remove(csv.c_str());
+  std::remove(scene.c_str());
+}
+
 TEST(CliTest, RunWithoutOut) {
   const std::string scene = WriteTempFile("tiny_no_out.json", kTinyScene);
   const CliResult r = Cli({"run", scene});

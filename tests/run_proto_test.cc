@@ -164,5 +164,26 @@ TEST(RunProtoTest, JointReactionsRoundTrip) {
   EXPECT_EQ(read.reactions[2].moment, frame.reactions[2].moment);
 }
 
+// The joints that may let go survive ModelInfo's round trip, each with a
+// column joints[i].released at the row's end that reads back.
+TEST(RunProtoTest, ReleasedJointsRoundTrip) {
+  ModelInfo info;
+  info.joint_names = {"a", "b", "c"};
+  info.release_joints = {0, 2};
+  const ModelInfo back = ModelInfoFromProto(ModelInfoToProto(info));
+  EXPECT_EQ(back.release_joints, info.release_joints);
+  const std::vector<std::string> columns = FrameColumns(back);
+  const std::vector<std::string> tail(columns.end() - 2, columns.end());
+  EXPECT_EQ(tail, (std::vector<std::string>{"joints[0].released", "joints[2].released"}));
+  Frame frame;
+  frame.joint_released = {0, 1};
+  std::vector<double> row;
+  ForEachFrameValue(frame, [&row](double v) { row.push_back(v); });
+  ASSERT_EQ(row.size(), columns.size());
+  Frame read;
+  FrameReader(back, columns).Read(row, &read);
+  EXPECT_EQ(read.joint_released, frame.joint_released);
+}
+
 }  // namespace
 }  // namespace cablesim

@@ -447,6 +447,7 @@ void RunModalAnalysis(MultibodyModel* model, const SolverSettings& settings, int
   if (model->tension()) model->Tensions(q, 1.0, &frame.probe_tensions, &frame.node_tensions);
   if (model->orientation()) model->Orientations(q, zero, &frame.body_orientation);
   if (model->bending_moment()) model->BendingMoments(q, 1.0, &frame.probe_bending_moments);
+  frame.joint_released = model->joint_released();
   frame.has_contact = model->has_contact();
   frame.constraint_violation = phi.size() ? phi.lpNorm<Eigen::Infinity>() : 0.0;
   summary->energy_initial = summary->energy_final = frame.energy.total;
@@ -493,6 +494,7 @@ void RunModalAnalysis(MultibodyModel* model, const SolverSettings& settings, int
     mode.node_tensions.assign(frame.node_tensions.size(), 0.0);
     mode.body_orientation.assign(frame.body_orientation.size(), 0.0);
     mode.probe_bending_moments.assign(frame.probe_bending_moments.size(), 0.0);
+    mode.joint_released = frame.joint_released;
     mode.probes.resize(samples.size());
     for (size_t p = 0; p < samples.size(); ++p)
       mode.probes[p].position_m = scale * samples[p].velocity_m_s;

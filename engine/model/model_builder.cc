@@ -341,8 +341,13 @@ void ModelBuilder::Probes() {
   MultibodyModel& m = model_;
   // The cable nodes (output.shape), a split node's second half left out.
   m.shape_ = scene_.output.shape;
-  for (const JointSpec& joint : scene_.joints) {
+  for (size_t j = 0; j < scene_.joints.size(); ++j) {
+    const JointSpec& joint = scene_.joints[j];
     m.joint_names_.push_back(joint.name);
+    if (joint.HasRelease()) {
+      m.release_joints_.push_back(static_cast<int>(j));
+      m.joint_released_.push_back(joint.released ? 1.0 : 0.0);
+    }
     if (!scene_.output.reactions) continue;
     m.joint_reaction_values_.push_back(joint.type == JointType::kSlide   ? 0
                                        : joint.type == JointType::kFixed ? 6

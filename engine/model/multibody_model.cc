@@ -143,6 +143,7 @@ ModelInfo MultibodyModel::Info() const {
   info.contact = has_contact();
   info.joint_names = joint_names_;
   info.joint_reaction_values = joint_reaction_values_;
+  info.release_joints = release_joints_;
   if (tension_) {
     for (int p : tension_probe_) info.tension_probe_names.push_back(probe_names_[p]);
   }

@@ -354,6 +354,9 @@ class MultibodyModel {
   // `lambda` null (no multipliers at hand, MODAL): zeros (a row keeps its
   // size).
   bool reactions() const { return !joint_reaction_values_.empty(); }
+  // Per joint of ModelInfo::release_joints: 1 when it has let go (the model
+  // was rebuilt without it, JointRelease), else 0 (Frame::joint_released).
+  const std::vector<double>& joint_released() const { return joint_released_; }
   void Reactions(const Eigen::VectorXd& q, const Eigen::VectorXd* lambda,
                  std::vector<JointReaction>* out) const;
   // With output.tension (tension()): the cable's axial force [N] at every
@@ -602,6 +605,10 @@ class MultibodyModel {
   // reaction in a row (ModelInfo::joint_reaction_values).
   std::vector<std::string> joint_names_;
   std::vector<int> joint_reaction_values_;
+  // The scene joints that may let go (ModelInfo::release_joints) and, per
+  // such joint, 1 when this model was built with it released, else 0.
+  std::vector<int> release_joints_;
+  std::vector<double> joint_released_;
   // output.tension: per probe on a cable, its probe, cable and arc length;
   // per cable its EA [N]; per shape node, its cable.
   bool tension_ = false;

@@ -51,6 +51,8 @@ std::vector<std::string> FrameColumns(const ModelInfo& info, bool with_nodes) {
   for (const std::string& name : info.bending_moment_probe_names) {
     columns.push_back(name + ".bending_moment");
   }
+  for (const int j : info.release_joints)
+    columns.push_back(absl::StrCat("joints[", j, "].released"));
   if (!info.shape || !with_nodes) return columns;
   for (size_t i = 0; i < info.cable_nodes.size(); ++i) {
     for (int k = 0; k < info.cable_nodes[i]; ++k) {
@@ -88,7 +90,8 @@ FrameReader::FrameReader(const ModelInfo& info, absl::Span<const std::string> co
       node_tension_(info.shape && info.node_tension),
       orientation_values_(info.body_orientation ? 10 * static_cast<int>(info.body_names.size())
                                                 : 0),
-      bending_moment_probes_(static_cast<int>(info.bending_moment_probe_names.size())) {
+      bending_moment_probes_(static_cast<int>(info.bending_moment_probe_names.size())),
+      release_joints_(static_cast<int>(info.release_joints.size())) {
   absl::flat_hash_map<std::string_view, int> column;
   for (size_t i = 0; i < columns.size(); ++i) column.emplace(columns[i], static_cast<int>(i));
   for (const std::string& name : FrameColumns(info)) {
@@ -108,6 +111,7 @@ void FrameReader::Read(absl::Span<const double> row, Frame* frame) const {
   frame->node_tensions.resize(node_tension_ ? nodes_ : 0);
   frame->body_orientation.resize(orientation_values_);
   frame->probe_bending_moments.resize(bending_moment_probes_);
+  frame->joint_released.resize(release_joints_);
   frame->reactions.resize(reaction_values_.size());
   for (size_t j = 0; j < reaction_values_.size(); ++j)
     frame->reactions[j].values = reaction_values_[j];

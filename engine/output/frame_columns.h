@@ -25,6 +25,9 @@
 //                bodies[i].qw .qx .qy .qz .roll .pitch .yaw .wx .wy .wz
 //   with output.bending_moment, per probe on a cable
 //                (ModelInfo::bending_moment_probe_names)  NAME.bending_moment
+//   per joint i that may let go (ModelInfo::release_joints, a scene
+//                joint with a `release`)  joints[i].released: 0 while it
+//                holds, 1 from the release on
 //   with output.shape (ModelInfo::shape), per cable i and node k
 //                cables[i].nodes[k].x cables[i].nodes[k].y cables[i].nodes[k].z
 //   with output.shape and output.tension (ModelInfo::node_tension), per
@@ -112,6 +115,7 @@ void ForEachFrameValue(FrameT& frame, Add&& add) {
   for (auto& t : frame.probe_tensions) add(t);
   for (auto& o : frame.body_orientation) add(o);
   for (auto& m : frame.probe_bending_moments) add(m);
+  for (auto& r : frame.joint_released) add(r);
 }
 
 // Calls add(value) for x, y, z of every node of `frame` (empty without
@@ -152,6 +156,7 @@ class FrameReader {
   bool node_tension_ = false;
   int orientation_values_ = 0;
   int bending_moment_probes_ = 0;
+  int release_joints_ = 0;
   // The column of every number of ForEachFrameValue's and then
   // ForEachNodeValue's order, or -1.
   std::vector<int> index_;

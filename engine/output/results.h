@@ -58,6 +58,10 @@ struct ModelInfo {
   // With output.bending_moment: the probes on a cable (scene order), each
   // with a column NAME.bending_moment.
   std::vector<std::string> bending_moment_probe_names;
+  // The joints that may let go (JointSpec::release_time_s, breaking_load_n),
+  // by scene index in scene order, each with a column joints[i].released
+  // after the bending moments. Empty in a scene without a release.
+  std::vector<int> release_joints;
 };
 
 // The force [N] a joint exerts on its side a (a joint to ground: on what it
@@ -162,6 +166,9 @@ struct Frame {
   // ModelInfo::bending_moment_probe_names the cable's bending moment there
   // [N m] (planar: about z; spatial: its size).
   std::vector<double> probe_bending_moments;
+  // Per joint of ModelInfo::release_joints: 0 while it holds, 1 from the
+  // state at which it let go on (JointRelease). Empty without a release.
+  std::vector<double> joint_released;
 };
 
 class FrameSink {

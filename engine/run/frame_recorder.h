@@ -48,6 +48,7 @@ class FrameRecorder {
       model_->Tensions(q_, load_factor, &frame_.probe_tensions, &frame_.node_tensions);
     }
     if (model_->orientation()) model_->Orientations(q_, qd_, &frame_.body_orientation);
+    frame_.joint_released = model_->joint_released();
     if (model_->bending_moment()) {
       model_->BendingMoments(q_, load_factor, &frame_.probe_bending_moments);
     }
