@@ -70,6 +70,42 @@ Eigen::Vector3d MultibodyModel::WinchTension(const VectorXd& q, int w) const {
   return f;
 }
 
+template <int D>
+double MultibodyModel::WinchPotentialRate(const VectorXd& q, const VectorXd& qdot) const {
+  constexpr int kN = 4 * D;
+  double power = 0;
+  for (const WinchData& w : winches_) {
+    const int n = w.element_end - w.element_begin;
+    const WinchReel::State now = w.reel.At(time_);
+    if (now.rate == 0) continue;
+    const double l = now.length / n, ldot = now.rate / n, dl = 1e-5 * l;
+    for (int index = w.element_begin; index < w.element_end; ++index) {
+      const ElementData<D>& data = Elements<D>()[index];
+      const ElementCoords<D> qe = q.segment<kN>(data.first_coord);
+      // The element's stored energy at length `length`, e fixed.
+      auto energy = [&](double length) {
+        AncfCableElement<D> element = data.element;
+        element.set_length(length);
+        const auto se = element.StrainEnergy(qe);
+        double u = se.axial + se.bending;
+        const ElementAt<D> at{element, index, time_, data.first_coord, &q, &qdot};
+        for (const ElementTerm* t : potential_terms_) t->AddElementEnergy(at, qe, &u);
+        return u;
+      };
+      power += ldot * (energy(l + dl) - energy(l - dl)) / (2 * dl);
+    }
+  }
+  return power;
+}
+
+double MultibodyModel::ExternalPower(const VectorXd& q, const VectorXd& qdot) const {
+  if (winches_.empty()) return 0;
+  double power = dim_ == 2 ? WinchPotentialRate<2>(q, qdot) : WinchPotentialRate<3>(q, qdot);
+  const ForceState state = StateAt(q, &qdot, 1.0);
+  for (const auto& c : contributors_) c->AddExternalPower(state, &power);
+  return power;
+}
+
 template void MultibodyModel::UpdateWinches<2>();
 template void MultibodyModel::UpdateWinches<3>();
 template Eigen::Vector3d MultibodyModel::WinchTension<2>(const VectorXd&, int) const;

@@ -158,7 +158,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       }
     }
     dense.BeginStep(*stepper);
-    external_work.Before(stepper->z(), t, stepper->lambda());
+    external_work.Before(stepper->z(), t, stepper->lambda(), &stepper->v());
     const auto st = stepper->Step(h_try);
     if (model->stop_requested()) {  // the step was cut short (StopPoll)
       stepper->Restore();
@@ -229,7 +229,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
         t_anchor = t;
         tick_anchor = tick;
       }
-      external_work.After(stepper->z(), t, stepper->lambda(), 1);
+      external_work.After(stepper->z(), t, stepper->lambda(), 1, &stepper->v());
       // Every run's error estimate: the stepper's embedded local error
       // (one pass over the unknowns), absolute and against the tolerance.
       // Without a relative tolerance the ratio is the estimate over the
