@@ -291,10 +291,10 @@ class MultibodyModel {
   // tension at the drum times the paid-in speed, with the energy the
   // material carries through the drum) as this discretisation sees it:
   // it books exactly what the semi-discrete equations exchange. dV/dt|_q
-  // = ldot dV/dl per element: the strain and contact energies' by a central
-  // difference in l (relative step 1e-5: truncation ~1e-10, rounding
-  // ~1e-11 of the element's energy over l), gravity's exactly
-  // (GravityLoads::AddExternalPower). 0 without winches.
+  // = ldot dV/dl per element: the strain and contact energies' by central
+  // differences in l extrapolated to fourth order (WinchPotentialRate),
+  // gravity's exactly (GravityLoads::AddExternalPower). 0 without
+  // winches.
   double ExternalPower(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot) const;
   bool has_external_power() const { return !winches_.empty(); }
   // Adds work [J] to the external work's sum (ExternalWork's integral of
