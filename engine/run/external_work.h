@@ -21,7 +21,6 @@ class ExternalWork {
     if (!model->has_external_work() && !model->has_external_power()) return;
     before_.setZero(model->coordinates());
     after_.setZero(model->coordinates());
-    rate_.setZero(model->coordinates());
     if (model->has_external_power()) rate_.setZero(model->coordinates());
     lambda_before_.setZero(model->multipliers());
   }
