@@ -38,6 +38,9 @@
 //    AddDissipative.
 //  - AddStepWork: work done over a step by external agents that have no
 //    potential (torques, time-varying loads) [J].
+//  - AddExternalPower: the power [W] an agent that drives the contributor's
+//    time dependence feeds into the energy (a winch reeling its cable):
+//    the model integrates it over each step (MultibodyModel::ExternalPower).
 //  - AddStaticFriction: its share of static friction (STATIC analyses).
 //  - SetTime: time-dependent data at time t.
 //  - name(): its energy column's name (per-feature energy reporting).
@@ -156,6 +159,15 @@ class ForceContributor {
   virtual void AddStepWork(const StepEnds& e, double* work) const {
     (void)e;
     (void)work;
+  }
+  // Adds the power [W] a prescribed time dependence feeds into the energy at
+  // s (at the time of SetTime): the explicit rate dU/dt|_q of its stored
+  // energy, plus, for a velocity-dependent force f_v that is not all
+  // dissipation, f_v . qdot + its dissipated power (what the agent supplies
+  // besides). A running sum. Needs s.qdot.
+  virtual void AddExternalPower(const ForceState& s, double* power) const {
+    (void)s;
+    (void)power;
   }
   // Whether AddDissipative adds anything (the model's has_damping()).
   virtual bool dissipates() const { return false; }

@@ -84,6 +84,24 @@ void GravityLoads<D>::AddEnergyParts(const ForceState& s, EnergyParts* parts) co
   if (loads_.size() > 0) parts->loads -= load_factor * loads_.dot(q);
 }
 
+template <int D>
+void GravityLoads<D>::AddExternalPower(const ForceState& s, double* power) const {
+  constexpr int kN = 4 * D;
+  const Eigen::Matrix<double, D, 1> gd = g_.head<D>();
+  for (const Winch& w : winches_) {
+    const int n = w.element_end - w.element_begin;
+    const WinchReel::State now = w.reel.At(s.time);
+    const double l = now.length / n, ldot = now.rate / n;
+    if (ldot == 0) continue;
+    for (int k = w.element_begin; k < w.element_end; ++k) {
+      const Coords dq_dl =
+          AncfCableElement<D>::GravityForceOfLength(2 * l, elements_[k].weight_per_length, gd) /
+          (2 * l);
+      *power -= s.load_factor * ldot * dq_dl.dot(s.q->template segment<kN>(elements_[k].first_coord));
+    }
+  }
+}
+
 template class GravityLoads<2>;
 template class GravityLoads<3>;
 

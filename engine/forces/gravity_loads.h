@@ -74,6 +74,11 @@ class GravityLoads : public ForceContributor {
   void AddAppliedLoad(const ForceState& s, ForceOutput* out) const override;
   double StoredEnergy(const ForceState& s) const override;
   void AddEnergyParts(const ForceState& s, EnergyParts* parts) const override;
+  // A winch element's gravity Q_g(l) = mu l [g/2, l g/12, g/2, -l g/12]
+  // changes with its length l(t) = L(t) / N: the explicit rate of the
+  // potential -Q_g . e is -ldot dQ_g/dl . e, dQ_g/dl = Q_g(2 l) / (2 l)
+  // (exact for Q_g = a l + b l^2).
+  void AddExternalPower(const ForceState& s, double* power) const override;
 
  private:
   std::vector<Element> elements_;

@@ -179,6 +179,34 @@ void WinchCables<D>::AddDissipatedPower(const ForceState& s, double* power) cons
 }
 
 template <int D>
+void WinchCables<D>::AddExternalPower(const ForceState& s, double* power) const {
+  const VectorXd& q = *s.q;
+  const VectorXd& qdot = *s.qdot;
+  Coords fd;
+  size_t slot = 0;
+  for (size_t i = 0; i < winches_.size(); ++i) {
+    const Winch& w = winches_[i];
+    for (int k = 0; k < static_cast<int>(w.elements.size()); ++k, ++slot) {
+      const Now& at = now_[slot];
+      const int first = w.elements[k].first_coord;
+      const auto qe = q.segment<kN>(first);
+      const auto ve = qdot.segment<kN>(first);
+      for (int d = 0; d < D; ++d) {
+        for (int a = 0; a < 4; ++a) {
+          for (int b = 0; b < 4; ++b) {
+            *power -= ve(D * a + d) * (0.5 * at.mdot(a, b) * ve(D * b + d) +
+                                       at.ce(a, b) * qe(D * b + d));
+          }
+        }
+      }
+      fd.setZero();
+      *power += Damping(w, state_[i], k, at, q, qdot, &fd, nullptr);
+      *power += fd.dot(ve);
+    }
+  }
+}
+
+template <int D>
 std::unique_ptr<ForceContributor> MakeWinchCables(
     std::vector<typename WinchCables<D>::Winch> winches) {
   if (winches.empty()) return nullptr;

@@ -62,6 +62,14 @@ class WinchCables : public ForceContributor {
   bool dissipates() const override { return true; }
   void AddDissipative(const ForceState& s, ForceOutput* out) const override;
   void AddDissipatedPower(const ForceState& s, double* power) const override;
+  // What the reel feeds in through the moving mesh, per element:
+  // f . edot + 1/2 edot^T Mdot edot + P_d, f = -cv edot - ce e + f_d this
+  // contributor's force, Mdot = ldot dM/dl the rate of the model's mass
+  // (whose kinetic energy 1/2 edot^T M(t) edot the model reports) and P_d
+  // the damping's power (energy.damped's share): with the skew part of cv
+  // dropping out, -1/2 edot^T Mdot edot - edot^T ce e + (f_d . edot + P_d)
+  // (MultibodyModel::ExternalPower has the derivation).
+  void AddExternalPower(const ForceState& s, double* power) const override;
 
  private:
   // Per element at the time of SetTime: the scalar mass matrix and the

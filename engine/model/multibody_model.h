@@ -272,6 +272,35 @@ class MultibodyModel {
                               double t_before, double t_after,
                               const Eigen::VectorXd& lambda_before,
                               const Eigen::VectorXd& lambda_after, double load_factor);
+  // The winches' power [W] at (q, qdot) and the time of SetTime: what a
+  // reel that prescribes L(t) feeds into the energy Energy() reports.
+  // Derivation (docs/model.md, "Winches"): that energy is
+  // E = 1/2 qdot^T M(t) qdot + V(q, t), V the strain, contact and gravity
+  // energies with the winch elements at l(t) = L(t) / N, and the motion
+  // obeys M qddot = -dV/dq + f_w + f_d - Phi_q^T lambda (f_w the winch
+  // cables' convective force -cv edot - ce e, f_d the damping). So
+  //   dE/dt = 1/2 qdot^T Mdot qdot + dV/dt|_q + qdot . (f_w + f_d)
+  //           - lambda^T Phi_q qdot,
+  // whose last term is the moving supports' (AccumulateExternalWork) and
+  // f_d . qdot = -P_d except on winch cables, whose damping acts on the
+  // material velocity (energy.damped integrates P_d). With
+  // qdot^T cv qdot = qdot^T Mdot qdot (the skew ldot (G - G^T) drops out),
+  //   P_w = dV/dt|_q - 1/2 edot^T Mdot edot - edot^T ce e + (f_d . edot + P_d)
+  // summed over the winch elements, and
+  //   d/dt (E + damped - W_supports - W_winch) = 0, W_winch = int P_w dt.
+  // Physically P_w is the drive's work on the modelled line (the line
+  // tension at the drum times the paid-in speed, with the energy the
+  // material carries through the drum) as this discretisation sees it:
+  // it books exactly what the semi-discrete equations exchange. dV/dt|_q
+  // = ldot dV/dl per element: the strain and contact energies' by central
+  // differences in l extrapolated to fourth order (WinchPotentialRate),
+  // gravity's exactly (GravityLoads::AddExternalPower). 0 without
+  // winches.
+  double ExternalPower(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot) const;
+  bool has_external_power() const { return !winches_.empty(); }
+  // Adds work [J] to the external work's sum (ExternalWork's integral of
+  // ExternalPower over a step).
+  void AddExternalWork(double work) { external_work_ += work; }
   // Starts the sum over (a new run of the same model).
   void ResetExternalWork() { external_work_ = 0; }
   double external_work() const { return external_work_; }
@@ -497,6 +526,8 @@ class MultibodyModel {
   // elements' length and mass (the mass matrix, which the steppers factor,
   // is the model's); its forces are contributors (forces/winch_cables.h,
   // and its gravity forces/gravity_loads.h).
+  template <int D>
+  double WinchPotentialRate(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot) const;
   struct WinchData {
     int cable = 0;
     int element_begin = 0, element_end = 0;  // the cable's elements

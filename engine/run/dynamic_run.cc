@@ -70,11 +70,10 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   auto frame_time = [&](long k) { return std::min(duration, k * interval); };
   // The energy guard on a state the stepper reached (a step's end): false
   // (with the summary failed) when its energy rose beyond the limit.
-  // A winch does work that is not summed (MultibodyModel::winches): no
-  // energy guard there. Rises below the model's energy rounding are a
-  // scene at rest.
-  const EnergyGuard guard(model->winches() == 0, summary->energy_initial,
-                          model->energy_roundoff());
+  // A winch's work is summed as a moving support's (MultibodyModel::
+  // ExternalPower), so the guard holds on winch scenes too. Rises below the
+  // model's energy rounding are a scene at rest.
+  const EnergyGuard guard(true, summary->energy_initial, model->energy_roundoff());
   auto EnergyHolds = [&](const EnergySample& e, double t_state) {
     if (guard.Fails(e, rec->energy_scale())) {
       const double rise = guard.Rise(e), scale = EnergyGuard::Scale(e, rec->energy_scale());
@@ -158,7 +157,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       }
     }
     dense.BeginStep(*stepper);
-    external_work.Before(stepper->z(), t, stepper->lambda());
+    external_work.Before(stepper->z(), t, stepper->lambda(), &stepper->v());
     const auto st = stepper->Step(h_try);
     if (model->stop_requested()) {  // the step was cut short (StopPoll)
       stepper->Restore();
@@ -229,7 +228,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
         t_anchor = t;
         tick_anchor = tick;
       }
-      external_work.After(stepper->z(), t, stepper->lambda(), 1);
+      external_work.After(stepper->z(), t, stepper->lambda(), 1, &stepper->v());
       // Every run's error estimate: the stepper's embedded local error
       // (one pass over the unknowns), absolute and against the tolerance.
       // Without a relative tolerance the ratio is the estimate over the

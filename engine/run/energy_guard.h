@@ -3,8 +3,8 @@
 
 // The dynamic run's energy guard. Every scene conserves its total energy
 // plus the work done against damping (gravity and constant loads are
-// potential; the work of torques, time-varying loads and moving supports is
-// counted in the total, MultibodyModel::Energy), so that sum never rises
+// potential; the work of torques, time-varying loads, moving supports and
+// winches is counted in the total, MultibodyModel::Energy), so that sum never rises
 // for the exact solution, and a
 // stepper may lose energy (backward Euler's numerical damping) but a rise
 // means it is unstable at this step (or Newton found a spurious root, such
@@ -13,8 +13,8 @@
 //   total + damped - E(0) > kRiseLimit * scale + floor,
 // scale being the largest energy term seen so far or in this state
 // (kinetic, potential, strain) and floor the model's rounding of the
-// energy (MultibodyModel::energy_roundoff). Off with a winch, whose work
-// is not summed.
+// energy (MultibodyModel::energy_roundoff). A winch's work is summed as
+// the moving supports' (MultibodyModel::ExternalPower).
 
 #include <algorithm>
 #include <cmath>
