@@ -90,7 +90,9 @@ TEST(StepperConformanceTest, EveryStepperReachesItsStatedOrder) {
                 std::string(t.name).c_str(), e1, e2, e3, e1 / e2, e2 / e3, expected);
     EXPECT_GT(e3, 1e-11) << "the finest error must be above the reference's";
     EXPECT_GE(e2 / e3, 0.7 * expected);
-    if (t.order < 5) EXPECT_LE(e2 / e3, 1.5 * expected);
+    if (t.order < 5) {
+      EXPECT_LE(e2 / e3, 1.5 * expected);
+    }
   }
 }
 
