@@ -38,7 +38,6 @@
 //
 // All vectors of size dofs() are "reduced"; of size coordinates() "full".
 
-#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -682,13 +681,8 @@ class MultibodyModel {
   int64_t damping_point_cost_ = 1;
   StopPoll* stop_poll_ = nullptr;
   // Counts `units` of work on the stop poll; true when the run should stop.
-  // Element loops ask the stop poll once per this many elements.
-  static constexpr int64_t kPollElements = 64;
-  // The elements from k to the end of its chunk (the work one poll counts,
-  // the same units as one poll per element).
-  static int64_t ChunkOf(size_t k, size_t count) {
-    return std::min<int64_t>(kPollElements, static_cast<int64_t>(count - k));
-  }
+  // The elastic forces ask the stop poll once per this many elements.
+  static constexpr size_t kPollElements = 64;
   bool StopNow(int64_t units) const { return stop_poll_ != nullptr && stop_poll_->Poll(units); }
   // The force contributors the scene uses (none in most scenes), summed in
   // this order; and typed views of some of them for the accessors above.
