@@ -122,24 +122,27 @@ absl::Status ConvertSolver(ConversionState* state) {
     CABLESIM_RETURN_IF_ERROR(CheckNonNegative("solver.duration", s.duration()));
   }
 
-  out.load_steps = s.has_load_steps() ? s.load_steps() : kDefaultLoadSteps;
-  CABLESIM_RETURN_IF_ERROR(CheckIntRange("solver.load_steps", out.load_steps, 1, kMaxLoadSteps));
+  // An optional count: the scene's value or the default, then its range.
+  const auto count_setting = [](bool has, int value, int fallback, absl::string_view path,
+                                int lo, int hi, int* setting) {
+    *setting = has ? value : fallback;
+    return CheckIntRange(path, *setting, lo, hi);
+  };
+  CABLESIM_RETURN_IF_ERROR(count_setting(s.has_load_steps(), s.load_steps(), kDefaultLoadSteps,
+                                         "solver.load_steps", 1, kMaxLoadSteps, &out.load_steps));
   out.newton_tolerance = s.has_newton_tolerance() ? s.newton_tolerance() : kDefaultNewtonTolerance;
   CABLESIM_RETURN_IF_ERROR(CheckTolerance("solver.newton_tolerance", out.newton_tolerance));
-  out.max_newton_iterations =
-      s.has_max_newton_iterations() ? s.max_newton_iterations() : kDefaultMaxNewtonIterations;
-  CABLESIM_RETURN_IF_ERROR(CheckIntRange("solver.max_newton_iterations", out.max_newton_iterations,
-                                         1, kMaxNewtonIterations));
-  out.max_step_halvings =
-      s.has_max_step_halvings() ? s.max_step_halvings() : kDefaultMaxStepHalvings;
-  CABLESIM_RETURN_IF_ERROR(
-      CheckIntRange("solver.max_step_halvings", out.max_step_halvings, 0, kMaxStepHalvings));
+  CABLESIM_RETURN_IF_ERROR(count_setting(
+      s.has_max_newton_iterations(), s.max_newton_iterations(), kDefaultMaxNewtonIterations,
+      "solver.max_newton_iterations", 1, kMaxNewtonIterations, &out.max_newton_iterations));
+  CABLESIM_RETURN_IF_ERROR(count_setting(
+      s.has_max_step_halvings(), s.max_step_halvings(), kDefaultMaxStepHalvings,
+      "solver.max_step_halvings", 0, kMaxStepHalvings, &out.max_step_halvings));
   out.linear_tolerance = s.has_linear_tolerance() ? s.linear_tolerance() : kDefaultLinearTolerance;
   CABLESIM_RETURN_IF_ERROR(CheckTolerance("solver.linear_tolerance", out.linear_tolerance));
-  out.max_linear_iterations =
-      s.has_max_linear_iterations() ? s.max_linear_iterations() : kDefaultMaxLinearIterations;
-  CABLESIM_RETURN_IF_ERROR(CheckIntRange("solver.max_linear_iterations", out.max_linear_iterations,
-                                         1, kMaxLinearIterations));
+  CABLESIM_RETURN_IF_ERROR(count_setting(
+      s.has_max_linear_iterations(), s.max_linear_iterations(), kDefaultMaxLinearIterations,
+      "solver.max_linear_iterations", 1, kMaxLinearIterations, &out.max_linear_iterations));
   switch (s.preconditioner()) {
     case v1::Solver::PRECONDITIONER_UNSPECIFIED:
     case v1::Solver::BLOCK:
