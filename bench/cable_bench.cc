@@ -110,7 +110,7 @@ Scene PinnedCable(const std::string& name, double length, int elements, double d
   scene.solver.duration_s = duration;
   scene.solver.step_s = 1e-4;
   scene.solver.output_interval_s = 1e-3;
-  scene.solver.integrator = Integrator::kImplicitEuler;
+  scene.solver.Use(Integrator::kImplicitEuler);
   scene.solver.linear_solver = linear_solver;
   return scene;
 }
@@ -139,7 +139,7 @@ class TipSink : public FrameSink {
 
 Scene FastPendulum(Integrator integrator, LinearSolverKind ls, double step) {
   Scene scene = FallingPendulum(ls);
-  scene.solver.integrator = integrator;
+  scene.solver.Use(integrator);
   scene.solver.step_s = step;
   scene.solver.output_interval_s = 0.01;
   return scene;
@@ -264,7 +264,7 @@ void BM_FallingPendulum_Fastest_Statistics(benchmark::State& state) {
 // HHT needs rho_infinity 0.9 (alpha = -0.053) for the same error bound.
 void BM_FallingPendulum_Fastest_Hht(benchmark::State& state) {
   Scene scene = Fastest();
-  scene.solver.integrator = Integrator::kHht;
+  scene.solver.Use(Integrator::kHht);
   scene.solver.rho_infinity = 0.9;
   RunBenchmark(state, scene);
 }
@@ -364,7 +364,7 @@ void BM_StepScaling_Direct(benchmark::State& state) {
   Scene scene = PinnedCable("soft-cable", 2.0, static_cast<int>(state.range(0)), 1000, 1e7,
                             kPi * d * d / 4, kPi * d * d * d * d / 64, 1e-3,
                             LinearSolverKind::kDirect);
-  scene.solver.integrator = Integrator::kHht;
+  scene.solver.Use(Integrator::kHht);
   scene.solver.step_s = 1e-5;
   scene.solver.output_interval_s = 1e-4;
   RunBenchmark(state, scene);
@@ -382,9 +382,9 @@ void BM_SteelCable(benchmark::State& state) {
   Scene scene = PinnedCable("steel-cable", 10.0, static_cast<int>(state.range(0)), 7850, 2e11,
                             kPi * d * d / 4, kPi * d * d * d * d / 64, 5e-3,
                             LinearSolverKind::kAuto);
-  scene.solver.integrator = state.range(1) == 0   ? Integrator::kHht
+  scene.solver.Use(state.range(1) == 0   ? Integrator::kHht
                             : state.range(1) == 1 ? Integrator::kGeneralizedAlpha
-                                                  : Integrator::kImplicitEuler;
+                                                  : Integrator::kImplicitEuler);
   scene.solver.reuse_factorization = state.range(1) != 2;
   scene.solver.step_s = 1e-4;
   scene.solver.output_interval_s = 0;

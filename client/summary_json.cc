@@ -116,6 +116,17 @@ std::string SummaryToJson(const RunSummary& summary) {
       releases.push_back(item.ToString());
     }
     json.AddJson("releases", JsonArray(releases));
+    // Which stepper ran when (AUTO may change it during the run).
+    std::vector<std::string> segments;
+    for (const IntegratorSegment& g : summary.integrator_segments) {
+      JsonLine item;
+      item.Add("integrator", g.integrator)
+          .Add("start_s", g.start_s)
+          .Add("steps", g.steps)
+          .Add("reason", g.reason);
+      segments.push_back(item.ToString());
+    }
+    json.AddJson("integrator_segments", JsonArray(segments));
     if (summary.has_error_estimate) {
       if (summary.error_estimate_m >= 0) json.Add("error_estimate_m", summary.error_estimate_m);
       json.Add("error_estimate_method", summary.error_estimate_method)

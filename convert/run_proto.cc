@@ -145,6 +145,13 @@ v1::RunSummary SummaryToProto(const RunSummary& s) {
   for (const std::string& w : s.warnings) p.add_warnings(w);
   p.set_integrator_requested(s.integrator_requested);
   p.set_integrator_reason(s.integrator_reason);
+  for (const IntegratorSegment& e : s.integrator_segments) {
+    v1::IntegratorSegment* g = p.add_integrator_segments();
+    g->set_integrator(e.integrator);
+    g->set_start_s(e.start_s);
+    g->set_steps(e.steps);
+    g->set_reason(e.reason);
+  }
   for (const JointReleaseEvent& e : s.releases) {
     v1::JointRelease* r = p.add_releases();
     r->set_joint(e.joint);
@@ -202,6 +209,8 @@ RunSummary SummaryFromProto(const v1::RunSummary& p) {
   s.warnings.assign(p.warnings().begin(), p.warnings().end());
   s.integrator_requested = p.integrator_requested();
   s.integrator_reason = p.integrator_reason();
+  for (const v1::IntegratorSegment& g : p.integrator_segments())
+    s.integrator_segments.push_back({g.integrator(), g.start_s(), g.steps(), g.reason()});
   for (const v1::JointRelease& r : p.releases())
     s.releases.push_back({r.joint(), r.name(), r.time_s(), r.force_n(), r.cause()});
   return s;

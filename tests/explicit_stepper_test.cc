@@ -285,7 +285,7 @@ TEST(ExplicitStepperTest, ScenesWithConstraintRowsAreRefusedNamingTheField) {
                 "b": {"body": "hook", "point": {"y": 0.1}}}],
     "solver": {"duration": 1, "integrator": "CENTRAL_DIFFERENCE"}})");
   for (Integrator integrator : {Integrator::kDormandPrince, Integrator::kCentralDifference}) {
-    scene.solver.integrator = integrator;
+    scene.solver.Use(integrator);
     const auto model = MultibodyModel::Build(scene);
     ASSERT_FALSE(model.ok());
     EXPECT_EQ(model.status().code(), absl::StatusCode::kInvalidArgument);

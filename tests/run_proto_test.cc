@@ -71,6 +71,7 @@ RunSummary EveryFieldSet() {
   s.error_tolerance_m = 0.037;
   s.warnings = {"one", "two \"quoted\""};
   s.releases = {{1, "fairlead", 10.5, 1234.5, "time"}, {3, "", 12.25, 98.5, "breaking_load"}};
+  s.integrator_segments = {{"CENTRAL_DIFFERENCE", 0, 120, "fits"}, {"HHT", 0.25, 64, "stiffer"}};
   return s;
 }
 
@@ -79,6 +80,11 @@ TEST(RunProtoTest, SummaryRoundTripKeepsEveryKeyOfTheSummaryLine) {
   EXPECT_EQ(SummaryToJson(SummaryFromProto(SummaryToProto(s))), SummaryToJson(s));
   // (The summary line prints the releases.)
   EXPECT_NE(SummaryToJson(s).find(R"("releases":[{"joint":1,"name":"fairlead","time_s":10.5,)"),
+            std::string::npos)
+      << SummaryToJson(s);
+  EXPECT_NE(SummaryToJson(s).find(
+                R"("integrator_segments":[{"integrator":"CENTRAL_DIFFERENCE","start_s":0,)"
+                R"("steps":120,"reason":"fits"},{"integrator":"HHT","start_s":0.25,"steps":64,)"),
             std::string::npos)
       << SummaryToJson(s);
   s.analysis = "MODAL";  // frequencies_hz is printed for MODAL only

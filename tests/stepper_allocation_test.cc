@@ -343,7 +343,7 @@ void ExpectEveryStepperDoesNotAllocate(Scene scene, double h, int steps) {
   for (Integrator integrator : {Integrator::kImplicitEuler, Integrator::kGeneralizedAlpha,
                                 Integrator::kHht, Integrator::kEnergyMomentum}) {
     SCOPED_TRACE(::testing::Message() << "integrator " << static_cast<int>(integrator));
-    scene.solver.integrator = integrator;
+    scene.solver.Use(integrator);
     ExpectStepsDoNotAllocate(scene, h, steps);
   }
 }
@@ -380,7 +380,7 @@ Scene FallingPendulum() {
   scene.solver.step_s = 1e-4;
   scene.solver.output_interval_s = 1e-3;
   scene.solver.linear_solver = LinearSolverKind::kMinres;
-  scene.solver.integrator = Integrator::kImplicitEuler;
+  scene.solver.Use(Integrator::kImplicitEuler);
   return scene;
 }
 
@@ -397,7 +397,7 @@ Scene SampleScene(const std::string& file) {
 Scene CableWithEndCylinder(LinearSolverKind linear_solver) {
   Scene scene = SampleScene("cable-with-end-cylinder.json");
   scene.solver.linear_solver = linear_solver;
-  scene.solver.integrator = Integrator::kImplicitEuler;
+  scene.solver.Use(Integrator::kImplicitEuler);
   return scene;
 }
 
@@ -458,7 +458,7 @@ TEST_F(StepperAllocationTest, DampedStepsDoNotAllocate) {
                                         << " spatial " << spatial);
       Scene scene = CableWithEndCylinder(LinearSolverKind::kMinres);
       ASSERT_FALSE(scene.bodies.empty());
-      scene.solver.integrator = integrator;
+      scene.solver.Use(integrator);
       if (spatial) scene.initial_velocity.angular_rad_s = Eigen::Vector3d(0, 4, 0);
       CableSpec& cable = scene.cables[0];
       cable.axial_damping_s = 1e-3;
@@ -507,7 +507,7 @@ TEST_F(StepperAllocationTest, ManyConstraintRowsDoNotAllocate) {
   scene.joints.push_back(first01);
   scene.joints.push_back(first12);
   scene.solver.step_s = 1e-3;
-  scene.solver.integrator = Integrator::kImplicitEuler;
+  scene.solver.Use(Integrator::kImplicitEuler);
   absl::StatusOr<MultibodyModel> model = MultibodyModel::Build(scene);
   ASSERT_TRUE(model.ok()) << model.status();
   ASSERT_GE(model->multipliers(), 400);
@@ -515,7 +515,7 @@ TEST_F(StepperAllocationTest, ManyConstraintRowsDoNotAllocate) {
   // And with the second-order steppers and the direct solver.
   for (Integrator integrator : {Integrator::kGeneralizedAlpha, Integrator::kHht}) {
     for (LinearSolverKind ls : {LinearSolverKind::kMinres, LinearSolverKind::kDirect}) {
-      scene.solver.integrator = integrator;
+      scene.solver.Use(integrator);
       scene.solver.linear_solver = ls;
       ExpectStepsDoNotAllocate(scene, 1e-3, 3);
     }
@@ -534,12 +534,12 @@ TEST_F(StepperAllocationTest, AlphaSteppersDoNotAllocate) {
                                         << " solver " << static_cast<int>(ls) << " reuse "
                                         << reuse);
         Scene pendulum = FallingPendulum();
-        pendulum.solver.integrator = integrator;
+        pendulum.solver.Use(integrator);
         pendulum.solver.linear_solver = ls;
         pendulum.solver.reuse_factorization = reuse;
         ExpectStepsDoNotAllocate(pendulum, 1e-3, 50);
         Scene cylinder = CableWithEndCylinder(ls);
-        cylinder.solver.integrator = integrator;
+        cylinder.solver.Use(integrator);
         cylinder.solver.reuse_factorization = reuse;
         ExpectStepsDoNotAllocate(cylinder, 0.005, 50);
       }
@@ -556,12 +556,12 @@ TEST_F(StepperAllocationTest, EnergyMomentumStepperDoesNotAllocate) {
       SCOPED_TRACE(::testing::Message() << "solver " << static_cast<int>(ls) << " reuse "
                                         << reuse);
       Scene pendulum = FallingPendulum();
-      pendulum.solver.integrator = Integrator::kEnergyMomentum;
+      pendulum.solver.Use(Integrator::kEnergyMomentum);
       pendulum.solver.linear_solver = ls;
       pendulum.solver.reuse_factorization = reuse;
       ExpectStepsDoNotAllocate(pendulum, 1e-3, 50);
       Scene cylinder = CableWithEndCylinder(ls);
-      cylinder.solver.integrator = Integrator::kEnergyMomentum;
+      cylinder.solver.Use(Integrator::kEnergyMomentum);
       cylinder.solver.reuse_factorization = reuse;
       ExpectStepsDoNotAllocate(cylinder, 0.005, 50);
     }
@@ -588,7 +588,7 @@ TEST_F(StepperAllocationTest, MovingSupportAndVaryingLoadsDoNotAllocate) {
        {Integrator::kImplicitEuler, Integrator::kGeneralizedAlpha, Integrator::kHht,
         Integrator::kEnergyMomentum}) {
     SCOPED_TRACE(::testing::Message() << "integrator " << static_cast<int>(integrator));
-    scene.solver.integrator = integrator;
+    scene.solver.Use(integrator);
     ExpectStepsDoNotAllocate(scene, 1e-3, 50);
   }
 }
@@ -627,10 +627,10 @@ TEST_F(StepperAllocationTest, ExplicitSteppersDoNotAllocate) {
     // The scene's step is the one Initialize checks against the stability
     // limit; the steps taken are h.
     Scene pendulum = FallingPendulum();
-    pendulum.solver.integrator = integrator;
+    pendulum.solver.Use(integrator);
     pendulum.solver.step_s = 5e-4;
     ExpectStepsDoNotAllocate(pendulum, 5e-4, 50);
-    riser.solver.integrator = integrator;
+    riser.solver.Use(integrator);
     riser.solver.step_s = 1e-4;
     ExpectStepsDoNotAllocate(riser, 1e-4, 50);
   }

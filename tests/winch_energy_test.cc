@@ -38,7 +38,7 @@ Scene Crane(double h, Integrator integrator) {
   EXPECT_TRUE(scene.ok()) << scene.status();
   scene->solver.step_s = h;
   scene->solver.output_interval_s = 0.4;
-  scene->solver.integrator = integrator;
+  scene->solver.Use(integrator);
   if (integrator == Integrator::kGeneralizedAlpha) scene->solver.rho_infinity = 1;  // trapezoidal
   return *scene;
 }

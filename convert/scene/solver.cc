@@ -168,7 +168,10 @@ absl::Status ConvertSolver(ConversionState* state) {
   }
 
   const IntegratorTraits& traits = TraitsOf(out.integrator);
-  out.auto_integrator = s.integrator() == v1::AUTO_STEPPER;
+  // AUTO_STEPPER, and the default for DYNAMIC runs (an unset integrator).
+  out.auto_integrator =
+      s.integrator() == v1::AUTO_STEPPER ||
+      (s.integrator() == v1::INTEGRATOR_UNSPECIFIED && out.analysis == Analysis::kDynamic);
   if (out.auto_integrator) {
     // The settings that only an implicit stepper uses keep AUTO implicit
     // (rather than be ignored by an explicit one, or refused).

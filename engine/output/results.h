@@ -219,6 +219,15 @@ struct JointReleaseEvent {
   std::string cause;    // "time" or "breaking_load"
 };
 
+// A stretch of a DYNAMIC run made by one stepper (AUTO may change it
+// during the run: engine/run/auto_integrator.h).
+struct IntegratorSegment {
+  std::string integrator;  // its name (integrator_traits.h)
+  double start_s = 0;      // the time it took over [s]
+  int64_t steps = 0;       // accepted steps it made
+  std::string reason;      // why it ran (one sentence)
+};
+
 struct RunSummary {
   std::string status = "ok";  // "ok", "failed" or "cancelled"
   std::string error;          // why, when not ok (with the time)
@@ -229,6 +238,9 @@ struct RunSummary {
   // why `integrator` was chosen (engine/run/auto_integrator.h).
   std::string integrator_requested;
   std::string integrator_reason;
+  // DYNAMIC: which stepper ran from when, for how many steps and why; one
+  // segment unless AUTO changed the stepper during the run.
+  std::vector<IntegratorSegment> integrator_segments;
   std::string linear_solver;
   ModelInfo info;
   int64_t frames = 0;

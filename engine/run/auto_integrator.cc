@@ -40,8 +40,21 @@ Integrator Choose(Integrator chosen, const std::string& why, std::string* reason
 
 }  // namespace
 
-Integrator ChooseIntegrator(MultibodyModel* model, const Scene& scene, std::string* reason) {
+std::unique_ptr<Stepper> TryExplicit(MultibodyModel* model, const SolverSettings& settings,
+                                     std::string* why) {
+  SolverSettings trial = settings;
+  trial.integrator = Integrator::kCentralDifference;
+  std::unique_ptr<Stepper> stepper = MakeStepper(model, trial);
+  const bool fits = stepper->Initialize(why);
+  model->SetTime(model->initial_time());
+  if (!fits) stepper.reset();
+  return stepper;
+}
+
+Integrator ChooseIntegrator(MultibodyModel* model, const Scene& scene, std::string* reason,
+                            bool* may_switch) {
   const SolverSettings& s = scene.solver;
+  if (may_switch != nullptr) *may_switch = false;
   if (const std::string need = ImplicitNeed(*model, scene); !need.empty())
     return Choose(Integrator::kHht, need, reason);
   if (s.adaptive) {
@@ -53,15 +66,13 @@ Integrator ChooseIntegrator(MultibodyModel* model, const Scene& scene, std::stri
                   "(and its stability: a growing mode's error is rejected)",
                   reason);
   }
-  SolverSettings trial = s;
-  trial.integrator = Integrator::kCentralDifference;
+  if (may_switch != nullptr) *may_switch = true;
   std::string why;
-  const std::unique_ptr<Stepper> stepper = MakeStepper(model, trial);
-  const bool fits = stepper->Initialize(&why);
-  model->SetTime(0);
-  if (!fits) {
+  if (TryExplicit(model, s, &why) == nullptr) {
     return Choose(Integrator::kHht,
-                  absl::StrCat(std::string(IntegratorName(trial.integrator)), " does not fit: ", why), reason);
+                  absl::StrCat(std::string(IntegratorName(Integrator::kCentralDifference)),
+                               " does not fit: ", why),
+                  reason);
   }
   return Choose(Integrator::kCentralDifference,
                 absl::StrFormat("no constraint rows, winch, contact or fluid, and solver.step "

@@ -22,9 +22,31 @@
 //    growing beyond the stable step raises at once.
 // Then CENTRAL_DIFFERENCE (one force evaluation a step, second order like
 // HHT; adaptive DORMAND_PRINCE, held to its stable step, was 2-7 times
-// slower on the pendulums); else HHT, the default. The step, output
-// interval and tolerance stay the scene's.
+// slower on the pendulums); else HHT. The step, output interval and
+// tolerance stay the scene's. AUTO is the default (an unset
+// solver.integrator, convert/scene/solver.cc).
+//
+// During a fixed-step run (RunDynamic) the choice is revisited when nothing
+// structural rules the explicit steppers out (*may_switch):
+//  - CENTRAL_DIFFERENCE -> HHT when a step's local error estimate exceeds
+//    the run's error tolerance (SolverSettings::error_tolerance_m): the
+//    step is taken back and HHT goes on from the state before it. A mode
+//    that tension or large strain has pushed beyond the stable step grows
+//    geometrically from rounding, so the estimate sees it long before the
+//    energy guard would; an answer the estimate calls inaccurate is not
+//    kept either way.
+//  - HHT -> CENTRAL_DIFFERENCE when a trial start at the current state fits
+//    (h omega_max < 2, TryExplicit): tried after 64 accepted HHT steps,
+//    then after twice as many as the last try each time, so that a scene
+//    that stays stiff, or sits at the edge of the stable step, pays a
+//    logarithmic number of power iterations and switches; back to 64 after
+//    an explicit stretch of at least four times the interval (the choice
+//    was right there).
+// The switch carries the state (z, v) exactly, as a joint's release does;
+// the summary lists each stepper's stretch (RunSummary::
+// integrator_segments).
 
+#include <memory>
 #include <string>
 
 #include "engine/model/multibody_model.h"
@@ -32,9 +54,19 @@
 
 namespace cablesim {
 
+class Stepper;
+
 // The stepper AUTO runs `scene` with, and in *reason why (one sentence).
 // Leaves `model` as it found it (a trial stepper is started on it).
-Integrator ChooseIntegrator(MultibodyModel* model, const Scene& scene, std::string* reason);
+// *may_switch (when given): the run may change stepper (see above).
+Integrator ChooseIntegrator(MultibodyModel* model, const Scene& scene, std::string* reason,
+                            bool* may_switch = nullptr);
+
+// CENTRAL_DIFFERENCE started at the model's initial state with `settings`'
+// step, or null (with *why) when that step is beyond its stable step there.
+// Leaves the model's time at its initial time.
+std::unique_ptr<Stepper> TryExplicit(MultibodyModel* model, const SolverSettings& settings,
+                                     std::string* why);
 
 }  // namespace cablesim
 

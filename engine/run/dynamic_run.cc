@@ -8,6 +8,7 @@
 #include <string>
 
 #include "absl/strings/str_format.h"
+#include "engine/run/auto_integrator.h"
 #include "engine/run/dense_output.h"
 #include "engine/run/energy_guard.h"
 #include "engine/run/external_work.h"
@@ -26,12 +27,17 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       return;
     }
   }
-  std::unique_ptr<Stepper> stepper = MakeStepper(model, settings);
+  // The stepper's settings: the scene's, with the stepper AUTO runs now.
+  SolverSettings stepping = settings;
+  std::unique_ptr<Stepper> stepper = MakeStepper(model, stepping);
   std::string reason;
   if (!stepper->Initialize(&reason)) {
     Fail(summary, 0, reason);
     return;
   }
+  summary->integrator_segments.push_back(
+      {std::string(IntegratorName(stepping.integrator)), 0, 0,
+       settings.auto_integrator ? summary->integrator_reason : "named by the scene"});
   ExternalWork external_work(model);
   model->SetTime(0);
   rec->AdvanceDamping(0, stepper->z(), stepper->v());
@@ -61,7 +67,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   double t_anchor = 0;
   auto ticks_of = [h_min](double step) { return std::llround(step / h_min); };
   // Backward Euler never raises the energy; the second-order steppers may.
-  const bool check_steps = !TraitsOf(settings.integrator).never_raises_energy;
+  bool check_steps = !TraitsOf(stepping.integrator).never_raises_energy;
   summary->min_step_s = settings.adaptive ? std::numeric_limits<double>::infinity() : h_nominal;
   // Steps of h (the last one or two shortened to end on the duration);
   // frames between step ends are interpolated (DenseOutput). A frame's
@@ -115,7 +121,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       return false;
     }
     if (!*let) return true;
-    stepper = MakeStepper(model, settings);
+    stepper = MakeStepper(model, stepping);
     std::string why;
     if (!stepper->Initialize(&why)) {
       Fail(summary, t_state,
@@ -125,6 +131,34 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     return true;
   };
   if (!LetGo(0)) return;
+  // AUTO's change of stepper at the state the stepper holds (time t):
+  // `next` (already started at that state, or null: made and started
+  // here). False (the summary failed) when it cannot start.
+  int64_t hht_steps = 0, next_explicit_try = 64;
+  auto SwitchTo = [&](Integrator to, std::unique_ptr<Stepper> next, const std::string& why,
+                      double t_state) {
+    if (next == nullptr) {
+      model->SetInitialState(stepper->z(), stepper->v(), model->external_work(), t_state);
+      SolverSettings trial = stepping;
+      trial.integrator = to;
+      next = MakeStepper(model, trial);
+      std::string failed;
+      if (!next->Initialize(&failed)) {
+        Fail(summary, t_state,
+             absl::StrFormat("AUTO could not change to %s at t = %.9g s: %s",
+                             std::string(IntegratorName(to)), t_state, failed));
+        return false;
+      }
+    }
+    stepping.integrator = to;
+    stepper = std::move(next);
+    check_steps = !TraitsOf(to).never_raises_energy;
+    hht_steps = 0;
+    summary->integrator_segments.push_back(
+        {std::string(IntegratorName(to)), t_state, 0, why});
+    return true;
+  };
+  const bool may_switch = settings.auto_integrator && settings.auto_may_switch;
   // A step cut to end on a release time leaves the fixed steps' grid; the
   // step after it ends where the uncut step would have (grid_end), so that
   // the frames on the grid stay step ends.
@@ -195,12 +229,36 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
         continue;
       }
     }
+    // AUTO: an explicit step whose error estimate exceeds the run's
+    // tolerance is taken back, and HHT goes on from the step's start.
+    if (st.converged && may_switch && TraitsOf(stepping.integrator).is_explicit) {
+      const double ratio =
+          stepper->LocalErrorNorm(h_try, settings.error_tolerance_m, settings.relative_tolerance);
+      if (!(ratio <= 1)) {
+        stepper->Restore();
+        // Tries back to central difference start again at 64 HHT steps
+        // after a long explicit stretch (the choice was right); after a
+        // short one they stay spaced out (the scene is at the edge).
+        const bool long_stretch =
+            summary->integrator_segments.back().steps >= 4 * next_explicit_try;
+        if (!SwitchTo(Integrator::kHht, nullptr,
+                      absl::StrFormat("CENTRAL_DIFFERENCE's local error estimate was %.3g times "
+                                      "the tolerance (%g m) in the step from t = %.9g s: the "
+                                      "scene stiffened beyond its stable step, or the step is "
+                                      "too long for its accuracy",
+                                      ratio, settings.error_tolerance_m, t),
+                      t))
+          return;
+        if (long_stretch) next_explicit_try = 64;
+        continue;
+      }
+    }
     if (st.converged && settings.adaptive) {
       // Adaptive steps: accept when the local error estimate meets the
       // tolerance, and choose the next step from it either way.
       const double err = stepper->LocalErrorNorm(h_try, settings.tolerance_m,
                                                 settings.relative_tolerance);
-      const double factor = StepFactor(err, TraitsOf(settings.integrator).local_error_order);
+      const double factor = StepFactor(err, TraitsOf(stepping.integrator).local_error_order);
       if (!(err <= 1)) {
         stepper->Restore();
         ++summary->rejected_steps;
@@ -243,6 +301,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
               : stepper->LocalErrorNorm(h_try, settings.error_tolerance_m,
                                         settings.relative_tolerance));
       ++summary->steps;
+      ++summary->integrator_segments.back().steps;
       summary->min_step_s = std::min(summary->min_step_s, h_try);
       summary->max_step_s = std::max(summary->max_step_s, h_try);
       summary->max_newton_residual = std::max(summary->max_newton_residual, st.residual);
@@ -291,6 +350,22 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       summary->end_time_s = t;
       if (grid_end >= 0 && t >= grid_end - 1e-9 * h_nominal) grid_end = -1;
       if (!LetGo(t)) return;
+      // AUTO: HHT back to CENTRAL_DIFFERENCE once the scene admits it.
+      if (may_switch && !TraitsOf(stepping.integrator).is_explicit && h == h_nominal &&
+          ++hht_steps >= next_explicit_try) {
+        next_explicit_try *= 2;
+        hht_steps = 0;
+        model->SetInitialState(stepper->z(), stepper->v(), model->external_work(), t);
+        std::string why;
+        std::unique_ptr<Stepper> trial = TryExplicit(model, stepping, &why);
+        if (trial != nullptr &&
+            !SwitchTo(Integrator::kCentralDifference, std::move(trial),
+                      absl::StrFormat("solver.step (%g s) is within CENTRAL_DIFFERENCE's stable "
+                                      "step again at t = %.9g s (h omega_max < 2)",
+                                      h_nominal, t),
+                      t))
+          return;
+      }
       continue;
     }
     ++summary->rejected_steps;

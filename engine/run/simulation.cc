@@ -96,10 +96,14 @@ absl::StatusOr<RunSummary> RunPrepared(PreparedRun* prepared, FrameSink* sink,
   p.used = true;
   MultibodyModel& model = p.model;
   RunSummary summary;
+  // AUTO holds while the integrator is the one convert/ left (HHT); code
+  // that set another itself meant it (SolverSettings::Use).
+  if (p.scene.solver.integrator != Integrator::kHht) p.scene.solver.auto_integrator = false;
   summary.integrator_requested =
       p.scene.solver.auto_integrator ? "AUTO" : std::string(IntegratorName(p.scene.solver.integrator));
   if (p.scene.solver.auto_integrator && p.scene.solver.analysis == Analysis::kDynamic)
-    p.scene.solver.integrator = ChooseIntegrator(&model, p.scene, &summary.integrator_reason);
+    p.scene.solver.integrator = ChooseIntegrator(&model, p.scene, &summary.integrator_reason,
+                                                 &p.scene.solver.auto_may_switch);
   const Scene& scene = p.scene;
   summary.info = p.info;
   summary.warnings = scene.warnings;

@@ -353,8 +353,19 @@ struct SolverSettings {
   // (engine/run/auto_integrator.h). auto_keep_implicit: when not empty, a
   // setting that applies to implicit steppers only was given (its field),
   // and AUTO keeps HHT.
+  // Code that sets the stepper itself calls Use(), which turns AUTO off
+  // (an assignment to `integrator` other than HHT does too: RunPrepared
+  // chooses only while `integrator` is still HHT).
   bool auto_integrator = false;
   std::string auto_keep_implicit;
+  void Use(Integrator chosen) {
+    integrator = chosen;
+    auto_integrator = false;
+  }
+  // AUTO with fixed steps, when nothing in the scene rules the explicit
+  // steppers out: the run changes between CENTRAL_DIFFERENCE and HHT as
+  // the scene stiffens and softens (set by ChooseIntegrator).
+  bool auto_may_switch = false;
   // Adds an estimate of the run's largest probe-position error to the
   // summary, from a companion run (RunScene).
   bool error_estimate = false;
