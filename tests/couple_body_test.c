@@ -29,6 +29,13 @@
  *     over |F|, 1.8e-3 at w = 0.1 rad/s: below 5e-3 (measured 2.2e-3). A
  *     wrong sign in the moment moves it by 2 |M| / (|F| r) = 0.1, the
  *     transposed rotation moves the fairleads by 2 w r = 4 m.
+ * MoorDyn's names: the same body through MoorDyn_Create / Init / Step with
+ * its 6 coupled degrees of freedom (x, y, z, roll, pitch, yaw; MoorDyn v2's
+ * R = Rx(roll) Ry(pitch) Rz(yaw)) gives the force and moment of the
+ * cablesim-named system driven by the quaternion qx qy qz multiplied out
+ * here, to rounding (1e-9 of |F|: the same equations, so only a wrong
+ * convention or layout can part them; the order Rz Ry Rx instead moves the
+ * fairleads by centimetres, the moment by 1e-3 and more).
  * (c) Bad inputs each return CABLESIM_INVALID_ARGUMENT naming the argument
  *     and leave the system usable: a body that does not exist, a quaternion
  *     that is not unit, a non-finite quaternion, a non-finite angular
@@ -40,6 +47,7 @@
 #include <string.h>
 
 #include "couple/cablesim_couple.h"
+#include "moordyn/MoorDyn2.h"
 #include "tests/c_expect.h"
 
 static const double kAxis[3] = {0, 0.4472135954999579, 0.8944271909999159};
@@ -209,6 +217,54 @@ static double Run(const char* body_file, const char* points_file, double rate, i
   return worst;
 }
 
+/* q = a * b (w, x, y, z). */
+static void Multiply(const double a[4], const double b[4], double q[4]) {
+  q[0] = a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3];
+  q[1] = a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2];
+  q[2] = a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1];
+  q[3] = a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0];
+}
+
+/* The body through MoorDyn's names against cablesim's, one step. */
+static void MoorDynNames(const char* body_file) {
+  const double angles[3] = {0.05, -0.08, 0.3}; /* roll, pitch, yaw [rad] */
+  MoorDyn md = MoorDyn_Create(body_file);
+  CableSimSystem cs = CableSim_Create(body_file);
+  if (md == NULL || cs == NULL) {
+    fprintf(stderr, "create: %s\n", CableSim_ErrorMessage());
+    exit(1);
+  }
+  unsigned int n = 0;
+  EXPECT(MoorDyn_NCoupledDOF(md, &n) == MOORDYN_SUCCESS && n == 6, "MoorDyn dof %u", n);
+  double x[6] = {0.1, 0, 0, angles[0], angles[1], angles[2]}, xd[6] = {0}, f[6];
+  double qx[4] = {cos(angles[0] / 2), sin(angles[0] / 2), 0, 0};
+  double qy[4] = {cos(angles[1] / 2), 0, sin(angles[1] / 2), 0};
+  double qz[4] = {cos(angles[2] / 2), 0, 0, sin(angles[2] / 2)};
+  double qxy[4], q[4], zero[3] = {0, 0, 0}, fb[3], mb[3];
+  Multiply(qx, qy, qxy);
+  Multiply(qxy, qz, q);
+  EXPECT(MoorDyn_Init(md, x, xd) == MOORDYN_SUCCESS, "MoorDyn_Init: %s", CableSim_ErrorMessage());
+  EXPECT(CableSim_SetBodyKinematics(cs, 0, x, q, zero, zero) == CABLESIM_OK &&
+             CableSim_Init(cs, NULL, NULL) == CABLESIM_OK,
+         "CableSim_Init: %s", CableSim_ErrorMessage());
+  double t = 0, dt = 0.05, t2 = 0, dt2 = 0.05;
+  x[0] += 0.02;
+  EXPECT(MoorDyn_Step(md, x, xd, f, &t, &dt) == MOORDYN_SUCCESS, "MoorDyn_Step: %s",
+         CableSim_ErrorMessage());
+  EXPECT(CableSim_SetBodyKinematics(cs, 0, x, q, zero, zero) == CABLESIM_OK &&
+             CableSim_Step(cs, NULL, NULL, NULL, &t2, &dt2) == CABLESIM_OK,
+         "CableSim_Step: %s", CableSim_ErrorMessage());
+  CableSim_GetBodyForces(cs, 0, fb, mb);
+  Compare("MoorDyn's names (roll, pitch, yaw)", f, f + 3, fb, mb, 1e-9);
+  /* A bad angle is named through the 6 it came from. */
+  x[4] = NAN;
+  EXPECT(MoorDyn_Step(md, x, xd, f, &t, &dt) == MOORDYN_INVALID_INPUT &&
+             strstr(CableSim_ErrorMessage(), "coupled body 0") != NULL,
+         "MoorDyn_Step with a NaN pitch: %s", CableSim_ErrorMessage());
+  MoorDyn_Close(md);
+  CableSim_Close(cs);
+}
+
 int main(int argc, char** argv) {
   if (argc != 3) {
     fprintf(stderr, "usage: %s couple_body_coupled.json couple_body_points.json\n", argv[0]);
@@ -216,6 +272,7 @@ int main(int argc, char** argv) {
   }
   const double e1 = Run(argv[1], argv[2], 0.1, 1);
   const double e2 = Run(argv[1], argv[2], 0.05, 0);
+  MoorDynNames(argv[1]);
   printf("ratio %.3f (second order: 4)\n", e1 / e2);
   EXPECT(e1 / e2 >= 3 && e1 / e2 <= 5.5, "the routes differ at order %.2f in w, not 2",
          log(e1 / e2) / log(2));
