@@ -106,5 +106,31 @@ TEST(CoupledBodyPrescribedTest, TheHostsMotionGivesThePrescribedMotionsForces) {
   std::printf("largest difference from the prescribed run: %.3g (of |F|, |F| r)\n", worst);
 }
 
+// A coupled body is held by its host: the scene may not hold it too, nor
+// hang a sliding joint on it (whose force the host would not be told of).
+TEST(CoupledBodyPrescribedTest, TheSceneRefusesAJointToGroundOrASlideOnACoupledBody) {
+  const std::string base = R"({"gravity": {"z": -9.81},
+    "cables": [{"name": "c", "length": 1, "elements": 4, "direction": {"x": 1},
+      "density": 1000, "youngs_modulus": 1e7, "diameter": 0.01}],
+    "bodies": [{"name": "b", "mass": 1, "inertia": {"x": 1, "y": 1, "z": 1},
+      "position": {"x": 1.5}, "coupled": true}],
+    "joints": [{"type": "PIN", "a": {"cable": "c", "s": 0}},
+               JOINT],
+    "solver": {"analysis": "DYNAMIC", "duration": 1, "step": 0.005}})";
+  auto with = [&](const std::string& joint) {
+    std::string json = base;
+    json.replace(json.find("JOINT"), 5, joint);
+    return json;
+  };
+  EXPECT_EQ(testing::SceneError(with(
+                R"({"type": "PIN", "a": {"cable": "c", "s": 1}, "b": {"body": "b", "point": {"x": -0.5}}})")),
+            "ok");
+  EXPECT_EQ(testing::SceneError(with(R"({"type": "PIN", "a": {"body": "b"}})")),
+            "bodies[0].coupled: the host holds the body: joints[1] must not join it to the ground");
+  EXPECT_EQ(testing::SceneError(with(
+                R"({"type": "SLIDE", "a": {"body": "b", "point": {"x": -0.5}}, "b": {"cable": "c", "s": 1}})")),
+            "bodies[0].coupled: joints[1]: a SLIDE joint on a coupled body is not supported");
+}
+
 }  // namespace
 }  // namespace cablesim
