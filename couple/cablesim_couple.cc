@@ -50,34 +50,40 @@ std::vector<Eigen::Vector3d> Points(const double* v, int n) {
   return out;
 }
 
-// Checks the system and the pointer arguments (named) of a call.
-int Check(CableSimSystem sys, std::initializer_list<std::pair<const void*, const char*>> args) {
-  if (sys == nullptr || sys->session == nullptr) {
-    return Error(CABLESIM_INVALID_ARGUMENT, "sys: null (CableSim_Create failed?)");
-  }
+using Args = std::initializer_list<std::pair<const void*, const char*>>;
+
+// The pointer arguments (named) of a call are not null.
+int CheckNonNull(Args args) {
   for (const auto& [p, name] : args) {
     if (p == nullptr) return Error(CABLESIM_INVALID_ARGUMENT, absl::StrCat(name, ": null"));
   }
   return CABLESIM_OK;
 }
 
+// Checks the system and the pointer arguments of a call.
+int Check(CableSimSystem sys, Args args) {
+  if (sys == nullptr || sys->session == nullptr) {
+    return Error(CABLESIM_INVALID_ARGUMENT, "sys: null (CableSim_Create failed?)");
+  }
+  return CheckNonNull(args);
+}
+
 // The coupled points' arrays may be NULL when there are none.
-int CheckPointArrays(CableSimSystem sys,
-                     std::initializer_list<std::pair<const void*, const char*>> args) {
-  if (sys->session->coupled_points() == 0) return CABLESIM_OK;
-  for (const auto& [p, name] : args) {
-    if (p == nullptr) return Error(CABLESIM_INVALID_ARGUMENT, absl::StrCat(name, ": null"));
+int CheckPointArrays(CableSimSystem sys, Args args) {
+  return sys->session->coupled_points() == 0 ? CABLESIM_OK : CheckNonNull(args);
+}
+
+// `index` (the argument `name`) is below `count` (of `what`).
+int CheckIndex(unsigned int index, int count, const char* name, const char* what) {
+  if (index >= static_cast<unsigned int>(count)) {
+    return Error(CABLESIM_INVALID_ARGUMENT, absl::StrFormat("%s: %u is not %s (the scene has %d)",
+                                                            name, index, what, count));
   }
   return CABLESIM_OK;
 }
 
 int CheckBody(CableSimSystem sys, unsigned int body) {
-  const int n = sys->session->coupled_bodies();
-  if (body >= static_cast<unsigned int>(n)) {
-    return Error(CABLESIM_INVALID_ARGUMENT,
-                 absl::StrFormat("body: %u is not a coupled body (the scene has %d)", body, n));
-  }
-  return CABLESIM_OK;
+  return CheckIndex(body, sys->session->coupled_bodies(), "body", "a coupled body");
 }
 
 int CheckFinite(const double* v, int n, const char* name) {
@@ -91,12 +97,7 @@ int CheckFinite(const double* v, int n, const char* name) {
 }
 
 int CheckLine(CableSimSystem sys, unsigned int line) {
-  const int lines = sys->session->cables();
-  if (line >= static_cast<unsigned int>(lines)) {
-    return Error(CABLESIM_INVALID_ARGUMENT,
-                 absl::StrFormat("line: %u is not a line (the scene has %d)", line, lines));
-  }
-  return CABLESIM_OK;
+  return CheckIndex(line, sys->session->cables(), "line", "a line");
 }
 
 int CheckNode(unsigned int node, unsigned int line, size_t nodes) {
