@@ -76,6 +76,29 @@ absl::Status ConvertInitialVelocity(ConversionState* state) {
   return absl::OkStatus();
 }
 
+// A coupled body is held by its host: no joint of the scene holds it to
+// the ground, and a sliding joint on it (a force the host would not be
+// told of) is refused.
+absl::Status CheckCoupledBodies(const Scene& scene) {
+  for (int i = 0; i < static_cast<int>(scene.bodies.size()); ++i) {
+    if (!scene.bodies[i].coupled) continue;
+    for (int j = 0; j < static_cast<int>(scene.joints.size()); ++j) {
+      const JointSpec& joint = scene.joints[j];
+      if (joint.a.body != i && joint.b.body != i) continue;
+      const std::string path = Sub(Indexed("", "bodies", i), "coupled");
+      if (joint.a.IsGround() || joint.b.IsGround()) {
+        return Invalid(path, absl::StrCat("the host holds the body: joints[", j,
+                                          "] must not join it to the ground"));
+      }
+      if (joint.type == JointType::kSlide) {
+        return Invalid(path, absl::StrCat("joints[", j,
+                                          "]: a SLIDE joint on a coupled body is not supported"));
+      }
+    }
+  }
+  return absl::OkStatus();
+}
+
 // Validates a scene and builds the engine's scene from it, stopping at the
 // first invalid field. The order of the sections is the order in which
 // fields are checked (and a later section reads the earlier ones).
@@ -85,6 +108,8 @@ absl::StatusOr<Scene> ConvertScene(const v1::Scene& proto) {
   CABLESIM_RETURN_IF_ERROR(scene_convert::ConvertCables(&state));
   CABLESIM_RETURN_IF_ERROR(scene_convert::ConvertBodies(&state));
   CABLESIM_RETURN_IF_ERROR(scene_convert::ConvertJoints(&state));
+  CABLESIM_RETURN_IF_ERROR(CheckCoupledBodies(state.scene));
+  AddCoupledBodyDrivers(&state.scene);
   CABLESIM_RETURN_IF_ERROR(scene_convert::ConvertLoads(&state));
   CABLESIM_RETURN_IF_ERROR(scene_convert::ConvertProbes(&state));
   CABLESIM_RETURN_IF_ERROR(ConvertInitialVelocity(&state));

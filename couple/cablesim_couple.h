@@ -19,7 +19,10 @@
  * The scene file is a cablesim scene (JSON or text format) whose coupled
  * supports are joints to ground with "coupled": true. The coupled degrees
  * of freedom are 3 per coupled support (x, y, z), in scene order of the
- * joints: x, xd and f have 3 n entries. See docs/coupling.md.
+ * joints: x, xd and f have 3 n entries (NULL allowed when n is 0).
+ * Coupled bodies (bodies with "coupled": true) are set apart:
+ * CableSim_SetBodyKinematics before Init and each Step, and
+ * CableSim_GetBodyForces after. See docs/coupling.md.
  *
  * Every function but Create returns CABLESIM_OK (0) or an error code; on an
  * error CableSim_ErrorMessage() (this thread's last error) says why and
@@ -83,6 +86,43 @@ int CableSim_GetLineNodePos(CableSimSystem sys, unsigned int line, unsigned int 
  * compression; docs/reference/output.md, "Tension along a line"). */
 int CableSim_GetLineTension(CableSimSystem sys, unsigned int line, unsigned int node,
                             double* tension);
+/* Coupled bodies (bodies with "coupled": true, 6 degrees of freedom), in
+ * scene order of the bodies, 0-based. A body's pose is its centre of mass
+ * [m] and its orientation, a unit quaternion q = (w, x, y, z) whose
+ * rotation matrix's columns are the body's local x, y, z axes in the world
+ * (absolute: the scene's own pose is CableSim_GetBodyScenePose). */
+int CableSim_NCoupledBodies(CableSimSystem sys, unsigned int* n);
+int CableSim_GetBodyScenePose(CableSimSystem sys, unsigned int body, double pos[3],
+                              double q[4]);
+/* Sets body `body`'s kinematics for the next CableSim_Init or
+ * CableSim_Step (until then they are the scene's pose at rest): its
+ * centre's position pos [m] and velocity vel [m/s], its orientation q
+ * (w, x, y, z; unit to 1e-6) and angular velocity omega [rad/s], world
+ * axes. Inside a step the centre moves linearly and the body turns about
+ * the fixed axis of q1 q0^-1 at a constant rate (slerp); the velocities
+ * are used at Init only, as the points'. CABLESIM_INVALID_ARGUMENT naming
+ * the argument (a body that does not exist, a non-finite value, a q that
+ * is not unit) leaves the staged kinematics as they were. */
+int CableSim_SetBodyKinematics(CableSimSystem sys, unsigned int body, const double pos[3],
+                               const double q[4], const double vel[3], const double omega[3]);
+/* The force [N] and the moment [N m] (about the centre, world axes) that
+ * the cables and bodies joined to body `body` exert on it: their mean over
+ * the last step (impulse / dt, as CableSim_GetMeanForces), and at the
+ * system's time. */
+int CableSim_GetBodyForces(CableSimSystem sys, unsigned int body, double force[3],
+                           double moment[3]);
+int CableSim_GetBodyEndForces(CableSimSystem sys, unsigned int body, double force[3],
+                              double moment[3]);
+/* The work the host has done on the lines since Init [J]: per step, minus
+ * the mean forces times the points' displacements and minus the bodies'
+ * mean moments times their rotation vectors (docs/coupling.md, "Energy at
+ * the fairleads"). */
+int CableSim_GetHostWork(CableSimSystem sys, double* work);
+/* The scene's mechanical energy now [J] (without the coupled bodies' own
+ * kinetic and gravity energy) and the work done against damping since Init
+ * [J]: host work = energy - energy at Init + dissipated, up to the
+ * integrator's own dissipation. */
+int CableSim_GetEnergy(CableSimSystem sys, double* energy, double* dissipated);
 /* The system's time [s]. */
 int CableSim_GetTime(CableSimSystem sys, double* t);
 /* Frees the system (NULL is allowed). */

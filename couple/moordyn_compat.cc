@@ -36,6 +36,7 @@ struct CableSimMoorDynPoint {
 struct CableSimMoorDynSystem {
   CableSimSystem sys = nullptr;
   unsigned int supports = 0;  // coupled supports (cablesim_couple.h's points)
+  unsigned int bodies = 0;    // coupled bodies (6 DOF each, first)
   // Every point held by a support, by id, and the host's coupled points in
   // its order.
   std::vector<std::unique_ptr<CableSimMoorDynPoint>> owned;
@@ -108,11 +109,48 @@ int CheckSystem(MoorDyn system) {
   return MOORDYN_SUCCESS;
 }
 
-// The host's coupled kinematics (3 per point) to every coupled support's.
+// The host's coupled kinematics (3 per point, after 6 per body) to every
+// coupled support's.
 void Spread(const MoorDyn system, const double* host, std::vector<double>* supports) {
+  host += 6 * system->bodies;
   for (size_t i = 0; i < system->coupled.size(); ++i)
     for (int member : system->coupled[i]->members)
       for (int d = 0; d < 3; ++d) (*supports)[3 * member + d] = host[3 * i + d];
+}
+
+// MoorDyn's body orientation: R = Rx(roll) Ry(pitch) Rz(yaw) as a
+// quaternion (w, x, y, z), and the angular velocity (world axes) of the
+// angles' rates: omega = roll' e_x + pitch' Rx e_y + yaw' Rx Ry e_z.
+void EulerToQuaternion(const double a[3], const double rates[3], double q[4], double omega[3]) {
+  const double c[3] = {std::cos(a[0] / 2), std::cos(a[1] / 2), std::cos(a[2] / 2)};
+  const double s[3] = {std::sin(a[0] / 2), std::sin(a[1] / 2), std::sin(a[2] / 2)};
+  // qx qy qz, each (cos, sin along its axis), multiplied out.
+  q[0] = c[0] * c[1] * c[2] - s[0] * s[1] * s[2];
+  q[1] = s[0] * c[1] * c[2] + c[0] * s[1] * s[2];
+  q[2] = c[0] * s[1] * c[2] - s[0] * c[1] * s[2];
+  q[3] = c[0] * c[1] * s[2] + s[0] * s[1] * c[2];
+  const double cr = std::cos(a[0]), sr = std::sin(a[0]), cp = std::cos(a[1]), sp = std::sin(a[1]);
+  // Rx e_y = (0, cr, sr); Rx Ry e_z = (sp, -sr cp, cr cp).
+  omega[0] = rates[0] + rates[2] * sp;
+  omega[1] = rates[1] * cr - rates[2] * sr * cp;
+  omega[2] = rates[1] * sr + rates[2] * cr * cp;
+}
+
+// Stages the coupled bodies' kinematics of the host's x, xd (6 each, first).
+int SetBodies(MoorDyn system, const double* x, const double* xd) {
+  for (unsigned int b = 0; b < system->bodies; ++b) {
+    double q[4], omega[3];
+    EulerToQuaternion(x + 6 * b + 3, xd + 6 * b + 3, q, omega);
+    const int rc =
+        CableSim_SetBodyKinematics(system->sys, b, x + 6 * b, q, xd + 6 * b, omega);
+    if (rc != CABLESIM_OK) {
+      // Its message names SetBodyKinematics' arguments: say where they came from.
+      SetError(absl::StrCat("x, xd: coupled body ", b, " (degrees of freedom ", 6 * b, " to ",
+                            6 * b + 5, "): ", CableSim_ErrorMessage()));
+      return rc;
+    }
+  }
+  return CABLESIM_OK;
 }
 
 }  // namespace
@@ -185,6 +223,7 @@ MoorDyn MoorDyn_Create(const char* infilename) {
     system->sys = cablesim::couple::CreateFromProto(scene, infilename);
     if (system->sys == nullptr) return nullptr;
     system->supports = static_cast<unsigned int>(support);
+    CableSim_NCoupledBodies(system->sys, &system->bodies);
     system->x.assign(3 * support, 0);
     system->xd.assign(3 * support, 0);
     system->f.assign(3 * support, 0);
@@ -198,7 +237,7 @@ MoorDyn MoorDyn_Create(const char* infilename) {
 int MoorDyn_NCoupledDOF(MoorDyn system, unsigned int* n) {
   if (int rc = CheckSystem(system); rc != MOORDYN_SUCCESS) return rc;
   if (n == nullptr) return Fail(MOORDYN_INVALID_INPUT, "n: null");
-  *n = 3u * static_cast<unsigned int>(system->coupled.size());
+  *n = 6u * system->bodies + 3u * static_cast<unsigned int>(system->coupled.size());
   return MOORDYN_SUCCESS;
 }
 
@@ -208,10 +247,12 @@ int MoorDyn_Init(MoorDyn system, const double* x, const double* xd) {
   if (xd == nullptr) return Fail(MOORDYN_INVALID_INPUT, "xd: null");
   Spread(system, x, &system->x);
   Spread(system, xd, &system->xd);
+  if (int rc = SetBodies(system, x, xd); rc != CABLESIM_OK) return FromCableSim(rc);
   const int rc = FromCableSim(CableSim_Init(system->sys, system->x.data(), system->xd.data()));
   if (rc == MOORDYN_SUCCESS) {
+    const double* points = x + 6 * system->bodies;
     for (size_t i = 0; i < system->coupled.size(); ++i)
-      for (int d = 0; d < 3; ++d) system->coupled[i]->position[d] = x[3 * i + d];
+      for (int d = 0; d < 3; ++d) system->coupled[i]->position[d] = points[3 * i + d];
   }
   return rc;
 }
@@ -224,15 +265,20 @@ int MoorDyn_Step(MoorDyn system, const double* x, const double* xd, double* f, d
   if (f == nullptr) return Fail(MOORDYN_INVALID_INPUT, "f: null");
   Spread(system, x, &system->x);
   Spread(system, xd, &system->xd);
+  if (int rc = SetBodies(system, x, xd); rc != CABLESIM_OK) return FromCableSim(rc);
   const int rc = FromCableSim(
       CableSim_Step(system->sys, system->x.data(), system->xd.data(), system->f.data(), t, dt));
   if (rc != MOORDYN_SUCCESS) return rc;
+  for (unsigned int b = 0; b < system->bodies; ++b)
+    CableSim_GetBodyForces(system->sys, b, f + 6 * b, f + 6 * b + 3);
+  const double* points = x + 6 * system->bodies;
+  double* forces = f + 6 * system->bodies;
   for (size_t i = 0; i < system->coupled.size(); ++i) {
     const CableSimMoorDynPoint& p = *system->coupled[i];
     for (int d = 0; d < 3; ++d) {
-      f[3 * i + d] = 0;
-      for (int member : p.members) f[3 * i + d] += system->f[3 * member + d];
-      system->coupled[i]->position[d] = x[3 * i + d];
+      forces[3 * i + d] = 0;
+      for (int member : p.members) forces[3 * i + d] += system->f[3 * member + d];
+      system->coupled[i]->position[d] = points[3 * i + d];
     }
   }
   return MOORDYN_SUCCESS;

@@ -86,6 +86,30 @@ absl::Status PointsOf(const google::protobuf::RepeatedPtrField<v1::CoupledPoint>
   return absl::OkStatus();
 }
 
+// The bodies of a message; InvalidArgument naming the field for a wrong
+// count or a number that is not finite (the session checks the rest: a
+// quaternion that is not unit, a jump).
+absl::Status BodiesOf(const google::protobuf::RepeatedPtrField<v1::CoupledBody>& bodies,
+                      int expected, std::vector<CoupledBodyKinematics>* out) {
+  if (bodies.size() != expected) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("bodies: %d coupled bodies given, the scene has %d (one per body with "
+                        "coupled: true, in scene order)",
+                        bodies.size(), expected));
+  }
+  out->clear();
+  for (const v1::CoupledBody& b : bodies) {
+    CoupledBodyKinematics k;
+    k.position = FromVec3(b.position());
+    k.velocity = FromVec3(b.velocity());
+    k.angular_velocity = FromVec3(b.angular_velocity());
+    const v1::Quaternion& q = b.orientation();
+    k.orientation = Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z());
+    out->push_back(k);
+  }
+  return absl::OkStatus();
+}
+
 // CouplingSession's messages name its C-style arguments (`x[1].z: ...`,
 // `xd[0]: ...`, `t: ...`): renamed to the message's fields
 // (`points[1].position.z`, `points[0].velocity`, `dt_s`).
@@ -109,6 +133,15 @@ void SetState(const CouplingSession& session, bool lines, v1::CoupleResponse* re
     ToVec3(session.mean_forces()[i], reply->add_forces());
     ToVec3(session.forces()[i], reply->add_end_forces());
   }
+  for (int i = 0; i < session.coupled_bodies(); ++i) {
+    ToVec3(session.mean_body_forces()[i], reply->add_body_forces());
+    ToVec3(session.mean_body_moments()[i], reply->add_body_moments());
+    ToVec3(session.body_forces()[i], reply->add_body_end_forces());
+    ToVec3(session.body_moments()[i], reply->add_body_end_moments());
+  }
+  reply->set_host_work_j(session.host_work());
+  reply->set_energy_j(session.energy());
+  reply->set_dissipated_j(session.dissipated());
   reply->set_steps(session.steps());
   reply->set_rejected_steps(session.rejected_steps());
   if (!lines) return;
@@ -170,15 +203,27 @@ grpc::Status CablesimServiceImpl::Couple(
     return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
                         "the scene needs more memory than the server can get");
   }
-  const int n = session->coupled_points();
+  const int n = session->coupled_points(), nb = session->coupled_bodies();
   std::vector<Eigen::Vector3d> x, v;
+  std::vector<CoupledBodyKinematics> bodies;
   if (absl::Status s = PointsOf(open.points(), n, &x, &v); !s.ok()) return Invalid(s.message());
-  if (absl::Status s = session->Initialize(x, v); !s.ok()) {
+  if (absl::Status s = BodiesOf(open.bodies(), nb, &bodies); !s.ok()) return Invalid(s.message());
+  if (absl::Status s = session->Initialize(x, v, bodies); !s.ok()) {
     return grpc::Status(static_cast<grpc::StatusCode>(s.code()), FieldsOfMessage(s.message()));
   }
   for (int i = 0; i < n; ++i) {
     reply.add_coupled_joints(session->coupled_joint(i));
     ToVec3(session->scene_position(i), reply.add_scene_positions());
+  }
+  for (int i = 0; i < nb; ++i) {
+    reply.add_coupled_bodies(session->coupled_body(i));
+    ToVec3(session->body_scene_position(i), reply.add_body_scene_positions());
+    const Eigen::Quaterniond& q = session->body_scene_orientation(i);
+    v1::Quaternion* out = reply.add_body_scene_orientations();
+    out->set_w(q.w());
+    out->set_x(q.x());
+    out->set_y(q.y());
+    out->set_z(q.z());
   }
   reply.set_max_jump_m(session->max_jump_m());
   reply.set_end_time_s(end_time_s);
@@ -186,7 +231,9 @@ grpc::Status CablesimServiceImpl::Couple(
   if (!TimedWrite(stream, reply, slot.watch())) {
     return grpc::Status(grpc::StatusCode::CANCELLED, "the client went away");
   }
-  if (log_) std::cerr << "cablesim-server: coupling session opened (" << n << " points)\n";
+  if (log_)
+    std::cerr << "cablesim-server: coupling session opened (" << n << " points, " << nb
+              << " bodies)\n";
   while (TimedRead(stream, &request, slot.watch())) {
     reply.Clear();
     absl::Status refused;
@@ -208,11 +255,12 @@ grpc::Status CablesimServiceImpl::Couple(
             t_end, end_time_s));
       } else {
         refused = PointsOf(step.points(), n, &x, &v);
+        if (refused.ok()) refused = BodiesOf(step.bodies(), nb, &bodies);
       }
       if (refused.ok()) {
         absl::Status stepped;
         try {
-          stepped = session->Step(t_end, x, v);
+          stepped = session->Step(t_end, x, v, bodies);
         } catch (const std::bad_alloc&) {
           return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
                               "a step needs more memory than the server can get");

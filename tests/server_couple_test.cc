@@ -34,6 +34,12 @@ constexpr char kString[] = R"({"gravity": {"z": -9.81},
 
 using Stream = grpc::ClientReaderWriter<v1::CoupleRequest, v1::CoupleResponse>;
 
+// A message the session must refuse, and what the error must say.
+struct Bad {
+  v1::CoupleRequest request;
+  std::string path, says;
+};
+
 class CoupleServiceTest : public ::testing::Test {
  protected:
   void Start(int max_streams_per_peer = std::numeric_limits<int>::max()) {
@@ -67,6 +73,24 @@ class CoupleServiceTest : public ::testing::Test {
     return reply;
   }
 
+  // Each of `bad` is refused naming its field, the session left as in
+  // `good` (its time, steps, forces and host work).
+  static void ExpectRefused(Stream* stream, const std::vector<Bad>& bad,
+                            const v1::CoupleResponse& good) {
+    for (const Bad& b : bad) {
+      SCOPED_TRACE(b.path);
+      const v1::CoupleResponse reply = Exchange(stream, b.request);
+      ASSERT_TRUE(reply.has_error());
+      EXPECT_EQ(reply.error().code(), "INVALID_ARGUMENT");
+      EXPECT_EQ(reply.error().path(), b.path);
+      EXPECT_THAT(reply.error().message(), HasSubstr(b.says));
+      v1::CoupleResponse state = reply, before = good;
+      state.clear_error();
+      before.clear_error();
+      EXPECT_EQ(state.SerializeAsString(), before.SerializeAsString());
+    }
+  }
+
   std::unique_ptr<CablesimServer> server_;
   std::unique_ptr<v1::CablesimService::Stub> stub_;
 };
@@ -93,10 +117,6 @@ TEST_F(CoupleServiceTest, StepsAndRefusesBadStepsWithoutLosingTheSession) {
   EXPECT_LT(reply.end_forces(0).z(), 0);
   const v1::CoupleResponse good = reply;
 
-  struct Bad {
-    v1::CoupleRequest request;
-    std::string path, says;
-  };
   std::vector<Bad> bad;
   bad.push_back({Step(-0.01, 1.001), "dt_s", "must be > 0"});
   bad.push_back({Step(0, 1.001), "dt_s", "must be > 0"});
@@ -118,18 +138,7 @@ TEST_F(CoupleServiceTest, StepsAndRefusesBadStepsWithoutLosingTheSession) {
   bad.push_back({Step(0.01, 1.5), "points[0].position", "more than the 0.25 m allowed"});
   bad.push_back({Open(kString), "open", "open already"});
   bad.push_back({v1::CoupleRequest(), "step", "a message after open is a step"});
-  for (const Bad& b : bad) {
-    SCOPED_TRACE(b.path);
-    reply = Exchange(stream.get(), b.request);
-    ASSERT_TRUE(reply.has_error());
-    EXPECT_EQ(reply.error().code(), "INVALID_ARGUMENT");
-    EXPECT_EQ(reply.error().path(), b.path);
-    EXPECT_THAT(reply.error().message(), HasSubstr(b.says));
-    // The session as it was.
-    EXPECT_EQ(reply.time_s(), good.time_s());
-    EXPECT_EQ(reply.steps(), good.steps());
-    EXPECT_EQ(reply.forces(0).x(), good.forces(0).x());
-  }
+  ExpectRefused(stream.get(), bad, good);
   reply = Exchange(stream.get(), Step(0.01, 1.002));
   ASSERT_FALSE(reply.has_error()) << reply.error().message();
   EXPECT_DOUBLE_EQ(reply.time_s(), 0.02);
@@ -216,6 +225,88 @@ TEST_F(CoupleServiceTest, ASessionHoldsOneOfTheClientsStreams) {
   EXPECT_FALSE(Exchange(again.get(), Open(kString)).has_error());
   again->WritesDone();
   EXPECT_TRUE(again->Finish().ok());
+}
+
+// The string's end held by a coupled body instead: the body's centre at
+// (1.5, 0, 0), the string pinned to its point (-0.5, 0, 0).
+constexpr char kStringOnBody[] = R"({"gravity": {"z": -9.81},
+  "cables": [{"name": "c", "length": 1, "elements": 4, "direction": {"x": 1},
+    "density": 1000, "youngs_modulus": 1e7, "diameter": 0.01}],
+  "bodies": [{"name": "b", "mass": 1, "inertia": {"x": 1, "y": 1, "z": 1},
+    "position": {"x": 1.5}, "coupled": true}],
+  "joints": [{"type": "PIN", "a": {"cable": "c", "s": 0}},
+             {"type": "PIN", "a": {"cable": "c", "s": 1}, "b": {"body": "b", "point": {"x": -0.5}}}],
+  "solver": {"duration": 1, "step": 0.005}})";
+
+// A body at (x, 0, 0) turned by `yaw` about z.
+v1::CoupledBody BodyAt(double x, double yaw) {
+  v1::CoupledBody b;
+  b.mutable_position()->set_x(x);
+  b.mutable_orientation()->set_w(std::cos(yaw / 2));
+  b.mutable_orientation()->set_z(std::sin(yaw / 2));
+  return b;
+}
+
+TEST_F(CoupleServiceTest, ACoupledBodyStepsAndRefusesBadPoses) {
+  grpc::ClientContext context;
+  std::unique_ptr<Stream> stream = stub_->Couple(&context);
+  v1::CoupleRequest open;
+  open.mutable_open()->set_scene_json(kStringOnBody);
+  *open.mutable_open()->add_bodies() = BodyAt(1.5, 0);
+  v1::CoupleResponse reply = Exchange(stream.get(), open);
+  ASSERT_FALSE(reply.has_error()) << reply.error().message();
+  ASSERT_EQ(reply.coupled_bodies_size(), 1);
+  EXPECT_EQ(reply.coupled_bodies(0), 0);
+  EXPECT_EQ(reply.body_scene_positions(0).x(), 1.5);
+  EXPECT_NEAR(reply.body_scene_orientations(0).w(), 1, 1e-12);
+  EXPECT_EQ(reply.forces_size(), 0);
+  ASSERT_EQ(reply.body_forces_size(), 1);
+  EXPECT_EQ(reply.host_work_j(), 0);
+
+  // Turned by 0.01 rad and moved 1 mm out: the string's end moves to
+  // (1.5 + 0.001, 0, 0) - 0.5 (cos 0.01, sin 0.01, 0), a stretch of
+  // about 1 mm: it pulls the body back towards the anchor.
+  auto step = [](double dt, const v1::CoupledBody& body) {
+    v1::CoupleRequest r;
+    r.mutable_step()->set_dt_s(dt);
+    *r.mutable_step()->add_bodies() = body;
+    return r;
+  };
+  reply = Exchange(stream.get(), step(0.01, BodyAt(1.501, 0.01)));
+  ASSERT_FALSE(reply.has_error()) << reply.error().message();
+  const v1::Vec3 f = reply.body_end_forces(0), m = reply.body_end_moments(0);
+  EXPECT_LT(f.x(), -0.3);
+  // One pin: the moment about the centre is r x F with r the pin's arm
+  // R (-0.5, 0, 0), to the constraint's tolerance.
+  const double rx = -0.5 * std::cos(0.01), ry = -0.5 * std::sin(0.01);
+  EXPECT_NEAR(m.z(), rx * f.y() - ry * f.x(), 1e-6 * std::abs(f.x()));
+  EXPECT_NEAR(m.x(), ry * f.z(), 1e-6 * std::abs(f.x()));
+  EXPECT_NEAR(m.y(), -rx * f.z(), 1e-6 * std::abs(f.x()));
+  EXPECT_NE(reply.host_work_j(), 0);
+  const v1::CoupleResponse good = reply;
+
+  std::vector<Bad> bad;
+  {
+    v1::CoupledBody b = BodyAt(1.502, 0.02);
+    b.mutable_orientation()->set_w(1.1);
+    bad.push_back({step(0.01, b), "bodies[0].orientation", "must be a unit quaternion"});
+    b = BodyAt(1.502, 0.02);
+    b.mutable_orientation()->set_y(std::nan(""));
+    bad.push_back({step(0.01, b), "bodies[0].orientation.y", "must be finite"});
+    b = BodyAt(1.502, 0.02);
+    b.mutable_angular_velocity()->set_x(std::numeric_limits<double>::infinity());
+    bad.push_back({step(0.01, b), "bodies[0].angular_velocity.x", "must be finite"});
+    v1::CoupleRequest r = step(0.01, BodyAt(1.502, 0.02));
+    *r.mutable_step()->add_bodies() = BodyAt(1.502, 0.02);  // a body the scene has not
+    bad.push_back({r, "bodies", "2 coupled bodies given, the scene has 1"});
+    bad.push_back({step(0.01, BodyAt(1.502, 1.0)), "bodies[0]", "more than the 0.25 m allowed"});
+  }
+  ExpectRefused(stream.get(), bad, good);
+  reply = Exchange(stream.get(), step(0.01, BodyAt(1.502, 0.02)));
+  ASSERT_FALSE(reply.has_error()) << reply.error().message();
+  EXPECT_DOUBLE_EQ(reply.time_s(), 0.02);
+  stream->WritesDone();
+  EXPECT_TRUE(stream->Finish().ok());
 }
 
 }  // namespace

@@ -152,6 +152,55 @@ class CoupleTest(unittest.TestCase):
         np.testing.assert_array_equal(session.forces, forces_before)
         return raised.exception.details
 
+    def test_a_coupled_body(self):
+        """A coupled body (tests/data/couple_body_coupled.json: three lines
+        pinned 10 m from its centre) opened turned by 0.2 rad about a tilted
+        axis: its force and moment are the sum of the forces and of r x F
+        of the same lines with their fairleads as coupled points
+        (couple_body_points.json) placed at the body's turned points: the
+        same static equilibrium, so to Newton's tolerance (1e-8 of |F|, of
+        |F| r for the moment; tests/couple_body_test.c measures 1e-11).
+        Then a step (the host's work booked) and each bad pose, refused
+        naming the field with the session unchanged."""
+        axis = np.array([0.0, 0.5, 1.0]) / math.sqrt(1.25)
+        angle = 0.2
+        q = np.concatenate([[math.cos(angle / 2)], math.sin(angle / 2) * axis])
+        k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+        rotation = np.eye(3) + math.sin(angle) * k + (1 - math.cos(angle)) * k @ k
+        body_file = os.path.join(SOURCE, "tests", "data", "couple_body_coupled.json")
+        points_file = os.path.join(SOURCE, "tests", "data", "couple_body_points.json")
+        with cablesim.couple(self.address, body_file, bodies=[(np.zeros(3), q)]) as session:
+            self.assertEqual(session.coupled_bodies, [0])
+            np.testing.assert_allclose(session.body_scene_orientations, [[1, 0, 0, 0]], atol=1e-12)
+            force, moment = session.body_forces[0].copy(), session.body_moments[0].copy()
+            self.assertEqual(session.host_work, 0)
+            session.step(0.05, bodies=[((0.01, 0, 0), q)])
+            self.assertNotEqual(session.host_work, 0)
+            good = session.body_forces.copy()
+            bad = [("bodies[0].orientation", [(np.zeros(3), 1.1 * q)]),
+                   ("bodies[0].orientation.x", [(np.zeros(3), (1, math.nan, 0, 0))]),
+                   ("bodies[0].angular_velocity.z",
+                    [(np.zeros(3), q, np.zeros(3), (0, 0, math.inf))]),
+                   ("bodies", [(np.zeros(3), q), (np.zeros(3), q)])]
+            for field, bodies in bad:
+                with self.assertRaises(cablesim.Error) as raised:
+                    session.step(0.05, bodies=bodies)
+                self.assertEqual(raised.exception.code, "INVALID_ARGUMENT")
+                self.assertEqual(raised.exception.field, field, raised.exception.details)
+                self.assertAlmostEqual(session.time, 0.05)
+                np.testing.assert_array_equal(session.body_forces, good)
+            session.step(0.05, bodies=[((0.02, 0, 0), q)])
+            self.assertAlmostEqual(session.time, 0.1)
+        base = np.array([[10 * math.cos(a), 10 * math.sin(a), 0.0]
+                         for a in (0, 2 * math.pi / 3, 4 * math.pi / 3)])
+        arms = base @ rotation.T
+        with cablesim.couple(self.address, points_file, arms) as session:
+            forces = session.forces
+        scale = np.linalg.norm(forces.sum(axis=0))
+        self.assertLess(np.linalg.norm(force - forces.sum(axis=0)), 1e-8 * scale)
+        self.assertLess(np.linalg.norm(moment - np.cross(arms, forces).sum(axis=0)),
+                        1e-8 * scale * 10)
+
     def test_bad_steps_name_the_field_and_leave_the_session_usable(self):
         x0 = self.start()
         with cablesim.couple(self.address, COUPLED, x0) as session:

@@ -200,6 +200,7 @@ absl::Status ConvertBody(ConversionState* state, int i, BodySpec* body) {
     body->linear_damping_n_s_m = b.damping().linear();
     body->angular_damping_n_m_s = b.damping().angular();
   }
+  body->coupled = b.coupled();
   if (b.has_on()) return PlaceOnCable(state, i, b);
   CABLESIM_ASSIGN_OR_RETURN(
       body->position_m, VectorInRange(Sub(path, "position"), b.position(), plausible::kCoordinate));

@@ -14,7 +14,9 @@
  * uses more fails to compile, naming the function, rather than at run time.
  *
  * Conventions, as a MoorDyn host expects them:
- *  - the coupled degrees of freedom are 3 per coupled point (the deck's
+ *  - the coupled degrees of freedom are first 6 per coupled body (a cablesim
+ *    scene's bodies with "coupled": true, in scene order; decks' coupled
+ *    bodies are not read yet), then 3 per coupled point (the deck's
  *    Vessel or Coupled points; in a cablesim scene, joints to ground with
  *    "coupled": true, one point per distinct joint name), in increasing
  *    point ID (scene order for a cablesim scene); every line end held at a
@@ -22,6 +24,14 @@
  *  - lines and points are numbered from 1 (MoorDyn_GetLine(sys, 1) is the
  *    deck's line 1; MoorDyn_GetPoint takes the deck's point ID);
  *  - a line's nodes run from end A (node 0) to end B, one per element end;
+ *  - a coupled body's 6 are x, y, z of its reference point (its centre of
+ *    mass) and its roll, pitch, yaw [rad], the orientation being
+ *    R = Rx(roll) Ry(pitch) Rz(yaw) (MoorDyn v2's for coupled bodies; its
+ *    columns are the body's axes in the world); in xd, the velocity and
+ *    the three angles' rates; in f, the force [N] and the moment [N m]
+ *    about the reference point, world axes. Unlike MoorDyn's, they are
+ *    the lines' (and joined bodies') only: the body's own weight,
+ *    buoyancy and inertia are the host's (docs/coupling.md);
  *  - MoorDyn_Step's forces are the lines' forces on the coupled points,
  *    their mean over the step (CableSim_GetMeanForces).
  *
@@ -49,15 +59,17 @@ enum {
 /* Reads a MoorDyn v2 deck (or a cablesim scene: JSON or text format) and
  * builds the model. NULL on error. */
 MoorDyn MoorDyn_Create(const char* infilename);
-/* 3 per coupled point. */
+/* 6 per coupled body and 3 per coupled point. */
 int MoorDyn_NCoupledDOF(MoorDyn system, unsigned int* n);
-/* x, xd: the coupled points' positions [m] and velocities [m/s] at t = 0,
- * 3 per point in the order above. The lines start from their static
+/* x, xd: the coupled bodies' poses and rates, then the coupled points'
+ * positions [m] and velocities [m/s] at t = 0, in the order above. The lines start from their static
  * equilibrium with the points there when the scene asks for it (a deck
  * always does: its TmaxIC). */
 int MoorDyn_Init(MoorDyn system, const double* x, const double* xd);
-/* From *t to *t + *dt, the coupled points moving linearly to x, xd; f gets
- * the lines' forces on them [N]. On success *t is the new time. */
+/* From *t to *t + *dt, the coupled points moving linearly to x, xd (the
+ * bodies' centres linearly, their orientations by slerp); f gets the lines'
+ * forces on them [N] (and the bodies' moments [N m]). On success *t is the
+ * new time. */
 int MoorDyn_Step(MoorDyn system, const double* x, const double* xd, double* f, double* t,
                  double* dt);
 /* Frees the system and its handles (NULL is allowed). */

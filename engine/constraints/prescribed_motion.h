@@ -46,6 +46,7 @@ class PrescribedMotion : public ConstraintFamily {
   struct TurningRow {
     int row = 0;
     int coord = 0;
+    int joint = -1;  // the scene joint that turns it
     Eigen::Vector3d n0 = Eigen::Vector3d::Zero(), axis = Eigen::Vector3d::UnitZ();
     TimeFunction angle;
     Eigen::Vector3d n = Eigen::Vector3d::Zero(), rate = Eigen::Vector3d::Zero(),
@@ -64,6 +65,17 @@ class PrescribedMotion : public ConstraintFamily {
   // Replaces moving row i's motion (a coupled support's motion, set by the
   // coupling session for each coupling step); SetTime applies it.
   void SetMotion(int i, TimeFunction motion) { moving_[i].motion = std::move(motion); }
+  const std::vector<TurningRow>& turning() const { return turning_; }
+  // Replaces turning row i's law: n(t) = Rot(axis, angle(t)) n0 (a coupled
+  // body's orientation, set by the coupling session for each coupling
+  // step: n0 its normal at the step's start, axis and angle(t) the step's
+  // rotation); SetTime applies it.
+  void SetTurning(int i, const Eigen::Vector3d& n0, const Eigen::Vector3d& axis,
+                  TimeFunction angle) {
+    turning_[i].n0 = n0;
+    turning_[i].axis = axis;
+    turning_[i].angle = std::move(angle);
+  }
 
   std::string_view name() const override { return "prescribed_motion"; }
   bool time_dependent() const override { return true; }

@@ -298,6 +298,7 @@ void ModelBuilder::KeepMovableRows() {
       PrescribedMotion::TurningRow turning;
       turning.row = m.joint_rows_->size() - 1;
       turning.coord = r.turn_coord;
+      turning.joint = r.joint;
       turning.n0 = r.turn_n0;
       turning.axis = scene_.joints[r.joint].rotation_axis;
       turning.angle = scene_.joints[r.joint].rotation;

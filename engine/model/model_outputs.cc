@@ -272,6 +272,18 @@ void MultibodyModel::Reactions(const VectorXd& q, const VectorXd* lambda,
   }
 }
 
+Eigen::Matrix3d MultibodyModel::BodyRotation(const VectorXd& q, int body) const {
+  const int c = bodies_[body].coord;
+  Eigen::Matrix3d r = Eigen::Matrix3d::Identity();
+  if (dim_ == 2) {
+    const Eigen::Vector2d u = q.segment<2>(c + 2).normalized();
+    r.topLeftCorner<2, 2>() << u.x(), -u.y(), u.y(), u.x();
+    return r;
+  }
+  for (int i = 0; i < 3; ++i) r.col(i) = q.segment<3>(c + 3 + 3 * i);
+  return r;
+}
+
 void MultibodyModel::Orientations(const VectorXd& q, const VectorXd& qdot,
                                   std::vector<double>* out) const {
   out->resize(10 * bodies_.size());

@@ -418,6 +418,10 @@ class MultibodyModel {
   // omega_z = (u x udot)_z / |u|^2. `out` is resized (no allocation once
   // it has the size).
   bool orientation() const { return orientation_; }
+  // Body `body`'s rotation R = [u v w] from full q (planar: about z, from
+  // u; not re-orthogonalised: the axes' rows hold them to the solver's
+  // tolerance).
+  Eigen::Matrix3d BodyRotation(const Eigen::VectorXd& q, int body) const;
   void Orientations(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
                     std::vector<double>* out) const;
   // The number of probes on a moving support or a winch's end (ProbeForces' size).

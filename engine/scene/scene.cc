@@ -15,6 +15,22 @@ Eigen::Vector3d Evaluate(const TimeVector& v, double t, int order) {
   return r;
 }
 
+void AddCoupledBodyDrivers(Scene* scene) {
+  for (int b = 0; b < static_cast<int>(scene->bodies.size()); ++b) {
+    if (!scene->bodies[b].coupled) continue;
+    bool has = false;
+    for (const JointSpec& j : scene->joints) has = has || (j.coupled_rotation && j.a.body == b);
+    if (has) continue;
+    JointSpec driver;
+    driver.type = JointType::kFixed;
+    driver.a.body = b;
+    driver.coupled = true;
+    driver.coupled_rotation = true;
+    driver.name = scene->bodies[b].name + " (coupled)";
+    scene->joints.push_back(driver);
+  }
+}
+
 std::string_view AnalysisName(Analysis analysis) {
   switch (analysis) {
     case Analysis::kDynamic:

@@ -128,6 +128,11 @@ struct BodySpec {
   double hydro_diameter_m = 0, hydro_height_m = 0;
   double hydro_drag = 0, hydro_heave_drag = 0;
   double hydro_added_mass = 0, hydro_heave_added_mass = 0;
+  // Driven by a coupling host (engine/run/coupling.h): its pose (centre of
+  // mass and axes) is the host's, step by step; the scene holds it by a
+  // driver joint (CoupledBodyDriver, appended to the joints). In an
+  // ordinary run it stays where the scene places it.
+  bool coupled = false;
 };
 
 // A place on a cable (cable >= 0), on a body (body >= 0), or the ground
@@ -172,7 +177,12 @@ struct JointSpec {
   // (world axes), and the held slope or body axes turn with it.
   TimeFunction rotation;
   Eigen::Vector3d rotation_axis = Eigen::Vector3d::UnitZ();
-  bool HasRotation() const { return !rotation.IsZero(); }
+  // A coupled body's driver (CoupledBodyDriver): a coupled FIXED joint to
+  // ground at the body's centre whose turning rows the coupling host also
+  // drives (their axis and angle are set step by step); zero rotation
+  // outside a coupling session.
+  bool coupled_rotation = false;
+  bool HasRotation() const { return coupled_rotation || !rotation.IsZero(); }
   // Free text naming the joint in the outputs (ModelInfo::joint_names).
   std::string name;
   // Line failure (PIN and FIXED only, not at a winch's end or coupled):
@@ -429,6 +439,13 @@ struct Scene {
   // plausibility_warnings.h): a run puts them first in RunSummary::warnings.
   std::vector<std::string> warnings;
 };
+
+// Appends a driver joint for every coupled body (BodySpec::coupled) that
+// has none yet: FIXED between the body's centre of mass and the ground,
+// coupled (its point the host's) and coupled_rotation (its axes the
+// host's), named "<body> (coupled)". Scene readers call it once all the
+// scene's own joints are in, so the drivers come last.
+void AddCoupledBodyDrivers(Scene* scene);
 
 }  // namespace cablesim
 
