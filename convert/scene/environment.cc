@@ -162,6 +162,13 @@ absl::Status ConvertFluid(ConversionState* state) {
         CheckRange("fluid.water_depth", f.water_depth(), plausible::kCableLength));
   }
   state->scene.fluid.water_depth_m = f.water_depth();
+  if (f.free_surface()) {
+    if (!(f.density() > 0))
+      return Invalid("fluid.free_surface", "needs a fluid (fluid.density > 0)");
+    if (!(state->scene.gravity_m_s2.norm() > 0))
+      return Invalid("fluid.free_surface", "needs gravity (the vertical the level is measured on)");
+    state->scene.fluid.free_surface = true;
+  }
   return ConvertWaves(state);
 }
 

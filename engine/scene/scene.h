@@ -91,6 +91,11 @@ struct CableSpec {
   double normal_drag = 0;
   double tangential_drag = 0;
   double added_mass = 0;
+  // Along the cable (MoorDyn's CaAx) [-], when has_axial_added_mass;
+  // otherwise added_mass acts in every direction
+  // (engine/forces/cable_added_mass.h).
+  bool has_axial_added_mass = false;
+  double axial_added_mass = 0;
   double hydro_diameter_m = 0;
   WinchSpec winch;  // disabled: the length is fixed
 };
@@ -243,6 +248,9 @@ struct FluidSpec {
   double still_water_level_m = 0;
   double water_depth_m = 0;
   WavesSpec waves;
+  // true: the cables' fluid loads act below the instantaneous water level
+  // only (engine/forces/cable_buoyancy.h); false: everywhere.
+  bool free_surface = false;
 };
 
 // A bathymetry grid (engine/forces/bathymetry_grid.h): depths [m] below
