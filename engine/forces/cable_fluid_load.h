@@ -17,6 +17,7 @@
 #include <Eigen/Core>
 
 #include "engine/forces/element_dissipation_term.h"
+#include "engine/forces/current_profile.h"
 #include "engine/forces/force_contributor.h"
 #include "engine/forces/free_surface.h"
 #include "engine/forces/wave_load.h"
@@ -38,12 +39,15 @@ class CableFluidLoad : public ElementDissipationTerm<CableFluidLoad> {
   // (null: none, then `current` [m/s] is the flow, and `surface` where the
   // fluid ends: with it enabled, only the Gauss points under the still
   // level get drag, engine/forces/free_surface.h).
+  // `profile` (not empty): the current by depth in place of `current`.
   CableFluidLoad(std::vector<Element> elements, std::shared_ptr<const WaveLoad> waves,
-                 const Eigen::Vector3d& current, const FreeSurface& surface = {})
+                 const Eigen::Vector3d& current, const FreeSurface& surface = {},
+                 CurrentProfile profile = {})
       : elements_(std::move(elements)),
         waves_(std::move(waves)),
         current_(current),
-        surface_(surface) {}
+        surface_(surface),
+        profile_(std::move(profile)) {}
 
   std::string_view name() const override { return "cable_fluid_load"; }
   bool has_potential() const override { return false; }
@@ -59,6 +63,7 @@ class CableFluidLoad : public ElementDissipationTerm<CableFluidLoad> {
   std::shared_ptr<const WaveLoad> waves_;
   Eigen::Vector3d current_;
   FreeSurface surface_;
+  CurrentProfile profile_;
 };
 
 // The scene's fluid load on its cables; null when no element has drag or
@@ -66,7 +71,8 @@ class CableFluidLoad : public ElementDissipationTerm<CableFluidLoad> {
 std::unique_ptr<CableFluidLoad> MakeCableFluidLoad(std::vector<CableFluidLoad::Element> elements,
                                                    std::shared_ptr<const WaveLoad> waves,
                                                    const Eigen::Vector3d& current,
-                                                   const FreeSurface& surface = {});
+                                                   const FreeSurface& surface = {},
+                                                   CurrentProfile profile = {});
 
 }  // namespace cablesim
 

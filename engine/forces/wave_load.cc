@@ -6,8 +6,9 @@
 
 namespace cablesim {
 
-WaveLoad::WaveLoad(WaveField field, const Eigen::Vector3d& current, bool free_surface)
-    : field_(std::move(field)), current_(current) {
+WaveLoad::WaveLoad(WaveField field, const Eigen::Vector3d& current, bool free_surface,
+                   CurrentProfile profile)
+    : field_(std::move(field)), current_(current), profile_(std::move(profile)) {
   surface_.enabled = free_surface;
   surface_.up = field_.up();
   surface_.level_m = field_.surface();
@@ -27,7 +28,8 @@ void WaveLoad::Add(const AncfCableElement<D>& element,
   for (int g = 0; g < element.gauss_points(); ++g) {
     r.head<D>() = element.GaussPosition(e, g);
     const WaveField::Kinematics k = field_.At(r, t);
-    velocity[g] = current_.head<D>() + k.velocity_m_s.head<D>();
+    velocity[g] =
+        (profile_.empty() ? current_ : profile_.At(r)).head<D>() + k.velocity_m_s.head<D>();
     acceleration[g] = k.acceleration_m_s2.head<D>();
     wet[g] = surface_.Wet(r, k.elevation_m);
   }

@@ -9,7 +9,8 @@
 // lumped-mass mooring line model with DeepCwind semisubmersible model test
 // data", Ocean Engineering 104, 2015, section 2).
 //
-// The flow at a point r and time t is the uniform current U plus the wave
+// The flow at a point r and time t is the uniform current U (or the current
+// by depth, engine/forces/current_profile.h) plus the wave
 // kinematics of WaveField (engine/forces/waves.h): u(r, t) = U + u_w(r, t),
 // du/dt = a_w(r, t). At each Gauss point x_g of an element, with the
 // cable's position r = S(x_g) e, velocity rdot = S(x_g) edot, unit tangent
@@ -64,6 +65,7 @@
 #include <Eigen/Core>
 
 #include "engine/elements/ancf_cable_element.h"
+#include "engine/forces/current_profile.h"
 #include "engine/forces/free_surface.h"
 #include "engine/forces/waves.h"
 
@@ -71,9 +73,11 @@ namespace cablesim {
 
 class WaveLoad {
  public:
-  // `field` the waves, `current` the fluid's uniform current [m/s],
-  // `free_surface` whether the fluid ends at the waves' surface.
-  WaveLoad(WaveField field, const Eigen::Vector3d& current, bool free_surface = false);
+  // `field` the waves, `current` the fluid's uniform current [m/s] (or,
+  // when `profile` is not empty, the current by depth), `free_surface`
+  // whether the fluid ends at the waves' surface.
+  WaveLoad(WaveField field, const Eigen::Vector3d& current, bool free_surface = false,
+           CurrentProfile profile = {});
 
   const WaveField& field() const { return field_; }
   // The surface the load ends at (disabled: none).
@@ -93,6 +97,7 @@ class WaveLoad {
   WaveField field_;
   Eigen::Vector3d current_;
   FreeSurface surface_;
+  CurrentProfile profile_;
 };
 
 extern template void WaveLoad::Add<2>(const AncfCableElement<2>&,

@@ -184,8 +184,8 @@ void ModelBuilder::BuildElements() {
     for (const JonswapSpec& j : fluid.waves.jonswap)
       field.AddJonswap(j.significant_height_m, j.peak_period_s, j.peak_factor, j.direction,
                        j.components, j.seed);
-    model_.wave_load_ =
-        std::make_shared<const WaveLoad>(std::move(field), fluid.current_m_s, fluid.free_surface);
+    model_.wave_load_ = std::make_shared<const WaveLoad>(std::move(field), fluid.current_m_s,
+                                                         fluid.free_surface, Current());
     model_.waves_ = &model_.wave_load_->field();
     model_.damping_point_cost_ = 1 + static_cast<int64_t>(model_.waves_->components().size());
   }
@@ -202,7 +202,7 @@ void ModelBuilder::BuildElements() {
   }
   const FreeSurface surface = Surface();
   if (auto load = MakeCableFluidLoad(std::move(fluid_elements_), model_.wave_load_,
-                                     scene_.fluid.current_m_s, surface))
+                                     scene_.fluid.current_m_s, surface, Current()))
     model_.element_terms_.push_back(std::move(load));
   // The added mass beyond the mass matrix's, for the dynamics (the surface
   // is the waves' where there are waves).
@@ -229,6 +229,14 @@ void ModelBuilder::BuildElements() {
       model_.has_damping_ = true;
     }
   }
+}
+
+CurrentProfile ModelBuilder::Current() const {
+  const FluidSpec& fluid = scene_.fluid;
+  const double g = scene_.gravity_m_s2.norm();
+  if (fluid.current_profile_depths_m.empty() || !(g > 0)) return {};
+  return CurrentProfile(-scene_.gravity_m_s2 / g, fluid.still_water_level_m,
+                        fluid.current_profile_depths_m, fluid.current_profile_velocities_m_s);
 }
 
 FreeSurface ModelBuilder::Surface() const {

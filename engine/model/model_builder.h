@@ -21,6 +21,7 @@
 #include "engine/forces/cable_buoyancy.h"
 #include "engine/forces/cable_damping.h"
 #include "engine/forces/cable_fluid_load.h"
+#include "engine/forces/current_profile.h"
 #include "engine/forces/free_surface.h"
 #include "engine/forces/gravity_loads.h"
 #include "engine/forces/winch_cables.h"
@@ -193,6 +194,8 @@ class ModelBuilder {
   // The scene's free surface (disabled without fluid.free_surface) and the
   // buoyancy the cables lose above it (CableSurfaceBuoyancy; null: none).
   FreeSurface Surface() const;
+  // The scene's current by depth (empty: the uniform current).
+  CurrentProfile Current() const;
   template <int D>
   std::unique_ptr<ForceContributor> SurfaceBuoyancy(
       const std::vector<MultibodyModel::ElementData<D>>& elements) const;

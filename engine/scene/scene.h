@@ -251,6 +251,11 @@ struct FluidSpec {
   // true: the cables' fluid loads act below the instantaneous water level
   // only (engine/forces/cable_buoyancy.h); false: everywhere.
   bool free_surface = false;
+  // The current by depth below the still level (engine/forces/
+  // current_profile.h): depths [m] strictly increasing, velocities [m/s];
+  // empty: the uniform current_m_s.
+  std::vector<double> current_profile_depths_m;
+  std::vector<Eigen::Vector3d> current_profile_velocities_m_s;
 };
 
 // A bathymetry grid (engine/forces/bathymetry_grid.h): depths [m] below
