@@ -649,6 +649,9 @@ class DeckReader {
     }
     const double depth = depth_it->second.value;
     scene.mutable_fluid()->set_water_depth(depth);
+    // MoorDyn's lines carry buoyancy, drag and added mass only where they
+    // are under the (instantaneous) surface.
+    scene.mutable_fluid()->set_free_surface(true);
 
     // The seabed: kBot [Pa/m] and cBot [Pa s/m] act on the line's
     // diameter, cablesim's per unit length: one value per scene, so every
@@ -746,6 +749,7 @@ class DeckReader {
       h->set_normal_drag(t.cd);
       h->set_tangential_drag(t.cd_axial);
       h->set_added_mass(t.ca);
+      h->set_axial_added_mass(t.ca_axial);
       h->set_diameter(t.diameter);
       for (const auto& [end, pid] : {std::pair{0.0, l.a}, std::pair{l.length, l.b}}) {
         const Point& p = points_.at(pid);

@@ -188,6 +188,20 @@ std::string ReelingWinch(const char* model) {
                          model);
 }
 
+// A line that pierces the free surface (the still level y = 0 or z = 0
+// 0.625 of the way along its third element, no Gauss point within 0.1 m
+// of it): the buoyancy it loses above the level (forces/cable_buoyancy.h).
+std::string PiercingLine(const char* model) {
+  const char* up = std::string(model) == "PLANAR" ? "y" : "z";
+  return absl::StrFormat(R"({
+    "model": "%s", "gravity": {"%s": -9.81},
+    "fluid": {"density": 1025, "free_surface": true},
+    "cables": [{"name": "riser", "points": [{"%s": 3}, {"x": 4, "%s": -5}], "elements": 7,
+                "density": 7850, "youngs_modulus": 1e9, "diameter": 0.05, "bending": "NONE"}],
+    "solver": {"duration": 1}})",
+                         model, up, up, up);
+}
+
 // One line per contributor (and per variant worth checking).
 const Case kCases[] = {
     {"GravityLoadsPendulum", "gravity_loads", [] { return SampleScene("falling-pendulum.json"); }},
@@ -215,6 +229,8 @@ const Case kCases[] = {
     {"BodyFluidSpatialInWaves", "body_fluid", [] { return SceneFromJson(Buoy("SPATIAL", true)); }},
     {"SlidingJointsZipLine", "sliding_joints", [] { return SampleScene("zip-line.json"); },
      kExact, kExact, 1e-3},
+    {"FreeSurfacePlanar", "free_surface", [] { return SceneFromJson(PiercingLine("PLANAR")); }},
+    {"FreeSurfaceSpatial", "free_surface", [] { return SceneFromJson(PiercingLine("SPATIAL")); }},
 };
 
 // A symmetric bound: m = m^T and no eigenvalue below -1e-12 of its

@@ -158,6 +158,14 @@ absl::Status ConvertCable(ConversionState* state, int i, CableSpec* cable) {
           CheckRange(Sub(hydro_path, name), value, plausible::kHydroCoefficient));
       *out = value;
     }
+    if (h.has_axial_added_mass()) {
+      const std::string axial_path = Sub(hydro_path, "axial_added_mass");
+      CABLESIM_RETURN_IF_ERROR(CheckNonNegative(axial_path, h.axial_added_mass()));
+      CABLESIM_RETURN_IF_ERROR(
+          CheckRange(axial_path, h.axial_added_mass(), plausible::kHydroCoefficient));
+      cable->has_axial_added_mass = true;
+      cable->axial_added_mass = h.axial_added_mass();
+    }
     if (h.has_diameter()) {
       CABLESIM_RETURN_IF_ERROR(
           CheckPositiveInRange(Sub(hydro_path, "diameter"), h.diameter(), plausible::kSize));

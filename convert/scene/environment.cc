@@ -162,6 +162,42 @@ absl::Status ConvertFluid(ConversionState* state) {
         CheckRange("fluid.water_depth", f.water_depth(), plausible::kCableLength));
   }
   state->scene.fluid.water_depth_m = f.water_depth();
+  if (f.free_surface()) {
+    if (!(f.density() > 0))
+      return Invalid("fluid.free_surface", "needs a fluid (fluid.density > 0)");
+    if (!(state->scene.gravity_m_s2.norm() > 0))
+      return Invalid("fluid.free_surface", "needs gravity (the vertical the level is measured on)");
+    state->scene.fluid.free_surface = true;
+  }
+  if (f.current_profile_size() > 0) {
+    if (!(f.density() > 0))
+      return Invalid("fluid.current_profile", "needs a fluid (fluid.density > 0)");
+    if (!(state->scene.gravity_m_s2.norm() > 0))
+      return Invalid("fluid.current_profile", "needs gravity (the vertical depth is measured on)");
+    if (state->scene.fluid.current_m_s != Eigen::Vector3d::Zero())
+      return Invalid("fluid.current_profile", "give fluid.current or fluid.current_profile, not both");
+    for (size_t b = 0; b < state->scene.bodies.size(); ++b) {
+      if (state->scene.bodies[b].has_hydrodynamics) {
+        return Invalid("fluid.current_profile",
+                       absl::StrCat("not taken by bodies[", b,
+                                    "].hydrodynamics (a body's drag takes the uniform "
+                                    "fluid.current)"));
+      }
+    }
+    for (int i = 0; i < f.current_profile_size(); ++i) {
+      const std::string path = absl::StrCat("fluid.current_profile[", i, "]");
+      const double depth = f.current_profile(i).depth();
+      CABLESIM_RETURN_IF_ERROR(CheckRange(path + ".depth", depth, plausible::kCoordinate));
+      if (i > 0 && !(depth > f.current_profile(i - 1).depth()))
+        return Invalid(path + ".depth", "depths must be strictly increasing");
+      Eigen::Vector3d velocity;
+      CABLESIM_ASSIGN_OR_RETURN(
+          velocity,
+          VectorInRange(path + ".velocity", f.current_profile(i).velocity(), plausible::kVelocity));
+      state->scene.fluid.current_profile_depths_m.push_back(depth);
+      state->scene.fluid.current_profile_velocities_m_s.push_back(velocity);
+    }
+  }
   return ConvertWaves(state);
 }
 

@@ -313,7 +313,8 @@ void AncfCableElement<D>::AddDampingMatrix(const Coords& e, double axial_s, doub
 template <int D>
 void AncfCableElement<D>::AddDrag(const Coords& e, const Coords& edot, const Point& current,
                                   double kn, double kt, Coords* force, Matrix* c) const {
-  for (int g = 0; g < rule_.n; ++g) AddFlowLoadAt(g, e, edot, current, nullptr, kn, kt, 0, force, c);
+  for (int g = 0; g < rule_.n; ++g)
+    AddFlowLoadAt(g, e, edot, current, nullptr, kn, kt, 0, 0, force, c);
 }
 
 template <int D>
@@ -327,16 +328,21 @@ typename AncfCableElement<D>::Point AncfCableElement<D>::GaussPosition(const Coo
 template <int D>
 void AncfCableElement<D>::AddMorison(const Coords& e, const Coords& edot,
                                      const Point* flow_velocity, const Point* flow_acceleration,
-                                     double kn, double kt, double mi, Coords* force,
-                                     Matrix* c) const {
-  for (int g = 0; g < rule_.n; ++g)
-    AddFlowLoadAt(g, e, edot, flow_velocity[g], &flow_acceleration[g], kn, kt, mi, force, c);
+                                     double kn, double kt, double mi_n, double mi_t,
+                                     const bool* wet, Coords* force, Matrix* c) const {
+  for (int g = 0; g < rule_.n; ++g) {
+    if (wet && !wet[g]) continue;
+    AddFlowLoadAt(g, e, edot, flow_velocity[g],
+                  flow_acceleration ? &flow_acceleration[g] : nullptr, kn, kt, mi_n, mi_t, force,
+                  c);
+  }
 }
 
 template <int D>
 void AncfCableElement<D>::AddFlowLoadAt(int g, const Coords& e, const Coords& edot,
                                         const Point& flow, const Point* accel, double kn,
-                                        double kt, double mi, Coords* force, Matrix* c) const {
+                                        double kt, double mi_n, double mi_t, Coords* force,
+                                        Matrix* c) const {
   {
     const double* s0 = s0_[g];
     Point u = Point::Zero(), v = flow;
@@ -347,16 +353,27 @@ void AncfCableElement<D>::AddFlowLoadAt(int g, const Coords& e, const Coords& ed
     const double un = u.norm();
     const double wl = rule_.weight[g] * length_;
     if (!(un > 0)) {
-      // No tangent (a collapsed point): no drag, but the flow's inertia acts.
+      // No tangent (a collapsed point): no drag, but the flow's inertia
+      // acts (with the coefficient across the line: no axis to split on).
       if (accel)
-        for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s0[k] * mi) * *accel;
+        for (int k = 0; k < 4; ++k)
+          force->template segment<D>(k * D) += (wl * s0[k] * mi_n) * *accel;
       return;
     }
     const Point t = u / un;
     const Point vt = t.dot(v) * t, vn = v - vt;
     const double an = vn.norm(), at = vt.norm();
     Point q = kn * an * vn + kt * at * vt;
-    if (accel) q += mi * *accel;
+    if (accel) {
+      // mi_n P du/dt + mi_t t t^T du/dt, P = I - t t^T (one product when
+      // the two are equal, as they were before the split).
+      if (mi_t == mi_n) {
+        q += mi_n * *accel;
+      } else {
+        const Point a_t = t.dot(*accel) * t;
+        q += mi_n * (*accel - a_t) + mi_t * a_t;
+      }
+    }
     for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s0[k]) * q;
     if (!c) return;
     Block h = (2 * kt * at) * t * t.transpose();
@@ -366,6 +383,35 @@ void AncfCableElement<D>::AddFlowLoadAt(int g, const Coords& e, const Coords& ed
     for (int k = 0; k < 4; ++k)
       for (int m = 0; m < 4; ++m)
         c->template block<D, D>(k * D, m * D) += (wl * s0[k] * s0[m]) * h;
+  }
+}
+
+template <int D>
+void AncfCableElement<D>::AddDirectionalMass(const Coords& e, const Coords& edd,
+                                             const double* a_n, const double* a_t, Coords* force,
+                                             Matrix* m) const {
+  for (int g = 0; g < rule_.n; ++g) {
+    if (a_n[g] == 0 && a_t[g] == 0) continue;
+    const double* s0 = s0_[g];
+    Point u = Point::Zero(), acc = Point::Zero();
+    for (int k = 0; k < 4; ++k) {
+      u += d1_[g][k] * e.template segment<D>(k * D);
+      acc += s0[k] * edd.template segment<D>(k * D);
+    }
+    const double un = u.norm();
+    Block a = a_n[g] * Block::Identity();
+    // A collapsed point has no axis: a_n in every direction.
+    if (un > 0) {
+      const Point t = u / un;
+      a += (a_t[g] - a_n[g]) * t * t.transpose();
+    }
+    const double wl = rule_.weight[g] * length_;
+    const Point q = a * acc;
+    for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) -= (wl * s0[k]) * q;
+    if (!m) continue;
+    for (int k = 0; k < 4; ++k)
+      for (int j = 0; j < 4; ++j)
+        m->template block<D, D>(k * D, j * D) += (wl * s0[k] * s0[j]) * a;
   }
 }
 

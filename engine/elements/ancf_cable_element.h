@@ -192,15 +192,37 @@ class AncfCableElement {
   // [m] at point g (WaveLoad evaluates the flow there).
   int gauss_points() const { return rule_.n; }
   Point GaussPosition(const Coords& e, int g) const;
+  // Adds Gauss point g's share of a load q per unit length [N/m],
+  // w_g l S(x_g)^T q, to `force` (the quadrature of int S^T q dx).
+  void AddLoadAtGaussPoint(int g, const Point& q, Coords* force) const {
+    const double wl = rule_.weight[g] * length_;
+    for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s0_[g][k]) * q;
+  }
+  // The quadrature weight of point g times the length, w_g l [m].
+  double GaussLength(int g) const { return rule_.weight[g] * length_; }
 
   // The Morison load in a flow that varies along the element
   // (engine/forces/wave_load.h): AddDrag with the fluid's velocity
   // flow_velocity[g] [m/s] at Gauss point g in place of the uniform current,
-  // plus the flow's inertia mi flow_acceleration[g] per unit length (mi
-  // [kg/m]); the inertia does not depend on edot, so `c` is AddDrag's.
+  // plus the flow's inertia (mi_n P + mi_t t t^T) flow_acceleration[g] per
+  // unit length (P = I - t t^T; mi_n across the line, mi_t along it
+  // [kg/m]; flow_acceleration null: none); the inertia does not depend on
+  // edot, so `c` is AddDrag's. `wet` (null: every point) marks the Gauss
+  // points the fluid reaches: the others get no load.
   void AddMorison(const Coords& e, const Coords& edot, const Point* flow_velocity,
-                  const Point* flow_acceleration, double kn, double kt, double mi,
-                  Coords* force, Matrix* c) const;
+                  const Point* flow_acceleration, double kn, double kt, double mi_n,
+                  double mi_t, const bool* wet, Coords* force, Matrix* c) const;
+
+  // A mass per unit length that depends on the direction of the line
+  // (engine/forces/cable_added_mass.h): at Gauss point g the matrix
+  // A_g = a_n[g] (I - t t^T) + a_t[g] t t^T [kg/m], t the unit tangent at
+  // e. Adds the inertia force -int S^T A S edd dx [N] to `force` (edd the
+  // element's coordinate accelerations) and, when `m` is not null, its
+  // acceleration derivative int S^T A S dx [kg] to `m` (symmetric; the
+  // derivative through t in e is left out). Points with a_n = a_t = 0 cost
+  // nothing.
+  void AddDirectionalMass(const Coords& e, const Coords& edd, const double* a_n,
+                          const double* a_t, Coords* force, Matrix* m) const;
 
  private:
   // ElasticForce for one axial law (the law a template argument, so the
@@ -221,8 +243,8 @@ class AncfCableElement {
   // The drag (and, with `accel` not null, the inertia mi accel) at Gauss
   // point g for the flow velocity `flow`: AddDrag's and AddMorison's body.
   void AddFlowLoadAt(int g, const Coords& e, const Coords& edot, const Point& flow,
-                     const Point* accel, double kn, double kt, double mi, Coords* force,
-                     Matrix* c) const;
+                     const Point* accel, double kn, double kt, double mi_n, double mi_t,
+                     Coords* force, Matrix* c) const;
 
   double length_ = 0;
   double ea_ = 0;

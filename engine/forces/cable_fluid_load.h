@@ -17,7 +17,9 @@
 #include <Eigen/Core>
 
 #include "engine/forces/element_dissipation_term.h"
+#include "engine/forces/current_profile.h"
 #include "engine/forces/force_contributor.h"
+#include "engine/forces/free_surface.h"
 #include "engine/forces/wave_load.h"
 
 namespace cablesim {
@@ -26,15 +28,26 @@ class CableFluidLoad : public ElementDissipationTerm<CableFluidLoad> {
  public:
   struct Element {
     double drag_n = 0, drag_t = 0;  // AddDrag's kn, kt [kg/m^2]
-    // With waves: the flow's inertia factor (1 + C_a) rho A [kg/m].
-    double fluid_inertia = 0;
-    bool any() const { return drag_n != 0 || drag_t != 0 || fluid_inertia != 0; }
+    // With waves: the flow's inertia factors (1 + C_a) rho A across the
+    // line and (1 + C_a,ax) rho A along it [kg/m] (WaveLoad).
+    double fluid_inertia = 0, fluid_inertia_axial = 0;
+    bool any() const {
+      return drag_n != 0 || drag_t != 0 || fluid_inertia != 0 || fluid_inertia_axial != 0;
+    }
   };
   // Per element of the model, in its order; `waves` the scene's wave load
-  // (null: none, then `current` [m/s] is the flow).
+  // (null: none, then `current` [m/s] is the flow, and `surface` where the
+  // fluid ends: with it enabled, only the Gauss points under the still
+  // level get drag, engine/forces/free_surface.h).
+  // `profile` (not empty): the current by depth in place of `current`.
   CableFluidLoad(std::vector<Element> elements, std::shared_ptr<const WaveLoad> waves,
-                 const Eigen::Vector3d& current)
-      : elements_(std::move(elements)), waves_(std::move(waves)), current_(current) {}
+                 const Eigen::Vector3d& current, const FreeSurface& surface = {},
+                 CurrentProfile profile = {})
+      : elements_(std::move(elements)),
+        waves_(std::move(waves)),
+        current_(current),
+        surface_(surface),
+        profile_(std::move(profile)) {}
 
   std::string_view name() const override { return "cable_fluid_load"; }
   bool has_potential() const override { return false; }
@@ -49,13 +62,17 @@ class CableFluidLoad : public ElementDissipationTerm<CableFluidLoad> {
   std::vector<Element> elements_;
   std::shared_ptr<const WaveLoad> waves_;
   Eigen::Vector3d current_;
+  FreeSurface surface_;
+  CurrentProfile profile_;
 };
 
 // The scene's fluid load on its cables; null when no element has drag or
 // (with waves) flow inertia.
 std::unique_ptr<CableFluidLoad> MakeCableFluidLoad(std::vector<CableFluidLoad::Element> elements,
                                                    std::shared_ptr<const WaveLoad> waves,
-                                                   const Eigen::Vector3d& current);
+                                                   const Eigen::Vector3d& current,
+                                                   const FreeSurface& surface = {},
+                                                   CurrentProfile profile = {});
 
 }  // namespace cablesim
 

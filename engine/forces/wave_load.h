@@ -9,7 +9,8 @@
 // lumped-mass mooring line model with DeepCwind semisubmersible model test
 // data", Ocean Engineering 104, 2015, section 2).
 //
-// The flow at a point r and time t is the uniform current U plus the wave
+// The flow at a point r and time t is the uniform current U (or the current
+// by depth, engine/forces/current_profile.h) plus the wave
 // kinematics of WaveField (engine/forces/waves.h): u(r, t) = U + u_w(r, t),
 // du/dt = a_w(r, t). At each Gauss point x_g of an element, with the
 // cable's position r = S(x_g) e, velocity rdot = S(x_g) edot, unit tangent
@@ -25,16 +26,25 @@
 // gradient of the undisturbed wave) plus the added-mass force C_a rho A
 // du/dt. The cable's own added mass C_a rho A joins its mass matrix in every
 // direction (ModelBuilder: one coefficient, so the mass matrix stays
-// constant), so the inertia term takes the whole vector du/dt with that
-// same C_a: the relative-acceleration form C_a rho A (du/dt - rddot) in
-// every direction, MoorDyn's line load with C_an = C_at = C_a. Gauss
-// quadrature (the element's rule, 5 points by default) integrates q.
+// constant), so with one coefficient the inertia term takes the whole
+// vector du/dt with that same C_a: the relative-acceleration form
+// C_a rho A (du/dt - rddot) in every direction, MoorDyn's line load with
+// C_an = C_at = C_a. With an axial coefficient see below. Gauss quadrature
+// (the element's rule, 5 points by default) integrates q.
 //
 // Above the still water level the kinematics are those at the level (z = 0)
-// and below the bed those at the bed, as WaveField::At documents: the fluid
-// of a scene fills all space (buoyancy and the current act on every cable,
-// whatever its height), and a load that stayed continuous where a cable
-// pierces the still level keeps Newton from stalling on a jump there.
+// and below the bed those at the bed, as WaveField::At documents. Without
+// the free surface the fluid of a scene fills all space (buoyancy and the
+// current act on every cable, whatever its height); with it
+// (engine/forces/free_surface.h) a Gauss point above the instantaneous
+// level h >= eta(x, t) gets no drag and no inertia (the points between the
+// still level and a crest keep the kinematics at z = 0: no stretching).
+//
+// Added mass along and across the line (MoorDyn's Ca and CaAx): the inertia
+// factor splits into mi_n = (1 + C_a) rho A across the line and
+// mi_t = (1 + C_a,ax) rho A along it, q_inertia = mi_n P du/dt +
+// mi_t t t^T du/dt (P = I - t t^T); the cable's own added mass is then
+// direction-dependent too (engine/forces/cable_added_mass.h).
 //
 // Tangent: -dQ/d(edot) is the drag's (AddDrag's formula, symmetric
 // positive semi-definite). The derivatives in e (through t and through the
@@ -55,40 +65,50 @@
 #include <Eigen/Core>
 
 #include "engine/elements/ancf_cable_element.h"
+#include "engine/forces/current_profile.h"
+#include "engine/forces/free_surface.h"
 #include "engine/forces/waves.h"
 
 namespace cablesim {
 
 class WaveLoad {
  public:
-  // `field` the waves, `current` the fluid's uniform current [m/s].
-  WaveLoad(WaveField field, const Eigen::Vector3d& current);
+  // `field` the waves, `current` the fluid's uniform current [m/s] (or,
+  // when `profile` is not empty, the current by depth), `free_surface`
+  // whether the fluid ends at the waves' surface.
+  WaveLoad(WaveField field, const Eigen::Vector3d& current, bool free_surface = false,
+           CurrentProfile profile = {});
 
   const WaveField& field() const { return field_; }
+  // The surface the load ends at (disabled: none).
+  const FreeSurface& surface() const { return surface_; }
 
   // For one element at coordinates e and rates edot at time t [s], with the
-  // drag factors kn, kt [kg/m^2] and the inertia factor mi [kg/m]: adds
-  // Q = int S^T q dx to `force` and, when `c` is not null, -dQ/d(edot) to it.
+  // drag factors kn, kt [kg/m^2] and the inertia factors mi_n (across),
+  // mi_t (along) [kg/m]: adds Q = int S^T q dx to `force` and, when `c` is
+  // not null, -dQ/d(edot) to it.
   template <int D>
   void Add(const AncfCableElement<D>& element, const typename AncfCableElement<D>::Coords& e,
            const typename AncfCableElement<D>::Coords& edot, double t, double kn, double kt,
-           double mi, typename AncfCableElement<D>::Coords* force,
+           double mi_n, double mi_t, typename AncfCableElement<D>::Coords* force,
            typename AncfCableElement<D>::Matrix* c) const;
 
  private:
   WaveField field_;
   Eigen::Vector3d current_;
+  FreeSurface surface_;
+  CurrentProfile profile_;
 };
 
 extern template void WaveLoad::Add<2>(const AncfCableElement<2>&,
                                       const AncfCableElement<2>::Coords&,
                                       const AncfCableElement<2>::Coords&, double, double, double,
-                                      double, AncfCableElement<2>::Coords*,
+                                      double, double, AncfCableElement<2>::Coords*,
                                       AncfCableElement<2>::Matrix*) const;
 extern template void WaveLoad::Add<3>(const AncfCableElement<3>&,
                                       const AncfCableElement<3>::Coords&,
                                       const AncfCableElement<3>::Coords&, double, double, double,
-                                      double, AncfCableElement<3>::Coords*,
+                                      double, double, AncfCableElement<3>::Coords*,
                                       AncfCableElement<3>::Matrix*) const;
 
 }  // namespace cablesim

@@ -88,6 +88,9 @@ class WaveField {
                   int components, uint64_t seed);
 
   const std::vector<Component>& components() const { return components_; }
+  // The unit vertical and the still water level along it [m].
+  const Eigen::Vector3d& up() const { return up_; }
+  double surface() const { return surface_; }
 
   // The kinematics at point r [m] and time t [s]. Allocates nothing.
   Kinematics At(const Eigen::Vector3d& r, double t) const;

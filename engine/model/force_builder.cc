@@ -146,8 +146,16 @@ void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* 
       fluid.drag_t = drag_t;
       // With waves, the flow's inertia: Froude-Krylov plus added mass
       // (WaveLoad).
-      if (model_.wave_load_) fluid.fluid_inertia = (1 + cable.added_mass) * displaced;
+      // Along the line C_a,ax when the scene gives it (CableAddedMass adds
+      // the difference to the mass matrix's isotropic C_a).
+      const double axial_added_mass =
+          cable.has_axial_added_mass ? cable.axial_added_mass : cable.added_mass;
+      if (model_.wave_load_) {
+        fluid.fluid_inertia = (1 + cable.added_mass) * displaced;
+        fluid.fluid_inertia_axial = (1 + axial_added_mass) * displaced;
+      }
       fluid_elements_.push_back(fluid);
+      added_mass_elements_.push_back({displaced, cable.added_mass, axial_added_mass});
       CableDamping::Element damping;
       damping.axial_s = cable.axial_damping_s + cable.rayleigh_beta_s;
       damping.bending_s = cable.bending_damping_s + cable.rayleigh_beta_s;
@@ -176,7 +184,8 @@ void ModelBuilder::BuildElements() {
     for (const JonswapSpec& j : fluid.waves.jonswap)
       field.AddJonswap(j.significant_height_m, j.peak_period_s, j.peak_factor, j.direction,
                        j.components, j.seed);
-    model_.wave_load_ = std::make_shared<const WaveLoad>(std::move(field), fluid.current_m_s);
+    model_.wave_load_ = std::make_shared<const WaveLoad>(std::move(field), fluid.current_m_s,
+                                                         fluid.free_surface, Current());
     model_.waves_ = &model_.wave_load_->field();
     model_.damping_point_cost_ = 1 + static_cast<int64_t>(model_.waves_->components().size());
   }
@@ -191,9 +200,15 @@ void ModelBuilder::BuildElements() {
     cable_damping_ = damping.get();
     model_.element_terms_.push_back(std::move(damping));
   }
+  const FreeSurface surface = Surface();
   if (auto load = MakeCableFluidLoad(std::move(fluid_elements_), model_.wave_load_,
-                                     scene_.fluid.current_m_s))
+                                     scene_.fluid.current_m_s, surface, Current()))
     model_.element_terms_.push_back(std::move(load));
+  // The added mass beyond the mass matrix's, for the dynamics (the surface
+  // is the waves' where there are waves).
+  if (scene_.solver.analysis == Analysis::kDynamic)
+    model_.cable_added_mass_ =
+        MakeCableAddedMass(std::move(added_mass_elements_), surface, model_.waves_);
   if (auto bed = MakeCableSeabed(scene_)) {
     model_.cable_seabed_ = bed.get();
     model_.element_terms_.push_back(std::move(bed));
@@ -216,6 +231,42 @@ void ModelBuilder::BuildElements() {
   }
 }
 
+CurrentProfile ModelBuilder::Current() const {
+  const FluidSpec& fluid = scene_.fluid;
+  const double g = scene_.gravity_m_s2.norm();
+  if (fluid.current_profile_depths_m.empty() || !(g > 0)) return {};
+  return CurrentProfile(-scene_.gravity_m_s2 / g, fluid.still_water_level_m,
+                        fluid.current_profile_depths_m, fluid.current_profile_velocities_m_s);
+}
+
+FreeSurface ModelBuilder::Surface() const {
+  FreeSurface surface;
+  const double g = scene_.gravity_m_s2.norm();
+  if (!scene_.fluid.free_surface || !(scene_.fluid.density_kg_m3 > 0) || !(g > 0)) return surface;
+  surface.enabled = true;
+  surface.up = -scene_.gravity_m_s2 / g;
+  surface.level_m = scene_.fluid.still_water_level_m;
+  return surface;
+}
+
+template <int D>
+std::unique_ptr<ForceContributor> ModelBuilder::SurfaceBuoyancy(
+    const std::vector<MultibodyModel::ElementData<D>>& elements) const {
+  const FreeSurface surface = Surface();
+  if (!surface.enabled) return nullptr;
+  std::vector<typename CableSurfaceBuoyancy<D>::Element> out;
+  const double rho_f = scene_.fluid.density_kg_m3, g = scene_.gravity_m_s2.norm();
+  for (size_t k = 0; k < elements.size(); ++k) {
+    const CableSpec& cable = scene_.cables[element_cable_[k]];
+    const double dh = cable.hydro_diameter_m > 0 ? cable.hydro_diameter_m
+                                                 : std::sqrt(4 * cable.area_m2 / kPi);
+    out.push_back({elements[k].first_coord, elements[k].element, rho_f * kPi * dh * dh / 4 * g});
+  }
+  // The waves' elevation in DYNAMIC runs only (STATIC sees the still level).
+  return MakeCableSurfaceBuoyancy<D>(std::move(out), surface,
+                                     scene_.solver.analysis == Analysis::kDynamic);
+}
+
 absl::Status ModelBuilder::Contributors() {
   MultibodyModel& m = model_;
   std::vector<int> body_coord(scene_.bodies.size());
@@ -236,6 +287,9 @@ absl::Status ModelBuilder::Contributors() {
     m.has_step_work_ = true;
     add(std::move(loads));
   }
+  if (auto buoyancy = m.dim_ == 2 ? SurfaceBuoyancy<2>(m.elements2_)
+                                  : SurfaceBuoyancy<3>(m.elements3_))
+    add(std::move(buoyancy));
   if (auto damping = MakeBodyDamping(scene_, body_coord, m.dim_)) add(std::move(damping));
   if (auto contact = MakeBodySeabedContact(scene_, body_coord, m.dim_)) {
     m.body_contact_ = contact.get();

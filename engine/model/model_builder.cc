@@ -324,6 +324,32 @@ absl::Status ModelBuilder::CheckIntegratorFits() const {
         name, m.multipliers(), what,
         IntegratorNames([](const IntegratorTraits& t) { return !t.is_explicit; })));
   }
+  // The cables' added mass beyond the constant mass matrix
+  // (CableAddedMass) joins the residual of the steppers that solve for
+  // accelerations: the alpha family.
+  if (!traits.has_rho_infinity && !scene_.solver.auto_integrator &&
+      scene_.fluid.density_kg_m3 > 0) {
+    for (int c = 0; c < static_cast<int>(scene_.cables.size()); ++c) {
+      const CableSpec& cable = scene_.cables[c];
+      std::string why;
+      if (cable.has_axial_added_mass && cable.axial_added_mass != cable.added_mass) {
+        why = absl::StrFormat("cables[%d].hydrodynamics.axial_added_mass differs from its "
+                              "added_mass",
+                              c);
+      } else if (scene_.fluid.free_surface && cable.added_mass != 0) {
+        why = absl::StrFormat("fluid.free_surface takes cables[%d]'s added mass off above the "
+                              "surface",
+                              c);
+      }
+      if (!why.empty()) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "solver.integrator: %s does not take an added mass that depends on the line's "
+            "direction or position (%s): use %s",
+            name, why,
+            IntegratorNames([](const IntegratorTraits& t) { return t.has_rho_infinity; })));
+      }
+    }
+  }
   if (traits.takes_winches) return absl::OkStatus();
   for (int c = 0; c < static_cast<int>(scene_.cables.size()); ++c) {
     if (scene_.cables[c].winch.enabled) {

@@ -17,8 +17,12 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "engine/forces/cable_added_mass.h"
+#include "engine/forces/cable_buoyancy.h"
 #include "engine/forces/cable_damping.h"
 #include "engine/forces/cable_fluid_load.h"
+#include "engine/forces/current_profile.h"
+#include "engine/forces/free_surface.h"
 #include "engine/forces/gravity_loads.h"
 #include "engine/forces/winch_cables.h"
 #include "engine/model/multibody_model.h"
@@ -187,6 +191,14 @@ class ModelBuilder {
   // slider's body point is more than 1e-6 m from its cable at t = 0, naming
   // the joint). A contributor that dissipates turns on the damping pass.
   absl::Status Contributors();
+  // The scene's free surface (disabled without fluid.free_surface) and the
+  // buoyancy the cables lose above it (CableSurfaceBuoyancy; null: none).
+  FreeSurface Surface() const;
+  // The scene's current by depth (empty: the uniform current).
+  CurrentProfile Current() const;
+  template <int D>
+  std::unique_ptr<ForceContributor> SurfaceBuoyancy(
+      const std::vector<MultibodyModel::ElementData<D>>& elements) const;
 
   // The winches' data (MultibodyModel::WinchData): their cables' element
   // ranges; the model then needs its damping pass (the convective terms).
@@ -287,6 +299,7 @@ class ModelBuilder {
   // damping term (the winches clear their cables' share).
   std::vector<CableDamping::Element> damping_elements_;
   std::vector<CableFluidLoad::Element> fluid_elements_;
+  std::vector<CableAddedMass::Element> added_mass_elements_;
   CableDamping* cable_damping_ = nullptr;
   // Per element: its cable, for GravityLoads (ConstantForces).
   std::vector<int> element_cable_;

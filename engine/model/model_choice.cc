@@ -64,6 +64,12 @@ std::string OutOfPlaneField(const Scene& scene) {
   if (auto f = Z("initial_velocity.linear", iv.linear_m_s); !f.empty()) return f;
   if (auto f = NotAboutZ("initial_velocity.angular", iv.angular_rad_s); !f.empty()) return f;
   if (auto f = Z("fluid.current", scene.fluid.current_m_s); !f.empty()) return f;
+  for (size_t i = 0; i < scene.fluid.current_profile_velocities_m_s.size(); ++i) {
+    if (auto f = Z(absl::StrCat("fluid.current_profile[", i, "].velocity"),
+                   scene.fluid.current_profile_velocities_m_s[i]);
+        !f.empty())
+      return f;
+  }
   const WavesSpec& waves = scene.fluid.waves;
   for (size_t i = 0; i < waves.regular.size(); ++i) {
     if (auto f = Z(absl::StrCat("fluid.waves.regular[", i, "].direction"), waves.regular[i].direction);

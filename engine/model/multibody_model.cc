@@ -373,6 +373,46 @@ double MultibodyModel::DampingForce(const VectorXd& q, const VectorXd& qdot, Vec
   return size;
 }
 
+template <int D>
+double MultibodyModel::ElementAddedMass(const VectorXd& q, const VectorXd& qdd, VectorXd* full,
+                                        SkylineLdlt* matrix, double scale) const {
+  constexpr int kN = 4 * D, kN2 = kN * kN;
+  const auto& elements = Elements<D>();
+  typename AncfCableElement<D>::Matrix me;
+  typename AncfCableElement<D>::Coords fe;
+  double* values = matrix ? matrix->values() : nullptr;
+  double size = 0;
+  for (size_t k = 0; k < elements.size(); ++k) {
+    if (!cable_added_mass_->ActsOn(static_cast<int>(k))) continue;
+    const ElementData<D>& e = elements[k];
+    fe.setZero();
+    if (matrix) me.setZero();
+    cable_added_mass_->Add<D>(e.element, static_cast<int>(k), q.segment<kN>(e.first_coord),
+                              qdd.segment<kN>(e.first_coord), time_, &fe,
+                              matrix ? &me : nullptr);
+    full->segment<kN>(e.first_coord) += fe;
+    size = std::max(size, fe.template lpNorm<Eigen::Infinity>());
+    if (matrix) ScatterElementMatrix<kN2>(static_cast<int>(k), me.data(), scale, values);
+  }
+  return size;
+}
+
+double MultibodyModel::AddedMassCorrection(const VectorXd& q, const VectorXd& zdd, VectorXd* f,
+                                           SkylineLdlt* matrix, double scale) {
+  if (!cable_added_mass_) return 0;
+  // Accelerations map as rates do: qdd = S zdd (c is constant).
+  scratch_qdd_.resize(coordinates());
+  RateToFull(zdd, &scratch_qdd_);
+  VectorXd& full = scratch_added_;
+  full.setZero(coordinates());
+  const double size = dim_ == 2 ? ElementAddedMass<2>(q, scratch_qdd_, &full, matrix, scale)
+                                : ElementAddedMass<3>(q, scratch_qdd_, &full, matrix, scale);
+  const int n = coordinates();
+  for (int i = 0; i < n; ++i)
+    if (j_[i] >= 0) (*f)(j_[i]) += s_(i) * full(i);
+  return size;
+}
+
 double MultibodyModel::DampingPower(const VectorXd& q, const VectorXd& qdot) const {
   if (!has_damping_) return 0;
   double power = 0;  // -Q_d . qdot

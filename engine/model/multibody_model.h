@@ -55,6 +55,7 @@
 #include "engine/forces/body_damping.h"
 #include "engine/forces/body_fluid_load.h"
 #include "engine/forces/body_seabed_contact.h"
+#include "engine/forces/cable_added_mass.h"
 #include "engine/forces/force_contributor.h"
 #include "engine/forces/seabed.h"
 #include "engine/forces/sheaves.h"
@@ -194,6 +195,18 @@ class MultibodyModel {
   double DampingForce(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, Eigen::VectorXd* f,
                       SkylineLdlt* tangent = nullptr, double tangent_scale = 0,
                       Eigen::VectorXd* roundoff = nullptr);
+
+  // The cables' added mass where it is not the constant mass matrix's
+  // (engine/forces/cable_added_mass.h: an axial coefficient apart, or none
+  // above the free surface); only the alpha-family steppers take it.
+  bool has_added_mass_correction() const { return cable_added_mass_ != nullptr; }
+  // Adds the inertia force -D(q) S zdd of that term, reduced, to `f` (zdd
+  // the unknowns' accelerations, q the full configuration, at the time of
+  // SetTime) and, when `matrix` is not null, scale * S^T D S to it (the
+  // force's derivative -d(f)/d(zdd), in the mass's place in the Newton
+  // matrix). Returns the largest force entry [N]. Nothing without the term.
+  double AddedMassCorrection(const Eigen::VectorXd& q, const Eigen::VectorXd& zdd,
+                             Eigen::VectorXd* f, SkylineLdlt* matrix = nullptr, double scale = 0);
 
   // The power the damping dissipates, -Q_d . qdot [W]: qdot^T C(q) qdot >= 0
   // without drag; a current or waves may make the fluid's share negative
@@ -553,6 +566,9 @@ class MultibodyModel {
                         Eigen::VectorXd* full, SkylineLdlt* tangent, double tangent_scale,
                         Eigen::VectorXd* roundoff, double* power) const;
   template <int D>
+  double ElementAddedMass(const Eigen::VectorXd& q, const Eigen::VectorXd& qdd,
+                          Eigen::VectorXd* full, SkylineLdlt* matrix, double scale) const;
+  template <int D>
   void ElementEnergy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, EnergySample* en,
                      EnergyParts* parts) const;
   // Tensions' and BendingMoments' parts: the section force at element k's
@@ -680,6 +696,10 @@ class MultibodyModel {
   // null without waves) to the contributors in ForceState.
   std::shared_ptr<const WaveLoad> wave_load_;
   const WaveField* waves_ = nullptr;
+  // The cables' added mass beyond the mass matrix's (null: none) and its
+  // scratch (full size: accelerations, force).
+  std::unique_ptr<CableAddedMass> cable_added_mass_;
+  Eigen::VectorXd scratch_qdd_, scratch_added_;
   // The stop poll's units of work per Gauss point in the damping pass: 1,
   // plus one per wave component the fluid's load sums there.
   int64_t damping_point_cost_ = 1;

@@ -91,6 +91,11 @@ struct CableSpec {
   double normal_drag = 0;
   double tangential_drag = 0;
   double added_mass = 0;
+  // Along the cable (MoorDyn's CaAx) [-], when has_axial_added_mass;
+  // otherwise added_mass acts in every direction
+  // (engine/forces/cable_added_mass.h).
+  bool has_axial_added_mass = false;
+  double axial_added_mass = 0;
   double hydro_diameter_m = 0;
   WinchSpec winch;  // disabled: the length is fixed
 };
@@ -253,6 +258,14 @@ struct FluidSpec {
   double still_water_level_m = 0;
   double water_depth_m = 0;
   WavesSpec waves;
+  // true: the cables' fluid loads act below the instantaneous water level
+  // only (engine/forces/cable_buoyancy.h); false: everywhere.
+  bool free_surface = false;
+  // The current by depth below the still level (engine/forces/
+  // current_profile.h): depths [m] strictly increasing, velocities [m/s];
+  // empty: the uniform current_m_s.
+  std::vector<double> current_profile_depths_m;
+  std::vector<Eigen::Vector3d> current_profile_velocities_m_s;
 };
 
 // A bathymetry grid (engine/forces/bathymetry_grid.h): depths [m] below

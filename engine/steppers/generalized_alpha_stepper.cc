@@ -27,7 +27,8 @@ GeneralizedAlphaStepper::GeneralizedAlphaStepper(MultibodyModel* model,
   acc_.setZero(n_);
   acc_h_.setZero(n_);
   g_.setZero(n_);
-  for (Eigen::VectorXd* x : {&z_pred_, &v_pred_, &zdd1_, &f_, &bt_lambda_}) x->setZero(n_);
+  for (Eigen::VectorXd* x : {&z_pred_, &v_pred_, &zdd1_, &f_, &bt_lambda_, &added_})
+    x->setZero(n_);
   q_.setZero(model->coordinates());
   qd_.setZero(model->coordinates());
   v1_.setZero(n_);
@@ -56,6 +57,13 @@ bool GeneralizedAlphaStepper::Initialize(std::string* reason) {
   model_->RateToFull(v_, &qdot);
   model_->ConstraintGamma(q_, qdot, &gamma);
   LoadMass();
+  // The added mass beyond M joins the matrix of the initial solve (its
+  // force at zdd = 0 is zero).
+  if (model_->has_added_mass_correction()) {
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n_);
+    added_.setZero();
+    model_->AddedMassCorrection(q_, zero, &added_, &solver_.a(), 1.0);
+  }
   kept_.have = false;
   if (!solver_.Prepare()) {
     *reason = "the mass matrix could not be factorized";
@@ -181,6 +189,13 @@ double GeneralizedAlphaStepper::EvaluateResidual(bool assemble, bool with_floor)
   } else {
     model_->mass().Multiply(zdd1_.data(), r.data());
   }
+  // The cables' added mass beyond M (CableAddedMass): its force -D zdd
+  // moves to the inertia side, and D joins M in the Newton matrix.
+  if (model_->has_added_mass_correction()) {
+    added_.setZero();
+    model_->AddedMassCorrection(q_, zdd1_, &added_, assemble ? &solver_.a() : nullptr, 1.0);
+    r -= added_;
+  }
   const double inertia = r.lpNorm<Eigen::Infinity>();
   bt_lambda_.setZero();
   jac_.AddTransposeMultiply(lambda1_.data(), bt_lambda_.data());
@@ -210,6 +225,10 @@ bool GeneralizedAlphaStepper::FactorMatrix(bool assembled, StepStats* st) {
   if (!assembled) {
     LoadMass();
     Forces(v1_, &f_, &a, c_, cd_, nullptr);
+    if (model_->has_added_mass_correction()) {
+      added_.setZero();
+      model_->AddedMassCorrection(q_, zdd1_, &added_, &a, 1.0);
+    }
   }
   if (m_ > 0) model_->AddConstraintHessian(q_, lambda1_, c_, &a);
   return FactorNewtonMatrix(&solver_, jac_, c_, &kept_, st);

@@ -141,6 +141,9 @@ class GeneralizedAlphaStepper final : public ImplicitStepper {
   // Newton work vectors.
   // v1_ and qd_: the iterate's velocity, with damping only.
   Eigen::VectorXd z_pred_, v_pred_, v1_, zdd1_, q_, qd_, f_, bt_lambda_;
+  // The cables' added-mass correction -D(q) zdd (MultibodyModel::
+  // AddedMassCorrection; zero without it).
+  Eigen::VectorXd added_;
   // The step's coefficients: z_{n+1} = z_pred + s zdd_{n+1}, v_{n+1} =
   // v_pred + sv zdd_{n+1}, and the Newton matrix's c = w s (of K_T) and
   // cd = w sv (of the damping matrix).

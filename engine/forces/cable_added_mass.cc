@@ -1,0 +1,49 @@
+#include "engine/forces/cable_added_mass.h"
+
+#include <utility>
+
+#include "engine/elements/gauss_quadrature.h"
+
+namespace cablesim {
+
+template <int D>
+void CableAddedMass::Add(const AncfCableElement<D>& element, int index,
+                         const typename AncfCableElement<D>::Coords& e,
+                         const typename AncfCableElement<D>::Coords& edd, double t,
+                         typename AncfCableElement<D>::Coords* force,
+                         typename AncfCableElement<D>::Matrix* m) const {
+  const Element& p = elements_[index];
+  if (!p.any(surface_.enabled)) return;
+  bool wet[GaussRule::kMaxPoints];
+  surface_.WetPoints<D>(element, e, waves_, t, wet);
+  double a_n[GaussRule::kMaxPoints], a_t[GaussRule::kMaxPoints];
+  for (int g = 0; g < element.gauss_points(); ++g) {
+    // D = m_a - rho_f A C_a I, split across (a_n) and along (a_t) [kg/m].
+    a_n[g] = wet[g] ? 0.0 : -p.displaced_kg_m * p.added_mass;
+    a_t[g] = wet[g] ? p.displaced_kg_m * (p.axial_added_mass - p.added_mass)
+                    : -p.displaced_kg_m * p.added_mass;
+  }
+  element.AddDirectionalMass(e, edd, a_n, a_t, force, m);
+}
+
+template void CableAddedMass::Add<2>(const AncfCableElement<2>&, int,
+                                     const AncfCableElement<2>::Coords&,
+                                     const AncfCableElement<2>::Coords&, double,
+                                     AncfCableElement<2>::Coords*,
+                                     AncfCableElement<2>::Matrix*) const;
+template void CableAddedMass::Add<3>(const AncfCableElement<3>&, int,
+                                     const AncfCableElement<3>::Coords&,
+                                     const AncfCableElement<3>::Coords&, double,
+                                     AncfCableElement<3>::Coords*,
+                                     AncfCableElement<3>::Matrix*) const;
+
+std::unique_ptr<CableAddedMass> MakeCableAddedMass(std::vector<CableAddedMass::Element> elements,
+                                                   const FreeSurface& surface,
+                                                   const WaveField* waves) {
+  for (const CableAddedMass::Element& e : elements)
+    if (e.any(surface.enabled))
+      return std::make_unique<CableAddedMass>(std::move(elements), surface, waves);
+  return nullptr;
+}
+
+}  // namespace cablesim
