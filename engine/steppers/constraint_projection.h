@@ -1,0 +1,86 @@
+#ifndef CABLESIM_ENGINE_STEPPERS_CONSTRAINT_PROJECTION_H_
+#define CABLESIM_ENGINE_STEPPERS_CONSTRAINT_PROJECTION_H_
+
+// The constraint rows of an explicit step (CENTRAL_DIFFERENCE's RATTLE form,
+// central_difference_stepper.h): the three solves with the small matrix
+// S = G M^-1 G^T, G = dPhi/dz the constraint Jacobian at one configuration,
+// M the constant reduced mass (factored once by ExplicitAcceleration):
+//
+//  - ProjectPositions: z1 = z_pred - W x with W = M^-1 G_n^T (G at the
+//    step's start) and x such that Phi(z1, t1) = 0, by simplified Newton
+//    (S_n x_k = Phi(z_k)); the velocity that moved z there, v_half, takes
+//    the same correction over h. This is RATTLE's position step (Andersen,
+//    J. Comput. Phys. 52:24-34, 1983) with x = (h^2 / 2) lambda_pos.
+//  - ProjectVelocity: v1 -= W y, S y = G v1 + Phi_t, so that
+//    G v1 + Phi_t = 0 (RATTLE's velocity step, the multiplier mu = 2 y / h).
+//  - ConsistentAcceleration: from a_free = M^-1 f, a = a_free - W lambda
+//    with S lambda = G a_free - gamma: the solution of
+//    [M G^T; G 0][a; lambda] = [f; gamma], the multipliers the implicit
+//    steppers report (M a + G^T lambda = f, support reactions and joint
+//    forces are read from them).
+//
+// Rebuild(q) recomputes G, W (m back-substitutions with the mass) and the
+// dense LDL^T of S (m x m, m the rows: a handful for a body and its joints)
+// at a configuration. Redundant rows make S singular; Eigen's LDLT with
+// pivoting solves it in the least-squares sense (zero pivots skipped).
+// Nothing here allocates after construction.
+
+#include <string>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+#include "engine/linear/skyline_ldlt.h"
+#include "engine/linear/sparse_rows.h"
+#include "engine/model/multibody_model.h"
+
+namespace cablesim {
+
+class ConstraintProjection {
+ public:
+  // `mass`: the factored reduced mass matrix, kept by the caller.
+  ConstraintProjection(MultibodyModel* model, const SkylineLdlt* mass);
+
+  int rows() const { return m_; }
+
+  // G, W and S's factor at reduced positions z (time as set on the model).
+  // False when S has a non-finite entry.
+  bool Rebuild(const Eigen::VectorXd& z);
+
+  // The position step: corrects z1 (and v_half by the same over h) along
+  // W (built at the step's start) until |Phi(z1)|_inf <= kTolerance (1 +
+  // |z1|_inf) at the model's time. False with `reason` when simplified
+  // Newton does not get there in kMaxIterations.
+  bool ProjectPositions(double h, Eigen::VectorXd* z1, Eigen::VectorXd* v_half,
+                        std::string* reason);
+
+  // The velocity step at the configuration of the last Rebuild.
+  void ProjectVelocity(Eigen::VectorXd* v);
+
+  // a (holding M^-1 f on entry) becomes the constrained acceleration and
+  // lambda the multipliers, at the last Rebuild's configuration with rates v.
+  void ConsistentAcceleration(const Eigen::VectorXd& v, Eigen::VectorXd* a,
+                              Eigen::VectorXd* lambda);
+
+  // The largest |Phi| after the last ProjectPositions (the drift it left).
+  double last_residual() const { return last_residual_; }
+
+  // Relative tolerance on the rows after a position step: a few hundred
+  // roundings of coordinates of size 1 + |z|_inf.
+  static constexpr double kTolerance = 1e-13;
+  static constexpr int kMaxIterations = 12;
+
+ private:
+  MultibodyModel* model_;
+  const SkylineLdlt* mass_;
+  int n_ = 0, m_ = 0;
+  SparseRows jac_;
+  Eigen::MatrixXd w_, s_;
+  Eigen::LDLT<Eigen::MatrixXd> s_ldlt_;
+  Eigen::VectorXd q_, qd_, phi_, x_, gamma_, dz_;
+  double last_residual_ = 0;
+};
+
+}  // namespace cablesim
+
+#endif  // CABLESIM_ENGINE_STEPPERS_CONSTRAINT_PROJECTION_H_
