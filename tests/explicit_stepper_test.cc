@@ -304,6 +304,44 @@ TEST(ExplicitStepperTest, DormandPrinceRefusesConstraintRowsNamingTheField) {
   EXPECT_TRUE(MultibodyModel::Build(scene).ok());
 }
 
+TEST(ExplicitStepperTest, ConstrainedCentralDifferenceRefusesBadSettingsNamingTheField) {
+  // CENTRAL_DIFFERENCE with rows (a cylinder FIXED to a pinned cable,
+  // scenes/cable-with-end-cylinder.json's parts): a fixed step beyond
+  // 2 / omega_max (5.2e-5 s here) is refused before the first step, and
+  // Newton's settings do not apply to the rows' projection (its tolerance
+  // is fixed), so they are refused naming the field.
+  const auto scene = [](const std::string& solver) {
+    return absl::StrCat(R"({"gravity": {"y": -9.81},
+      "cables": [{"name": "cable", "length": 0.5, "elements": 20, "direction": {"x": 1},
+                  "density": 1000, "youngs_modulus": 1e7, "diameter": 0.01}],
+      "bodies": [{"name": "cylinder", "cylinder": {"diameter": 0.04, "height": 0.1},
+                  "density": 1000, "position": {"x": 0.55}, "axis": {"x": 1}}],
+      "joints": [{"type": "PIN", "a": {"cable": "cable", "s": 0}},
+                 {"type": "FIXED", "a": {"cable": "cable", "s": 0.5},
+                  "b": {"body": "cylinder", "point": {"x": -0.05}}}],
+      "solver": {"duration": 0.01, "integrator": "CENTRAL_DIFFERENCE", )",
+                        solver, "}}");
+  };
+  CollectingSink sink;
+  const auto summary = RunScene(SceneFromJson(scene(R"("step": 1e-4)")), &sink);
+  ASSERT_TRUE(summary.ok()) << summary.status();
+  EXPECT_EQ(summary->status, "failed");
+  EXPECT_NE(summary->error.find("solver.step: 0.0001 s is beyond CENTRAL_DIFFERENCE's stability "
+                                "limit"),
+            std::string::npos)
+      << summary->error;
+  EXPECT_EQ(RunOk(SceneFromJson(scene(R"("step": 4e-5)")), &sink).status, "ok");
+  for (const auto& [setting, field] :
+       {std::pair{R"("newton_tolerance": 1e-6)", "solver.newton_tolerance"},
+        std::pair{R"("max_newton_iterations": 5)", "solver.max_newton_iterations"},
+        std::pair{R"("linear_solver": "MINRES")", "solver.linear_solver"}}) {
+    EXPECT_NE(SceneError(scene(absl::StrCat(R"("step": 4e-5, )", setting)))
+                  .find(absl::StrCat(field, ": ")),
+              std::string::npos)
+        << setting;
+  }
+}
+
 TEST(ExplicitStepperTest, WinchesAreRefusedNamingTheField) {
   Scene scene = SceneFromJson(R"({
     "gravity": {"y": -9.81},

@@ -12,7 +12,11 @@ namespace cablesim {
 ConstraintProjection::ConstraintProjection(MultibodyModel* model, const SkylineLdlt* mass)
     : model_(model), mass_(mass), n_(model->dofs()), m_(model->multipliers()),
       jac_(model->jacobian_pattern()), s_ldlt_(model->multipliers()) {
-  w_.setZero(n_, m_);
+  y_.setZero(n_, m_);
+  from_.assign(m_, n_);
+  for (int r = 0; r < m_; ++r)
+    for (int k = jac_.row_start[r]; k < jac_.row_start[r + 1]; ++k)
+      from_[r] = std::min(from_[r], jac_.col[k]);
   s_.setZero(m_, m_);
   q_.setZero(model->coordinates());
   qd_.setZero(model->coordinates());
@@ -25,16 +29,21 @@ ConstraintProjection::ConstraintProjection(MultibodyModel* model, const SkylineL
 bool ConstraintProjection::Rebuild(const Eigen::VectorXd& z) {
   model_->ToFull(z, &q_);
   model_->Constraints(q_, &phi_, &jac_);
-  w_.setZero();
   for (int r = 0; r < m_; ++r) {
-    for (int k = jac_.row_start[r]; k < jac_.row_start[r + 1]; ++k)
-      w_(jac_.col[k], r) += jac_.value[k];
-    mass_->Solve(w_.col(r).data());
+    double* y = y_.col(r).data();
+    std::fill(y + std::min(from_[r], n_), y + n_, 0.0);
+    for (int k = jac_.row_start[r]; k < jac_.row_start[r + 1]; ++k) y[jac_.col[k]] += jac_.value[k];
+    mass_->ForwardSolve(y, from_[r]);
   }
-  for (int c = 0; c < m_; ++c) jac_.Multiply(w_.col(c).data(), s_.col(c).data());
-  // Symmetric in exact arithmetic: average the rounding away.
-  for (int c = 0; c < m_; ++c)
-    for (int r = c + 1; r < m_; ++r) s_(r, c) = s_(c, r) = 0.5 * (s_(r, c) + s_(c, r));
+  for (int c = 0; c < m_; ++c) {
+    for (int r = c; r < m_; ++r) {
+      double acc = 0;
+      const double* yr = y_.col(r).data();
+      const double* yc = y_.col(c).data();
+      for (int i = std::max(from_[r], from_[c]); i < n_; ++i) acc += yr[i] * yc[i] / mass_->pivot(i);
+      s_(r, c) = s_(c, r) = acc;
+    }
+  }
   if (!s_.allFinite()) return false;
   s_ldlt_.compute(s_);
   return s_ldlt_.info() == Eigen::Success;
@@ -57,7 +66,7 @@ bool ConstraintProjection::ProjectPositions(double h, Eigen::VectorXd* z1,
     if (!std::isfinite(err) || it == kMaxIterations) break;
     previous = err;
     x_ = s_ldlt_.solve(phi_);
-    dz_.noalias() = w_ * x_;
+    ApplyW(x_);
     *z1 -= dz_;
     *v_half -= (1.0 / h) * dz_;
   }
@@ -73,7 +82,8 @@ void ConstraintProjection::ProjectVelocity(Eigen::VectorXd* v) {
   jac_.Multiply(v->data(), phi_.data());
   for (const ConstraintFamily* f : model_->constraint_families()) f->AddRate(q_, &phi_);
   x_ = s_ldlt_.solve(phi_);
-  v->noalias() -= w_ * x_;
+  ApplyW(x_);
+  *v -= dz_;
 }
 
 void ConstraintProjection::ConsistentAcceleration(const Eigen::VectorXd& v, Eigen::VectorXd* a,
@@ -83,7 +93,14 @@ void ConstraintProjection::ConsistentAcceleration(const Eigen::VectorXd& v, Eige
   jac_.Multiply(a->data(), phi_.data());
   phi_ -= gamma_;
   *lambda = s_ldlt_.solve(phi_);
-  a->noalias() -= w_ * *lambda;
+  ApplyW(*lambda);
+  *a -= dz_;
+}
+
+void ConstraintProjection::ApplyW(const Eigen::VectorXd& x) {
+  dz_.setZero();
+  jac_.AddTransposeMultiply(x.data(), dz_.data());
+  mass_->Solve(dz_.data());
 }
 
 }  // namespace cablesim

@@ -19,13 +19,18 @@
 //    steppers report (M a + G^T lambda = f, support reactions and joint
 //    forces are read from them).
 //
-// Rebuild(q) recomputes G, W (m back-substitutions with the mass) and the
-// dense LDL^T of S (m x m, m the rows: a handful for a body and its joints)
-// at a configuration. Redundant rows make S singular; Eigen's LDLT with
+// Rebuild(q) recomputes G and S at a configuration, and the dense LDL^T of S
+// (m x m, m the rows: a handful for a body and its joints). S is built as
+// Y^T D^-1 Y with Y = L^-1 G^T (M = L D L^T, the skyline factor): a row's
+// forward substitution starts at its first coordinate, and the rows of
+// bodies and of a cable's end sit late in the ordering, so S costs far less
+// than m full solves; W x is applied as M^-1 (G^T x), one solve each time
+// (2 to 4 a step). Redundant rows make S singular; Eigen's LDLT with
 // pivoting solves it in the least-squares sense (zero pivots skipped).
 // Nothing here allocates after construction.
 
 #include <string>
+#include <vector>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
@@ -71,11 +76,15 @@ class ConstraintProjection {
   static constexpr int kMaxIterations = 12;
 
  private:
+  // dz = W x = M^-1 G^T x (the Jacobian of the last Rebuild).
+  void ApplyW(const Eigen::VectorXd& x);
+
   MultibodyModel* model_;
   const SkylineLdlt* mass_;
   int n_ = 0, m_ = 0;
   SparseRows jac_;
-  Eigen::MatrixXd w_, s_;
+  std::vector<int> from_;  // each row's first coordinate
+  Eigen::MatrixXd y_, s_;  // Y = L^-1 G^T (zero above from_), S
   Eigen::LDLT<Eigen::MatrixXd> s_ldlt_;
   Eigen::VectorXd q_, qd_, phi_, x_, gamma_, dz_;
   double last_residual_ = 0;
