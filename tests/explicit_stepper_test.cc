@@ -17,6 +17,7 @@
 #include "engine/model/multibody_model.h"
 #include "engine/scene/integrator_traits.h"
 #include "tests/energy_momentum_scenes.h"
+#include "tests/sample_scene_json.h"
 #include "tests/test_util.h"
 
 namespace cablesim {
@@ -305,22 +306,15 @@ TEST(ExplicitStepperTest, DormandPrinceRefusesConstraintRowsNamingTheField) {
 }
 
 TEST(ExplicitStepperTest, ConstrainedCentralDifferenceRefusesBadSettingsNamingTheField) {
-  // CENTRAL_DIFFERENCE with rows (a cylinder FIXED to a pinned cable,
-  // scenes/cable-with-end-cylinder.json's parts): a fixed step beyond
+  // CENTRAL_DIFFERENCE with rows (scenes/cable-with-end-cylinder.json: a
+  // cylinder FIXED to a pinned cable): a fixed step beyond
   // 2 / omega_max (5.2e-5 s here) is refused before the first step, and
   // Newton's settings do not apply to the rows' projection (its tolerance
   // is fixed), so they are refused naming the field.
   const auto scene = [](const std::string& solver) {
-    return absl::StrCat(R"({"gravity": {"y": -9.81},
-      "cables": [{"name": "cable", "length": 0.5, "elements": 20, "direction": {"x": 1},
-                  "density": 1000, "youngs_modulus": 1e7, "diameter": 0.01}],
-      "bodies": [{"name": "cylinder", "cylinder": {"diameter": 0.04, "height": 0.1},
-                  "density": 1000, "position": {"x": 0.55}, "axis": {"x": 1}}],
-      "joints": [{"type": "PIN", "a": {"cable": "cable", "s": 0}},
-                 {"type": "FIXED", "a": {"cable": "cable", "s": 0.5},
-                  "b": {"body": "cylinder", "point": {"x": -0.05}}}],
-      "solver": {"duration": 0.01, "integrator": "CENTRAL_DIFFERENCE", )",
-                        solver, "}}");
+    return testing::SampleSceneJsonWithSolver(
+        "cable-with-end-cylinder.json", "",
+        absl::StrCat(R"("duration": 0.01, "integrator": "CENTRAL_DIFFERENCE", )", solver));
   };
   CollectingSink sink;
   const auto summary = RunScene(SceneFromJson(scene(R"("step": 1e-4)")), &sink);

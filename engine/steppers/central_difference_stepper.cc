@@ -43,6 +43,12 @@ bool CentralDifferenceStepper::Initialize(std::string* reason) {
 
 Stepper::StepStats CentralDifferenceStepper::Step(double h) {
   StepStats st;
+  // A failed step leaves the state and the model's time as they were.
+  const auto fail = [&](const std::string& what) {
+    st.reason = absl::StrFormat("%s after the explicit step (h = %.3g s)", what, h);
+    model_->SetTime(t_);
+    return st;
+  };
   const bool rows = rows_.rows() > 0;
   if (rows && !rows_current_) {
     model_->SetTime(t_);
@@ -62,14 +68,7 @@ Stepper::StepStats CentralDifferenceStepper::Step(double h) {
     }
     // From here the rows' matrices are those of the step's end.
     rows_current_ = false;
-    if (!rows_.Rebuild(z1_)) {
-      st.reason = absl::StrFormat(
-          "the constraint rows' matrix G M^-1 G^T is not finite after the explicit step "
-          "(h = %.3g s)",
-          h);
-      model_->SetTime(t_);
-      return st;
-    }
+    if (!rows_.Rebuild(z1_)) return fail("the constraint rows' matrix G M^-1 G^T is not finite");
   }
   if (model_->has_damping()) v_pred_ = v_ + h * a_;
   if (!acceleration_.Evaluate(t_ + h, z1_, v_pred_, &a1_)) {
@@ -84,14 +83,8 @@ Stepper::StepStats CentralDifferenceStepper::Step(double h) {
   if (rows) {
     rows_.ProjectVelocity(&v1_);
     rows_.ConsistentAcceleration(v1_, &a1_, &lambda1_);
-    if (!a1_.allFinite() || !lambda1_.allFinite()) {
-      st.reason = absl::StrFormat(
-          "the acceleration with the constraint rows is not finite after the explicit step "
-          "(h = %.3g s)",
-          h);
-      model_->SetTime(t_);
-      return st;
-    }
+    if (!a1_.allFinite() || !lambda1_.allFinite())
+      return fail("the acceleration with the constraint rows is not finite");
     Accept(h, &z1_, &v1_, &a1_, &lambda1_);
     rows_current_ = true;
   } else {
