@@ -40,7 +40,8 @@
 //
 //   v_half = v_n + (h/2) a_n - W_n x / h,   z_{n+1} = z_n + h v_half,
 //     x such that Phi(z_{n+1}, t_{n+1}) = 0 (simplified Newton with
-//     S_n = G_n W_n, W_n = M^-1 G_n^T; to 1e-13 (1 + |z|_inf));
+//     S_n = G_n W_n, W_n = M^-1 G_n^T; to 1e-13 (1 + |z|_inf), or to
+//     1e-10 (1 + |z|_inf) where rounding stalls it: the drift bound);
 //   a_free = M^-1 f(t_{n+1}, z_{n+1}, v_n + h a_n),
 //   v_{n+1} = v_half + (h/2) a_free - W_{n+1} y,
 //     y such that G_{n+1} v_{n+1} + Phi_t(z_{n+1}, t_{n+1}) = 0 (linear);

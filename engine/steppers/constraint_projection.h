@@ -54,7 +54,8 @@ class ConstraintProjection {
 
   // The position step: corrects z1 (and v_half by the same over h) along
   // W (built at the step's start) until |Phi(z1)|_inf <= kTolerance (1 +
-  // |z1|_inf) at the model's time. False with `reason` when simplified
+  // |z1|_inf) at the model's time, or <= 1e3 kTolerance (1 + |z1|_inf)
+  // once an iteration no longer halves it (rounding). False with `reason` when simplified
   // Newton does not get there in kMaxIterations.
   bool ProjectPositions(double h, Eigen::VectorXd* z1, Eigen::VectorXd* v_half,
                         std::string* reason);
