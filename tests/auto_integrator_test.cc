@@ -111,10 +111,37 @@ TEST(AutoIntegratorTest, ImplicitForImplicitSettingsConstraintsAndContact) {
       {{R"("joints": [{"type": "PIN", "a": {"cable": "rope", "s": 0}}])",
         R"("joints": [{"type": "PIN", "a": {"cable": "rope", "s": 0}},
                       {"type": "PIN", "a": {"cable": "rope", "s": 2}, "b": {"body": "b"}}])"}});
-  const Result body = RunJson(with_body);
+  // Adaptive steps with rows keep HHT.
+  const Result body = RunJson(absl::StrReplaceAll(
+      with_body, {{R"("integrator": "AUTO_STEPPER")",
+                   R"("integrator": "AUTO_STEPPER", "adaptive": true, "tolerance": 1e-4)"}}));
   EXPECT_EQ(body.summary.integrator, "HHT");
   EXPECT_TRUE(absl::StrContains(body.summary.integrator_reason, "constraint rows"))
       << body.summary.integrator_reason;
+}
+
+TEST(AutoIntegratorTest, CentralDifferenceWithConstraintRowsAtAFixedStableStep) {
+  // The rope with a body pinned to its end: 9 rows. At a fixed step within
+  // the stable step (omega_max about 1e4 rad/s, 1e-4 s) AUTO takes
+  // CENTRAL_DIFFERENCE, the same run as named; beyond it (5e-3 s), HHT.
+  const std::string more = R"("bodies": [{"name": "b", "mass": 1, "inertia": {"x": 1, "y": 1, "z": 1},
+                          "position": {"x": 2, "y": 0}}],)";
+  const auto with_body = [&](const std::string& solver) {
+    return absl::StrReplaceAll(
+        Rope(solver, more),
+        {{R"("joints": [{"type": "PIN", "a": {"cable": "rope", "s": 0}}])",
+          R"("joints": [{"type": "PIN", "a": {"cable": "rope", "s": 0}},
+                        {"type": "PIN", "a": {"cable": "rope", "s": 2}, "b": {"body": "b"}}])"}});
+  };
+  const Result chosen = RunJson(with_body(R"("step": 1e-4, "integrator": "AUTO_STEPPER")"));
+  EXPECT_EQ(chosen.summary.status, "ok");
+  EXPECT_EQ(chosen.summary.integrator, "CENTRAL_DIFFERENCE");
+  EXPECT_TRUE(absl::StrContains(chosen.summary.integrator_reason, "constraint rows held by RATTLE"))
+      << chosen.summary.integrator_reason;
+  ExpectSameFrames(chosen,
+                   RunJson(with_body(R"("step": 1e-4, "integrator": "CENTRAL_DIFFERENCE")")));
+  EXPECT_EQ(RunJson(with_body(R"("step": 5e-3, "integrator": "AUTO_STEPPER")")).summary.integrator,
+            "HHT");
 }
 
 TEST(AutoIntegratorTest, CentralDifferenceWhenAdaptive) {

@@ -636,6 +636,26 @@ TEST_F(StepperAllocationTest, ExplicitSteppersDoNotAllocate) {
   }
 }
 
+// Central difference with constraint rows (RATTLE: the rows' matrix S and
+// its dense LDL^T sized once): the end cylinder (planar, a FIXED joint)
+// and the same spun in space (a body's six axis rows), and the crane's
+// moving trolley with its bodies, within the stable step.
+TEST_F(StepperAllocationTest, CentralDifferenceWithConstraintRowsDoesNotAllocate) {
+  Scene planar = CableWithEndCylinder(LinearSolverKind::kAuto);
+  planar.solver.Use(Integrator::kCentralDifference);
+  planar.solver.step_s = 4e-5;
+  ExpectStepsDoNotAllocate(planar, 4e-5, 100);
+  Scene spatial = planar;
+  spatial.initial_velocity.angular_rad_s = Eigen::Vector3d(0, 4, 0);
+  ExpectStepsDoNotAllocate(spatial, 4e-5, 100);
+  // A moving support (the trolley) and bodies: rheonomic rows.
+  Scene crane = SampleScene("crane-trolley-hoist.json");
+  crane.solver.Use(Integrator::kCentralDifference);
+  crane.solver.linear_solver = LinearSolverKind::kAuto;
+  crane.solver.step_s = 2e-5;
+  ExpectStepsDoNotAllocate(crane, 2e-5, 100);
+}
+
 // Nor bodies on the seabed (contact points in fixed-size blocks): a block
 // laid at its resting depth slides on a damped, frictional bed, pulled at
 // the contact level by its friction force (so it keeps sliding: the

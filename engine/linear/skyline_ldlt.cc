@@ -121,6 +121,16 @@ void SkylineLdlt::SolveImpl(double* x, bool abs) const {
   }
 }
 
+void SkylineLdlt::ForwardSolve(double* x, int from) const {
+  for (int i = from; i < n_; ++i) {
+    const double* row = &factor_[start_[i]];
+    const int fi = std::max(first_[i], from);
+    double acc = x[i];
+    for (int k = fi; k < i; ++k) acc -= row[k - first_[i]] * x[k];
+    x[i] = acc;
+  }
+}
+
 void SkylineLdlt::Solve(double* x) const { SolveImpl(x, false); }
 void SkylineLdlt::SolveAbs(double* x) const { SolveImpl(x, true); }
 

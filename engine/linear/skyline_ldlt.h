@@ -59,6 +59,12 @@ class SkylineLdlt {
   void Solve(double* x) const;
   // x = (L |D| L^T)^{-1} b, in place.
   void SolveAbs(double* x) const;
+  // The first half of Solve: x = L^{-1} b in place, for b (and so x) zero
+  // before index `from` (entries there are neither read nor written): a
+  // right-hand side that starts late in the ordering costs only the rows
+  // after it. With pivot(i) = D_ii, b^T A^{-1} c = sum_i x_b[i] x_c[i] / D_ii.
+  void ForwardSolve(double* x, int from) const;
+  double pivot(int i) const { return d_[i]; }
 
  private:
   void SolveImpl(double* x, bool abs) const;

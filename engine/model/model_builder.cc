@@ -312,7 +312,7 @@ absl::Status ModelBuilder::CheckIntegratorFits() const {
   if (scene_.solver.analysis != Analysis::kDynamic) return absl::OkStatus();
   const std::string name(traits.name);
   const MultibodyModel& m = model_;
-  if (traits.is_explicit && m.joint_rows_->size() > 0) {
+  if (!traits.takes_constraint_rows && m.joint_rows_->size() > 0) {
     const JointRows::Row& r = m.joint_rows_->row(0);
     const std::string what = r.joint >= 0
                                  ? absl::StrFormat("joints[%d] is kept as constraint rows", r.joint)
@@ -322,7 +322,7 @@ absl::Status ModelBuilder::CheckIntegratorFits() const {
         "only, and this scene has %d constraint rows (%s; only joints to fixed ground "
         "points are eliminated): use %s",
         name, m.multipliers(), what,
-        IntegratorNames([](const IntegratorTraits& t) { return !t.is_explicit; })));
+        IntegratorNames([](const IntegratorTraits& t) { return t.takes_constraint_rows; })));
   }
   // The cables' added mass beyond the constant mass matrix
   // (CableAddedMass) joins the residual of the steppers that solve for

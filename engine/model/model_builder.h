@@ -169,12 +169,12 @@ class ModelBuilder {
   // point is also held by a fixed joint to ground): names the joint.
   absl::Status CheckMovingRows() const;
 
-  // Fails when the scene's integrator cannot take what it holds: the
-  // explicit ones (DORMAND_PRINCE, CENTRAL_DIFFERENCE) integrate
-  // unconstrained motion only (no
-  // constraint rows after KeepMovableRows: joints to ground eliminate
-  // coordinates, every other joint and a body's axes are rows), and no
-  // winches (its mass is factored once). Names the first joint or body.
+  // Fails when the scene's integrator cannot take what it holds:
+  // DORMAND_PRINCE integrates unconstrained motion only (no constraint rows
+  // after KeepMovableRows: joints to ground eliminate coordinates, every
+  // other joint and a body's axes are rows; IntegratorTraits::
+  // takes_constraint_rows), and the explicit ones take no winches (the mass
+  // is factored once). Names the first joint or body.
   absl::Status CheckIntegratorFits() const;
 
   // The ANCF elements between consecutive nodes (not between the halves

@@ -8,8 +8,10 @@
 // costs one force evaluation against a Newton iteration's assembly and
 // factorisations (the falling pendulum at <= 1e-3 m: central difference
 // 60-70 times faster than the paper's method, bench/results/summary.md):
-//  - no constraint rows (bodies, joints between parts, moving supports:
-//    the explicit steppers integrate unconstrained motion only);
+//  - constraint rows (bodies, joints between parts, moving supports) only
+//    at fixed steps: CENTRAL_DIFFERENCE holds them by RATTLE
+//    (central_difference_stepper.h), within its stable step as checked
+//    below; adaptive steps with rows keep HHT (not yet measured);
 //  - no winch (they factor a constant mass once);
 //  - no contact (seabed, sheaves, body contact points) and no fluid: these
 //    stiffen or load the scene mid-run, and the explicit steppers' stable

@@ -34,8 +34,8 @@ struct IntegratorTraits {
   int frame_order;
   // No Newton iteration: the constant mass matrix is factored once and
   // every step costs force evaluations only. Such steppers take no
-  // constraint rows and no winches (the mass must be constant), and the
-  // Newton and linear-solver settings do not apply to them.
+  // winches (the mass must be constant), and the Newton and linear-solver
+  // settings do not apply to them.
   bool is_explicit;
   // Takes winches (a mass that changes with time).
   bool takes_winches;
@@ -50,10 +50,16 @@ struct IntegratorTraits {
   // Never raises the energy (backward Euler): the per-step energy guard is
   // not needed.
   bool never_raises_energy;
+  // Takes constraint rows (bodies' axes, joints between parts, moving
+  // supports): every implicit stepper, and CENTRAL_DIFFERENCE by RATTLE
+  // (central_difference_stepper.h); DORMAND_PRINCE integrates unconstrained
+  // motion only.
+  bool takes_constraint_rows = true;
 };
 
 inline constexpr std::array<IntegratorTraits, 6> kIntegratorTraits = {{
-    // integrator, name, order, local, frames, explicit, winches, rho, rho_min, keep, reuse, no-rise
+    // integrator, name, order, local, frames, explicit, winches, rho, rho_min, keep, reuse, no-rise,
+    // rows (default true)
     {Integrator::kImplicitEuler, "IMPLICIT_EULER", 1, 2, 1, false, true, false, 0.0, false, false,
      true},
     {Integrator::kGeneralizedAlpha, "GENERALIZED_ALPHA", 2, 3, 2, false, true, true, 0.0, true,
@@ -64,9 +70,9 @@ inline constexpr std::array<IntegratorTraits, 6> kIntegratorTraits = {{
      false, false},
     // Fifth order at its steps; frames between steps are cubic Hermite.
     {Integrator::kDormandPrince, "DORMAND_PRINCE", 5, 5, 4, true, false, false, 0.0, false, false,
-     false},
-    {Integrator::kCentralDifference, "CENTRAL_DIFFERENCE", 2, 3, 2, true, false, false, 0.0, false,
      false, false},
+    {Integrator::kCentralDifference, "CENTRAL_DIFFERENCE", 2, 3, 2, true, false, false, 0.0, false,
+     false, false, true},
 }};
 
 // The row of `integrator` (every enumerator has one; checked in

@@ -42,7 +42,7 @@ bool DormandPrinceStepper::Initialize(std::string* reason) {
   // more than 1 % a step.
   if (!Start("DORMAND_PRINCE", 1.725,
              "1.725 / omega_max, where its stiffest undamped mode grows by 1 % a step",
-             &omega_max_, reason))
+             /*takes_rows=*/false, &omega_max_, reason))
     return false;
   stable_step_ = omega_max_ > 0 ? 0.99 / omega_max_ : stable_step_;
   return true;

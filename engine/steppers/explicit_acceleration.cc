@@ -22,9 +22,9 @@ ExplicitAcceleration::ExplicitAcceleration(MultibodyModel* model)
 
 bool ExplicitAcceleration::Prepare(const char* stepper, const SolverSettings& settings,
                                    const Eigen::VectorXd& z0, double limit,
-                                   const char* limit_text, double* omega_max,
-                                   std::string* reason) {
-  if (model_->multipliers() > 0) {
+                                   const char* limit_text, bool takes_rows,
+                                   double* omega_max, std::string* reason) {
+  if (model_->multipliers() > 0 && !takes_rows) {
     *reason = absl::StrCat(stepper, " integrates unconstrained motion only");
     return false;
   }

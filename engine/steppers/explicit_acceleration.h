@@ -26,15 +26,23 @@ class ExplicitAcceleration {
   explicit ExplicitAcceleration(MultibodyModel* model);
 
   // Factors the mass; false with `reason` when the model has constraint
-  // rows (ModelBuilder::CheckIntegratorFits refuses those first) or the
-  // mass is not positive definite. `stepper` names the caller in messages.
+  // rows and the stepper does not take them (`takes_rows` false;
+  // ModelBuilder::CheckIntegratorFits refuses those first) or the mass is
+  // not positive definite. With rows, omega_max is that of the
+  // unconstrained mesh: the rows only take modes away (the constrained
+  // frequencies interlace below it), apart from the multipliers' own
+  // stiffness (lambda . Phi_zz), which is not counted. `stepper` names the caller in messages.
   // Puts omega_max at the initial state z0 (StiffestFrequency) into
   // *omega_max. With a fixed step (settings not adaptive), also false when
   // the step is beyond `limit` / omega_max (`limit`: the stepper's omega h
   // where its stiffest undamped mode starts to grow by more than 1 % a
   // step; `limit_text` explains it in the message).
   bool Prepare(const char* stepper, const SolverSettings& settings, const Eigen::VectorXd& z0,
-               double limit, const char* limit_text, double* omega_max, std::string* reason);
+               double limit, const char* limit_text, bool takes_rows, double* omega_max,
+               std::string* reason);
+
+  // The reduced mass matrix as factored by Prepare.
+  const SkylineLdlt& factored_mass() const { return mass_; }
 
   // The stiffest mode's angular frequency [rad/s] of the linearization at
   // z (time as last set): sqrt of the largest |eigenvalue| of M^-1 K_T(z),

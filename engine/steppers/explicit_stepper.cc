@@ -18,8 +18,9 @@ ExplicitStepper::ExplicitStepper(MultibodyModel* model, const SolverSettings& se
 }
 
 bool ExplicitStepper::Start(const char* stepper, double limit, const char* limit_text,
-                            double* omega_max, std::string* reason) {
-  if (!acceleration_.Prepare(stepper, settings_, z_, limit, limit_text, omega_max, reason))
+                            bool takes_rows, double* omega_max, std::string* reason) {
+  if (!acceleration_.Prepare(stepper, settings_, z_, limit, limit_text, takes_rows, omega_max,
+                             reason))
     return false;
   if (!acceleration_.Evaluate(t_, z_, v_, &a_)) {
     *reason = absl::StrCat("the initial acceleration is not finite",
@@ -31,7 +32,11 @@ bool ExplicitStepper::Start(const char* stepper, double limit, const char* limit
 }
 
 void ExplicitStepper::Accept(double h, Eigen::VectorXd* z1, Eigen::VectorXd* v1,
-                             Eigen::VectorXd* a1) {
+                             Eigen::VectorXd* a1, Eigen::VectorXd* lambda1) {
+  if (lambda1 != nullptr) {
+    lambda_old_.swap(lambda_);
+    lambda_.swap(*lambda1);
+  }
   z_old_.swap(z_);
   v_old_.swap(v_);
   a_old_.swap(a_);
@@ -46,6 +51,7 @@ void ExplicitStepper::Restore() {
   z_.swap(z_old_);
   v_.swap(v_old_);
   a_.swap(a_old_);
+  lambda_.swap(lambda_old_);
   t_ = t_old_;
   model_->SetTime(t_);
 }

@@ -8,7 +8,8 @@
 // initial acceleration. A step computes its end into scratch vectors and
 // hands them to Accept() only when it succeeded, so a failed step leaves
 // both the state and the one Restore() returns to untouched. lambda() is
-// empty: these steppers take no constraint rows.
+// empty unless the stepper takes constraint rows (CENTRAL_DIFFERENCE): then
+// it holds the multipliers of the state, swapped with the state.
 
 #include <string>
 
@@ -23,7 +24,7 @@ namespace cablesim {
 
 class ExplicitStepper : public Stepper {
  public:
-  void Restore() final;
+  void Restore() override;
 
   const Eigen::VectorXd& z() const final { return z_; }
   const Eigen::VectorXd& v() const final { return v_; }
@@ -36,21 +37,23 @@ class ExplicitStepper : public Stepper {
   // ExplicitAcceleration::Prepare (named `stepper`, with its stability
   // `limit` on omega h explained by `limit_text`; omega_max of the initial
   // state into *omega_max), then a = M^-1 f at the start.
-  bool Start(const char* stepper, double limit, const char* limit_text, double* omega_max,
-             std::string* reason);
+  // `takes_rows`: the stepper integrates constraint rows itself.
+  bool Start(const char* stepper, double limit, const char* limit_text, bool takes_rows,
+             double* omega_max, std::string* reason);
 
   // The step of size h succeeded with end state (z1, v1, a1): the current
   // state becomes the one Restore() returns to and the end state the
-  // current one. Swaps (no allocation); the three vectors come back as
-  // scratch.
-  void Accept(double h, Eigen::VectorXd* z1, Eigen::VectorXd* v1, Eigen::VectorXd* a1);
+  // current one. Swaps (no allocation); the vectors come back as scratch.
+  // `lambda1`: the end's multipliers (null: none, the model has no rows).
+  void Accept(double h, Eigen::VectorXd* z1, Eigen::VectorXd* v1, Eigen::VectorXd* a1,
+              Eigen::VectorXd* lambda1 = nullptr);
 
   MultibodyModel* model_;
   SolverSettings settings_;
   ExplicitAcceleration acceleration_;
   int n_ = 0;
   Eigen::VectorXd z_, v_, a_, lambda_;
-  Eigen::VectorXd z_old_, v_old_, a_old_;
+  Eigen::VectorXd z_old_, v_old_, a_old_, lambda_old_;
   double t_ = 0, t_old_ = 0;
 };
 
