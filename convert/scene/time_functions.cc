@@ -2,12 +2,13 @@
 
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 
 namespace cablesim::scene_convert {
 
-// How deep TimeFunction.sum may nest.
+// How deep TimeFunction.sum and .product may nest.
 constexpr int kMaxTimeFunctionDepth = 8;
 
 absl::StatusOr<TimeFunction> ConvertTimeFunction(const std::string& path, const v1::TimeFunction& p,
@@ -56,10 +57,26 @@ absl::StatusOr<TimeFunction> ConvertTimeFunction(const std::string& path, const 
   for (int i = 0; i < p.sum_size(); ++i) {
     const std::string sub = Indexed(path, "sum", i);
     if (depth + 1 >= kMaxTimeFunctionDepth)
-      return Invalid(sub, absl::StrCat("at most ", kMaxTimeFunctionDepth, " levels of sum"));
+      return Invalid(sub, absl::StrCat("at most ", kMaxTimeFunctionDepth,
+                                       " levels of sum and product"));
     CABLESIM_ASSIGN_OR_RETURN(TimeFunction term,
                               ConvertTimeFunction(sub, p.sum(i), range, depth + 1));
     f.add_term(std::move(term));
+  }
+  if (p.product_size() > 0) {
+    std::vector<TimeFunction> factors;
+    for (int i = 0; i < p.product_size(); ++i) {
+      const std::string sub = Indexed(path, "product", i);
+      if (depth + 1 >= kMaxTimeFunctionDepth)
+        return Invalid(sub, absl::StrCat("at most ", kMaxTimeFunctionDepth,
+                                         " levels of sum and product"));
+      // A factor is dimensionless or in the quantity's unit: each must be
+      // finite, which the quantity's range (wider than any factor's) checks.
+      CABLESIM_ASSIGN_OR_RETURN(TimeFunction factor,
+                                ConvertTimeFunction(sub, p.product(i), range, depth + 1));
+      factors.push_back(std::move(factor));
+    }
+    f.add_product(std::move(factors));
   }
   return f;
 }

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include <Eigen/Geometry>
 
@@ -12,9 +13,10 @@ namespace cablesim {
 template <int D>
 AncfCableElement<D>::AncfCableElement(double length_m, double ea_n, double ei_n_m2,
                                       BendingModel bending, int gauss_points,
-                                      AxialLaw axial_law)
+                                      AxialLaw axial_law,
+                                      std::shared_ptr<const TensionTable> table)
     : length_(length_m), ea_(ea_n), ei_(ei_n_m2), bending_(bending), axial_law_(axial_law),
-      rule_(MakeGaussRule(gauss_points)) {
+      table_(std::move(table)), rule_(MakeGaussRule(gauss_points)) {
   set_length(length_m);
 }
 
@@ -113,10 +115,14 @@ typename AncfCableElement<D>::Energy AncfCableElement<D>::StrainEnergy(const Coo
       w += d2_[g][k] * e.template segment<D>(k * D);
     }
     const double a = u.squaredNorm(), b = u.dot(w), c = w.squaredNorm();
-    const double eps =
-        axial_law_ == AxialLaw::kEngineering ? std::sqrt(a) - 1 : (a - 1) / 2;
     const double wl = rule_.weight[g] * length_;
-    energy.axial += wl * 0.5 * ea_ * eps * eps;
+    if (axial_law_ == AxialLaw::kTable) {
+      energy.axial += wl * table_->Energy(std::sqrt(a) - 1);
+    } else {
+      const double eps =
+          axial_law_ == AxialLaw::kEngineering ? std::sqrt(a) - 1 : (a - 1) / 2;
+      energy.axial += wl * 0.5 * ea_ * eps * eps;
+    }
     double kappa2 = 0;
     if (bending_ == BendingModel::kExact) {
       kappa2 = (a * c - b * b) / (a * a * a);
@@ -164,6 +170,17 @@ void AncfCableElement<D>::ElasticForceWith(const Coords& e, Coords* force, Matri
         gu = ea_ * f * u;
         if (tangent) huu = ea_ * (f * Id::Identity() + u * u.transpose() / (a * s));
         if (roundoff) nuu = ea_ * (std::abs(f) + 1);
+      }
+    } else if constexpr (kLaw == AxialLaw::kTable) {
+      // psi = W(s - 1), s = |u|: gradient T u / s, Hessian
+      // T / s (I - u u^T / s^2) + k u u^T / s^2 (eigenvalues T / s and k).
+      const double s = std::sqrt(a);
+      if (s > 0) {
+        const TensionTable::Value tk = table_->At(s - 1);
+        const double f = tk.tension / s;
+        gu = f * u;
+        if (tangent) huu = f * Id::Identity() + ((tk.stiffness - f) / a) * u * u.transpose();
+        if (roundoff) nuu = std::abs(f) + tk.stiffness;
       }
     } else {
       const double eps = (a - 1) / 2;
@@ -234,6 +251,8 @@ void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* t
   // The law chosen once per element, not per Gauss point (the hot loop).
   if (axial_law_ == AxialLaw::kEngineering)
     ElasticForceWith<AxialLaw::kEngineering>(e, force, tangent, roundoff);
+  else if (axial_law_ == AxialLaw::kTable)
+    ElasticForceWith<AxialLaw::kTable>(e, force, tangent, roundoff);
   else
     ElasticForceWith<AxialLaw::kGreenLagrange>(e, force, tangent, roundoff);
 }
@@ -280,7 +299,7 @@ void AncfCableElement<D>::AddDampingMatrix(const Coords& e, double axial_s, doub
     const double wl = rule_.weight[g] * length_;
     // Engineering strain: d eps/dt = u.udot / |u|.
     const double axial_scale =
-        axial_law_ == AxialLaw::kEngineering && u.squaredNorm() > 0 ? 1 / u.squaredNorm() : 1.0;
+        axial_law_ != AxialLaw::kGreenLagrange && u.squaredNorm() > 0 ? 1 / u.squaredNorm() : 1.0;
     Block huu = (ca * axial_scale) * u * u.transpose(), huw = Block::Zero(), hww = Block::Zero();
     if (cb != 0) {
       // k = u x w / a^(3/2), a = u.u: dk/dw = [u]x / a^(3/2),
@@ -424,6 +443,13 @@ void AncfCableElement<D>::AddDiscreteGradientCorrection(const Coords& e0, const 
       const double s0 = std::sqrt(a0), s1 = std::sqrt(a1), sm = std::sqrt(am);
       fa = 0.5 * ea_ * (s0 + s1 - 2) / (s0 + s1);
       ga = 0.5 * ea_ * (sm - 1) / sm;
+    } else if (axial_law_ == AxialLaw::kTable) {
+      // psi = W(s - 1): (W(e1) - W(e0)) / (a1 - a0) = Tbar / (s0 + s1),
+      // Tbar the table's exact mean tension over [e0, e1]; dpsi/da =
+      // T / (2 s) at the midpoint.
+      const double s0 = std::sqrt(a0), s1 = std::sqrt(a1), sm = std::sqrt(am);
+      fa = table_->MeanTension(s0 - 1, s1 - 1) / (s0 + s1);
+      ga = 0.5 * table_->At(sm - 1).tension / sm;
     }
     if (bending_ == BendingModel::kLinear) fc = gc = k;
     if (exact) {
