@@ -20,6 +20,7 @@
 #include "absl/strings/str_format.h"
 #include "engine/elements/ancf_cable_element.h"
 #include "engine/elements/tension_table.h"
+#include "tests/ancf_element_checks.h"
 #include "tests/test_util.h"
 
 namespace cablesim {
@@ -73,25 +74,8 @@ constexpr double kEI = 3.0;
 
 template <int D>
 typename AncfCableElement<D>::Coords Deformed(std::mt19937* rng) {
-  // A strongly deformed element: slopes turned by up to ~60 degrees,
-  // stretched or shortened by up to 20 % (strains across the knots below).
-  std::uniform_real_distribution<double> u(-1, 1);
-  Eigen::Matrix<double, D, 1> r0, dir, t0, t1;
-  for (int d = 0; d < D; ++d) r0(d) = u(*rng);
-  dir.setZero();
-  dir(0) = 1;
-  for (int d = 1; d < D; ++d) dir(d) = 0.8 * u(*rng);
-  dir.normalize();
-  const Eigen::Matrix<double, D, 1> r1 = r0 + kLength * (1 + 0.2 * u(*rng)) * dir;
-  for (int d = 0; d < D; ++d) {
-    t0(d) = dir(d) + 0.6 * u(*rng);
-    t1(d) = dir(d) + 0.6 * u(*rng);
-  }
-  t0 *= (1 + 0.2 * u(*rng)) / t0.norm();
-  t1 *= (1 + 0.2 * u(*rng)) / t1.norm();
-  typename AncfCableElement<D>::Coords e;
-  e << r0, t0, r1, t1;
-  return e;
+  // Stretched or shortened by up to 20 %: strains across the knots below.
+  return testing::Deformed<D>(rng, kLength);
 }
 
 template <int D>
@@ -102,8 +86,7 @@ AncfCableElement<D> WithTable(BendingModel bending, std::shared_ptr<const Tensio
 
 template <int D>
 double Energy(const AncfCableElement<D>& element, const typename AncfCableElement<D>::Coords& e) {
-  const auto u = element.StrainEnergy(e);
-  return u.axial + u.bending;
+  return testing::TotalStrainEnergy(element, e);
 }
 
 // A table of one segment of slope EA is ENGINEERING with that EA: the
@@ -162,36 +145,12 @@ std::shared_ptr<const TensionTable> Kinked() {
       std::vector<double>{0, 0.05 * kEA, 0.2 * kEA, 0.225 * kEA});
 }
 
-// Central differences with h = 1e-6 as in axial_law_test (error O(h^2)
-// where T is smooth; a Gauss point's strain within ~1e-6 of a knot, where
-// the difference straddles the kink, has probability ~1e-4 per point).
+// Force and tangent against central differences (ancf_element_checks.h;
+// where the difference straddles a knot's kink it errs, but a Gauss
+// point's strain within ~1e-6 of a knot has probability ~1e-4 per point).
 template <int D>
 void CheckForceAndTangent(BendingModel bending, int seed) {
-  using C = typename AncfCableElement<D>::Coords;
-  using M = typename AncfCableElement<D>::Matrix;
-  std::mt19937 rng(seed);
-  const AncfCableElement<D> element = WithTable<D>(bending, Kinked());
-  const double h = 1e-6;
-  for (int trial = 0; trial < 20; ++trial) {
-    const C e = Deformed<D>(&rng);
-    C f = C::Zero();
-    M k = M::Zero();
-    element.ElasticForce(e, &f, &k);
-    M fd;
-    for (int i = 0; i < AncfCableElement<D>::kCoords; ++i) {
-      C ep = e, em = e, fp = C::Zero(), fm = C::Zero();
-      ep(i) += h;
-      em(i) -= h;
-      EXPECT_NEAR(f(i), (Energy(element, ep) - Energy(element, em)) / (2 * h),
-                  1e-6 * f.cwiseAbs().maxCoeff())
-          << "coordinate " << i;
-      element.ElasticForce(ep, &fp, nullptr);
-      element.ElasticForce(em, &fm, nullptr);
-      fd.col(i) = (fp - fm) / (2 * h);
-    }
-    EXPECT_LT((k - fd).cwiseAbs().maxCoeff(), 1e-6 * k.cwiseAbs().maxCoeff());
-    EXPECT_LT((k - k.transpose()).cwiseAbs().maxCoeff(), 1e-12 * k.cwiseAbs().maxCoeff());
-  }
+  testing::CheckForceAndTangent<D>(WithTable<D>(bending, Kinked()), seed);
 }
 
 TEST(TensionTableTest, ForceAndTangentAreDerivativesOfTheEnergy) {
