@@ -19,11 +19,11 @@ TensionTable::TensionTable(std::vector<double> strains, std::vector<double> tens
 }
 
 int TensionTable::Segment(double e) const {
+  // The number of inner knots e_1 .. e_last at or below e (a bisection: a
+  // table read from a file may have hundreds of knots).
   const int last = static_cast<int>(slope_.size()) - 1;
-  // Few knots: a linear scan from the start is as quick as a bisection.
-  int k = 0;
-  while (k < last && e >= strain_[k + 1]) ++k;
-  return k;
+  return static_cast<int>(std::upper_bound(strain_.begin() + 1, strain_.begin() + 1 + last, e) -
+                          (strain_.begin() + 1));
 }
 
 TensionTable::Value TensionTable::At(double e) const {
