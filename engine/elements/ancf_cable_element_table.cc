@@ -1,6 +1,7 @@
 // The TABLE law's elastic force loop (ancf_cable_element_force.h says why
 // it is instantiated in a file of its own).
 
+#include "engine/elements/ancf_cable_element.h"
 #include "engine/elements/ancf_cable_element_force.h"
 
 namespace cablesim {
