@@ -7,6 +7,7 @@
 #include <numbers>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -43,6 +44,9 @@ struct LineType {
   int line = 0;
   double diameter = 0, mass_per_length = 0, ea = 0, ba = 0, ei = 0;
   double cd = 0, ca = 0, cd_axial = 0, ca_axial = 0;
+  // A tension-strain table (EA given as a file): its knots, as the file
+  // gives them; empty for a constant EA.
+  std::vector<double> table_strains, table_tensions;
 };
 
 enum class PointKind { kFixed, kCoupled, kFree };
@@ -80,8 +84,8 @@ struct Option {
 
 class DeckReader {
  public:
-  DeckReader(absl::string_view text, absl::string_view file_name)
-      : text_(text), file_(file_name) {}
+  DeckReader(absl::string_view text, absl::string_view file_name, MoorDynFileReader read_file)
+      : text_(text), file_(file_name), read_file_(std::move(read_file)) {}
 
   absl::StatusOr<v1::Scene> Read() {
     if (absl::Status s = Parse(); !s.ok()) return s;
@@ -274,13 +278,16 @@ class DeckReader {
     };
     if (absl::Status s = column(1, true, &t.diameter); !s.ok()) return s;
     if (absl::Status s = column(2, true, &t.mass_per_length); !s.ok()) return s;
-    if (!absl::SimpleAtod(w[3], &v)) {
+    if (absl::SimpleAtod(w[3], &v)) {
+      if (absl::Status s = column(3, true, &t.ea); !s.ok()) return s;
+    } else if (absl::StrContains(w[3], "|") || absl::StartsWith(w[3], "SYROPE:")) {
       return Error(n, col(3),
                    absl::StrCat("\"", w[3],
-                                "\": only a constant EA can be expressed (a tension-strain table "
-                                "or a viscoelastic law is not supported yet)"));
+                                "\": a viscoelastic or Syrope law cannot be expressed (a constant "
+                                "EA or a tension-strain table file only)"));
+    } else {
+      if (absl::Status s = ReadTensionTable(n, col(3), w[3], &t); !s.ok()) return s;
     }
-    if (absl::Status s = column(3, true, &t.ea); !s.ok()) return s;
     if (!absl::SimpleAtod(w[4], &v)) {
       return Error(n, col(4),
                    absl::StrCat("\"", w[4],
@@ -301,6 +308,76 @@ class DeckReader {
     if (absl::Status s = column(8, false, &t.cd_axial); !s.ok()) return s;
     if (absl::Status s = column(9, false, &t.ca_axial); !s.ok()) return s;
     line_types_.push_back(t);
+    return absl::OkStatus();
+  }
+
+  // EA given as a file name (MoorDyn's nonlinear line type): the file,
+  // relative to the deck's directory, has three header lines, then a knot
+  // a line, "strain tension" [-, N] separated by blanks. Its knots become
+  // the scene's tension_table (strains from 0 increasing, tensions from 0
+  // non-decreasing); the nominal EA is MoorDyn's own for such a type, the
+  // last tension over the last strain (what a negative BA, a damping
+  // ratio, is scaled by, and EI is divided by).
+  absl::Status ReadTensionTable(int n, absl::string_view field, absl::string_view name,
+                                LineType* t) const {
+    if (!read_file_) {
+      return Error(n, field,
+                   absl::StrCat("\"", name,
+                                "\": a tension-strain table file cannot be read here (a deck's "
+                                "text alone, as the service takes it, has no directory): give "
+                                "the scene with cables[].tension_table, or run the deck's file"));
+    }
+    absl::StatusOr<std::string> text = read_file_(std::string_view(name.data(), name.size()));
+    if (!text.ok()) {
+      return Error(n, field,
+                   absl::StrCat("\"", name, "\": cannot read the tension-strain table: ",
+                                text.status().message()));
+    }
+    auto bad = [&](int row, absl::string_view message) {
+      return Error(n, field, absl::StrCat(name, ":", row, ": ", message));
+    };
+    int row = 0;
+    for (absl::string_view raw : absl::StrSplit(*text, '\n')) {
+      ++row;
+      if (row <= 3) continue;  // MoorDyn's three header lines
+      const std::vector<absl::string_view> w =
+          absl::StrSplit(raw, absl::ByAnyChar(" \t\r,"), absl::SkipEmpty());
+      if (w.empty()) continue;
+      double strain = 0, tension = 0;
+      if (w.size() < 2 || !absl::SimpleAtod(w[0], &strain) ||
+          !absl::SimpleAtod(w[1], &tension) || !std::isfinite(strain) ||
+          !std::isfinite(tension)) {
+        return bad(row, absl::StrCat("expected a strain and a tension, got \"",
+                                     absl::StripAsciiWhitespace(raw), "\""));
+      }
+      if (strain < 0) {
+        return bad(row, absl::StrCat("strain ", w[0],
+                                     " < 0: compression is not tabulated (the first segment "
+                                     "continues into it)"));
+      }
+      if (!t->table_strains.empty() && !(strain > t->table_strains.back())) {
+        return bad(row, absl::StrCat("strain ", w[0], " does not increase"));
+      }
+      if (strain == 0 && tension != 0) {
+        return bad(row, absl::StrCat("tension ", w[1], " at zero strain (must be 0)"));
+      }
+      if (tension < (t->table_tensions.empty() ? 0.0 : t->table_tensions.back())) {
+        return bad(row, absl::StrCat("tension ", w[1],
+                                     " is below the row before's (tensions must not decrease)"));
+      }
+      t->table_strains.push_back(strain);
+      t->table_tensions.push_back(tension);
+    }
+    if (t->table_strains.size() < 2) {
+      return Error(n, field,
+                   absl::StrCat("\"", name,
+                                "\": a tension-strain table needs at least two knots after the "
+                                "three header lines (MoorDyn reads one as a constant EA)"));
+    }
+    if (!(t->table_tensions.back() > 0)) {
+      return Error(n, field, absl::StrCat("\"", name, "\": every tension is 0"));
+    }
+    t->ea = t->table_tensions.back() / t->table_strains.back();
     return absl::OkStatus();
   }
 
@@ -738,7 +815,15 @@ class DeckReader {
       } else {
         c->set_bending(v1::NONE);
       }
-      c->set_axial_law(v1::ENGINEERING);
+      if (t.table_strains.empty()) {
+        c->set_axial_law(v1::ENGINEERING);
+      } else {
+        c->set_axial_law(v1::TABLE);
+        for (size_t k = 0; k < t.table_strains.size(); ++k) {
+          c->mutable_tension_table()->add_strains(t.table_strains[k]);
+          c->mutable_tension_table()->add_tensions(t.table_tensions[k]);
+        }
+      }
       // BA: a coefficient [N s] on the strain rate, or minus a damping
       // ratio of a segment's axial mode (MoorDyn: BA = zeta (L / N)
       // sqrt(EA m)); cablesim's Kelvin-Voigt time is BA / EA.
@@ -828,6 +913,7 @@ class DeckReader {
 
   absl::string_view text_;
   std::string file_;
+  MoorDynFileReader read_file_;  // null: files the deck names cannot be read
   std::vector<LineType> line_types_;
   std::map<int, Point> points_;
   std::vector<Line> lines_;
@@ -840,9 +926,10 @@ class DeckReader {
 
 }  // namespace
 
-absl::StatusOr<v1::Scene> SceneFromMoorDyn(std::string_view text, std::string_view file_name) {
+absl::StatusOr<v1::Scene> SceneFromMoorDyn(std::string_view text, std::string_view file_name,
+                                           MoorDynFileReader read_file) {
   return DeckReader(absl::string_view(text.data(), text.size()),
-                    absl::string_view(file_name.data(), file_name.size()))
+                    absl::string_view(file_name.data(), file_name.size()), std::move(read_file))
       .Read();
 }
 

@@ -36,6 +36,8 @@ inline constexpr PlausibleRange kInertia{0, 1e15, "kg m^2"};
 // Each component of gravity (a centrifuge's 10,000 g is inside).
 inline constexpr PlausibleRange kGravity{-1e6, 1e6, "m/s^2"};
 inline constexpr PlausibleRange kForce{-1e12, 1e12, "N"};
+// A tension-strain table's strain (a rubber cord stretches to 5 or 6).
+inline constexpr PlausibleRange kStrain{0, 10, "(dimensionless)"};
 inline constexpr PlausibleRange kTorque{-1e12, 1e12, "N m"};
 inline constexpr PlausibleRange kVelocity{-1e5, 1e5, "m/s"};
 inline constexpr PlausibleRange kAngularVelocity{-1e5, 1e5, "rad/s"};

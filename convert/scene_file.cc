@@ -492,7 +492,15 @@ absl::StatusOr<v1::Scene> ReadSceneFile(const std::string& path) {
   absl::StatusOr<std::string> text = ReadBoundedFile(path, "scene file");
   if (!text.ok()) return text.status();
   // A MoorDyn deck's messages already start with the path and its line.
-  if (IsMoorDynDeck(path, *text)) return SceneFromMoorDyn(*text, path);
+  if (IsMoorDynDeck(path, *text)) {
+    // Files the deck names are relative to its directory (MoorDyn's base
+    // path).
+    const std::string dir = std::filesystem::path(path).parent_path().string();
+    return SceneFromMoorDyn(*text, path, [&dir](std::string_view name) {
+      return ReadBoundedFile((std::filesystem::path(dir) / std::string(name)).string(),
+                             "tension-strain table");
+    });
+  }
   absl::StatusOr<v1::Scene> scene =
       IsTextFormatScenePath(path) ? ParseSceneTextFormat(*text) : ParseSceneJson(*text);
   if (!scene.ok()) return WithPath(path, scene.status());

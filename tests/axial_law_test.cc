@@ -14,6 +14,7 @@
 
 #include "absl/strings/str_format.h"
 #include "engine/elements/ancf_cable_element.h"
+#include "tests/ancf_element_checks.h"
 #include "tests/test_util.h"
 
 namespace cablesim {
@@ -23,29 +24,6 @@ constexpr double kLength = 0.3;
 constexpr double kEA = 2.0e4;
 constexpr double kEI = 3.0;
 
-// A strongly deformed element: nodes displaced, slopes rotated by up to
-// ~60 degrees and stretched or shortened by up to 20 %.
-template <int D>
-typename AncfCableElement<D>::Coords Deformed(std::mt19937* rng) {
-  std::uniform_real_distribution<double> u(-1, 1);
-  Eigen::Matrix<double, D, 1> r0, dir, t0, t1;
-  for (int d = 0; d < D; ++d) r0(d) = u(*rng);
-  dir.setZero();
-  dir(0) = 1;
-  for (int d = 1; d < D; ++d) dir(d) = 0.8 * u(*rng);
-  dir.normalize();
-  const Eigen::Matrix<double, D, 1> r1 = r0 + kLength * (1 + 0.2 * u(*rng)) * dir;
-  for (int d = 0; d < D; ++d) {
-    t0(d) = dir(d) + 0.6 * u(*rng);
-    t1(d) = dir(d) + 0.6 * u(*rng);
-  }
-  t0 *= (1 + 0.2 * u(*rng)) / t0.norm();
-  t1 *= (1 + 0.2 * u(*rng)) / t1.norm();
-  typename AncfCableElement<D>::Coords e;
-  e << r0, t0, r1, t1;
-  return e;
-}
-
 template <int D>
 AncfCableElement<D> Engineering(BendingModel bending) {
   return AncfCableElement<D>(kLength, kEA, kEI, bending, AncfCableElement<D>::kDefaultGaussPoints,
@@ -54,40 +32,18 @@ AncfCableElement<D> Engineering(BendingModel bending) {
 
 template <int D>
 double Energy(const AncfCableElement<D>& element, const typename AncfCableElement<D>::Coords& e) {
-  const auto u = element.StrainEnergy(e);
-  return u.axial + u.bending;
+  return testing::TotalStrainEnergy(element, e);
 }
 
-// Central differences with h = 1e-6 have an error O(h^2 U''') ~ 1e-10
-// relative on these elements; 1e-6 relative is far above it and far below
-// any wrong term (a missing 1/s factor is O(20 %) here).
+template <int D>
+typename AncfCableElement<D>::Coords Deformed(std::mt19937* rng) {
+  return testing::Deformed<D>(rng, kLength);
+}
+
+// Force and tangent against central differences (ancf_element_checks.h).
 template <int D>
 void CheckForceAndTangent(BendingModel bending, int seed) {
-  using C = typename AncfCableElement<D>::Coords;
-  using M = typename AncfCableElement<D>::Matrix;
-  std::mt19937 rng(seed);
-  const AncfCableElement<D> element = Engineering<D>(bending);
-  const double h = 1e-6;
-  for (int trial = 0; trial < 20; ++trial) {
-    const C e = Deformed<D>(&rng);
-    C f = C::Zero();
-    M k = M::Zero();
-    element.ElasticForce(e, &f, &k);
-    M fd;
-    for (int i = 0; i < AncfCableElement<D>::kCoords; ++i) {
-      C ep = e, em = e, fp = C::Zero(), fm = C::Zero();
-      ep(i) += h;
-      em(i) -= h;
-      EXPECT_NEAR(f(i), (Energy(element, ep) - Energy(element, em)) / (2 * h),
-                  1e-6 * f.cwiseAbs().maxCoeff())
-          << "coordinate " << i;
-      element.ElasticForce(ep, &fp, nullptr);
-      element.ElasticForce(em, &fm, nullptr);
-      fd.col(i) = (fp - fm) / (2 * h);
-    }
-    EXPECT_LT((k - fd).cwiseAbs().maxCoeff(), 1e-6 * k.cwiseAbs().maxCoeff());
-    EXPECT_LT((k - k.transpose()).cwiseAbs().maxCoeff(), 1e-12 * k.cwiseAbs().maxCoeff());
-  }
+  testing::CheckForceAndTangent<D>(Engineering<D>(bending), seed);
 }
 
 TEST(AxialLawTest, EngineeringForceAndTangentAreDerivativesPlanar) {
@@ -214,34 +170,13 @@ TEST(AxialLawTest, BarPulledByOnePercentOfEAStretchesByOnePercentUnderEngineerin
 // stretch at the mean of a0 and a1 drifted by 4e-10 J here, within the
 // tolerance; EngineeringDiscreteGradientIsExact above catches it.)
 TEST(AxialLawTest, EnergyMomentumKeepsEnergyAndMomentumUnderEngineeringStrain) {
-  const std::string json = R"({
-    "gravity": {"y": -9.81},
-    "cables": [{"name": "pendulum", "length": 1.0, "elements": 16, "direction": {"x": 1},
-                "density": 320, "youngs_modulus": 1.6e6, "area": 2.5e-5,
-                "second_moment": 4.973591971621729e-11, "bending": "EXACT",
-                "axial_law": "ENGINEERING"}],
-    "joints": [{"type": "PIN", "a": {"cable": "pendulum", "s": 0}}],
-    "initial_velocity": {"angular": {"y": 4.0}},
-    "probes": [{"name": "tip", "cable": "pendulum", "s": 1.0}],
-    "solver": {"duration": 0.5, "step": 1e-3, "output_interval": 0.01,
-               "newton_tolerance": 1e-12, "integrator": "ENERGY_MOMENTUM"}})";
-  testing::CollectingSink sink;
-  testing::RunOk(testing::SceneFromJson(json), &sink);
-  ASSERT_FALSE(sink.frames().empty());
-  const Frame& first = sink.frames().front();
-  double dl = 0, de = 0, axial = 0;
-  for (const Frame& f : sink.frames()) {
-    dl = std::max(dl, std::abs(f.angular_momentum.y() - first.angular_momentum.y()) /
-                          std::abs(first.angular_momentum.y()));
-    de = std::max(de, std::abs(f.energy.total - first.energy.total));
-    axial = std::max(axial, f.energy.axial);
-  }
+  const testing::PendulumDrift d = testing::SpunPendulumDrift(R"("axial_law": "ENGINEERING")");
   std::printf("engineering strain, ENERGY_MOMENTUM: |dL_y| / L_y = %.3g, |dE| = %.3g J, "
               "largest axial energy %.3g J\n",
-              dl, de, axial);
-  EXPECT_GT(axial, 1e-3 * first.energy.kinetic);  // it does stretch
-  EXPECT_LT(dl, 1e-11);
-  EXPECT_LT(de, 1e-9 * first.energy.kinetic);
+              d.momentum, d.energy, d.axial);
+  EXPECT_GT(d.axial, 1e-3 * d.kinetic);  // it does stretch
+  EXPECT_LT(d.momentum, 1e-11);
+  EXPECT_LT(d.energy, 1e-9 * d.kinetic);
 }
 
 TEST(AxialLawTest, EngineeringLawOnAWinchCableIsRefusedNamingTheField) {

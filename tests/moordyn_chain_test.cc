@@ -24,50 +24,13 @@
 
 #include <gtest/gtest.h>
 
-#include "absl/strings/str_format.h"
 #include "convert/moordyn_deck.h"
 #include "convert/scene_from_proto.h"
+#include "tests/moordyn_chain_cases.h"
 #include "tests/test_util.h"
 
 namespace cablesim {
 namespace {
-
-struct ChainCase {
-  double depth_m, anchor_x_m, length_m;
-  int segments;
-  double orcaflex_kn;
-};
-
-std::string ChainDeck(const ChainCase& c) {
-  return absl::StrFormat(R"(--------------------- MoorDyn Input File ------------------------------------
-Chain at %g m depth (numbers of MoorDyn's WD%04d_Chain case)
------------------------ LINE TYPES ------------------------------------------
-TypeName   Diam    Mass/m     EA         BA/-zeta    EI         Cd     Ca     CdAx    CaAx
-(name)     (m)     (kg/m)     (N)        (N-s/-)     (N-m^2)    (-)    (-)    (-)     (-)
-chain      0.252   390        1.674e9    -1.0        0          1.37   1.0    0.64    0.0
----------------------- POINT PROPERTIES --------------------------------
-ID    Type      X       Y       Z       Mass   Volume  CdA    Ca
-(#)   (-)       (m)     (m)     (m)     (kg)   (m^3)   (m^2)  (-)
-1     Fixed     %g      0.0     %g      0      0       0      0
-2     Vessel    0.0     0.0     0.0     0      0       0      0
----------------------- LINES ----------------------------------------
-ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
-(#)   (name)     (#)      (#)       (m)       (-)     (-)
-1     chain      1        2         %g        %d      -
----------------------- OPTIONS -----------------------------------------
-1.0e5                kBot                 bottom stiffness (Pa/m)
-1.0e4                cBot                 bottom damping (Pa-s/m)
-1025.0               WtrDnsty             water density (kg/m^3)
-%g                   WtrDpth              water depth (m)
-100.0                TmaxIC               max time for ic gen (s)
-0.5                  FrictionCoefficient  general bottom friction coefficient (-)
----------------------- OUTPUTS -----------------------------------------
-FairTen1
-------------------------- need this line --------------------------------------
-)",
-                         c.depth_m, static_cast<int>(c.depth_m), c.anchor_x_m, -c.depth_m,
-                         c.length_m, c.segments, c.depth_m);
-}
 
 double FairleadTensionKn(const ChainCase& c) {
   absl::StatusOr<v1::Scene> proto = SceneFromMoorDyn(ChainDeck(c), "chain.dat");
@@ -110,17 +73,17 @@ double FairleadTensionKn(const ChainCase& c) {
 constexpr double kTolerance = 0.10;
 
 TEST(MoorDynChainSlowTest, Depth50mFairleadTensionWithinTenPercentOfOrcaFlex) {
-  const ChainCase c{50, 400, 410, 41, 991.6};
+  const ChainCase c = kChain50;
   EXPECT_NEAR(FairleadTensionKn(c), c.orcaflex_kn, kTolerance * c.orcaflex_kn);
 }
 
 TEST(MoorDynChainSlowTest, Depth200mFairleadTensionWithinTenPercentOfOrcaFlex) {
-  const ChainCase c{200, 700, 760, 76, 2065.4};
+  const ChainCase c = kChain200;
   EXPECT_NEAR(FairleadTensionKn(c), c.orcaflex_kn, kTolerance * c.orcaflex_kn);
 }
 
 TEST(MoorDynChainSlowTest, Depth600mFairleadTensionWithinTenPercentOfOrcaFlex) {
-  const ChainCase c{600, 1500, 1700, 170, 5232.6};
+  const ChainCase c = kChain600;
   EXPECT_NEAR(FairleadTensionKn(c), c.orcaflex_kn, kTolerance * c.orcaflex_kn);
 }
 

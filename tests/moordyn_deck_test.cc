@@ -8,11 +8,15 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <numbers>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <tuple>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -294,6 +298,76 @@ TEST(MoorDynDeckTest, RefusalsNameTheLineAndField) {
   }
 }
 
+// A line type whose EA names a file (MoorDyn's nonlinear line type): the
+// file's knots after its three header lines become the TABLE law's, the
+// nominal EA is MoorDyn's (the last tension over the last strain), which
+// the negative BA's damping ratio scales as for a constant EA.
+constexpr char kPolyTable[] = R"(Strain Tension
+(-)    (N)
+-----------
+0.0    0.0
+0.01   1.0e6
+0.02   3.0e6
+)";
+
+absl::StatusOr<std::string> PolyFile(std::string_view name) {
+  if (name == "poly.txt") return std::string(kPolyTable);
+  return absl::NotFoundError(absl::StrCat("no file ", std::string(name)));
+}
+
+TEST(MoorDynDeckTest, TensionStrainTableFileBecomesTheTableLaw) {
+  const std::string deck = Edited("1.0e9      -0.5", "poly.txt   -0.5");
+  absl::StatusOr<v1::Scene> scene = SceneFromMoorDyn(deck, "t.dat", PolyFile);
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  const v1::Cable& chain = CableNamed(*scene, "line1");
+  EXPECT_EQ(chain.axial_law(), v1::TABLE);
+  EXPECT_EQ(std::vector<double>(chain.tension_table().strains().begin(),
+                                chain.tension_table().strains().end()),
+            (std::vector<double>{0, 0.01, 0.02}));
+  EXPECT_EQ(std::vector<double>(chain.tension_table().tensions().begin(),
+                                chain.tension_table().tensions().end()),
+            (std::vector<double>{0, 1e6, 3e6}));
+  const double area = kPi * 0.1 * 0.1 / 4, ea = 3e6 / 0.02;
+  EXPECT_NEAR(chain.youngs_modulus() * area, ea, 1e-6 * ea);
+  // BA = zeta (L / N) sqrt(EA m), axial_time = BA / EA.
+  const double ba = 0.5 * (450.0 / 30) * std::sqrt(ea * 100);
+  EXPECT_NEAR(chain.damping().axial_time(), ba / ea, 1e-9 * ba / ea);
+  // The rope keeps its constant EA.
+  EXPECT_EQ(CableNamed(*scene, "line2").axial_law(), v1::ENGINEERING);
+
+  // Bad tables are refused naming the deck's line and the file's row.
+  struct Case {
+    std::string table, expected;
+  };
+  const Case cases[] = {
+      {"a\nb\nc\n0 0\n0.02 1e6\n0.01 2e6\n", "bad.dat:6: LINE TYPES EA: poly.txt:6: strain 0.01"},
+      {"a\nb\nc\n0 0\n0.01 2e6\n0.02 1e6\n", "bad.dat:6: LINE TYPES EA: poly.txt:6: tension 1e6"},
+      {"a\nb\nc\n0 5\n0.01 2e6\n", "poly.txt:4: tension 5 at zero strain"},
+      {"a\nb\nc\n-0.01 0\n0.01 2e6\n", "poly.txt:4: strain -0.01 < 0"},
+      {"a\nb\nc\n0 0\n0.01 x\n", "poly.txt:5: expected a strain and a tension"},
+      {"a\nb\nc\n0.01 2e6\n", "at least two knots"},
+  };
+  for (const Case& c : cases) {
+    absl::StatusOr<v1::Scene> bad =
+        SceneFromMoorDyn(deck, "bad.dat", [&](std::string_view) -> absl::StatusOr<std::string> {
+          return c.table;
+        });
+    ASSERT_FALSE(bad.ok()) << c.table;
+    EXPECT_NE(bad.status().message().find(c.expected), std::string::npos)
+        << "expected \"" << c.expected << "\" in: " << bad.status().message();
+  }
+  absl::StatusOr<v1::Scene> missing = SceneFromMoorDyn(
+      Edited("1.0e9      -0.5", "other.txt  -0.5"), "bad.dat", PolyFile);
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.status().message().find("bad.dat:6: LINE TYPES EA: \"other.txt\": cannot "
+                                            "read"),
+            std::string::npos)
+      << missing.status();
+  // Viscoelastic and Syrope laws stay refused.
+  EXPECT_NE(Refusal(Edited("1.0e9      -0.5", "poly.txt|2e9 -0.5")).find("viscoelastic"),
+            std::string::npos);
+}
+
 // MoorDyn's optional 11th to 13th line-type columns (vortex-induced
 // vibration) read when their lift coefficient is 0, '#' comments, and a
 // SOLVER OPTIONS header.
@@ -368,8 +442,8 @@ TEST(MoorDynDeckTest, CliImportWritesTheSceneAndRefusesABadDeckWithExit2) {
 
 // A taut single line, statics by `cablesim run` on a .txt deck (MoorDyn's
 // own inputs are .txt): the run succeeds.
-TEST(MoorDynDeckTest, CliRunsATxtDeck) {
-  constexpr char kTaut[] = R"(--------------------- MoorDyn Input File ------------------------------------
+// A taut wire (CliRunsATxtDeck, CliReadsATableFileBesideTheDeck).
+constexpr char kTautDeck[] = R"(--------------------- MoorDyn Input File ------------------------------------
 A taut wire
 ----------------------- LINE TYPES ------------------------------------------
 TypeName   Diam    Mass/m     EA         BA/-zeta    EI         Cd     Ca     CdAx    CaAx
@@ -388,10 +462,33 @@ ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
 50            WtrDpth       water depth (m)
 ------------------------- need this line --------------------------------------
 )";
-  const std::string deck = WriteTemp("taut.txt", kTaut);
+
+TEST(MoorDynDeckTest, CliRunsATxtDeck) {
+  const std::string deck = WriteTemp("taut.txt", kTautDeck);
   std::string out, err;
   EXPECT_EQ(Cli({"run", deck}, &out, &err), 0) << err;
   EXPECT_NE(out.find("\"status\":\"ok\""), std::string::npos) << out;
+}
+
+// The CLI reads a table file beside the deck (MoorDyn's base path).
+TEST(MoorDynDeckTest, CliReadsATableFileBesideTheDeck) {
+  const std::string dir = absl::StrCat(::testing::TempDir(), "/moordyn_table_", ::getpid());
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/wire_ea.txt") << "Strain Tension\n(-) (N)\n---\n0 0\n0.002 1e6\n"
+                                         "0.01 6e6\n";
+  const std::string deck_text =
+      absl::StrReplaceAll(kTautDeck, {{"5.0e8      -0.8", "wire_ea.txt -0.8"}});
+  ASSERT_NE(deck_text, kTautDeck);
+  std::ofstream(dir + "/taut.dat") << deck_text;
+  std::string out, err;
+  EXPECT_EQ(Cli({"run", dir + "/taut.dat"}, &out, &err), 0) << err;
+  EXPECT_NE(out.find("\"status\":\"ok\""), std::string::npos) << out;
+  EXPECT_EQ(Cli({"import", dir + "/taut.dat", "--out", dir + "/taut.json"}, &out, &err), 0)
+      << err;
+  std::ifstream json(dir + "/taut.json");
+  const std::string imported((std::istreambuf_iterator<char>(json)),
+                             std::istreambuf_iterator<char>());
+  EXPECT_NE(imported.find("\"TABLE\""), std::string::npos) << imported;
 }
 
 TEST(MoorDynDeckTest, ServiceReadsSceneMoorDynAndRefusesTwoScenes) {

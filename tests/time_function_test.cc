@@ -100,6 +100,63 @@ TEST(TimeFunctionTest, PartsAndTermsAdd) {
   EXPECT_NEAR(v.ddf, -2 * w1 * w1 * std::sin(w1 * t) - w2 * w2 * std::cos(w2 * t), 1e-11);
 }
 
+// A ramp times a harmonic, s max(0, t - t0) A sin(w t + phi), against the
+// product rule's closed form: f' = s A sin + s (t - t0) A w cos,
+// f'' = 2 s A w cos - s (t - t0) A w^2 sin (after t0; 0 before).
+// Tolerance: rounding, 1e-12 relative to the largest term (s t A w^2 ~ 60).
+TEST(TimeFunctionTest, ProductOfRampAndHarmonicFollowsTheProductRule) {
+  const double slope = 0.2, t0 = 0.5, a = 1.5, freq = 0.8, phi = 0.3, w = 2 * kPi * freq;
+  TimeFunction f;
+  f.add_product({TimeFunction::Linear(slope, t0), TimeFunction::Sine(a, freq, phi)});
+  EXPECT_FALSE(f.IsZero());
+  EXPECT_TRUE(f.HasProduct());
+  for (double t : {0.0, 0.4, 0.5, 0.9, 3.7, 10.2}) {
+    const TimeFunction::Value v = f.Evaluate(t);
+    const double r = t >= t0 ? slope * (t - t0) : 0, dr = t >= t0 ? slope : 0;
+    const double sn = std::sin(w * t + phi), cs = std::cos(w * t + phi);
+    EXPECT_NEAR(v.f, r * a * sn, 1e-12 * 60) << t;
+    EXPECT_NEAR(v.df, dr * a * sn + r * a * w * cs, 1e-12 * 60) << t;
+    EXPECT_NEAR(v.ddf, 2 * dr * a * w * cs - r * a * w * w * sn, 1e-12 * 60) << t;
+  }
+}
+
+// Three factors, one a sum: 2 (A1 sin a)(A2 sin b + c) with a = w1 t,
+// b = w2 t + phi: the second derivative has the cross term
+// 2 f' g' that a two-factor rule applied wrongly would miss.
+TEST(TimeFunctionTest, ProductOfThreeFactorsAndASumFollowsTheProductRule) {
+  const double a1 = 0.7, f1 = 0.3, a2 = 1.2, f2 = 1.1, phi = 0.9, c = 0.4;
+  const double w1 = 2 * kPi * f1, w2 = 2 * kPi * f2;
+  TimeFunction sum = TimeFunction::Sine(a2, f2, phi);
+  sum.add_term(TimeFunction::Constant(c));
+  TimeFunction f = TimeFunction::Constant(1.0);  // other parts still add
+  f.add_product({TimeFunction::Constant(2), TimeFunction::Sine(a1, f1, 0), sum});
+  for (double t : {0.0, 0.37, 1.9, 7.25}) {
+    const double sa = std::sin(w1 * t), ca = std::cos(w1 * t);
+    const double g = a2 * std::sin(w2 * t + phi) + c, dg = a2 * w2 * std::cos(w2 * t + phi),
+                 ddg = -a2 * w2 * w2 * std::sin(w2 * t + phi);
+    const TimeFunction::Value v = f.Evaluate(t);
+    EXPECT_NEAR(v.f, 1 + 2 * a1 * sa * g, 1e-12 * 20) << t;
+    EXPECT_NEAR(v.df, 2 * a1 * (w1 * ca * g + sa * dg), 1e-12 * 20) << t;
+    EXPECT_NEAR(v.ddf, 2 * a1 * (-w1 * w1 * sa * g + 2 * w1 * ca * dg + sa * ddg), 1e-12 * 200)
+        << t;
+  }
+}
+
+// A product with a zero factor adds nothing; a product has no closed-form
+// integral (NaN: a winch's speed refuses products, below).
+TEST(TimeFunctionTest, ProductWithAZeroFactorIsZeroAndHasNoIntegral) {
+  TimeFunction zero;
+  zero.add_product({TimeFunction::Sine(1, 1, 0), TimeFunction()});
+  EXPECT_TRUE(zero.IsZero());
+  EXPECT_FALSE(zero.HasProduct());
+  TimeFunction f;
+  TimeFunction inner;
+  inner.add_product({TimeFunction::Sine(1, 1, 0), TimeFunction::Linear(1, 0)});
+  f.add_term(inner);
+  EXPECT_TRUE(f.HasProduct());
+  EXPECT_TRUE(std::isnan(f.Integral(1.0)));
+}
+
 absl::Status Validate(const std::string& json) {
   auto proto = ParseSceneJson(json);
   if (!proto.ok()) return proto.status();
@@ -123,6 +180,25 @@ TEST(TimeFunctionValidationTest, NamesTheField) {
   EXPECT_THAT(s.message(), HasSubstr("joints[0].motion.x.harmonic.frequency: must be >= 0"));
   s = Validate(PinnedRope(R"({"x": {"sum": [{"ramp": {"slope": 1, "start": -1}}]}})"));
   EXPECT_THAT(s.message(), HasSubstr("joints[0].motion.x.sum[0].ramp.start: must be >= 0"));
+  // A ramp in (a table from 0 to 1 over 20 s) times a harmonic: the
+  // fields of each factor are checked and named.
+  EXPECT_TRUE(Validate(PinnedRope(R"({"x": {"product": [{"table": {"times": [0, 20],
+      "values": [0, 1]}}, {"harmonic": {"amplitude": 2, "frequency": 0.1}}]}})")).ok());
+  s = Validate(PinnedRope(R"({"x": {"product": [{"ramp": {"slope": 1}},
+      {"harmonic": {"amplitude": 1, "frequency": -1}}]}})"));
+  EXPECT_THAT(s.message(), HasSubstr("joints[0].motion.x.product[1].harmonic.frequency: must be"));
+  std::string deep = R"({"ramp": {"slope": 1}})";
+  for (int k = 0; k < 8; ++k) deep = R"({"product": [)" + deep + R"(, {"constant": 1}]})";
+  s = Validate(PinnedRope(R"({"x": )" + deep + "}"));
+  EXPECT_THAT(s.message(), HasSubstr("levels of sum and product"));
+  EXPECT_THAT(s.message(), HasSubstr("joints[0].motion.x.product[0].product[0]"));
+  // A winch's free length integrates its speed: no product there.
+  s = Validate(R"({"gravity": {"y": -9.81},
+      "cables": [{"name": "c", "length": 1, "density": 7850, "youngs_modulus": 2e11,
+                  "diameter": 0.01, "winch": {"speed": {"product": [{"constant": 1},
+                  {"harmonic": {"amplitude": 0.1, "frequency": 1}}]}}}],
+      "joints": [{"type": "PIN", "a": {"cable": "c", "s": 1}}], "solver": {"duration": 1}})");
+  EXPECT_THAT(s.message(), HasSubstr("cables[0].winch.speed: a product is not available"));
   // The scene places the joint at t = 0: a motion must start at 0.
   s = Validate(PinnedRope(R"({"z": {"constant": 0.5}})"));
   EXPECT_THAT(s.message(), HasSubstr("joints[0].motion.z: must be 0 at t = 0"));

@@ -33,6 +33,60 @@ absl::Status CheckCorner(absl::string_view cable_path, int corner,
   return absl::OkStatus();
 }
 
+// The tension-strain table of axial_law TABLE (scene.proto TensionTable)
+// into the cable's knots, the origin (0, 0) first.
+absl::Status ConvertTensionTable(const std::string& path, const v1::TensionTable& t,
+                                 CableSpec* cable) {
+  const auto& strains = t.strains();
+  const auto& tensions = t.tensions();
+  if (strains.empty()) return Invalid(Sub(path, "strains"), "must have at least one entry");
+  if (tensions.size() != strains.size()) {
+    return Invalid(Sub(path, "tensions"),
+                   absl::StrCat("must have as many entries as strains (", strains.size(),
+                                "; got ", tensions.size(), ")"));
+  }
+  cable->tension_table_strains = {0.0};
+  cable->tension_table_tensions = {0.0};
+  for (int k = 0; k < strains.size(); ++k) {
+    const std::string strain = Indexed(path, "strains", k);
+    const std::string tension = Indexed(path, "tensions", k);
+    CABLESIM_RETURN_IF_ERROR(CheckNonNegative(strain, strains[k]));
+    CABLESIM_RETURN_IF_ERROR(CheckRange(strain, strains[k], plausible::kStrain));
+    CABLESIM_RETURN_IF_ERROR(CheckNonNegative(tension, tensions[k]));
+    CABLESIM_RETURN_IF_ERROR(CheckRange(tension, tensions[k], plausible::kForce));
+    if (strains[k] == 0) {
+      if (k > 0) {
+        return Invalid(Sub(path, "strains"),
+                       absl::StrCat("strains must increase (strains[", k, "] = 0 after ",
+                                    Num(strains[k - 1]), ")"));
+      }
+      if (tensions[k] != 0) {
+        return Invalid(tension, absl::StrCat("must be 0 at zero strain (got ", Num(tensions[k]),
+                                             " N): a line is unloaded unstretched"));
+      }
+      continue;  // the origin, already there
+    }
+    if (!(strains[k] > cable->tension_table_strains.back())) {
+      return Invalid(Sub(path, "strains"),
+                     absl::StrCat("strains must increase (strains[", k, "] = ", Num(strains[k]),
+                                  " after ", Num(strains[k - 1]), ")"));
+    }
+    if (tensions[k] < cable->tension_table_tensions.back()) {
+      return Invalid(Sub(path, "tensions"),
+                     absl::StrCat("tensions must not decrease (tensions[", k,
+                                  "] = ", Num(tensions[k]), " after ",
+                                  Num(cable->tension_table_tensions.back()),
+                                  "): the line would soften into instability"));
+    }
+    cable->tension_table_strains.push_back(strains[k]);
+    cable->tension_table_tensions.push_back(tensions[k]);
+  }
+  if (!(cable->tension_table_tensions.back() > 0)) {
+    return Invalid(Sub(path, "tensions"), "must not all be 0 (the line would have no stiffness)");
+  }
+  return absl::OkStatus();
+}
+
 absl::Status ConvertCable(ConversionState* state, int i, CableSpec* cable) {
   const v1::Cable& c = state->proto.cables(i);
   const std::string path = Indexed("", "cables", i);
@@ -102,8 +156,13 @@ absl::Status ConvertCable(ConversionState* state, int i, CableSpec* cable) {
   CABLESIM_RETURN_IF_ERROR(
       CheckPositiveInRange(Sub(path, "density"), c.density(), plausible::kDensity));
   cable->density_kg_m3 = c.density();
-  CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange(Sub(path, "youngs_modulus"), c.youngs_modulus(),
-                                                plausible::kYoungsModulus));
+  // With a tension-strain table youngs_modulus may be omitted (it then
+  // follows from the table, below).
+  const bool modulus_from_table = c.axial_law() == v1::TABLE && c.youngs_modulus() == 0;
+  if (!modulus_from_table) {
+    CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange(Sub(path, "youngs_modulus"),
+                                                  c.youngs_modulus(), plausible::kYoungsModulus));
+  }
   cable->youngs_modulus_pa = c.youngs_modulus();
 
   if (c.has_diameter()) {
@@ -180,21 +239,53 @@ absl::Status ConvertCable(ConversionState* state, int i, CableSpec* cable) {
     case v1::ENGINEERING:
       cable->axial_law = AxialLaw::kEngineering;
       break;
+    case v1::TABLE:
+      cable->axial_law = AxialLaw::kTable;
+      break;
     default:
       return Invalid(Sub(path, "axial_law"),
                      absl::StrCat("unknown value ", c.axial_law(),
-                                  " (must be GREEN_LAGRANGE or ENGINEERING)"));
+                                  " (must be GREEN_LAGRANGE, ENGINEERING or TABLE)"));
+  }
+  if (cable->axial_law == AxialLaw::kTable) {
+    if (!c.has_tension_table()) {
+      return Invalid(Sub(path, "tension_table"), "required with axial_law TABLE");
+    }
+    CABLESIM_RETURN_IF_ERROR(
+        ConvertTensionTable(Sub(path, "tension_table"), c.tension_table(), cable));
+    if (modulus_from_table) {
+      // The table's steepest slope as the nominal EA.
+      double stiffest = 0;
+      for (size_t k = 1; k < cable->tension_table_strains.size(); ++k) {
+        stiffest = std::max(stiffest, (cable->tension_table_tensions[k] -
+                                       cable->tension_table_tensions[k - 1]) /
+                                          (cable->tension_table_strains[k] -
+                                           cable->tension_table_strains[k - 1]));
+      }
+      cable->youngs_modulus_pa = stiffest / cable->area_m2;
+      CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange(Sub(path, "youngs_modulus"),
+                                                    cable->youngs_modulus_pa,
+                                                    plausible::kYoungsModulus));
+    }
+  } else if (c.has_tension_table()) {
+    return Invalid(Sub(path, "tension_table"), "only with axial_law TABLE");
   }
   if (c.has_winch()) {
-    if (cable->axial_law == AxialLaw::kEngineering) {
+    if (cable->axial_law != AxialLaw::kGreenLagrange) {
       return Invalid(Sub(path, "axial_law"),
-                     "ENGINEERING is not available on a cable with a winch (its line tension "
-                     "is the Green-Lagrange law's)");
+                     absl::StrCat(cable->axial_law == AxialLaw::kTable ? "TABLE" : "ENGINEERING",
+                                  " is not available on a cable with a winch (its line tension "
+                                  "is the Green-Lagrange law's)"));
     }
     cable->winch.enabled = true;
     CABLESIM_ASSIGN_OR_RETURN(
         cable->winch.speed, ConvertTimeFunction(Sub(Sub(path, "winch"), "speed"), c.winch().speed(),
                                                 plausible::kVelocity));
+    if (cable->winch.speed.HasProduct()) {
+      return Invalid(Sub(Sub(path, "winch"), "speed"),
+                     "a product is not available in a winch's speed (the free length is the "
+                     "speed's integral, exact for the other parts only)");
+    }
   }
   if (c.has_damping()) {
     const v1::CableDamping& d = c.damping();

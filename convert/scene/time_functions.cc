@@ -2,12 +2,13 @@
 
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 
 namespace cablesim::scene_convert {
 
-// How deep TimeFunction.sum may nest.
+// How deep TimeFunction.sum and .product may nest.
 constexpr int kMaxTimeFunctionDepth = 8;
 
 absl::StatusOr<TimeFunction> ConvertTimeFunction(const std::string& path, const v1::TimeFunction& p,
@@ -53,14 +54,27 @@ absl::StatusOr<TimeFunction> ConvertTimeFunction(const std::string& path, const 
     CABLESIM_RETURN_IF_ERROR(CheckRange(Sub(r, "start"), p.ramp().start(), plausible::kDuration));
     f.add_ramp({p.ramp().slope(), p.ramp().start()});
   }
-  for (int i = 0; i < p.sum_size(); ++i) {
-    const std::string sub = Indexed(path, "sum", i);
-    if (depth + 1 >= kMaxTimeFunctionDepth)
-      return Invalid(sub, absl::StrCat("at most ", kMaxTimeFunctionDepth, " levels of sum"));
-    CABLESIM_ASSIGN_OR_RETURN(TimeFunction term,
-                              ConvertTimeFunction(sub, p.sum(i), range, depth + 1));
-    f.add_term(std::move(term));
-  }
+  // The nested functions of `sum` (added) and `product` (multiplied). A
+  // product's factor is dimensionless or in the quantity's unit: each must
+  // be finite, which the quantity's range (wider than any factor's) checks.
+  auto nested = [&](const char* field, const auto& functions)
+      -> absl::StatusOr<std::vector<TimeFunction>> {
+    std::vector<TimeFunction> out;
+    for (int i = 0; i < functions.size(); ++i) {
+      const std::string sub = Indexed(path, field, i);
+      if (depth + 1 >= kMaxTimeFunctionDepth)
+        return Invalid(sub, absl::StrCat("at most ", kMaxTimeFunctionDepth,
+                                         " levels of sum and product"));
+      CABLESIM_ASSIGN_OR_RETURN(TimeFunction g,
+                                ConvertTimeFunction(sub, functions[i], range, depth + 1));
+      out.push_back(std::move(g));
+    }
+    return out;
+  };
+  CABLESIM_ASSIGN_OR_RETURN(std::vector<TimeFunction> terms, nested("sum", p.sum()));
+  for (TimeFunction& term : terms) f.add_term(std::move(term));
+  CABLESIM_ASSIGN_OR_RETURN(std::vector<TimeFunction> factors, nested("product", p.product()));
+  f.add_product(std::move(factors));
   return f;
 }
 

@@ -14,7 +14,10 @@
 // or, with AxialLaw::kEngineering, eps = |u| - 1 (the engineering strain:
 // the tension EA eps along the tangent is linear in the stretch, the law a
 // mooring data sheet's EA means; Green-Lagrange's tension is
-// EA (e + e^2/2)(1 + e) in the engineering strain e, 1.5 % stiffer at 1 %).
+// EA (e + e^2/2)(1 + e) in the engineering strain e, 1.5 % stiffer at 1 %),
+// or, with AxialLaw::kTable, psi = W(e) = int_0^e T de of a tension-strain
+// table T(e) in the engineering strain (engine/elements/tension_table.h;
+// the tension along the tangent is T(e), its stiffness the table's slope).
 //
 // and, writing a = u.u, b = u.w, c = w.w,
 //
@@ -30,9 +33,12 @@
 // Units: SI. Forces in N (or N for position coordinates and N m for slope
 // coordinates), stiffness in N/m accordingly, energy in J.
 
+#include <memory>
+
 #include <Eigen/Core>
 
 #include "engine/elements/gauss_quadrature.h"
+#include "engine/elements/tension_table.h"
 #include "engine/scene/scene.h"
 
 namespace cablesim {
@@ -60,8 +66,12 @@ class AncfCableElement {
   AncfCableElement() = default;
   AncfCableElement(double length_m, double ea_n, double ei_n_m2, BendingModel bending,
                    int gauss_points = kDefaultGaussPoints,
-                   AxialLaw axial_law = AxialLaw::kGreenLagrange);
+                   AxialLaw axial_law = AxialLaw::kGreenLagrange,
+                   std::shared_ptr<const TensionTable> table = nullptr);
 
+  // With AxialLaw::kTable, `table` (shared by a cable's elements) gives the
+  // tension; ea_n stays the nominal EA that AddDampingMatrix's axial_s
+  // multiplies.
   AxialLaw axial_law() const { return axial_law_; }
 
   double length() const { return length_; }
@@ -131,6 +141,9 @@ class AncfCableElement {
   //    Tarnow, ZAMP 43:757-792, 1992); engineering strain, psi =
   //    EA/2 (s - 1)^2 with s = sqrt(a): the exact difference quotient
   //    EA/2 (s0 + s1 - 2) / (s0 + s1) (no cancellation as a1 -> a0);
+  //    a table, psi = W(s - 1): the quotient Tbar / (s0 + s1) with Tbar
+  //    the table's exact mean tension over [e0, e1] (TensionTable::
+  //    MeanTension, free of cancellation as well);
   //  - LINEAR bending: psi = EI c / 2 is linear: exact;
   //  - EXACT bending, psi = k (c A(a) - b^2 B(a)), k = EI / 2, A = a^-2,
   //    B = a^-3, by the discrete product rule
@@ -157,8 +170,8 @@ class AncfCableElement {
   //
   //   D = EA axial_s / 2 (d eps/dt)^2 + EI bending_s / 2 |d k/dt|^2,
   //
-  // d eps/dt = u.udot (engineering strain: u.udot / |u|, so its term is
-  // EA axial_s u u^T / |u|^2), k = u x w / |u|^3 the curvature vector (a scalar in
+  // d eps/dt = u.udot (engineering strain, also under a table:
+  // u.udot / |u|, so its term is EA axial_s u u^T / |u|^2), k = u x w / |u|^3 the curvature vector (a scalar in
   // the plane; |k| is the EXACT model's curvature), so that
   // C = int B^T (EA axial_s u u^T + EI bending_s G^T G) B dx with
   // G = dk/d(u, w). This is exactly axial_s times the material part of the
@@ -251,6 +264,7 @@ class AncfCableElement {
   double ei_ = 0;
   BendingModel bending_ = BendingModel::kExact;
   AxialLaw axial_law_ = AxialLaw::kGreenLagrange;
+  std::shared_ptr<const TensionTable> table_;  // AxialLaw::kTable only
   GaussRule rule_;
   // Shape-function derivatives at the Gauss points: d1_[g][k] = s_k'(x),
   // d2_[g][k] = s_k''(x), derivatives in x.

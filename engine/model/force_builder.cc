@@ -3,8 +3,10 @@
 // contributors the scene uses (one line each, in the order of the sums),
 // the winches' data and contributor, gravity and the constant loads.
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <utility>
 
@@ -125,17 +127,25 @@ void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* 
     const double displaced = rho_f > 0 ? rho_f * kPi * dh * dh / 4 : 0.0;  // [kg/m]
     const double drag_n = 0.5 * rho_f * cable.normal_drag * dh;
     const double drag_t = 0.5 * rho_f * cable.tangential_drag * kPi * dh;
+    // A tension-strain table, shared by the cable's elements.
+    std::shared_ptr<const TensionTable> table;
+    if (cable.axial_law == AxialLaw::kTable) {
+      table = std::make_shared<const TensionTable>(cable.tension_table_strains,
+                                                   cable.tension_table_tensions);
+    }
     for (int k = first_node[c]; k + 1 < first_node[c + 1]; ++k) {
       if (mesh_.twin_of[k + 1] == k) continue;  // the two halves of a split node
       const int local = k - first_node[c];
       const double l = mesh_.node_s[c][local + 1] - mesh_.node_s[c][local];
       MultibodyModel::ElementData<D> e;
       e.element = AncfCableElement<D>(l, ea, ei, cable.bending,
-                                      AncfCableElement<D>::kDefaultGaussPoints, cable.axial_law);
+                                      AncfCableElement<D>::kDefaultGaussPoints, cable.axial_law,
+                                      table);
       // Energy the element can hold from coordinates known to 16 eps
       // (1 + |q0|_inf): a strain of that over l, a curvature of it over l^2.
       const double strain = 16 * std::numeric_limits<double>::epsilon() * (1 + extent) / l;
-      model_.energy_roundoff_ += (ea + ei / (l * l)) * l * strain * strain;
+      const double stiffest = table ? std::max(ea, table->max_stiffness()) : ea;
+      model_.energy_roundoff_ += (stiffest + ei / (l * l)) * l * strain * strain;
       e.first_coord = NodeCoord(k);
       e.mass_per_length = mpl + cable.added_mass * displaced;
       // Gravity acts on the mass less the displaced fluid's (buoyancy).

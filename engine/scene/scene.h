@@ -27,8 +27,9 @@ enum class BendingModel { kExact, kLinear, kNone };
 // The axial law (engine/elements/ancf_cable_element.h): the strain energy
 // EA/2 eps^2 of the Green-Lagrange strain eps = (|r'|^2 - 1) / 2, or of the
 // engineering strain e = |r'| - 1 (tension T = EA e, as mooring decks
-// mean their EA).
-enum class AxialLaw { kGreenLagrange, kEngineering };
+// mean their EA), or a tension-strain table T(e) in the engineering strain
+// (CableSpec::tension_table_*; engine/elements/tension_table.h).
+enum class AxialLaw { kGreenLagrange, kEngineering, kTable };
 // kSlide: a body point kept on a cable, free to slide along it
 // (SlidingJoint; JointSpec::slide).
 enum class JointType { kPin, kFixed, kSlide };
@@ -74,6 +75,12 @@ struct CableSpec {
   double second_moment_m4 = 0;
   BendingModel bending = BendingModel::kExact;
   AxialLaw axial_law = AxialLaw::kGreenLagrange;
+  // With AxialLaw::kTable: the knots of T(e) [-, N], strains increasing
+  // from 0, tensions non-decreasing from 0 (TensionTable). The tension is
+  // the table's; youngs_modulus_pa * area_m2 stays the nominal EA that
+  // the axial damping time multiplies and the step checks use.
+  std::vector<double> tension_table_strains;
+  std::vector<double> tension_table_tensions;
   // Damping (MultibodyModel::DampingForce; 0: none). Kelvin-Voigt
   // retardation times [s]: axial stress E (eps + axial_damping_s deps/dt),
   // bending moment EI (kappa + bending_damping_s dkappa/dt). Rayleigh:

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 namespace cablesim {
@@ -39,6 +40,20 @@ void TimeFunction::add_term(TimeFunction f) {
   if (!f.IsZero()) terms_.push_back(std::move(f));
 }
 
+void TimeFunction::add_product(std::vector<TimeFunction> factors) {
+  if (factors.empty()) return;
+  for (const TimeFunction& f : factors)
+    if (f.IsZero()) return;  // a zero factor: the product adds nothing
+  products_.push_back(std::move(factors));
+}
+
+bool TimeFunction::HasProduct() const {
+  if (!products_.empty()) return true;
+  for (const TimeFunction& f : terms_)
+    if (f.HasProduct()) return true;
+  return false;
+}
+
 bool TimeFunction::IsZero() const {
   if (constant_ != 0) return false;
   for (double v : values_)
@@ -49,7 +64,7 @@ bool TimeFunction::IsZero() const {
     if (r.slope != 0) return false;
   for (const TimeFunction& f : terms_)
     if (!f.IsZero()) return false;
-  return true;
+  return products_.empty();  // add_product keeps no product with a zero factor
 }
 
 TimeFunction::Value TimeFunction::Evaluate(double t) const {
@@ -89,6 +104,18 @@ TimeFunction::Value TimeFunction::Evaluate(double t) const {
     v.f += u.f;
     v.df += u.df;
     v.ddf += u.ddf;
+  }
+  for (const std::vector<TimeFunction>& factors : products_) {
+    // The product rule, one factor at a time: p <- p g, p' <- p' g + p g',
+    // p'' <- p'' g + 2 p' g' + p g''.
+    Value p{1, 0, 0};
+    for (const TimeFunction& factor : factors) {
+      const Value g = factor.Evaluate(t);
+      p = {p.f * g.f, p.df * g.f + p.f * g.df, p.ddf * g.f + 2 * p.df * g.df + p.f * g.ddf};
+    }
+    v.f += p.f;
+    v.df += p.df;
+    v.ddf += p.ddf;
   }
   return v;
 }
@@ -139,6 +166,7 @@ double TimeFunction::Integral(double t) const {
     sum += 0.5 * r.slope * (a * a - b * b);
   }
   for (const TimeFunction& f : terms_) sum += f.Integral(t);
+  if (!products_.empty()) sum = std::numeric_limits<double>::quiet_NaN();
   return sum;
 }
 

@@ -11,6 +11,9 @@
 //   harmonic     A sin(2 pi f t + phi)         (A, f [Hz], phi [rad])
 //   ramp         m max(0, t - t_0)              (m per second, from t_0 [s])
 //   sum          the sum of further TimeFunctions
+//   product      the product of further TimeFunctions (a ramp in times a
+//                harmonic), with (fg)' = f'g + fg' and
+//                (fg)'' = f''g + 2f'g' + fg'' over its factors
 //
 // Evaluate() returns the value and its first and second derivatives exactly.
 // A table (and a ramp at t_0) has a kink: there the derivative is that of
@@ -57,6 +60,11 @@ class TimeFunction {
   void add_harmonic(const Harmonic& h) { harmonics_.push_back(h); }
   void add_ramp(const Ramp& r) { ramps_.push_back(r); }
   void add_term(TimeFunction f);
+  // A product of `factors` added to the value (none: nothing added).
+  void add_product(std::vector<TimeFunction> factors);
+  // True when a product is part of it, here or in a term: Integral is then
+  // not exact (see there).
+  bool HasProduct() const;
 
   // True when every part is absent: the function is identically 0.
   bool IsZero() const;
@@ -66,6 +74,8 @@ class TimeFunction {
   // segments by the trapezoidal rule, which is exact on them; a harmonic of
   // frequency 0 is the constant A sin(phi)). A winch's free length is its
   // initial length plus the integral of its pay-out speed (scene.h).
+  // A product has no closed-form integral: it contributes NaN (convert/
+  // refuses products where an integral is taken, a winch's speed).
   double Integral(double t) const;
   double operator()(double t) const { return Evaluate(t).f; }
 
@@ -75,6 +85,7 @@ class TimeFunction {
   std::vector<Harmonic> harmonics_;
   std::vector<Ramp> ramps_;
   std::vector<TimeFunction> terms_;
+  std::vector<std::vector<TimeFunction>> products_;
 };
 
 }  // namespace cablesim
