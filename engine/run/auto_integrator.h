@@ -37,7 +37,8 @@
 //    geometrically from rounding, so the estimate sees it long before the
 //    energy guard would; an answer the estimate calls inaccurate is not
 //    kept either way.
-//  - HHT -> CENTRAL_DIFFERENCE when a trial start at the current state fits
+//  - HHT -> CENTRAL_DIFFERENCE, in a run that started on central
+//    difference, when a trial start at the current state fits
 //    (h omega_max < 2, TryExplicit): tried after 64 accepted HHT steps,
 //    then after twice as many as the last try each time, so that a scene
 //    that stays stiff, or sits at the edge of the stable step, pays a

@@ -159,6 +159,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     return true;
   };
   const bool may_switch = settings.auto_integrator && settings.auto_may_switch;
+  const bool ran_explicit = TraitsOf(stepping.integrator).is_explicit;
   // A step cut to end on a release time leaves the fixed steps' grid; the
   // step after it ends where the uncut step would have (grid_end), so that
   // the frames on the grid stay step ends.
@@ -351,8 +352,11 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       if (grid_end >= 0 && t >= grid_end - 1e-9 * h_nominal) grid_end = -1;
       if (!LetGo(t)) return;
       // AUTO: HHT back to CENTRAL_DIFFERENCE once the scene admits it.
-      if (may_switch && !TraitsOf(stepping.integrator).is_explicit && h == h_nominal &&
-          ++hht_steps >= next_explicit_try) {
+      // Only a run that was explicit before tries (one that started on HHT
+      // because the step was beyond the stable step is not expected to
+      // soften that far, and a trial start would touch its model's caches).
+      if (may_switch && ran_explicit && !TraitsOf(stepping.integrator).is_explicit &&
+          h == h_nominal && ++hht_steps >= next_explicit_try) {
         next_explicit_try *= 2;
         hht_steps = 0;
         model->SetInitialState(stepper->z(), stepper->v(), model->external_work(), t);
