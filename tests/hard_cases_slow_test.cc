@@ -231,16 +231,33 @@ TEST(HardCasesTest, HundredSecondsWithoutNumericalDamping) {
   std::printf("100 s, HHT rho_infinity 0.9: %lld steps, energy removed %.4g J\n",
               static_cast<long long>(d.steps), d.energy_dissipated);
   EXPECT_LE(MaxEnergyRise(damped), 1e-6 * EnergyScale(damped));
-  // And the defaults (HHT, rho_infinity 0.5, AUTO).
+  // HHT with its default rho_infinity 0.5 (the default stepper before
+  // AUTO): the same, energy never rises.
+  CollectingSink hht;
+  const RunSummary hs = RunOk(
+      SceneFromJson(FallingPendulum(12, 9.81, 100, R"("step": 1e-3, "integrator": "HHT")")), &hht);
+  std::printf("100 s, HHT (rho %g, %s): %lld steps, %lld rejected, energy removed %.4g J\n",
+              hs.rho_infinity, hs.linear_solver_used.c_str(), static_cast<long long>(hs.steps),
+              static_cast<long long>(hs.rejected_steps), hs.energy_dissipated);
+  EXPECT_LE(MaxEnergyRise(hht), 1e-6 * EnergyScale(hht));
+  // And the defaults (AUTO: central difference while its error estimate
+  // holds, HHT where it does not). They finish the 100 s, remove energy on
+  // balance (HHT's stretches damp), and central difference's stretches keep
+  // it without drift: a symplectic step's energy error oscillates at
+  // O((omega h)^2) of the fast modes' share, measured 1.2e-5 of the scale,
+  // bounded here by 1e-4 (a drift of the kind undamped generalized-alpha
+  // shows above grows to 3 % of the scale).
   CollectingSink defaults;
   const RunSummary ds =
       RunOk(SceneFromJson(FallingPendulum(12, 9.81, 100, R"("step": 1e-3)")), &defaults);
-  std::printf("100 s, defaults (%s, rho %g, %s): %lld steps, %lld rejected, energy removed "
-              "%.4g J\n",
-              ds.integrator.c_str(), ds.rho_infinity, ds.linear_solver_used.c_str(),
-              static_cast<long long>(ds.steps), static_cast<long long>(ds.rejected_steps),
-              ds.energy_dissipated);
-  EXPECT_LE(MaxEnergyRise(defaults), 1e-6 * EnergyScale(defaults));
+  std::printf("100 s, defaults (%s first, %zu stretches, %s): %lld steps, %lld rejected, energy "
+              "removed %.4g J\n",
+              ds.integrator.c_str(), ds.integrator_segments.size(),
+              ds.linear_solver_used.c_str(), static_cast<long long>(ds.steps),
+              static_cast<long long>(ds.rejected_steps), ds.energy_dissipated);
+  EXPECT_EQ(ds.integrator_requested, "AUTO");
+  EXPECT_GT(ds.energy_dissipated, 0);
+  EXPECT_LE(MaxEnergyRise(defaults), 1e-4 * EnergyScale(defaults));
 }
 
 TEST(HardCasesTest, SettingThatCannotConvergeFailsWithAMessage) {
