@@ -230,11 +230,25 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
         continue;
       }
     }
+    // Every run's error estimate of a converged step: the stepper's
+    // embedded local error (one pass over the unknowns), absolute [m] and
+    // against the tolerance. Without a relative tolerance the ratio is the
+    // estimate over the tolerance, to the last bit (a division by a
+    // positive constant is monotone), so one pass serves both. Computed
+    // once per step: AUTO's check below needs it before acceptance.
+    double error_m = -1, error_ratio = 0;
+    auto EstimateStepError = [&] {
+      error_m = stepper->LocalErrorNorm(h_try, 1, 0);
+      error_ratio = settings.relative_tolerance == 0
+                        ? error_m / settings.error_tolerance_m
+                        : stepper->LocalErrorNorm(h_try, settings.error_tolerance_m,
+                                                  settings.relative_tolerance);
+    };
     // AUTO: an explicit step whose error estimate exceeds the run's
     // tolerance is taken back, and HHT goes on from the step's start.
     if (st.converged && may_switch && TraitsOf(stepping.integrator).is_explicit) {
-      const double ratio =
-          stepper->LocalErrorNorm(h_try, settings.error_tolerance_m, settings.relative_tolerance);
+      EstimateStepError();
+      const double ratio = error_ratio;
       if (!(ratio <= 1)) {
         stepper->Restore();
         // Tries back to central difference start again at 64 HHT steps
@@ -288,19 +302,9 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
         tick_anchor = tick;
       }
       external_work.After(stepper->z(), t, stepper->lambda(), 1, &stepper->v());
-      // Every run's error estimate: the stepper's embedded local error
-      // (one pass over the unknowns), absolute and against the tolerance.
-      // Without a relative tolerance the ratio is the estimate over the
-      // tolerance, to the last bit (a division by a positive constant is
-      // monotone), so one pass serves both.
-      const double error_m = stepper->LocalErrorNorm(h_try, 1, 0);
+      if (error_m < 0) EstimateStepError();
       summary->local_error_estimate_m = std::max(summary->local_error_estimate_m, error_m);
-      summary->local_error_ratio = std::max(
-          summary->local_error_ratio,
-          settings.relative_tolerance == 0
-              ? error_m / settings.error_tolerance_m
-              : stepper->LocalErrorNorm(h_try, settings.error_tolerance_m,
-                                        settings.relative_tolerance));
+      summary->local_error_ratio = std::max(summary->local_error_ratio, error_ratio);
       ++summary->steps;
       ++summary->integrator_segments.back().steps;
       summary->min_step_s = std::min(summary->min_step_s, h_try);
