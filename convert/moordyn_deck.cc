@@ -946,8 +946,13 @@ bool IsMoorDynDeck(std::string_view path_std, std::string_view text_std) {
     line = absl::StripAsciiWhitespace(line);
     if (!absl::StartsWith(line, "---")) continue;
     const std::string upper = absl::AsciiStrToUpper(line);
-    if (absl::StrContains(upper, "LINE TYPES") || absl::StrContains(upper, "LINE DICTIONARY"))
-      return true;
+    // MoorDyn's title line, or any of its section headers: a deck of rods or bodies alone
+    // (MoorDyn's RodPinnedFloating.txt, body_tests/orbitalBody.txt) has no LINE TYPES.
+    for (absl::string_view header :
+         {"MOORDYN", "LINE TYPES", "LINE DICTIONARY", "ROD TYPES", "ROD DICTIONARY",
+          "POINT PROPERTIES", "CONNECTION PROPERTIES", "BODIES", "BODY LIST", "RODS", "ROD LIST"}) {
+      if (absl::StrContains(upper, header)) return true;
+    }
   }
   return false;
 }

@@ -407,6 +407,11 @@ TEST(MoorDynDeckTest, RecognisesDecksByNameOrContents) {
   EXPECT_FALSE(IsMoorDynDeck("scene.json", kDeck));
   EXPECT_FALSE(IsMoorDynDeck("scene.txt", "{\"name\": \"x\"}"));
   EXPECT_FALSE(IsMoorDynDeck("scene.txtpb", kDeck));
+  // A deck of rods alone has no LINE TYPES section; it is still a deck, and is read (and its
+  // rods refused by name) rather than parsed as a text-format scene.
+  EXPECT_TRUE(IsMoorDynDeck("rods.txt", "--- MoorDyn Input File ---\nrods\n--- ROD TYPES ---\n"));
+  EXPECT_TRUE(IsMoorDynDeck("rods.txt", "title\n------ ROD TYPES ------\n"));
+  EXPECT_FALSE(IsMoorDynDeck("scene.txt", "name: \"x\"\ncables { length: 1 }\n"));
 }
 
 std::string WriteTemp(const std::string& name, const std::string& text) {
