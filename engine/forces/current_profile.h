@@ -63,7 +63,7 @@ class CurrentProfile {
 
   // U at the point r [m/s] and time t [s].
   Eigen::Vector3d At(const Eigen::Vector3d& r, double t = 0) const {
-    if (!axes_[0].empty()) return GridAt(r, t);
+    if (depths_.empty()) return axes_[0].empty() ? Eigen::Vector3d::Zero() : GridAt(r, t);
     const double d = level_ - up_.dot(r);
     if (d <= depths_.front()) return velocities_.front();
     if (d >= depths_.back()) return velocities_.back();
