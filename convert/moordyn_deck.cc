@@ -34,6 +34,7 @@ constexpr double kDefaultGravity = 9.80665;
 constexpr double kDefaultDensity = 1025;
 constexpr double kDefaultKBot = 3.0e6;  // [Pa/m]
 constexpr double kDefaultCBot = 3.0e5;  // [Pa s/m]
+constexpr double kDefaultFricDamp = 200;  // [N s/m per node]
 
 enum class Section {
   kPreamble, kLineTypes, kRodTypes, kBodies, kRods, kPoints, kLines, kOptions, kOutputs,
@@ -501,7 +502,7 @@ class DeckReader {
         "dtm", "dt", "cfl", "tscheme", "writelog", "writeunits", "disableoutput",
         "disableouttime", "dtout", "dtic", "icdt", "tmaxic", "ictmax", "cdscaleic", "icdfac",
         "threshic", "icthresh", "icgendynamic", "gendynamicic", "fileic", "icfile", "echo",
-        "fricdamp", "cv", "unifycurrentgrid"};
+        "cv", "unifycurrentgrid"};
     for (const char* k : kNoEffect)
       if (name == k) return absl::OkStatus();
     // Names of the translated options and their MoorDyn synonyms.
@@ -511,7 +512,8 @@ class DeckReader {
         {"kb", "kbot"},      {"cbot", "cbot"},     {"cb", "cbot"},
         {"frictioncoefficient", "mu"}, {"mu_kt", "mu_t"}, {"mu_ka", "mu_a"},
         {"wavekin", "wavekin"}, {"currents", "currents"}, {"statdynfricscale", "mc"},
-        {"mc", "mc"}, {"seafloorfile", "seafloor"}, {"dtwave", "dtwave"}};
+        {"mc", "mc"}, {"seafloorfile", "seafloor"}, {"dtwave", "dtwave"},
+        {"fricdamp", "fricdamp"}};
     const auto it = kTranslated.find(name);
     if (it == kTranslated.end()) {
       return Error(n, field, "an option cablesim does not know (nothing is dropped: remove it or "
@@ -541,12 +543,9 @@ class DeckReader {
     }
     if (key == "dtwave" && !(*v > 0))
       return Error(n, field, absl::StrCat("must be > 0 (got ", w[0], ")"));
-    if (key == "mc") {
-      if (*v != 1) {
-        return Error(n, field, "static friction above the kinetic one cannot be expressed "
-                               "(cablesim's friction is Coulomb's, one coefficient: 1 only)");
-      }
-      return absl::OkStatus();
+    if (key == "mc" || key == "fricdamp") {
+      // MoorDyn's friction law (MoorDynFriction).
+      if (!(*v > 0)) return Error(n, field, absl::StrCat("must be > 0 (got ", w[0], ")"));
     }
     if (key == "g" || key == "rho" || key == "depth" || key == "kbot") {
       if (!(*v > 0)) return Error(n, field, absl::StrCat("must be > 0 (got ", w[0], ")"));
@@ -554,6 +553,34 @@ class DeckReader {
       return Error(n, field, absl::StrCat("must be >= 0 (got ", w[0], ")"));
     }
     options_[key] = Option{*v, n};
+    return absl::OkStatus();
+  }
+
+  // FricDamp or StatDynFricScale given: MoorDyn's friction law (its
+  // viscous-then-Coulomb saturation) in place of the regularised Coulomb
+  // law. FricDamp [N s/m] acts per node, so per unit length it is FricDamp
+  // over the segment length, one value per scene: every line must share
+  // its segment length (else refused). MoorDyn's default FricDamp is 200.
+  absl::Status MoorDynFriction(v1::Seabed* bed) const {
+    const auto damp = options_.find("fricdamp"), scale = options_.find("mc");
+    if (damp == options_.end() && scale == options_.end()) return absl::OkStatus();
+    const int line = damp != options_.end() ? damp->second.line : scale->second.line;
+    const std::string field =
+        damp != options_.end() ? "OPTIONS FricDamp" : "OPTIONS StatDynFricScale";
+    const double segment = lines_.front().length / lines_.front().segments;
+    for (const Line& l : lines_) {
+      const double own = l.length / l.segments;
+      if (std::abs(own - segment) > 1e-9 * segment) {
+        return Error(line, field,
+                     absl::StrCat("lines ", lines_.front().id, " and ", l.id,
+                                  " differ in segment length (", segment, " and ", own,
+                                  " m), and MoorDyn's per-node friction damping becomes one "
+                                  "value per unit length per scene"));
+      }
+    }
+    bed->set_friction_law(v1::Seabed::MOORDYN);
+    bed->set_friction_damping(OptionOr("fricdamp", kDefaultFricDamp) / segment);
+    bed->set_static_friction_scale(OptionOr("mc", 1));
     return absl::OkStatus();
   }
 
@@ -1058,6 +1085,7 @@ class DeckReader {
     const double mu = OptionOr("mu", 0);
     bed->set_friction_axial(OptionOr("mu_a", mu));
     bed->set_friction_transverse(OptionOr("mu_t", mu));
+    if (absl::Status s = MoorDynFriction(bed); !s.ok()) return s;
     scene.mutable_solver()->set_analysis(v1::STATIC);
 
     // The points where free points become bodies (mass or volume) or where

@@ -242,6 +242,32 @@ TEST(MoorDynWaveKinTest, BadKinematicsRefusedNamingTheLineAndRow) {
       << text_only.status();
 }
 
+// FricDamp and StatDynFricScale select MoorDyn's friction law: FricDamp
+// per node over the segment length (120 m / 20 = 6 m) per unit length;
+// without them the regularised law stays.
+TEST(MoorDynWaveKinTest, FricDampSelectsMoorDynsFrictionLaw) {
+  const std::string plain = absl::StrReplaceAll(
+      kDeck, {{"WAVES     ", "0"}, {"CURRENTS      Currents", "0 Currents\n0.5  FrictionCoefficient"}});
+  absl::StatusOr<v1::Scene> regular = SceneFromMoorDyn(plain, "a.dat");
+  ASSERT_TRUE(regular.ok()) << regular.status();
+  EXPECT_EQ(regular->seabed().friction_law(), v1::Seabed::FRICTION_LAW_UNSPECIFIED);
+  absl::StatusOr<v1::Scene> moordyn = SceneFromMoorDyn(
+      absl::StrReplaceAll(plain, {{"FrictionCoefficient", "FrictionCoefficient\n20000 FricDamp\n"
+                                                          "1.5 StatDynFricScale"}}),
+      "b.dat");
+  ASSERT_TRUE(moordyn.ok()) << moordyn.status();
+  EXPECT_EQ(moordyn->seabed().friction_law(), v1::Seabed::MOORDYN);
+  EXPECT_NEAR(moordyn->seabed().friction_damping(), 20000.0 / 6, 1e-9);
+  EXPECT_EQ(moordyn->seabed().static_friction_scale(), 1.5);
+  EXPECT_EQ(moordyn->seabed().friction_axial(), 0.5);
+  // MoorDyn's default FricDamp (200) when only the scale is given.
+  absl::StatusOr<v1::Scene> scaled = SceneFromMoorDyn(
+      absl::StrReplaceAll(plain, {{"FrictionCoefficient", "FrictionCoefficient\n2 mc"}}), "c.dat");
+  ASSERT_TRUE(scaled.ok()) << scaled.status();
+  EXPECT_NEAR(scaled->seabed().friction_damping(), 200.0 / 6, 1e-12);
+  EXPECT_TRUE(SceneFromProto(*moordyn).ok());
+}
+
 // The scene's new fields, each bad value refused naming the field.
 TEST(MoorDynWaveKinTest, SceneFieldsRefusedNamingTheField) {
   auto base = [] {
@@ -319,6 +345,16 @@ TEST(MoorDynWaveKinTest, SceneFieldsRefusedNamingTheField) {
          s->mutable_fluid()->add_current_profile()->set_depth(1);
        },
        "fluid.current_grid: give fluid.current_profile or fluid.current_grid, not both"},
+      {[](v1::Scene* s) { s->mutable_seabed()->set_friction_law(v1::Seabed::MOORDYN); },
+       "seabed.friction_damping: must be > 0"},
+      {[](v1::Scene* s) { s->mutable_seabed()->set_friction_damping(5); },
+       "seabed.friction_damping: only with seabed.friction_law MOORDYN"},
+      {[](v1::Scene* s) {
+         s->mutable_seabed()->set_friction_law(v1::Seabed::MOORDYN);
+         s->mutable_seabed()->set_friction_damping(5);
+         s->mutable_seabed()->set_static_friction_scale(-1);
+       },
+       "seabed.static_friction_scale: must be > 0"},
   };
   for (const Case& c : cases) {
     v1::Scene s = base();

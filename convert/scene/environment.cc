@@ -369,6 +369,25 @@ absl::Status ConvertSeabed(ConversionState* state) {
                                                   plausible::kFrictionLength));
     spec.friction_length_m = b.friction_length();
   }
+  if (b.friction_law() == v1::Seabed::MOORDYN) {
+    spec.friction_law = FrictionLaw::kMoorDyn;
+    CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange("seabed.friction_damping", b.friction_damping(),
+                                                  plausible::kDampingCoefficient));
+    spec.friction_damping_n_s_m2 = b.friction_damping();
+    if (b.static_friction_scale() != 0) {
+      CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange("seabed.static_friction_scale",
+                                                    b.static_friction_scale(),
+                                                    plausible::kFrictionCoefficient));
+      spec.static_friction_scale = b.static_friction_scale();
+    }
+  } else if (b.friction_damping() != 0 || b.static_friction_scale() != 0) {
+    return Invalid(b.friction_damping() != 0 ? "seabed.friction_damping"
+                                             : "seabed.static_friction_scale",
+                   "only with seabed.friction_law MOORDYN");
+  } else if (b.friction_law() != v1::Seabed::FRICTION_LAW_UNSPECIFIED &&
+             b.friction_law() != v1::Seabed::REGULARIZED) {
+    return Invalid("seabed.friction_law", absl::StrCat("unknown value ", b.friction_law()));
+  }
   if (b.has_bathymetry()) CABLESIM_RETURN_IF_ERROR(ConvertBathymetry(state, b));
   return absl::OkStatus();
 }

@@ -319,6 +319,9 @@ struct BathymetrySpec {
   std::vector<double> depths_m;
 };
 
+// The seabed's dynamic friction law (SeabedSpec::friction_law).
+enum class FrictionLaw { kRegularized, kMoorDyn };
+
 // A seabed the cables lie on (MultibodyModel, engine/forces/seabed.h): the
 // plane of points r with normal . r = -depth_m, the normal pointing out of
 // the bed into the water. Contact is a distributed spring and damper per
@@ -338,6 +341,12 @@ struct SeabedSpec {
   // starts from (where the line was laid) below which friction is
   // regularised (Seabed::AddStaticFriction).
   double friction_length_m = 1e-5;
+  // The dynamic friction law (engine/forces/seabed.h): kRegularized (the
+  // law above) or kMoorDyn, MoorDyn's viscous-then-Coulomb law with
+  // friction_damping [N s/m per m of cable] and static_friction_scale.
+  FrictionLaw friction_law = FrictionLaw::kRegularized;
+  double friction_damping_n_s_m2 = 0;
+  double static_friction_scale = 1;
   // When enabled, the bed is this grid instead of the plane (depth_m is
   // then 0 and the normal a coordinate axis: the grid's "up").
   BathymetrySpec bathymetry;
