@@ -519,12 +519,17 @@ std::string DraggedChain(const std::string& up, double span, const std::string& 
                          joints, probes, along, kV, kK, mu_a, mu_t, law);
 }
 
-TEST(SeabedFrictionTest, DraggedAlongTheBedPullsWithMuWL) {
-  const double mu = 0.7;
-  const std::string joints = absl::StrFormat(
+// The chain's end s = 0 pinned to a support moving along x at kV.
+std::string PulledAlongX() {
+  return absl::StrFormat(
       R"([{"type": "PIN", "a": {"cable": "chain", "s": 0},
            "motion": {"x": {"ramp": {"slope": %.17g}}}}])",
       kV);
+}
+
+TEST(SeabedFrictionTest, DraggedAlongTheBedPullsWithMuWL) {
+  const double mu = 0.7;
+  const std::string joints = PulledAlongX();
   CollectingSink sink;
   const RunSummary s = RunOk(
       SceneFromJson(DraggedChain("y", kChainLength, "x", joints,
@@ -552,10 +557,7 @@ TEST(SeabedFrictionTest, DraggedAlongTheBedPullsWithMuWL) {
 // branch run up to 10 w). Tolerance 2e-3 relative, as above.
 TEST(SeabedFrictionTest, MoorDynLawPullsWithItsClosedForm) {
   const double mu = 0.7;
-  const std::string joints = absl::StrFormat(
-      R"([{"type": "PIN", "a": {"cable": "chain", "s": 0},
-           "motion": {"x": {"ramp": {"slope": %.17g}}}}])",
-      kV);
+  const std::string joints = PulledAlongX();
   struct Case {
     double c, scale, expect;
   };
