@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <complex>
 #include <map>
 #include <numbers>
 #include <optional>
@@ -45,6 +46,7 @@ constexpr double kDefaultGravity = 9.80665;
 constexpr double kDefaultDensity = 1025;
 constexpr double kDefaultKBot = 3.0e6;  // [Pa/m]
 constexpr double kDefaultCBot = 3.0e5;  // [Pa s/m]
+constexpr double kDefaultFricDamp = 200;  // [N s/m per node]
 
 enum class Section {
   kPreamble, kLineTypes, kRodTypes, kBodies, kRods, kPoints, kLines, kOptions, kOutputs,
@@ -132,7 +134,8 @@ class DeckReader {
       line = body_points_[index];
     } else {
       for (const auto& [prefix, key] :
-           {std::pair{"seabed", "kbot"}, std::pair{"fluid", "rho"}, std::pair{"gravity", "g"}}) {
+           {std::pair{"seabed", "kbot"}, std::pair{"fluid", "rho"}, std::pair{"gravity", "g"},
+            std::pair{"fluid.waves", "wavekin"}, std::pair{"fluid.current", "currents"}}) {
         const auto it = options_.find(key);
         if (absl::StartsWith(m, prefix) && it != options_.end()) line = it->second.line;
       }
@@ -535,7 +538,7 @@ class DeckReader {
         "dtm", "dt", "cfl", "tscheme", "writelog", "writeunits", "disableoutput",
         "disableouttime", "dtout", "dtic", "icdt", "tmaxic", "ictmax", "cdscaleic", "icdfac",
         "threshic", "icthresh", "icgendynamic", "gendynamicic", "fileic", "icfile", "echo",
-        "dtwave", "fricdamp", "cv", "unifycurrentgrid"};
+        "cv", "unifycurrentgrid"};
     for (const char* k : kNoEffect)
       if (name == k) return absl::OkStatus();
     // Names of the translated options and their MoorDyn synonyms.
@@ -545,7 +548,8 @@ class DeckReader {
         {"kb", "kbot"},      {"cbot", "cbot"},     {"cb", "cbot"},
         {"frictioncoefficient", "mu"}, {"mu_kt", "mu_t"}, {"mu_ka", "mu_a"},
         {"wavekin", "wavekin"}, {"currents", "currents"}, {"statdynfricscale", "mc"},
-        {"mc", "mc"}, {"seafloorfile", "seafloor"}};
+        {"mc", "mc"}, {"seafloorfile", "seafloor"}, {"dtwave", "dtwave"},
+        {"fricdamp", "fricdamp"}};
     const auto it = kTranslated.find(name);
     if (it == kTranslated.end()) {
       return Error(n, field, "an option cablesim does not know (nothing is dropped: remove it or "
@@ -558,18 +562,26 @@ class DeckReader {
     absl::StatusOr<double> v = Number(n, field, w[0]);
     if (!v.ok()) return v.status();
     if (key == "wavekin" || key == "currents") {
-      if (*v != 0) {
-        return Error(n, field, "MoorDyn's wave and current kinematics inputs are not read yet "
-                               "(0 only)");
+      // The files each value reads are read by Build (WaterKinematics).
+      const int mode = static_cast<int>(*v);
+      const bool known = key == "wavekin" ? (mode == 0 || mode == 1 || mode == 2 || mode == 3 ||
+                                             mode == 7)
+                                          : (mode >= 0 && mode <= 5);
+      if (mode != *v || !known) {
+        return Error(n, field,
+                     key == "wavekin"
+                         ? absl::StrCat("WaveKin ", w[0], " is not read (0 still water, 1 "
+                                        "kinematics from the calling program, 2 and 7 "
+                                        "wave_frequencies.txt, 3 wave_elevation.txt; MoorDyn's "
+                                        "own setup reads files for 2, 3 and 7 only)")
+                         : absl::StrCat("Currents ", w[0], " is not one of MoorDyn's 0 to 5"));
       }
-      return absl::OkStatus();
     }
-    if (key == "mc") {
-      if (*v != 1) {
-        return Error(n, field, "static friction above the kinetic one cannot be expressed "
-                               "(cablesim's friction is Coulomb's, one coefficient: 1 only)");
-      }
-      return absl::OkStatus();
+    if (key == "dtwave" && !(*v > 0))
+      return Error(n, field, absl::StrCat("must be > 0 (got ", w[0], ")"));
+    if (key == "mc" || key == "fricdamp") {
+      // MoorDyn's friction law (MoorDynFriction).
+      if (!(*v > 0)) return Error(n, field, absl::StrCat("must be > 0 (got ", w[0], ")"));
     }
     if (key == "g" || key == "rho" || key == "depth" || key == "kbot") {
       if (!(*v > 0)) return Error(n, field, absl::StrCat("must be > 0 (got ", w[0], ")"));
@@ -577,6 +589,328 @@ class DeckReader {
       return Error(n, field, absl::StrCat("must be >= 0 (got ", w[0], ")"));
     }
     options_[key] = Option{*v, n};
+    return absl::OkStatus();
+  }
+
+  // FricDamp or StatDynFricScale given: MoorDyn's friction law (its
+  // viscous-then-Coulomb saturation) in place of the regularised Coulomb
+  // law. FricDamp [N s/m] acts per node, so per unit length it is FricDamp
+  // over the segment length, one value per scene: every line must share
+  // its segment length (else refused). MoorDyn's default FricDamp is 200.
+  absl::Status MoorDynFriction(v1::Seabed* bed) const {
+    const auto damp = options_.find("fricdamp"), scale = options_.find("mc");
+    if (damp == options_.end() && scale == options_.end()) return absl::OkStatus();
+    const int line = damp != options_.end() ? damp->second.line : scale->second.line;
+    const std::string field =
+        damp != options_.end() ? "OPTIONS FricDamp" : "OPTIONS StatDynFricScale";
+    const double segment = lines_.front().length / lines_.front().segments;
+    for (const Line& l : lines_) {
+      const double own = l.length / l.segments;
+      if (std::abs(own - segment) > 1e-9 * segment) {
+        return Error(line, field,
+                     absl::StrCat("lines ", lines_.front().id, " and ", l.id,
+                                  " differ in segment length (", segment, " and ", own,
+                                  " m), and MoorDyn's per-node friction damping becomes one "
+                                  "value per unit length per scene"));
+      }
+    }
+    bed->set_friction_law(v1::Seabed::MOORDYN);
+    bed->set_friction_damping(OptionOr("fricdamp", kDefaultFricDamp) / segment);
+    bed->set_static_friction_scale(OptionOr("mc", 1));
+    return absl::OkStatus();
+  }
+
+  // The rows of a file WaveKin or Currents names (MoorDyn's fixed names,
+  // in the deck's directory): its lines, trailing blanks and carriage
+  // returns removed, blank ones kept (MoorDyn counts them).
+  absl::StatusOr<std::vector<std::string>> KinematicsFile(const std::string& key,
+                                                          absl::string_view name) const {
+    const Option& o = options_.at(key);
+    const std::string field = key == "wavekin" ? "OPTIONS WaveKin" : "OPTIONS Currents";
+    if (!read_file_) {
+      return Error(o.line, field,
+                   absl::StrCat(name, " cannot be read here (a deck's text alone, as the service "
+                                      "takes it, has no directory): give the scene's fluid "
+                                      "fields, or run the deck's file"));
+    }
+    absl::StatusOr<std::string> text = read_file_(std::string_view(name.data(), name.size()));
+    if (!text.ok()) {
+      return Error(o.line, field, absl::StrCat("cannot read ", name, ": ", text.status().message()));
+    }
+    std::vector<std::string> lines;
+    for (absl::string_view raw : absl::StrSplit(*text, '\n'))
+      lines.emplace_back(absl::StripTrailingAsciiWhitespace(raw));
+    while (!lines.empty() && lines.back().empty()) lines.pop_back();
+    return lines;
+  }
+
+  // The numbers of row `row` (0-based) of file `name`, at least `least`.
+  absl::StatusOr<std::vector<double>> Row(const std::string& key, absl::string_view name,
+                                          const std::vector<std::string>& lines, size_t row,
+                                          size_t least) const {
+    const Option& o = options_.at(key);
+    const std::string field = key == "wavekin" ? "OPTIONS WaveKin" : "OPTIONS Currents";
+    auto bad = [&](absl::string_view message) {
+      return Error(o.line, field, absl::StrCat(name, ":", row + 1, ": ", message));
+    };
+    if (row >= lines.size()) return bad("missing (the file ends before it)");
+    std::vector<double> out;
+    for (absl::string_view word :
+         absl::StrSplit(lines[row], absl::ByAnyChar(" \t,"), absl::SkipEmpty())) {
+      double v = 0;
+      if (!absl::SimpleAtod(word, &v) || !std::isfinite(v))
+        return bad(absl::StrCat("\"", word, "\" is not a number"));
+      out.push_back(v);
+    }
+    if (out.size() < least)
+      return bad(absl::StrCat("expected at least ", least, " numbers, got ", out.size()));
+    return out;
+  }
+
+  // WaveKin and Currents (MoorDyn's Waves setup) as the scene's fluid
+  // fields (docs/moordyn-files.md, "Wave and current kinematics").
+  absl::Status WaterKinematics(v1::Fluid* fluid) const {
+    const int wave_mode = static_cast<int>(OptionOr("wavekin", 0));
+    const int current_mode = static_cast<int>(OptionOr("currents", 0));
+    if (wave_mode == 2 || wave_mode == 7) {
+      if (absl::Status s = WaveFrequencies(wave_mode, fluid->mutable_waves()); !s.ok()) return s;
+    } else if (wave_mode == 3) {
+      if (absl::Status s = WaveElevation(fluid->mutable_waves()); !s.ok()) return s;
+    }
+    if (current_mode == 1 || current_mode == 3) return SteadyCurrent(fluid);
+    if (current_mode == 2 || current_mode == 4) return DynamicCurrent(fluid);
+    if (current_mode == 5) return Current4d(fluid);
+    return absl::OkStatus();
+  }
+
+  // wave_frequencies.txt: rows "omega Re(A) Im(A) [beta]" (rad/s, m, m,
+  // rad), the first at omega = 0. WaveKin 7 sums them as
+  // |A| sin(omega t - k l + arg A) (l = x cos beta + y sin beta), WaveKin 2
+  // interpolates them linearly onto the multiples of the smallest spacing
+  // and sums |A| cos(omega t - k l + arg A) (its inverse FFT): the scene's
+  // components with phase pi/2 - arg A and -arg A.
+  absl::Status WaveFrequencies(int mode, v1::Waves* waves) const {
+    const absl::string_view name = "wave_frequencies.txt";
+    absl::StatusOr<std::vector<std::string>> lines = KinematicsFile("wavekin", name);
+    if (!lines.ok()) return lines.status();
+    const Option& o = options_.at("wavekin");
+    auto bad = [&](size_t row, absl::string_view message) {
+      return Error(o.line, "OPTIONS WaveKin", absl::StrCat(name, ":", row + 1, ": ", message));
+    };
+    struct Freq {
+      double omega;
+      std::complex<double> a;
+      double beta;
+    };
+    std::vector<Freq> rows;
+    for (size_t r = 0; r < lines->size(); ++r) {
+      absl::StatusOr<std::vector<double>> v = Row("wavekin", name, *lines, r, 3);
+      if (!v.ok()) return v.status();
+      const double beta = v->size() >= 4 ? (*v)[3] : 0.0;
+      if (std::abs(beta) > 2 * kPi)
+        return bad(r, "the direction (4th column) must be in [-2 pi, 2 pi] rad");
+      if (r == 0 && (*v)[0] != 0)
+        return bad(r, "the first frequency must be 0 rad/s (as MoorDyn requires)");
+      if (r > 0 && !((*v)[0] > rows.back().omega))
+        return bad(r, "frequencies must increase");
+      rows.push_back({(*v)[0], {(*v)[1], (*v)[2]}, beta});
+    }
+    if (rows.size() < 2) return bad(rows.size(), "at least 2 frequencies (the first 0 rad/s)");
+    if (std::abs(rows[0].a) != 0)
+      return bad(0, "a non-zero amplitude at 0 rad/s (a constant offset of the surface) cannot "
+                    "be expressed");
+    std::vector<Freq> comps;
+    if (mode == 7) {
+      comps.assign(rows.begin() + 1, rows.end());
+    } else {
+      // MoorDyn's even spacing: the smallest spacing dw, components at
+      // i dw up to the last frequency, amplitudes and directions linear
+      // between the rows; the last is the FFT's Nyquist bin.
+      double dw = rows[1].omega;
+      for (size_t r = 1; r < rows.size(); ++r) dw = std::min(dw, rows[r].omega - rows[r - 1].omega);
+      const int nw = static_cast<int>(std::floor(rows.back().omega / dw)) + 1;
+      size_t r = 1;
+      for (int i = 1; i < nw; ++i) {
+        double w = i * dw;
+        while (r + 1 < rows.size() && rows[r].omega < w * (1 - 1e-9)) ++r;
+        // A row at this frequency (to round-off): its values as given.
+        if (std::abs(rows[r].omega - w) <= 1e-9 * w) w = rows[r].omega;
+        const double f = std::clamp((w - rows[r - 1].omega) / (rows[r].omega - rows[r - 1].omega),
+                                    0.0, 1.0);
+        Freq c{w, rows[r - 1].a + f * (rows[r].a - rows[r - 1].a),
+               rows[r - 1].beta + f * (rows[r].beta - rows[r - 1].beta)};
+        if (i == nw - 1 && std::abs(c.a) != 0)
+          return bad(rows.size() - 1,
+                     "a non-zero amplitude at the last frequency (WaveKin 2's Nyquist bin, "
+                     "halved by its inverse FFT) cannot be expressed");
+        comps.push_back(c);
+      }
+    }
+    for (const Freq& c : comps) {
+      if (std::abs(c.a) == 0) continue;
+      v1::Waves::Component* out = waves->add_components();
+      out->set_amplitude(std::abs(c.a));
+      out->set_angular_frequency(c.omega);
+      SetVec(out->mutable_direction(), std::cos(c.beta), std::sin(c.beta), 0);
+      out->set_phase((mode == 7 ? kPi / 2 : 0.0) - std::arg(c.a));
+    }
+    return absl::OkStatus();
+  }
+
+  // wave_elevation.txt: rows "t eta" (s, m) at the origin; MoorDyn
+  // resamples it every dtWave from t = 0, takes its FFT, drops harmonics
+  // above 0.5 Hz and sums the rest by linear theory along x.
+  absl::Status WaveElevation(v1::Waves* waves) const {
+    const absl::string_view name = "wave_elevation.txt";
+    absl::StatusOr<std::vector<std::string>> lines = KinematicsFile("wavekin", name);
+    if (!lines.ok()) return lines.status();
+    v1::Waves::ElevationSeries* e = waves->mutable_elevation_series();
+    for (size_t r = 0; r < lines->size(); ++r) {
+      absl::StatusOr<std::vector<double>> v = Row("wavekin", name, *lines, r, 2);
+      if (!v.ok()) return v.status();
+      if (r == 0 && (*v)[0] < 0) {
+        return Error(options_.at("wavekin").line, "OPTIONS WaveKin",
+                     absl::StrCat(name, ":1: the series must start at t >= 0 (MoorDyn samples "
+                                        "it from 0)"));
+      }
+      // Held at its first value from t = 0, as MoorDyn's interpolation.
+      if (r == 0 && (*v)[0] > 0) {
+        e->add_times(0);
+        e->add_elevations((*v)[1]);
+      }
+      e->add_times((*v)[0]);
+      e->add_elevations((*v)[1]);
+    }
+    e->set_interval(OptionOr("dtwave", 0.25));  // MoorDyn's default dtWave
+    e->set_cutoff_frequency(2 * kPi * 0.5);
+    SetVec(e->mutable_direction(), 1, 0, 0);
+    return absl::OkStatus();
+  }
+
+  // current_profile.txt: three header lines, then rows "z ux [uy [uz]]"
+  // (m, m/s): the scene's current_profile, depth = -z.
+  absl::Status SteadyCurrent(v1::Fluid* fluid) const {
+    const absl::string_view name = "current_profile.txt";
+    absl::StatusOr<std::vector<std::string>> lines = KinematicsFile("currents", name);
+    if (!lines.ok()) return lines.status();
+    std::vector<std::pair<double, std::array<double, 3>>> knots;
+    for (size_t r = 3; r < lines->size(); ++r) {
+      absl::StatusOr<std::vector<double>> v = Row("currents", name, *lines, r, 2);
+      if (!v.ok()) return v.status();
+      v->resize(std::max<size_t>(v->size(), 4), 0.0);
+      if (!knots.empty() && !(-(*v)[0] < knots.back().first) && !(-(*v)[0] > knots.back().first))
+        return Error(options_.at("currents").line, "OPTIONS Currents",
+                     absl::StrCat(name, ":", r + 1, ": a depth given twice"));
+      knots.push_back({-(*v)[0], {(*v)[1], (*v)[2], (*v)[3]}});
+    }
+    if (knots.empty()) {
+      return Error(options_.at("currents").line, "OPTIONS Currents",
+                   absl::StrCat(name, ": no rows after its three header lines"));
+    }
+    std::sort(knots.begin(), knots.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (const auto& [depth, u] : knots) {
+      v1::Fluid::CurrentPoint* p = fluid->add_current_profile();
+      p->set_depth(depth);
+      SetVec(p->mutable_velocity(), u[0], u[1], u[2]);
+    }
+    return absl::OkStatus();
+  }
+
+  // current_profile_dynamic.txt: four header lines, the depths row (z,
+  // m), a line skipped, then rows "t ux(z_1..z_n) [uy(...) [uz(...)]]":
+  // the scene's current_grid with one x and one y.
+  absl::Status DynamicCurrent(v1::Fluid* fluid) const {
+    const absl::string_view name = "current_profile_dynamic.txt";
+    absl::StatusOr<std::vector<std::string>> lines = KinematicsFile("currents", name);
+    if (!lines.ok()) return lines.status();
+    absl::StatusOr<std::vector<double>> z = Row("currents", name, *lines, 4, 1);
+    if (!z.ok()) return z.status();
+    const size_t nz = z->size();
+    std::vector<double> times;
+    std::vector<std::vector<double>> rows;
+    for (size_t r = 6; r < lines->size(); ++r) {
+      absl::StatusOr<std::vector<double>> v = Row("currents", name, *lines, r, nz + 1);
+      if (!v.ok()) return v.status();
+      times.push_back((*v)[0]);
+      v->resize(std::max(v->size(), 3 * nz + 1), 0.0);
+      rows.push_back(*std::move(v));
+    }
+    if (times.empty()) {
+      return Error(options_.at("currents").line, "OPTIONS Currents",
+                   absl::StrCat(name, ": no time rows (from line 7)"));
+    }
+    v1::Fluid::CurrentGrid* g = fluid->mutable_current_grid();
+    g->add_x(0);
+    g->add_y(0);
+    for (double v : *z) g->add_z(v);
+    for (double t : times) g->add_times(t);
+    for (size_t c = 0; c < nz; ++c)
+      for (const std::vector<double>& row : rows)
+        SetVec(g->add_velocities(), row[1 + c], row[1 + nz + c], row[1 + 2 * nz + c]);
+    return absl::OkStatus();
+  }
+
+  // current_profile_4d.txt: "nx ny nz nt", the x, y, z and t rows, then
+  // one row "x y z t ux uy uz" per node in any order: the scene's
+  // current_grid.
+  absl::Status Current4d(v1::Fluid* fluid) const {
+    const absl::string_view name = "current_profile_4d.txt";
+    absl::StatusOr<std::vector<std::string>> lines = KinematicsFile("currents", name);
+    if (!lines.ok()) return lines.status();
+    const int line = options_.at("currents").line;
+    absl::StatusOr<std::vector<double>> counts = Row("currents", name, *lines, 0, 4);
+    if (!counts.ok()) return counts.status();
+    std::array<std::vector<double>, 4> axes;
+    std::array<size_t, 4> size{};
+    for (int a = 0; a < 4; ++a) {
+      const double c = (*counts)[a];
+      if (!(c >= 1 && c <= 1e7 && c == std::floor(c)))
+        return Error(line, "OPTIONS Currents",
+                     absl::StrCat(name, ":1: the counts must be whole numbers >= 1"));
+      size[a] = static_cast<size_t>(c);
+      absl::StatusOr<std::vector<double>> v = Row("currents", name, *lines, 1 + a, size[a]);
+      if (!v.ok()) return v.status();
+      v->resize(size[a]);
+      axes[a] = *std::move(v);
+    }
+    const size_t nodes = size[0] * size[1] * size[2] * size[3];
+    if (nodes > 10000000)
+      return Error(line, "OPTIONS Currents", absl::StrCat(name, ": more than 1e7 nodes"));
+    std::vector<std::array<double, 3>> u(nodes);
+    std::vector<bool> given(nodes, false);
+    for (size_t r = 5; r < lines->size(); ++r) {
+      if (absl::StripAsciiWhitespace((*lines)[r]).empty()) continue;
+      absl::StatusOr<std::vector<double>> v = Row("currents", name, *lines, r, 7);
+      if (!v.ok()) return v.status();
+      size_t flat = 0;
+      for (int a = 0; a < 4; ++a) {
+        const auto it = std::find(axes[a].begin(), axes[a].end(), (*v)[a]);
+        if (it == axes[a].end()) {
+          return Error(line, "OPTIONS Currents",
+                       absl::StrCat(name, ":", r + 1, ": ", std::string(1, "xyzt"[a]), " = ", (*v)[a],
+                                    " is not on the grid's axis (line ", a + 2, ")"));
+        }
+        flat = flat * size[a] + static_cast<size_t>(it - axes[a].begin());
+      }
+      if (given[flat])
+        return Error(line, "OPTIONS Currents",
+                     absl::StrCat(name, ":", r + 1, ": a node given twice"));
+      given[flat] = true;
+      u[flat] = {(*v)[4], (*v)[5], (*v)[6]};
+    }
+    for (size_t k = 0; k < nodes; ++k) {
+      if (!given[k])
+        return Error(line, "OPTIONS Currents",
+                     absl::StrCat(name, ": ", nodes - std::count(given.begin(), given.end(), true),
+                                  " of the grid's ", nodes, " nodes have no row"));
+    }
+    v1::Fluid::CurrentGrid* g = fluid->mutable_current_grid();
+    for (double v : axes[0]) g->add_x(v);
+    for (double v : axes[1]) g->add_y(v);
+    for (double v : axes[2]) g->add_z(v);
+    for (double v : axes[3]) g->add_times(v);
+    for (const auto& v : u) SetVec(g->add_velocities(), v[0], v[1], v[2]);
     return absl::OkStatus();
   }
 
@@ -765,6 +1099,7 @@ class DeckReader {
     // MoorDyn's lines carry buoyancy, drag and added mass only where they
     // are under the (instantaneous) surface.
     scene.mutable_fluid()->set_free_surface(true);
+    if (absl::Status s = WaterKinematics(scene.mutable_fluid()); !s.ok()) return s;
 
     // The seabed: kBot [Pa/m] and cBot [Pa s/m] act on the line's
     // diameter, cablesim's per unit length: one value per scene, so every
@@ -786,6 +1121,7 @@ class DeckReader {
     const double mu = OptionOr("mu", 0);
     bed->set_friction_axial(OptionOr("mu_a", mu));
     bed->set_friction_transverse(OptionOr("mu_t", mu));
+    if (absl::Status s = MoorDynFriction(bed); !s.ok()) return s;
     scene.mutable_solver()->set_analysis(v1::STATIC);
 
     // The points where free points become bodies (mass or volume) or where

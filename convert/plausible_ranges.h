@@ -68,6 +68,8 @@ inline constexpr PlausibleRange kStiffness{1e-6, 1e15, "N/m (N/m^2 per area)"};
 inline constexpr PlausibleRange kDampingCoefficient{0, 1e15, "N s/m (N m s, N s/m^2)"};
 // Wave periods [s]: ripples to swells, wide.
 inline constexpr PlausibleRange kWavePeriod{1e-2, 1e4, "s"};
+// Wave angular frequencies [rad/s] (2 pi over the periods above).
+inline constexpr PlausibleRange kWaveFrequency{0, 1e3, "rad/s"};
 // Friction's regularising speed [m/s] and length [m].
 inline constexpr PlausibleRange kFrictionSpeed{1e-12, 1e5, "m/s"};
 inline constexpr PlausibleRange kFrictionLength{1e-12, 1e5, "m"};

@@ -498,7 +498,7 @@ absl::StatusOr<v1::Scene> ReadSceneFile(const std::string& path) {
     const std::string dir = std::filesystem::path(path).parent_path().string();
     return SceneFromMoorDyn(*text, path, [&dir](std::string_view name) {
       return ReadBoundedFile((std::filesystem::path(dir) / std::string(name)).string(),
-                             "tension-strain table");
+                             "file the deck names");
     });
   }
   absl::StatusOr<v1::Scene> scene =

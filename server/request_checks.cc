@@ -165,6 +165,14 @@ ServerLimits DefaultServerLimits() {
 int64_t WorkPerStep(const Scene& scene, int64_t elements) {
   int64_t components = static_cast<int64_t>(scene.fluid.waves.regular.size());
   for (const JonswapSpec& sea : scene.fluid.waves.jonswap) components += sea.components;
+  components += static_cast<int64_t>(scene.fluid.waves.components.size());
+  // An elevation series: at most half its resampled points as components.
+  for (const ElevationSeriesSpec& e : scene.fluid.waves.elevation_series) {
+    const double period = e.times_s.back() - e.times_s.front();
+    const double interval =
+        e.interval_s > 0 ? e.interval_s : period / static_cast<double>(e.times_s.size() - 1);
+    components += static_cast<int64_t>(std::min(1e12, period / interval)) / 2 + 1;
+  }
   int64_t contacts = 0;
   for (const BodySpec& body : scene.bodies) {
     contacts += static_cast<int64_t>(body.contact_points_m.size());

@@ -502,7 +502,7 @@ constexpr double kChainLength = 10, kV = 0.1, kK = 1e6;
 // `joints` with probes `probes`.
 std::string DraggedChain(const std::string& up, double span, const std::string& along,
                          const std::string& joints, const std::string& probes, double mu_a,
-                         double mu_t) {
+                         double mu_t, const std::string& law = "") {
   const double sink = -kW / kK;
   return absl::StrFormat(R"({
     "gravity": {"%s": -9.81},
@@ -513,18 +513,23 @@ std::string DraggedChain(const std::string& up, double span, const std::string& 
     "joints": %s, "probes": %s,
     "initial_velocity": {"linear": {"%s": %.17g}},
     "seabed": {"stiffness": %.17g, "damping": 1e4, "friction_axial": %.17g,
-               "friction_transverse": %.17g},
+               "friction_transverse": %.17g%s},
     "solver": {"analysis": "DYNAMIC", "duration": 5, "step": 0.01, "output_interval": 0.01}})",
                          up, kChainLength, kDensity, kEa / kArea, kArea, up, sink, span, up, sink,
-                         joints, probes, along, kV, kK, mu_a, mu_t);
+                         joints, probes, along, kV, kK, mu_a, mu_t, law);
+}
+
+// The chain's end s = 0 pinned to a support moving along x at kV.
+std::string PulledAlongX() {
+  return absl::StrFormat(
+      R"([{"type": "PIN", "a": {"cable": "chain", "s": 0},
+           "motion": {"x": {"ramp": {"slope": %.17g}}}}])",
+      kV);
 }
 
 TEST(SeabedFrictionTest, DraggedAlongTheBedPullsWithMuWL) {
   const double mu = 0.7;
-  const std::string joints = absl::StrFormat(
-      R"([{"type": "PIN", "a": {"cable": "chain", "s": 0},
-           "motion": {"x": {"ramp": {"slope": %.17g}}}}])",
-      kV);
+  const std::string joints = PulledAlongX();
   CollectingSink sink;
   const RunSummary s = RunOk(
       SceneFromJson(DraggedChain("y", kChainLength, "x", joints,
@@ -541,6 +546,45 @@ TEST(SeabedFrictionTest, DraggedAlongTheBedPullsWithMuWL) {
               sink.frames().back().support_forces[0].x(), expect, s.energy_damped,
               s.energy_final + s.energy_damped - s.energy_initial);
   EXPECT_NEAR(s.energy_final + s.energy_damped, s.energy_initial, 1e-3 * s.energy_damped);
+}
+
+// MoorDyn's law (seabed.friction_law MOORDYN), the same drag along the
+// bed: its closed form in steady sliding at v = kV with N = w per unit
+// length is a pull of mu c v L while c v <= m_c w (viscous), mu w L above
+// (Coulomb's, without the regularised law's factor). Three cases: c v =
+// w / 2 (viscous), c v = 5 w with m_c = 1 (saturated) and with m_c = 10
+// (viscous again: static friction ten times the kinetic lets the viscous
+// branch run up to 10 w). Tolerance 2e-3 relative, as above.
+TEST(SeabedFrictionTest, MoorDynLawPullsWithItsClosedForm) {
+  const double mu = 0.7;
+  const std::string joints = PulledAlongX();
+  struct Case {
+    double c, scale, expect;
+  };
+  const Case cases[] = {
+      {0.5 * kW / kV, 1, mu * 0.5 * kW * kChainLength},
+      {5 * kW / kV, 1, mu * kW * kChainLength},
+      {5 * kW / kV, 10, mu * 5 * kW * kChainLength},
+  };
+  for (const Case& c : cases) {
+    const std::string law = absl::StrFormat(
+        R"(, "friction_law": "MOORDYN", "friction_damping": %.17g, "static_friction_scale": %.17g)",
+        c.c, c.scale);
+    CollectingSink sink;
+    RunOk(SceneFromJson(DraggedChain("y", kChainLength, "x", joints,
+                                     R"([{"name": "pull", "cable": "chain", "s": 0}])", mu, 1,
+                                     law)),
+          &sink);
+    ASSERT_FALSE(sink.frames().empty());
+    for (const Frame& f : sink.frames()) {
+      if (f.t < 4) continue;
+      ASSERT_EQ(f.support_forces.size(), 1u);
+      EXPECT_NEAR(f.support_forces[0].x(), c.expect, 2e-3 * c.expect)
+          << "c " << c.c << " scale " << c.scale << " t " << f.t;
+    }
+    std::printf("MoorDyn law c %.4g, m_c %.3g: pull %.4f N against %.4f N\n", c.c, c.scale,
+                sink.frames().back().support_forces[0].x(), c.expect);
+  }
 }
 
 TEST(SeabedFrictionTest, DraggedAcrossTheBedUsesTheTransverseCoefficient) {

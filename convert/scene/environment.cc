@@ -12,6 +12,10 @@ namespace {
 // JONSWAP components per sea (each costs a few exponentials per Gauss
 // point per force evaluation).
 constexpr int kMaxWaveComponents = 1000;
+// An elevation series' resampled steps (half as many components).
+constexpr double kMaxSeriesSteps = 2 * kMaxWaveComponents;
+// A current grid's nodes (x * y * z * times).
+constexpr int64_t kMaxGridNodes = 10000000;
 
 // A wave's direction of travel: its part normal to gravity, normalised.
 // Omitted: x (y when gravity is along x).
@@ -40,7 +44,9 @@ absl::Status ConvertWaves(ConversionState* state) {
   CABLESIM_RETURN_IF_ERROR(
       CheckRange("fluid.waves.ramp_time", w.ramp_time(), plausible::kDuration));
   spec.ramp_s = w.ramp_time();
-  if (w.regular_size() == 0 && w.jonswap_size() == 0) return absl::OkStatus();
+  if (w.regular_size() == 0 && w.jonswap_size() == 0 && w.components_size() == 0 &&
+      !w.has_elevation_series())
+    return absl::OkStatus();
   if (!(f.density() > 0)) return Invalid("fluid.waves", "needs a fluid (fluid.density > 0)");
   if (!(f.water_depth() > 0)) {
     return Invalid("fluid.water_depth", "must be > 0 with waves (their kinematics depend on it)");
@@ -91,6 +97,128 @@ absl::Status ConvertWaves(ConversionState* state) {
     CABLESIM_ASSIGN_OR_RETURN(out.direction, WaveDirection(*state, Sub(path, "direction"),
                                                            j.has_direction(), j.direction()));
     spec.jonswap.push_back(out);
+  }
+  if (w.components_size() > kMaxWaveComponents) {
+    return Invalid("fluid.waves.components", absl::StrCat("at most ", kMaxWaveComponents,
+                                                          " (got ", w.components_size(), ")"));
+  }
+  for (int i = 0; i < w.components_size(); ++i) {
+    const v1::Waves::Component& c = w.components(i);
+    const std::string path = Indexed("fluid.waves", "components", i);
+    WaveComponentSpec out;
+    CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(path, "amplitude"), c.amplitude()));
+    CABLESIM_RETURN_IF_ERROR(CheckRange(Sub(path, "amplitude"), c.amplitude(), plausible::kCoordinate));
+    out.amplitude_m = c.amplitude();
+    CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange(Sub(path, "angular_frequency"),
+                                                  c.angular_frequency(), plausible::kWaveFrequency));
+    out.omega_rad_s = c.angular_frequency();
+    CABLESIM_ASSIGN_OR_RETURN(out.direction, WaveDirection(*state, Sub(path, "direction"),
+                                                           c.has_direction(), c.direction()));
+    CABLESIM_RETURN_IF_ERROR(CheckRange(Sub(path, "phase"), c.phase(), plausible::kPhase));
+    out.phase_rad = c.phase();
+    spec.components.push_back(out);
+  }
+  if (w.has_elevation_series()) {
+    const v1::Waves::ElevationSeries& e = w.elevation_series();
+    const std::string path = "fluid.waves.elevation_series";
+    ElevationSeriesSpec out;
+    if (e.times_size() < 2)
+      return Invalid(Sub(path, "times"), absl::StrCat("at least 2 (got ", e.times_size(), ")"));
+    if (e.elevations_size() != e.times_size()) {
+      return Invalid(Sub(path, "elevations"), absl::StrCat("one per time: expected ",
+                                                           e.times_size(), ", got ",
+                                                           e.elevations_size()));
+    }
+    for (int i = 0; i < e.times_size(); ++i) {
+      CABLESIM_RETURN_IF_ERROR(
+          CheckRange(absl::StrCat(path, ".times[", i, "]"), e.times(i), plausible::kTime));
+      if (i > 0 && !(e.times(i) > e.times(i - 1)))
+        return Invalid(Sub(path, "times"), absl::StrCat("must increase (times[", i, "] = ",
+                                                        Num(e.times(i)), " follows ",
+                                                        Num(e.times(i - 1)), ")"));
+      CABLESIM_RETURN_IF_ERROR(CheckRange(absl::StrCat(path, ".elevations[", i, "]"),
+                                          e.elevations(i), plausible::kCoordinate));
+      out.times_s.push_back(e.times(i));
+      out.elevations_m.push_back(e.elevations(i));
+    }
+    CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(path, "interval"), e.interval()));
+    CABLESIM_RETURN_IF_ERROR(CheckRange(Sub(path, "interval"), e.interval(), plausible::kDuration));
+    const double period = out.times_s.back() - out.times_s.front();
+    const double steps =
+        e.interval() > 0 ? period / e.interval() : static_cast<double>(e.times_size() - 1);
+    if (steps > kMaxSeriesSteps) {
+      return Invalid(Sub(path, "interval"),
+                     absl::StrCat("cuts the series into ", Num(steps), " steps (at most ",
+                                  kMaxSeriesSteps, ")"));
+    }
+    out.interval_s = e.interval();
+    CABLESIM_RETURN_IF_ERROR(
+        CheckNonNegative(Sub(path, "cutoff_frequency"), e.cutoff_frequency()));
+    CABLESIM_RETURN_IF_ERROR(CheckRange(Sub(path, "cutoff_frequency"), e.cutoff_frequency(),
+                                        plausible::kWaveFrequency));
+    out.cutoff_rad_s = e.cutoff_frequency();
+    CABLESIM_ASSIGN_OR_RETURN(out.direction, WaveDirection(*state, Sub(path, "direction"),
+                                                           e.has_direction(), e.direction()));
+    spec.elevation_series.push_back(std::move(out));
+  }
+  return absl::OkStatus();
+}
+
+// fluid.current_grid: axes strictly increasing, one velocity per node.
+absl::Status ConvertCurrentGrid(ConversionState* state) {
+  const v1::Fluid& f = state->proto.fluid();
+  const v1::Fluid::CurrentGrid& g = f.current_grid();
+  FluidSpec& fluid = state->scene.fluid;
+  const std::string path = "fluid.current_grid";
+  if (!(f.density() > 0)) return Invalid(path, "needs a fluid (fluid.density > 0)");
+  if (fluid.current_m_s != Eigen::Vector3d::Zero())
+    return Invalid(path, "give fluid.current or fluid.current_grid, not both");
+  if (f.current_profile_size() > 0)
+    return Invalid(path, "give fluid.current_profile or fluid.current_grid, not both");
+  for (size_t b = 0; b < state->scene.bodies.size(); ++b) {
+    if (state->scene.bodies[b].has_hydrodynamics) {
+      return Invalid(path, absl::StrCat("not taken by bodies[", b,
+                                        "].hydrodynamics (a body's drag takes the uniform "
+                                        "fluid.current)"));
+    }
+  }
+  struct Axis {
+    const char* name;
+    const google::protobuf::RepeatedField<double>& values;
+    std::vector<double>* out;
+    const PlausibleRange& range;
+  };
+  const Axis axes[] = {{"x", g.x(), &fluid.current_grid_x_m, plausible::kCoordinate},
+                       {"y", g.y(), &fluid.current_grid_y_m, plausible::kCoordinate},
+                       {"z", g.z(), &fluid.current_grid_z_m, plausible::kCoordinate},
+                       {"times", g.times(), &fluid.current_grid_t_s, plausible::kTime}};
+  int64_t nodes = 1;
+  for (const Axis& a : axes) {
+    const std::string axis = Sub(path, a.name);
+    if (a.values.empty()) return Invalid(axis, "at least one value");
+    for (int i = 0; i < a.values.size(); ++i) {
+      CABLESIM_RETURN_IF_ERROR(
+          CheckRange(absl::StrCat(axis, "[", i, "]"), a.values[i], a.range));
+      if (i > 0 && !(a.values[i] > a.values[i - 1]))
+        return Invalid(axis, absl::StrCat("must increase (", a.name, "[", i, "] = ",
+                                          Num(a.values[i]), " follows ",
+                                          Num(a.values[i - 1]), ")"));
+    }
+    nodes *= a.values.size();
+    if (nodes > kMaxGridNodes)
+      return Invalid(path, absl::StrCat("at most ", kMaxGridNodes, " nodes"));
+    a.out->assign(a.values.begin(), a.values.end());
+  }
+  if (g.velocities_size() != nodes) {
+    return Invalid(Sub(path, "velocities"),
+                   absl::StrCat("expected x * y * z * times = ", nodes, " velocities, got ",
+                                g.velocities_size()));
+  }
+  for (int i = 0; i < g.velocities_size(); ++i) {
+    Eigen::Vector3d v;
+    CABLESIM_ASSIGN_OR_RETURN(v, VectorInRange(absl::StrCat(path, ".velocities[", i, "]"),
+                                               g.velocities(i), plausible::kVelocity));
+    fluid.current_grid_velocities_m_s.push_back(v);
   }
   return absl::OkStatus();
 }
@@ -198,6 +326,7 @@ absl::Status ConvertFluid(ConversionState* state) {
       state->scene.fluid.current_profile_velocities_m_s.push_back(velocity);
     }
   }
+  if (f.has_current_grid()) CABLESIM_RETURN_IF_ERROR(ConvertCurrentGrid(state));
   return ConvertWaves(state);
 }
 
@@ -239,6 +368,25 @@ absl::Status ConvertSeabed(ConversionState* state) {
     CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange("seabed.friction_length", b.friction_length(),
                                                   plausible::kFrictionLength));
     spec.friction_length_m = b.friction_length();
+  }
+  if (b.friction_law() == v1::Seabed::MOORDYN) {
+    spec.friction_law = FrictionLaw::kMoorDyn;
+    CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange("seabed.friction_damping", b.friction_damping(),
+                                                  plausible::kDampingCoefficient));
+    spec.friction_damping_n_s_m2 = b.friction_damping();
+    if (b.static_friction_scale() != 0) {
+      CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange("seabed.static_friction_scale",
+                                                    b.static_friction_scale(),
+                                                    plausible::kFrictionCoefficient));
+      spec.static_friction_scale = b.static_friction_scale();
+    }
+  } else if (b.friction_damping() != 0 || b.static_friction_scale() != 0) {
+    return Invalid(b.friction_damping() != 0 ? "seabed.friction_damping"
+                                             : "seabed.static_friction_scale",
+                   "only with seabed.friction_law MOORDYN");
+  } else if (b.friction_law() != v1::Seabed::FRICTION_LAW_UNSPECIFIED &&
+             b.friction_law() != v1::Seabed::REGULARIZED) {
+    return Invalid("seabed.friction_law", absl::StrCat("unknown value ", b.friction_law()));
   }
   if (b.has_bathymetry()) CABLESIM_RETURN_IF_ERROR(ConvertBathymetry(state, b));
   return absl::OkStatus();

@@ -29,7 +29,7 @@ double CableFluidLoad::Dissipation(const ElementAt<D>& at, const ElementCoords<D
         velocity[g] = current_.head<D>();
       } else {
         r.head<D>() = at.element.GaussPosition(e, g);
-        velocity[g] = profile_.At(r).head<D>();
+        velocity[g] = profile_.At(r, at.time).template head<D>();
       }
     }
     at.element.AddMorison(e, edot, velocity, nullptr, p.drag_n, p.drag_t, 0, 0,

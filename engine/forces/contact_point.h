@@ -32,7 +32,8 @@ double PointDissipation(const Eigen::Matrix<double, D, 1>& n,
                         const Eigen::Matrix<double, D, 1>& v,
                         const Eigen::Matrix<double, D, 1>& u, double c, double mu_a, double mu_t,
                         double v_s, Eigen::Matrix<double, D, 1>* q,
-                        Eigen::Matrix<double, D, D>* h) {
+                        Eigen::Matrix<double, D, D>* h, double moordyn_damping = 0,
+                        double moordyn_scale = 1) {
   using Point = Eigen::Matrix<double, D, 1>;
   using Block = Eigen::Matrix<double, D, D>;
   const double vn = n.dot(v);
@@ -48,10 +49,17 @@ double PointDissipation(const Eigen::Matrix<double, D, 1>& n,
       t /= tn;
       amat += (mu_a - mu_t) * t * t.transpose();
     }
-    const double sq = std::sqrt(vb.squaredNorm() + v_s * v_s);
-    const Point qf = (-normal_force / sq) * (amat * vb);
+    // MoorDyn's law (moordyn_damping c > 0): viscous, q_f = -c A v_b,
+    // while c |v_b| <= moordyn_scale N, else Coulomb's -N A v_b / |v_b|.
+    const double speed = vb.norm();
+    const bool viscous =
+        moordyn_damping > 0 && moordyn_damping * speed <= moordyn_scale * normal_force;
+    const double factor =
+        moordyn_damping > 0 ? (viscous ? moordyn_damping : normal_force / speed)
+                            : normal_force / std::sqrt(speed * speed + v_s * v_s);
+    const Point qf = -factor * (amat * vb);
     *q += qf;
-    *h += (normal_force / sq) * amat;
+    *h += factor * amat;
     power -= qf.dot(vb);
   }
   return power;

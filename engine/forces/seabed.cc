@@ -58,7 +58,9 @@ Seabed::Seabed(const SeabedSpec& spec)
       mu_a_(spec.friction_axial),
       mu_t_(spec.friction_transverse),
       v_s_(spec.friction_speed_m_s),
-      u_s_(spec.friction_length_m) {
+      u_s_(spec.friction_length_m),
+      moordyn_c_(spec.friction_law == FrictionLaw::kMoorDyn ? spec.friction_damping_n_s_m2 : 0),
+      moordyn_scale_(spec.static_friction_scale) {
   if (spec.bathymetry.enabled) {
     int axis = 0;
     normal_.cwiseAbs().maxCoeff(&axis);
@@ -245,7 +247,7 @@ double Seabed::GridDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
                                const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
                                Eigen::Matrix<double, 4 * D, 1>* force,
                                Eigen::Matrix<double, 4 * D, 4 * D>* c, double damping,
-                               double speed) const {
+                               double speed, double moordyn_damping) const {
   using Point = Eigen::Matrix<double, D, 1>;
   using Block = Eigen::Matrix<double, D, D>;
   static const GaussRule rule = MakeGaussRule(7);
@@ -271,7 +273,8 @@ double Seabed::GridDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
       Point q;
       Block h;
       power += wl * contact::PointDissipation<D>(n, proj, k_ * pen * gn, v, u, damping, mu_a_,
-                                                 mu_t_, speed, &q, &h);
+                                                 mu_t_, speed, &q, &h, moordyn_damping,
+                                                 moordyn_scale_);
       if (force)
         for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s[k]) * q;
       if (c) AddShapeBlocks<D>(wl, s, h, c);
@@ -389,8 +392,8 @@ double Seabed::AddDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
                               const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
                               Eigen::Matrix<double, 4 * D, 1>* force,
                               Eigen::Matrix<double, 4 * D, 4 * D>* c) const {
-  if (grid_) return GridDissipation<D>(e, edot, length, force, c, c_, v_s_);
-  return PlaneDissipation<D>(e, edot, length, force, c, c_, v_s_);
+  if (grid_) return GridDissipation<D>(e, edot, length, force, c, c_, v_s_, moordyn_c_);
+  return PlaneDissipation<D>(e, edot, length, force, c, c_, v_s_, moordyn_c_);
 }
 
 template <int D>
@@ -402,9 +405,9 @@ void Seabed::AddStaticFriction(const Eigen::Matrix<double, 4 * D, 1>& e,
   // The displacement from the start takes the rate's place, u_s v_s's.
   const Eigen::Matrix<double, 4 * D, 1> displacement = e - e0;
   if (grid_) {
-    GridDissipation<D>(e, displacement, length, force, matrix, 0.0, u_s_);
+    GridDissipation<D>(e, displacement, length, force, matrix, 0.0, u_s_, 0.0);
   } else {
-    PlaneDissipation<D>(e, displacement, length, force, matrix, 0.0, u_s_);
+    PlaneDissipation<D>(e, displacement, length, force, matrix, 0.0, u_s_, 0.0);
   }
 }
 
@@ -480,7 +483,7 @@ double Seabed::PlaneDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
                                 const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
                                 Eigen::Matrix<double, 4 * D, 1>* force,
                                 Eigen::Matrix<double, 4 * D, 4 * D>* c, double damping,
-                                double speed) const {
+                                double speed, double moordyn_damping) const {
   using Point = Eigen::Matrix<double, D, 1>;
   using Block = Eigen::Matrix<double, D, D>;
   double pieces[2][2];
@@ -500,7 +503,7 @@ double Seabed::PlaneDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
     Point q;
     Block h;
     power += wl * contact::PointDissipation<D>(n, proj, k_ * pen, v, u, damping, mu_a_, mu_t_,
-                                               speed, &q, &h);
+                                               speed, &q, &h, moordyn_damping, moordyn_scale_);
     if (force)
       for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s[k]) * q;
     if (c) AddShapeBlocks<D>(wl, s, h, c);

@@ -56,6 +56,20 @@
 // with the same Gauss points as the damping (exact only for the
 // polynomial terms). STATIC analyses see the static friction below.
 //
+// MoorDyn's law (seabed.friction_law MOORDYN, dynamic runs; MoorDyn's
+// Line.cpp bottom contact, per unit length here): with c the friction
+// damping [N s/m^2] and m_c the static scale,
+//
+//   q_f = -c A v_b                 while c |v_b| <= m_c N,
+//   q_f = -N A v_b / |v_b|         above,
+//
+// A = mu_a t_b t_b^T + mu_t (P - t_b t_b^T) as above: a viscous law of
+// slope c mu up to the speed m_c N / c, where it jumps to Coulomb's mu N
+// (down when m_c > 1: MoorDyn's static friction above the kinetic one;
+// continuous at m_c = 1). Its tangent is c A and N A / |v_b| (the same
+// over-estimate as above); STATIC analyses keep the static friction
+// below.
+//
 // Bathymetry (engine/forces/bathymetry_grid.h). When the scene gives a
 // grid, the height above the bed is measured along the grid's up axis,
 //
@@ -252,13 +266,13 @@ class Seabed {
                          const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
                          Eigen::Matrix<double, 4 * D, 1>* force,
                          Eigen::Matrix<double, 4 * D, 4 * D>* c, double damping,
-                         double speed) const;
+                         double speed, double moordyn_damping) const;
   template <int D>
   double PlaneDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
                           const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
                           Eigen::Matrix<double, 4 * D, 1>* force,
                           Eigen::Matrix<double, 4 * D, 4 * D>* c, double damping,
-                          double speed) const;
+                          double speed, double moordyn_damping) const;
   // The gap g at a point of D coordinates, its gradient (and, on a grid,
   // Hessian when not null).
   template <int D>
@@ -268,6 +282,9 @@ class Seabed {
   double depth_ = 0;
   Eigen::Vector3d normal_ = Eigen::Vector3d::UnitY();
   double k_ = 0, c_ = 0, mu_a_ = 0, mu_t_ = 0, v_s_ = 1e-3, u_s_ = 1e-5;
+  // MoorDyn's friction law (seabed.friction_law MOORDYN): its damping
+  // [N s/m^2] (0: the regularised Coulomb law) and static scale.
+  double moordyn_c_ = 0, moordyn_scale_ = 1;
   std::optional<BathymetryGrid> grid_;  // only with a bathymetry grid
 };
 

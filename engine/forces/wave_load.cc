@@ -29,7 +29,7 @@ void WaveLoad::Add(const AncfCableElement<D>& element,
     r.head<D>() = element.GaussPosition(e, g);
     const WaveField::Kinematics k = field_.At(r, t);
     velocity[g] =
-        (profile_.empty() ? current_ : profile_.At(r)).head<D>() + k.velocity_m_s.head<D>();
+        (profile_.empty() ? current_ : profile_.At(r, t)).head<D>() + k.velocity_m_s.head<D>();
     acceleration[g] = k.acceleration_m_s2.head<D>();
     wet[g] = surface_.Wet(r, k.elevation_m);
   }

@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <numbers>
 #include <random>
+
+#include <unsupported/Eigen/FFT>
 
 namespace cablesim {
 
@@ -54,13 +57,7 @@ Eigen::Vector3d WaveField::Horizontal(const Eigen::Vector3d& direction) const {
 
 void WaveField::AddRegular(double height_m, double period_s, const Eigen::Vector3d& direction,
                            double phase_rad) {
-  Component c;
-  c.amplitude_m = 0.5 * height_m;
-  c.omega_rad_s = 2 * std::numbers::pi / period_s;
-  c.wavenumber_1_m = Wavenumber(c.omega_rad_s, depth_, g_);
-  c.direction = Horizontal(direction);
-  c.phase_rad = phase_rad;
-  components_.push_back(c);
+  AddComponent(0.5 * height_m, 2 * std::numbers::pi / period_s, direction, phase_rad);
 }
 
 void WaveField::AddJonswap(double hs_m, double tp_s, double gamma,
@@ -86,6 +83,55 @@ void WaveField::AddJonswap(double hs_m, double tp_s, double gamma,
   }
 }
 
+void WaveField::AddComponent(double amplitude_m, double omega_rad_s,
+                             const Eigen::Vector3d& direction, double phase_rad) {
+  Component c;
+  c.amplitude_m = amplitude_m;
+  c.omega_rad_s = omega_rad_s;
+  c.wavenumber_1_m = Wavenumber(omega_rad_s, depth_, g_);
+  c.direction = Horizontal(direction);
+  c.phase_rad = phase_rad;
+  components_.push_back(c);
+}
+
+int WaveField::AddElevationSeries(const std::vector<double>& times_s,
+                                  const std::vector<double>& elevations_m, double interval_s,
+                                  double cutoff_rad_s, const Eigen::Vector3d& direction) {
+  const double t0 = times_s.front(), period = times_s.back() - t0;
+  if (!(interval_s > 0)) interval_s = period / static_cast<double>(times_s.size() - 1);
+  const int n = std::max(2, static_cast<int>(std::lround(period / interval_s)));
+  const double dt = period / n;
+  // Linear interpolation of the series at t0 + j dt, j < n.
+  std::vector<double> x(n);
+  size_t k = 0;
+  for (int j = 0; j < n; ++j) {
+    const double t = t0 + j * dt;
+    while (k + 2 < times_s.size() && times_s[k + 1] <= t) ++k;
+    const double w = std::clamp((t - times_s[k]) / (times_s[k + 1] - times_s[k]), 0.0, 1.0);
+    x[j] = elevations_m[k] + w * (elevations_m[k + 1] - elevations_m[k]);
+  }
+  Eigen::FFT<double> fft;
+  std::vector<std::complex<double>> spectrum;
+  fft.fwd(spectrum, x);
+  mean_elevation_m_ += spectrum[0].real() / n;
+  std::vector<double> amplitude(n / 2 + 1, 0.0);
+  double largest = 0;
+  for (int m = 1; m <= n / 2; ++m) {
+    amplitude[m] = (2 * m == n ? 1.0 : 2.0) * std::abs(spectrum[m]) / n;
+    largest = std::max(largest, amplitude[m]);
+  }
+  const Eigen::Vector3d d = Horizontal(direction);
+  int added = 0;
+  for (int m = 1; m <= n / 2; ++m) {
+    const double omega = 2 * std::numbers::pi * m / period;
+    if (cutoff_rad_s > 0 && omega > cutoff_rad_s) break;
+    if (!(amplitude[m] > 1e-12 * largest)) continue;
+    AddComponent(amplitude[m], omega, d, omega * t0 - std::arg(spectrum[m]));
+    ++added;
+  }
+  return added;
+}
+
 WaveField::Kinematics WaveField::At(const Eigen::Vector3d& r, double t) const {
   Kinematics out;
   double ramp = 1, ramp_rate = 0;
@@ -97,7 +143,7 @@ WaveField::Kinematics WaveField::At(const Eigen::Vector3d& r, double t) const {
   }
   const double z = std::clamp(up_.dot(r) - surface_, -depth_, 0.0);
   Eigen::Vector3d u = Eigen::Vector3d::Zero(), a = Eigen::Vector3d::Zero();
-  double eta = 0;
+  double eta = mean_elevation_m_;
   for (const Component& c : components_) {
     const double k = c.wavenumber_1_m, w = c.omega_rad_s;
     const double theta = k * c.direction.dot(r) - w * t + c.phase_rad;

@@ -39,6 +39,31 @@
 // from a seeded 64-bit Mersenne twister (std::mt19937_64, whose output is
 // fixed by the C++ standard, so a seed gives the same sea everywhere).
 //
+// User-supplied seas:
+//
+// - components given one by one (AddComponent: amplitude, angular
+//   frequency, direction, phase; MoorDyn's wave_frequencies.txt), each
+//   evaluated by the formulas above;
+// - an elevation time series eta(t_j) at the origin's horizontal position
+//   (AddElevationSeries; MoorDyn's wave_elevation.txt), taken as one period
+//   of a periodic sea of period T = t_last - t_0: resampled by linear
+//   interpolation at N = max(2, round(T / interval)) equal steps
+//   dt = T / N, transformed by the discrete Fourier transform
+//   X_m = sum_j x_j exp(-2 pi i m j / N) (Eigen's FFT), and written back as
+//   the sum of its real harmonics
+//
+//     eta(t) = X_0 / N + sum_{0 < m < N/2} (2 |X_m| / N) cos(omega_m (t - t_0) + arg X_m)
+//              [+ (|X_{N/2}| / N) cos(omega_{N/2} (t - t_0) + arg X_{N/2}) for N even],
+//     omega_m = 2 pi m / T,
+//
+//   which passes through every resampled point (the inverse transform);
+//   each harmonic up to the cutoff frequency becomes a component travelling
+//   along the series' direction (phase omega_m t_0 - arg X_m, so that its
+//   elevation at the origin is the harmonic's), its kinematics by linear
+//   theory as any other component; X_0 / N, the series' mean, raises the
+//   surface everywhere (no velocity). Harmonics below 1e-12 of the largest
+//   amplitude (round-off of the transform) are left out.
+//
 // Units SI.
 
 #include <cstdint>
@@ -87,7 +112,25 @@ class WaveField {
   void AddJonswap(double hs_m, double tp_s, double gamma, const Eigen::Vector3d& direction,
                   int components, uint64_t seed);
 
+  // One component: amplitude a [m] (>= 0), angular frequency omega
+  // [rad/s] (> 0), horizontal direction (as AddRegular) and phase [rad]
+  // (the elevation at the origin at t = 0 is a cos(phase)).
+  void AddComponent(double amplitude_m, double omega_rad_s, const Eigen::Vector3d& direction,
+                    double phase_rad);
+
+  // A sea from the elevations [m] at times [s] (strictly increasing, at
+  // least 2) at the origin, as the header says: resampled at about
+  // `interval_s` (0: the series' mean interval), harmonics above
+  // `cutoff_rad_s` (0: none) dropped, travelling along `direction`.
+  // Returns the number of components added.
+  int AddElevationSeries(const std::vector<double>& times_s,
+                         const std::vector<double>& elevations_m, double interval_s,
+                         double cutoff_rad_s, const Eigen::Vector3d& direction);
+
   const std::vector<Component>& components() const { return components_; }
+  // The surface's mean elevation above the still level from elevation
+  // series [m] (0 without).
+  double mean_elevation() const { return mean_elevation_m_; }
   // The unit vertical and the still water level along it [m].
   const Eigen::Vector3d& up() const { return up_; }
   double surface() const { return surface_; }
@@ -100,6 +143,7 @@ class WaveField {
 
   Eigen::Vector3d up_;
   double surface_ = 0, depth_ = 0, g_ = 9.81, ramp_s_ = 0;
+  double mean_elevation_m_ = 0;
   std::vector<Component> components_;
 };
 

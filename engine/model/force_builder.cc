@@ -194,6 +194,11 @@ void ModelBuilder::BuildElements() {
     for (const JonswapSpec& j : fluid.waves.jonswap)
       field.AddJonswap(j.significant_height_m, j.peak_period_s, j.peak_factor, j.direction,
                        j.components, j.seed);
+    for (const WaveComponentSpec& c : fluid.waves.components)
+      field.AddComponent(c.amplitude_m, c.omega_rad_s, c.direction, c.phase_rad);
+    for (const ElevationSeriesSpec& e : fluid.waves.elevation_series)
+      field.AddElevationSeries(e.times_s, e.elevations_m, e.interval_s, e.cutoff_rad_s,
+                               e.direction);
     model_.wave_load_ = std::make_shared<const WaveLoad>(std::move(field), fluid.current_m_s,
                                                          fluid.free_surface, Current());
     model_.waves_ = &model_.wave_load_->field();
@@ -244,6 +249,10 @@ void ModelBuilder::BuildElements() {
 CurrentProfile ModelBuilder::Current() const {
   const FluidSpec& fluid = scene_.fluid;
   const double g = scene_.gravity_m_s2.norm();
+  if (!fluid.current_grid_x_m.empty())
+    return CurrentProfile::Grid(fluid.current_grid_x_m, fluid.current_grid_y_m,
+                                fluid.current_grid_z_m, fluid.current_grid_t_s,
+                                fluid.current_grid_velocities_m_s);
   if (fluid.current_profile_depths_m.empty() || !(g > 0)) return {};
   return CurrentProfile(-scene_.gravity_m_s2 / g, fluid.still_water_level_m,
                         fluid.current_profile_depths_m, fluid.current_profile_velocities_m_s);

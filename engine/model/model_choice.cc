@@ -81,6 +81,20 @@ std::string OutOfPlaneField(const Scene& scene) {
         !f.empty())
       return f;
   }
+  for (size_t i = 0; i < waves.components.size(); ++i) {
+    if (auto f = Z(absl::StrCat("fluid.waves.components[", i, "].direction"),
+                   waves.components[i].direction);
+        !f.empty())
+      return f;
+  }
+  for (const ElevationSeriesSpec& e : waves.elevation_series)
+    if (auto f = Z("fluid.waves.elevation_series.direction", e.direction); !f.empty()) return f;
+  for (size_t i = 0; i < scene.fluid.current_grid_velocities_m_s.size(); ++i) {
+    if (auto f = Z(absl::StrCat("fluid.current_grid.velocities[", i, "]"),
+                   scene.fluid.current_grid_velocities_m_s[i]);
+        !f.empty())
+      return f;
+  }
   if (scene.seabed.enabled)
     if (auto f = Z("seabed.normal", scene.seabed.normal); !f.empty()) return f;
   for (size_t i = 0; i < scene.sheaves.size(); ++i) {

@@ -243,14 +243,40 @@ struct JonswapSpec {
   Eigen::Vector3d direction = Eigen::Vector3d::UnitX();  // horizontal, unit
 };
 
+// One wave component given by the user (WaveField::AddComponent):
+// amplitude [m], angular frequency [rad/s], horizontal unit direction,
+// phase [rad].
+struct WaveComponentSpec {
+  double amplitude_m = 0;
+  double omega_rad_s = 0;
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
+  double phase_rad = 0;
+};
+
+// A sea given by its elevation at the origin (WaveField::
+// AddElevationSeries): times [s] strictly increasing, elevations [m],
+// resampling interval [s] (0: the mean interval), cutoff [rad/s] (0: none).
+struct ElevationSeriesSpec {
+  std::vector<double> times_s;
+  std::vector<double> elevations_m;
+  double interval_s = 0;
+  double cutoff_rad_s = 0;
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
+};
+
 // Waves on the fluid's surface (engine/forces/waves.h, their load
 // engine/forces/wave_load.h): the sum of every component, ramped in over
 // ramp_s [s] (0: none).
 struct WavesSpec {
   std::vector<RegularWaveSpec> regular;
   std::vector<JonswapSpec> jonswap;
+  std::vector<WaveComponentSpec> components;
+  std::vector<ElevationSeriesSpec> elevation_series;  // none or one
   double ramp_s = 0;
-  bool any() const { return !regular.empty() || !jonswap.empty(); }
+  bool any() const {
+    return !regular.empty() || !jonswap.empty() || !components.empty() ||
+           !elevation_series.empty();
+  }
 };
 
 // A fluid filling the scene: density [kg/m^3] (0: none) and a uniform,
@@ -273,6 +299,12 @@ struct FluidSpec {
   // empty: the uniform current_m_s.
   std::vector<double> current_profile_depths_m;
   std::vector<Eigen::Vector3d> current_profile_velocities_m_s;
+  // The current on a grid in space and time (engine/forces/
+  // current_profile.h): axes x, y, z [m] and times [s], each strictly
+  // increasing; velocities [m/s] at index ((a ny + b) nz + c) nt + d;
+  // empty axes: none.
+  std::vector<double> current_grid_x_m, current_grid_y_m, current_grid_z_m, current_grid_t_s;
+  std::vector<Eigen::Vector3d> current_grid_velocities_m_s;
 };
 
 // A bathymetry grid (engine/forces/bathymetry_grid.h): depths [m] below
@@ -286,6 +318,9 @@ struct BathymetrySpec {
   int nx = 1, ny = 1;
   std::vector<double> depths_m;
 };
+
+// The seabed's dynamic friction law (SeabedSpec::friction_law).
+enum class FrictionLaw { kRegularized, kMoorDyn };
 
 // A seabed the cables lie on (MultibodyModel, engine/forces/seabed.h): the
 // plane of points r with normal . r = -depth_m, the normal pointing out of
@@ -306,6 +341,12 @@ struct SeabedSpec {
   // starts from (where the line was laid) below which friction is
   // regularised (Seabed::AddStaticFriction).
   double friction_length_m = 1e-5;
+  // The dynamic friction law (engine/forces/seabed.h): kRegularized (the
+  // law above) or kMoorDyn, MoorDyn's viscous-then-Coulomb law with
+  // friction_damping [N s/m per m of cable] and static_friction_scale.
+  FrictionLaw friction_law = FrictionLaw::kRegularized;
+  double friction_damping_n_s_m2 = 0;
+  double static_friction_scale = 1;
   // When enabled, the bed is this grid instead of the plane (depth_m is
   // then 0 and the normal a coordinate axis: the grid's "up").
   BathymetrySpec bathymetry;
