@@ -310,7 +310,9 @@ def main():
     if args.docs:
         os.makedirs(args.docs, exist_ok=True)
         for p in (csv_path, md_path):
-            shutil.copy(p, args.docs)
+            target = os.path.join(args.docs, os.path.basename(p))
+            if not (os.path.exists(target) and os.path.samefile(p, target)):
+                shutil.copy(p, target)
     shutil.rmtree(tmp, ignore_errors=True)
     log(f"wrote {csv_path} and {md_path}")
 
