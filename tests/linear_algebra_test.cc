@@ -76,6 +76,45 @@ TEST(SkylineLdltTest, AbsoluteSolveIsPositiveDefinite) {
   EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(p).eigenvalues().minCoeff(), 0);
 }
 
+// A right-hand side with few non-zeros (a constraint row's column: one node
+// of one cable) in a matrix of uncoupled blocks (three cables): the solve
+// skips the zeros, so its solution must still match dense LU everywhere and
+// be exactly zero outside the block that holds the non-zeros.
+TEST(SkylineLdltTest, SparseRightHandSidesInUncoupledBlocksMatchDenseLu) {
+  std::mt19937 rng(5);
+  constexpr int kBlock = 20, kBlocks = 3, n = kBlock * kBlocks;
+  std::vector<int> first(n);
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
+  for (int b = 0; b < kBlocks; ++b) {
+    std::vector<int> f;
+    const Eigen::MatrixXd block = RandomBanded(kBlock, &f, false, &rng);
+    a.block(b * kBlock, b * kBlock, kBlock, kBlock) = block;
+    for (int i = 0; i < kBlock; ++i) first[b * kBlock + i] = b * kBlock + f[i];
+  }
+  SkylineLdlt s;
+  s.SetPattern(first);
+  Load(a, &s);
+  ASSERT_TRUE(s.Factor());
+  const auto lu = a.partialPivLu();
+  // Non-zeros: inside the middle block (its last rows, as a fairlead's), at
+  // the first and last index of the whole system, and one in two blocks.
+  const std::vector<std::vector<int>> patterns = {
+      {kBlock + 17, kBlock + 18, kBlock + 19}, {0}, {n - 1}, {3, 2 * kBlock + 5}};
+  for (const std::vector<int>& nz : patterns) {
+    Eigen::VectorXd b = Eigen::VectorXd::Zero(n);
+    for (int i : nz) b(i) = 1.0 + i;
+    Eigen::VectorXd x = b;
+    s.Solve(x.data());
+    const Eigen::VectorXd ref = lu.solve(b);
+    EXPECT_LT((x - ref).norm(), 1e-8 * ref.norm());
+    for (int blk = 0; blk < kBlocks; ++blk) {
+      bool touched = false;
+      for (int i : nz) touched |= i / kBlock == blk;
+      if (!touched) EXPECT_EQ(x.segment(blk * kBlock, kBlock).norm(), 0) << "block " << blk;
+    }
+  }
+}
+
 TEST(KrylovTest, MinresMatchesEigenMinresOnSymmetricIndefiniteSystems) {
   std::mt19937 rng(5);
   for (int trial = 0; trial < 5; ++trial) {

@@ -103,20 +103,33 @@ bool SkylineLdlt::Factor(double tiny) {
 }
 
 void SkylineLdlt::SolveImpl(double* x, bool abs) const {
-  // L y = b.
+  // Zeros are skipped, not multiplied: a right-hand side with few non-zero
+  // entries (a constraint row's column of B^T, touching one node) costs only
+  // the rows its solution reaches, the block of the cable that holds that
+  // node, instead of the whole matrix twice. Every non-zero value is the one
+  // the full loops give (they would only add products with exact zeros).
+  // L y = b. `last`: the last non-zero entry of y so far; a row whose
+  // envelope starts after it sees only zeros and keeps b's entry.
+  int last = -1;
   for (int i = 0; i < n_; ++i) {
-    const double* row = &factor_[start_[i]];
     const int fi = first_[i];
+    if (fi > last) {
+      if (x[i] != 0) last = i;
+      continue;
+    }
+    const double* row = &factor_[start_[i]];
     double acc = x[i];
     for (int k = fi; k < i; ++k) acc -= row[k - fi] * x[k];
     x[i] = acc;
+    if (acc != 0) last = i;
   }
   for (int i = 0; i < n_; ++i) x[i] /= abs ? std::abs(d_[i]) : d_[i];
-  // L^T x = y.
+  // L^T x = y: a zero x_i changes nothing above it.
   for (int i = n_ - 1; i >= 0; --i) {
+    const double xi = x[i];
+    if (xi == 0) continue;
     const double* row = &factor_[start_[i]];
     const int fi = first_[i];
-    const double xi = x[i];
     for (int k = fi; k < i; ++k) x[k] -= row[k - fi] * xi;
   }
 }
