@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
 #include "engine/model/multibody_model.h"
@@ -191,6 +192,95 @@ TEST(WinchFluidTest, FreeSurfacePotentialRateIsTheEnergysTimeDerivative) {
   std::printf("dE/dt|_q %.12g W, ExternalPower - DampingPower %.12g W\n", rate, power);
   EXPECT_GT(std::abs(rate), 10);
   EXPECT_NEAR(power, rate, 1e-9 * std::abs(rate));
+}
+
+// (d) Paying out onto the seabed: a chain-like line (steel, d = 50 mm,
+// bending NONE: w = (7850 - 1025) g pi d^2 / 4 = 131.5 N/m in water, EA =
+// 1.96e8 N, 50 elements) from a fixed winch 20 m above a flat bed to an
+// anchor on the bed 30 m away, laid on the bed for 9 m and then straight
+// up to the winch (38 m). The bed (k = 1e5 N/m^2) sits w / k = 1.3 mm
+// above y = -20, so that a grounded line rests at the anchor's height.
+// The winch pays 1.5 m out, rests 23 s, pays 1.5 m more and rests (0.25
+// m/s; Rayleigh alpha 0.5 /s on the material's motion settles the swing,
+// the energy of the pay-out's swing falling by exp(-11) over the rest).
+// At the end of each rest (t = 29 and 60 s, L = 39.5 and 41 m) and at the
+// static start the line is the inextensible catenary with touchdown and
+// no friction: with a = H / w, the suspended length Ls = sqrt(h^2 + 2 h
+// a), its span a asinh(Ls / a), and L - Ls + a asinh(Ls / a) = X fixes a
+// (the grounded length grows from 2.2 to 13.4 m). The winch holds (H, w
+// Ls), the anchor nothing vertical, and the bed carries the grounded
+// length's weight w (L - Ls): the line's weight less the joints' vertical
+// reactions. The reference's errors: the stretch (T / EA <= 2.5e-5, 1 mm
+// of line, 0.4 N on w Ls at most), the mesh (0.4 N between 50 and 100
+// elements, measured). Tolerance 3 N (1e-3 of w Ls, 3e-3 of the smallest
+// grounded weight); measured 1.2 N at most. A bed integrated over the
+// elements' initial length (38 m / 50) would carry 4 % too little at L =
+// 39.5 m (43 N); a winch whose mesh lagged L(t) would carry 1.5 m x 131.5
+// N/m less on the bed and more on the winch.
+struct Catenary {
+  double horizontal, suspended;  // H [N], Ls [m]
+};
+Catenary Touchdown(double w, double h, double span, double length) {
+  double lo = 1e-6, hi = 1e6;  // a [m]: the span rises with a
+  for (int i = 0; i < 200; ++i) {
+    const double a = std::sqrt(lo * hi);
+    const double ls = std::sqrt(h * h + 2 * h * a);
+    (length - ls + a * std::asinh(ls / a) < span ? lo : hi) = a;
+  }
+  const double a = std::sqrt(lo * hi);
+  return {w * a, std::sqrt(h * h + 2 * h * a)};
+}
+
+TEST(WinchFluidTest, PayingOutOntoTheSeabedTheBedCarriesTheGroundedWeight) {
+  const double d = 0.05, area = kPi * d * d / 4, w = (7850 - 1025) * area * kG;
+  const double length0 = 38;  // 9 m on the bed, 29 m up to the winch
+  const Scene scene = SceneFromJson(absl::StrCat(R"({"gravity": {"y": -9.81}, "model": "PLANAR",
+    "fluid": {"density": 1025},
+    "seabed": {"depth": )", absl::StrFormat("%.17g", 20 - w / 1e5),
+                                                 R"(, "normal": {"y": 1}, "stiffness": 1e5},
+    "cables": [{"name": "line", "points": [{"x": -30, "y": -20}, {"x": -21, "y": -20},
+                                           {"x": 0, "y": 0}],
+                "elements": 50, "density": 7850, "youngs_modulus": 1e11, "diameter": 0.05,
+                "bending": "NONE", "damping": {"axial_time": 1e-3, "rayleigh_alpha": 0.5},
+                "winch": {"speed": {"table": {"times": [0, 1, 6, 7, 30, 31, 36, 37],
+                    "values": [0, 0.25, 0.25, 0, 0, 0.25, 0.25, 0]}}}}],
+    "joints": [{"name": "anchor", "type": "PIN", "a": {"cable": "line", "s": 0}},
+               {"name": "winch", "type": "PIN", "a": {"cable": "line", "s": )",
+               absl::StrFormat("%.17g", length0), R"(}}],
+    "output": {"reactions": true},
+    "solver": {"duration": 60, "step": 0.01, "output_interval": 1,
+               "initial_state": "STATIC"}})"));
+  EXPECT_NEAR(scene.cables[0].length_m, length0, 1e-12);
+  CollectingSink sink;
+  RunOk(scene, &sink);
+  int checked = 0;
+  for (const Frame& f : sink.frames()) {
+    // The rests' ends (and the start, from the static solution).
+    if (!(f.t == 0 || std::abs(f.t - 29) < 1e-9 || std::abs(f.t - 60) < 1e-9)) continue;
+    const double length = length0 + scene.cables[0].winch.speed.Integral(f.t);
+    const Catenary c = Touchdown(w, 20, 30, length);
+    ASSERT_EQ(f.reactions.size(), 2u);
+    const Eigen::Vector3d anchor = f.reactions[0].force, winch = f.reactions[1].force;
+    const double bed = w * length - winch.y() - anchor.y();
+    std::printf("t = %g s, L = %.4f m: bed %.3f N (grounded weight %.3f N), winch (%.3f, %.3f) "
+                "N (catenary (%.3f, %.3f) N), anchor (%.3f, %.3f) N\n",
+                f.t, length, bed, w * (length - c.suspended), winch.x(), winch.y(),
+                c.horizontal, w * c.suspended, anchor.x(), anchor.y());
+    EXPECT_NEAR(bed, w * (length - c.suspended), 3) << "t = " << f.t;
+    // The bed's own account: a grounded line at rest penetrates by w / k,
+    // storing w^2 / (2 k) per metre, so energy.contact gives the grounded
+    // length, short by the touchdown's boundary layer, where the
+    // penetration ramps up over ~sqrt(H / k) = 0.11 to 0.17 m. Tolerance
+    // 0.25 m; measured 0.08 m at most.
+    const double grounded = 2 * 1e5 * f.energy.contact / (w * w);
+    std::printf("  grounded length from energy.contact %.4f m, catenary %.4f m\n", grounded,
+                length - c.suspended);
+    EXPECT_NEAR(grounded, length - c.suspended, 0.25) << "t = " << f.t;
+    EXPECT_NEAR(winch.y(), w * c.suspended, 3) << "t = " << f.t;
+    EXPECT_NEAR(winch.x(), c.horizontal, 3) << "t = " << f.t;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 3);
 }
 
 absl::Status Validate(const std::string& json) {
