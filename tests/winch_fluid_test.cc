@@ -24,6 +24,7 @@
 namespace cablesim {
 namespace {
 
+using testing::BuildStatus;
 using testing::CollectingSink;
 using testing::RunOk;
 using testing::SceneFromJson;
@@ -116,12 +117,13 @@ TEST(WinchFluidTest, LoweringInStillWaterCarriesTheSubmergedWeight) {
 // 12.6 N light at 2 m in the air; with the free surface's Gauss points
 // left on the elements' initial length (0.2 m, a first version's
 // CableSurfaceBuoyancy kept a copy of the elements) 8.7 N off.
+// The splash zone's water: its still level 4 m below the winch.
+const char kSplashFluid[] = R"("density": 1025, "still_water_level": -4, "free_surface": true)";
+
 double SplashTolerance() { return 2 * 1025 * kArea * kG * 0.2847 * 0.59; }
 
 TEST(WinchFluidTest, SplashZoneTensionChangesByTheDisplacedWeightPerMetre) {
-  const Scene scene = SceneFromJson(
-      Lowering(2, kPayOut, R"("density": 1025, "still_water_level": -4, "free_surface": true)",
-               10));
+  const Scene scene = SceneFromJson(Lowering(2, kPayOut, kSplashFluid, 10));
   CollectingSink sink;
   RunOk(scene, &sink);
   const TimeFunction& speed = scene.cables[0].winch.speed;
@@ -151,9 +153,7 @@ TEST(WinchFluidTest, SplashZoneTensionChangesByTheDisplacedWeightPerMetre) {
 // of the 8 kJ of work). Measured 2.4e-4 J; without the buoyancy's share
 // of the winch's power (CableSurfaceBuoyancy::AddExternalPower) 25.6 J.
 TEST(WinchFluidTest, SplashZoneEnergyBalances) {
-  const Scene scene = SceneFromJson(
-      Lowering(2, kPayOut, R"("density": 1025, "still_water_level": -4, "free_surface": true)",
-               10));
+  const Scene scene = SceneFromJson(Lowering(2, kPayOut, kSplashFluid, 10));
   CollectingSink sink;
   RunOk(scene, &sink);
   const Frame& first = sink.frames().front();
@@ -183,19 +183,7 @@ TEST(WinchFluidTest, FreeSurfacePotentialRateIsTheEnergysTimeDerivative) {
                2));
   auto model = MultibodyModel::Build(scene);
   ASSERT_TRUE(model.ok()) << model.status();
-  Eigen::VectorXd q(model->coordinates());
-  model->ToFull(model->initial_z(), &q);
-  for (int i = 0; i < q.size(); ++i) q(i) += 1e-4 * std::sin(1.7 * i + 0.3);
-  const Eigen::VectorXd rest = Eigen::VectorXd::Zero(q.size());
-  const double t = 1.0;
-  auto energy = [&](double at) {
-    model->SetTime(at);
-    return model->Energy(q, rest, 1.0).total;
-  };
-  auto difference = [&](double h) { return (energy(t + h) - energy(t - h)) / (2 * h); };
-  const double rate = (4 * difference(5e-4) - difference(1e-3)) / 3;
-  model->SetTime(t);
-  const double power = model->ExternalPower(q, rest) - model->DampingPower(q, rest);
+  const auto [rate, power] = testing::EnergyRateAndWinchPower(*model, 1.0);
   std::printf("dE/dt|_q %.12g W, ExternalPower - DampingPower %.12g W\n", rate, power);
   EXPECT_GT(std::abs(rate), 10);
   EXPECT_NEAR(power, rate, 1e-9 * std::abs(rate));
@@ -265,10 +253,7 @@ TEST(WinchFluidTest, TangentialDragActsOnTheMaterialVelocity) {
 // (the split between damped and the winch's work cancels in it).
 TEST(WinchFluidTest, SplashZoneEnergyBalancesWithDragInACurrent) {
   const Scene scene = SceneFromJson(Edit(
-      Lowering(2, kPayOut,
-               R"("density": 1025, "still_water_level": -4, "free_surface": true,
-                  "current": {"x": 0.5})",
-               10),
+      Lowering(2, kPayOut, absl::StrCat(kSplashFluid, R"(, "current": {"x": 0.5})"), 10),
       R"("winch": {"speed")",
       R"("hydrodynamics": {"normal_drag": 1.2, "tangential_drag": 0.5}, "winch": {"speed")"));
   CollectingSink sink;
@@ -371,15 +356,6 @@ TEST(WinchFluidTest, PayingOutOntoTheSeabedTheBedCarriesTheGroundedWeight) {
   EXPECT_EQ(checked, 3);
 }
 
-absl::Status Validate(const std::string& json) {
-  auto proto = ParseSceneJson(json);
-  if (!proto.ok()) return proto.status();
-  auto scene = SceneFromProto(*proto);
-  if (!scene.ok()) return scene.status();
-  return MultibodyModel::Build(*scene).status();
-}
-
-
 // Added mass and the bed's damping and friction act on the material's
 // velocity or acceleration, which on a winch cable is not the mesh's:
 // refused in DYNAMIC runs, naming the field; accepted in STATIC (L fixed).
@@ -387,48 +363,48 @@ absl::Status Validate(const std::string& json) {
 // waves.
 TEST(WinchFluidValidationTest, RefusesTheVelocityLoadsNamingTheField) {
   const std::string base = Lowering(5, kPayOut, R"("density": 1025)", 5);
-  EXPECT_TRUE(Validate(base).ok());
+  EXPECT_TRUE(BuildStatus(base).ok());
   const std::string winch = R"("winch": {"speed")";
   auto hydro = [&](const std::string& h) {
     return Edit(base, winch, absl::StrCat(R"("hydrodynamics": )", h, ", ", winch));
   };
   // Drag is WinchCables' in a current, refused in waves.
-  EXPECT_TRUE(Validate(hydro(R"({"normal_drag": 1.2, "tangential_drag": 0.01})")).ok());
+  EXPECT_TRUE(BuildStatus(hydro(R"({"normal_drag": 1.2, "tangential_drag": 0.01})")).ok());
   const std::string waves = R"("waves": {"regular": [{"height": 1, "period": 8}]}, )";
   auto in_waves = [&](const std::string& h) {
     return Edit(Edit(hydro(h), R"("density": 1025)", absl::StrCat(waves, R"("density": 1025)")),
                 R"("fluid": {)", R"("fluid": {"water_depth": 50, )");
   };
-  EXPECT_TRUE(Validate(in_waves(R"({"diameter": 0.02})")).ok());
-  absl::Status s = Validate(in_waves(R"({"normal_drag": 1.2})"));
+  EXPECT_TRUE(BuildStatus(in_waves(R"({"diameter": 0.02})")).ok());
+  absl::Status s = BuildStatus(in_waves(R"({"normal_drag": 1.2})"));
   EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(s.message(), HasSubstr("cables[0].hydrodynamics.normal_drag: drag on a winch "
                                      "cable in waves is not modelled"));
-  s = Validate(in_waves(R"({"tangential_drag": 0.01})"));
+  s = BuildStatus(in_waves(R"({"tangential_drag": 0.01})"));
   EXPECT_THAT(s.message(), HasSubstr("cables[0].hydrodynamics.tangential_drag: drag on a winch"));
-  s = Validate(hydro(R"({"added_mass": 1})"));
+  s = BuildStatus(hydro(R"({"added_mass": 1})"));
   EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(s.message(), HasSubstr("cables[0].hydrodynamics.added_mass: added mass on a winch "
                                      "cable is not modelled"));
-  s = Validate(hydro(R"({"axial_added_mass": 0.5})"));
+  s = BuildStatus(hydro(R"({"axial_added_mass": 0.5})"));
   EXPECT_THAT(s.message(), HasSubstr("cables[0].hydrodynamics.axial_added_mass"));
   // A diameter alone (buoyancy on it) is fine.
-  EXPECT_TRUE(Validate(hydro(R"({"diameter": 0.03})")).ok());
+  EXPECT_TRUE(BuildStatus(hydro(R"({"diameter": 0.03})")).ok());
   // STATIC: L stays fixed, the material moves with the mesh.
-  EXPECT_TRUE(Validate(Edit(hydro(R"({"normal_drag": 1.2, "added_mass": 1})"),
+  EXPECT_TRUE(BuildStatus(Edit(hydro(R"({"normal_drag": 1.2, "added_mass": 1})"),
                             R"("initial_state": "STATIC")", R"("analysis": "STATIC")"))
                   .ok());
   const std::string bed = R"("seabed": {"depth": 20, "normal": {"y": 1}, "stiffness": 1e5)";
   auto with_bed = [&](const std::string& more) {
     return Edit(base, R"("fluid")", absl::StrCat(bed, more, "}, \"fluid\""));
   };
-  EXPECT_TRUE(Validate(with_bed("")).ok());
-  s = Validate(with_bed(R"(, "damping": 100)"));
+  EXPECT_TRUE(BuildStatus(with_bed("")).ok());
+  s = BuildStatus(with_bed(R"(, "damping": 100)"));
   EXPECT_THAT(s.message(), HasSubstr("seabed.damping: the seabed's damping and friction on a "
                                      "winch cable (cables[0].winch)"));
-  s = Validate(with_bed(R"(, "friction_axial": 0.5)"));
+  s = BuildStatus(with_bed(R"(, "friction_axial": 0.5)"));
   EXPECT_THAT(s.message(), HasSubstr("seabed.friction_axial:"));
-  s = Validate(with_bed(R"(, "friction_transverse": 0.5)"));
+  s = BuildStatus(with_bed(R"(, "friction_transverse": 0.5)"));
   EXPECT_THAT(s.message(), HasSubstr("seabed.friction_transverse:"));
 }
 
