@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -37,6 +38,36 @@ inline std::string SceneError(const std::string& json) {
   if (scene.ok()) return "ok";
   EXPECT_EQ(scene.status().code(), absl::StatusCode::kInvalidArgument);
   return std::string(scene.status().message());
+}
+
+// The scene's error from parsing, converting or building its model (ok
+// when all three pass).
+inline absl::Status BuildStatus(const std::string& json) {
+  auto proto = ParseSceneJson(json);
+  if (!proto.ok()) return proto.status();
+  auto scene = SceneFromProto(*proto);
+  if (!scene.ok()) return scene.status();
+  return MultibodyModel::Build(*scene).status();
+}
+
+// A winch model's power at rest against its energy's explicit rate: at q
+// (the layout off by up to 1e-4 m a coordinate) with qdot = 0 and time t,
+// {dE/dt|_q by central differences at 1e-3 and 5e-4 s extrapolated,
+// ExternalPower - DampingPower} (the two agree when the winch's power
+// books every potential's change with L(t)).
+inline std::pair<double, double> EnergyRateAndWinchPower(MultibodyModel& model, double t) {
+  Eigen::VectorXd q(model.coordinates());
+  model.ToFull(model.initial_z(), &q);
+  for (int i = 0; i < q.size(); ++i) q(i) += 1e-4 * std::sin(1.7 * i + 0.3);
+  const Eigen::VectorXd rest = Eigen::VectorXd::Zero(q.size());
+  auto energy = [&](double at) {
+    model.SetTime(at);
+    return model.Energy(q, rest, 1.0).total;
+  };
+  auto difference = [&](double h) { return (energy(t + h) - energy(t - h)) / (2 * h); };
+  const double rate = (4 * difference(5e-4) - difference(1e-3)) / 3;
+  model.SetTime(t);
+  return {rate, model.ExternalPower(q, rest) - model.DampingPower(q, rest)};
 }
 
 // A sample scene from scenes/ (e.g. "mooring-three-line-buoy.json"), that

@@ -232,19 +232,7 @@ TEST(WinchEnergyTest, PotentialRateIsTheEnergysTimeDerivative) {
   ASSERT_TRUE(scene.ok()) << scene.status();
   auto model = MultibodyModel::Build(*scene);
   ASSERT_TRUE(model.ok()) << model.status();
-  Eigen::VectorXd q(model->coordinates());
-  model->ToFull(model->initial_z(), &q);
-  for (int i = 0; i < q.size(); ++i) q(i) += 1e-4 * std::sin(1.7 * i + 0.3);
-  const Eigen::VectorXd rest = Eigen::VectorXd::Zero(q.size());
-  const double t = 0.5;
-  auto energy = [&](double at) {
-    model->SetTime(at);
-    return model->Energy(q, rest, 1.0).total;
-  };
-  auto difference = [&](double h) { return (energy(t + h) - energy(t - h)) / (2 * h); };
-  const double rate = (4 * difference(5e-4) - difference(1e-3)) / 3;
-  model->SetTime(t);
-  const double power = model->ExternalPower(q, rest) - model->DampingPower(q, rest);
+  const auto [rate, power] = testing::EnergyRateAndWinchPower(*model, 0.5);
   std::printf("dE/dt|_q %.12g W, ExternalPower - DampingPower %.12g W\n", rate, power);
   EXPECT_GT(std::abs(rate), 100);  // the strain and gravity do change
   EXPECT_NEAR(power, rate, 1e-10 * std::abs(rate));

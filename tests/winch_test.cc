@@ -26,6 +26,7 @@ namespace {
 
 constexpr double kG = 9.81;
 
+using testing::BuildStatus;
 using testing::CollectingSink;
 using testing::ProbeIndex;
 using testing::RunOk;
@@ -304,27 +305,19 @@ TEST(WinchTest, CraneSceneRuns) {
 
 // --- Validation --------------------------------------------------------------
 
-absl::Status Validate(const std::string& json) {
-  auto proto = ParseSceneJson(json);
-  if (!proto.ok()) return proto.status();
-  auto scene = SceneFromProto(*proto);
-  if (!scene.ok()) return scene.status();
-  return MultibodyModel::Build(*scene).status();
-}
-
 TEST(WinchValidationTest, NamesTheField) {
-  EXPECT_TRUE(Validate(VerticalCable(SteadySpeed(-1), 5, "PLANAR")).ok());
-  absl::Status s = Validate(
+  EXPECT_TRUE(BuildStatus(VerticalCable(SteadySpeed(-1), 5, "PLANAR")).ok());
+  absl::Status s = BuildStatus(
       VerticalCable(R"({"harmonic": {"amplitude": 1, "frequency": -1}})", 5, "PLANAR"));
   EXPECT_THAT(s.message(), HasSubstr("cables[0].winch.speed.harmonic.frequency: must be >= 0"));
   // Reeling 5 m in at 2 m/s takes 2.5 s.
-  s = Validate(VerticalCable(R"({"constant": -2})", 5, "PLANAR"));
+  s = BuildStatus(VerticalCable(R"({"constant": -2})", 5, "PLANAR"));
   EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(s.message(), HasSubstr("cables[0].winch.speed: reels in the whole cable"));
   EXPECT_THAT(s.message(), HasSubstr("reaches 0 at t = 2.5 s"));
   // ... but not within 2 s.
-  EXPECT_TRUE(Validate(VerticalCable(R"({"constant": -2})", 2, "PLANAR")).ok());
-  s = Validate(VerticalCable(SteadySpeed(-1), 5, "PLANAR", "ENERGY_MOMENTUM"));
+  EXPECT_TRUE(BuildStatus(VerticalCable(R"({"constant": -2})", 2, "PLANAR")).ok());
+  s = BuildStatus(VerticalCable(SteadySpeed(-1), 5, "PLANAR", "ENERGY_MOMENTUM"));
   EXPECT_THAT(s.message(), HasSubstr("solver.integrator: ENERGY_MOMENTUM does not take winches"));
   auto edit = [](std::string json, const std::string& from, const std::string& to) {
     const size_t at = json.find(from);
@@ -332,12 +325,12 @@ TEST(WinchValidationTest, NamesTheField) {
     return at == std::string::npos ? json : json.replace(at, from.size(), to);
   };
   const std::string base = VerticalCable(SteadySpeed(-1), 5, "PLANAR");
-  s = Validate(edit(base, R"({"type": "PIN", "a": {"cable": "rope", "s": 5}},)", ""));
+  s = BuildStatus(edit(base, R"({"type": "PIN", "a": {"cable": "rope", "s": 5}},)", ""));
   EXPECT_THAT(s.message(), HasSubstr("cables[0].winch: the winch holds the cable's last point"));
-  s = Validate(edit(base, R"("name": "winch", "cable": "rope", "s": 5)",
+  s = BuildStatus(edit(base, R"("name": "winch", "cable": "rope", "s": 5)",
                     R"("name": "winch", "cable": "rope", "s": 2)"));
   EXPECT_THAT(s.message(), HasSubstr("probes[1].at: a winch cable (cables[0].winch)"));
-  s = Validate(edit(base, R"("axial_time": 1e-3)", R"("bending_time": 1e-3)"));
+  s = BuildStatus(edit(base, R"("axial_time": 1e-3)", R"("bending_time": 1e-3)"));
   EXPECT_THAT(s.message(), HasSubstr("cables[0].damping: a winch cable takes axial_time"));
 }
 

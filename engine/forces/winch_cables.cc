@@ -47,7 +47,7 @@ template <int D>
 double WinchCables<D>::Damping(const Winch& w, const WinchReel::State& now, int k, const Now& at,
                                const VectorXd& q, const VectorXd& qdot, Coords* fe,
                                Matrix* ce) const {
-  if (w.alpha_1_s == 0 && w.axial_damping_s == 0) return 0;
+  if (w.alpha_1_s == 0 && w.axial_damping_s == 0 && w.drag_n == 0 && w.drag_t == 0) return 0;
   const int first = w.elements[k].first_coord;
   const auto qe = q.segment<kN>(first);
   const auto ve = qdot.segment<kN>(first);
@@ -102,6 +102,52 @@ double WinchCables<D>::Damping(const Winch& w, const WinchReel::State& now, int 
         for (int a = 0; a < 4; ++a)
           for (int b = 0; b < 4; ++b)
             ce->template block<D, D>(D * a, D * b) += (wl * c * d1[a] * d1[b]) * uu;
+      }
+    }
+  }
+  if (w.drag_n != 0 || w.drag_t != 0) {
+    // Morison drag on the material velocity v = S edot + ldot W e relative
+    // to the fluid, W = dS/dl - (xi + k) S' (winch_inertia.h).
+    using Point = Eigen::Matrix<double, D, 1>;
+    using Block = Eigen::Matrix<double, D, D>;
+    static const GaussRule rule = MakeGaussRule(AncfCableElement<D>::kDefaultGaussPoints);
+    Eigen::Vector3d r3 = Eigen::Vector3d::Zero();
+    for (int gp = 0; gp < rule.n; ++gp) {
+      const double xi = rule.xi[gp];
+      double sh[4], d1[4], s_l[4];
+      HermiteShape(xi, l, sh);
+      HermiteShapeD1(xi, l, d1);
+      HermiteShape(xi, 1.0, s_l);  // dS/dl: the slope functions' factor l
+      s_l[0] = s_l[2] = 0;
+      Point r = Point::Zero(), u = Point::Zero(), v = Point::Zero();
+      for (int a = 0; a < 4; ++a) {
+        const auto ea = qe.template segment<D>(D * a);
+        r += sh[a] * ea;
+        u += d1[a] * ea;
+        v += sh[a] * ve.template segment<D>(D * a) + (ldot * (s_l[a] - (xi + k) * d1[a])) * ea;
+      }
+      r3.head<D>() = r;
+      if (!w.surface.Wet(r3, 0.0)) continue;
+      const Point flow = (w.profile.empty() ? w.current : w.profile.At(r3)).template head<D>();
+      const double un = u.norm();
+      if (!(un > 0)) continue;
+      const Point t = u / un, vr = flow - v;
+      const Point vt = t.dot(vr) * t, vn = vr - vt;
+      const double an = vn.norm(), at_ = vt.norm();
+      const Point q = w.drag_n * an * vn + w.drag_t * at_ * vt;  // [N/m]
+      const double wl = rule.weight[gp] * l;
+      power -= wl * q.dot(v);
+      if (fe)
+        for (int a = 0; a < 4; ++a) fe->template segment<D>(D * a) += (wl * sh[a]) * q;
+      if (ce) {
+        // -dq/dv = kn (|v_n| P + v_n v_n^T / |v_n|) + 2 kt |v_t| t t^T
+        // (AncfCableElement::AddDrag's), S onto both sides.
+        const Block tt = t * t.transpose();
+        Block c = (w.drag_n * an) * (Block::Identity() - tt) + (2 * w.drag_t * at_) * tt;
+        if (an > 0) c += (w.drag_n / an) * vn * vn.transpose();
+        for (int a = 0; a < 4; ++a)
+          for (int b = 0; b < 4; ++b)
+            ce->template block<D, D>(D * a, D * b) += (wl * sh[a] * sh[b]) * c;
       }
     }
   }

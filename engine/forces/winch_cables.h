@@ -18,7 +18,19 @@
 //    be), and Kelvin-Voigt axial damping on the material strain rate
 //    (WinchSlopeRateShape); its power alpha int mu |v|^2 + int c rate^2
 //    >= 0. Bending damping is refused on winch cables (the model
-//    builder's CheckWinches), and the elements' own damping cleared there.
+//    builder's CheckWinches), and the elements' own damping cleared there;
+//  - Morison drag on the material's velocity relative to the fluid (a
+//    uniform current or a current profile; with a free surface on the
+//    Gauss points under the still level only): at each Gauss point, v_r =
+//    u(r) - v, v = S edot + ldot W e the material velocity, split along
+//    the tangent t = r' / |r'| and across it, q = kn |v_n| v_n + kt |v_t|
+//    v_t [N/m] (the coefficients of AncfCableElement::AddDrag), Q = int S^T
+//    q dx (the virtual work of q on the material, whose virtual
+//    displacement at fixed time is S de). Its power -int q . v dx goes to
+//    energy.damped (the current's work with it, as the ordinary cables'
+//    drag); its velocity tangent is AddDrag's (dv/d(edot) = S). The
+//    elements' own drag (CableFluidLoad, on the mesh's velocity) is left
+//    out for winch cables; drag in waves is refused there.
 //
 // What stays in the model: the winch cables' elements (their length
 // L(t) / N) and their mass matrices in the model's mass matrix, which
@@ -31,7 +43,9 @@
 
 #include <Eigen/Core>
 
+#include "engine/forces/current_profile.h"
 #include "engine/forces/force_contributor.h"
+#include "engine/forces/free_surface.h"
 #include "engine/forces/winch_inertia.h"
 
 namespace cablesim {
@@ -51,6 +65,13 @@ class WinchCables : public ForceContributor {
     double mass_per_length = 0;  // rho A [kg/m]
     double ea = 0;               // [N]
     double axial_damping_s = 0, alpha_1_s = 0;
+    // Drag: kn = rho C_dn d / 2, kt = rho C_dt pi d / 2 [kg/m^2], the
+    // fluid's velocity (the profile's at the point when it has one), where
+    // the water ends.
+    double drag_n = 0, drag_t = 0;
+    Eigen::Vector3d current = Eigen::Vector3d::Zero();
+    CurrentProfile profile;
+    FreeSurface surface;
     std::vector<Element> elements;  // from the payload end (k = 0)
   };
 

@@ -18,6 +18,12 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
+// The diameter the fluid sees [m]: the hydrodynamic one, or the solid
+// section's.
+double HydroDiameter(const CableSpec& cable) {
+  return cable.hydro_diameter_m > 0 ? cable.hydro_diameter_m : std::sqrt(4 * cable.area_m2 / kPi);
+}
+
 }  // namespace
 
 absl::Status ModelBuilder::CheckWinches() const {
@@ -97,10 +103,45 @@ absl::Status ModelBuilder::CheckWinches() const {
           "damping on an axially moving mesh is not built)",
           c));
     }
-    if (scene_.fluid.density_kg_m3 > 0 || scene_.seabed.enabled) {
+    // In a fluid and on a seabed the position-only loads follow the mesh
+    // (buoyancy through GravityLoads' weight per length and, with a free
+    // surface, CableSurfaceBuoyancy; the bed's contact as an element term
+    // on the model's elements): each takes the elements' length L(t) / N.
+    // The loads that depend on the velocity or the acceleration act on the
+    // material, whose velocity on a winch cable is S edot + ldot W e, not
+    // the mesh's edot their terms take: drag is WinchCables' (in a current,
+    // not in waves); the rest is refused in DYNAMIC runs (STATIC holds L
+    // fixed, so the material and the mesh move together).
+    if (scene_.solver.analysis != Analysis::kDynamic) continue;
+    if (scene_.fluid.density_kg_m3 > 0) {
+      if ((cable.normal_drag != 0 || cable.tangential_drag != 0) && scene_.fluid.waves.any()) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "cables[%d].hydrodynamics.%s: drag on a winch cable in waves is not modelled "
+            "(WinchCables takes the drag on the material velocity S edot + ldot W e in a "
+            "current, not the waves' flow): set normal_drag and tangential_drag to 0, or "
+            "leave out fluid.waves",
+            c, cable.normal_drag != 0 ? "normal_drag" : "tangential_drag"));
+      }
+      if (cable.added_mass != 0 || (cable.has_axial_added_mass && cable.axial_added_mass != 0)) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "cables[%d].hydrodynamics.%s: added mass on a winch cable is not modelled "
+            "(the fluid's inertia rides with the material through the moving mesh, which the "
+            "winch's convective inertia does not carry): set added_mass (and axial_added_mass) "
+            "to 0",
+            c, cable.added_mass != 0 ? "added_mass" : "axial_added_mass"));
+      }
+    }
+    if (scene_.seabed.enabled &&
+        (scene_.seabed.damping_n_s_m2 != 0 || scene_.seabed.friction_axial != 0 ||
+         scene_.seabed.friction_transverse != 0)) {
       return absl::InvalidArgumentError(absl::StrFormat(
-          "cables[%d].winch: a winch cable in a fluid or on a seabed is not modelled (their "
-          "loads on an axially moving mesh are not built)",
+          "seabed.%s: the seabed's damping and friction on a winch cable (cables[%d].winch) "
+          "are not modelled in DYNAMIC runs (they need the material velocity S edot + ldot W "
+          "e, not the axially moving mesh's): set seabed.damping, seabed.friction_axial and "
+          "seabed.friction_transverse to 0",
+          scene_.seabed.damping_n_s_m2 != 0 ? "damping"
+          : scene_.seabed.friction_axial != 0 ? "friction_axial"
+                                              : "friction_transverse",
           c));
     }
   }
@@ -122,8 +163,7 @@ void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* 
     // In a fluid: buoyancy (the displaced fluid's weight off gravity),
     // isotropic added mass, and the drag factors of AddDrag.
     const double rho_f = scene_.fluid.density_kg_m3;
-    const double dh = cable.hydro_diameter_m > 0 ? cable.hydro_diameter_m
-                                                 : std::sqrt(4 * cable.area_m2 / kPi);
+    const double dh = HydroDiameter(cable);
     const double displaced = rho_f > 0 ? rho_f * kPi * dh * dh / 4 : 0.0;  // [kg/m]
     const double drag_n = 0.5 * rho_f * cable.normal_drag * dh;
     const double drag_t = 0.5 * rho_f * cable.tangential_drag * kPi * dh;
@@ -152,8 +192,9 @@ void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* 
       e.weight_per_length = mpl - displaced;
       element_cable_.push_back(c);
       CableFluidLoad::Element fluid;
-      fluid.drag_n = drag_n;
-      fluid.drag_t = drag_t;
+      // A winch cable's drag acts on the material velocity (WinchCables).
+      fluid.drag_n = cable.winch.enabled ? 0.0 : drag_n;
+      fluid.drag_t = cable.winch.enabled ? 0.0 : drag_t;
       // With waves, the flow's inertia: Froude-Krylov plus added mass
       // (WaveLoad).
       // Along the line C_a,ax when the scene gives it (CableAddedMass adds
@@ -275,15 +316,27 @@ std::unique_ptr<ForceContributor> ModelBuilder::SurfaceBuoyancy(
   if (!surface.enabled) return nullptr;
   std::vector<typename CableSurfaceBuoyancy<D>::Element> out;
   const double rho_f = scene_.fluid.density_kg_m3, g = scene_.gravity_m_s2.norm();
+  // Winch cables' elements follow L(t) / N (CableSurfaceBuoyancy::SetTime).
+  std::vector<typename CableSurfaceBuoyancy<D>::Winch> winches;
+  for (int c = 0; c < static_cast<int>(scene_.cables.size()); ++c) {
+    const CableSpec& cable = scene_.cables[c];
+    if (!cable.winch.enabled) continue;
+    typename CableSurfaceBuoyancy<D>::Winch w;
+    w.element_begin = model_.cable_element_begin_[c];
+    w.element_end = model_.cable_element_begin_[c + 1];
+    w.reel.length0 = cable.length_m;
+    w.reel.speed = cable.winch.speed;
+    winches.push_back(std::move(w));
+  }
   for (size_t k = 0; k < elements.size(); ++k) {
     const CableSpec& cable = scene_.cables[element_cable_[k]];
-    const double dh = cable.hydro_diameter_m > 0 ? cable.hydro_diameter_m
-                                                 : std::sqrt(4 * cable.area_m2 / kPi);
+    const double dh = HydroDiameter(cable);
     out.push_back({elements[k].first_coord, elements[k].element, rho_f * kPi * dh * dh / 4 * g});
   }
   // The waves' elevation in DYNAMIC runs only (STATIC sees the still level).
   return MakeCableSurfaceBuoyancy<D>(std::move(out), surface,
-                                     scene_.solver.analysis == Analysis::kDynamic);
+                                     scene_.solver.analysis == Analysis::kDynamic,
+                                     std::move(winches));
 }
 
 absl::Status ModelBuilder::Contributors() {
@@ -387,6 +440,15 @@ void ModelBuilder::WinchContributor(const std::vector<MultibodyModel::ElementDat
     w.ea = data.ea;
     w.axial_damping_s = cable.axial_damping_s;
     w.alpha_1_s = cable.rayleigh_alpha_1_s;
+    const double rho_f = scene_.fluid.density_kg_m3;
+    if (rho_f > 0 && scene_.solver.analysis == Analysis::kDynamic) {
+      const double dh = HydroDiameter(cable);
+      w.drag_n = 0.5 * rho_f * cable.normal_drag * dh;
+      w.drag_t = 0.5 * rho_f * cable.tangential_drag * kPi * dh;
+      w.current = scene_.fluid.current_m_s;
+      w.profile = Current();
+      w.surface = Surface();
+    }
     for (int k = data.element_begin; k < data.element_end; ++k)
       w.elements.push_back({elements[k].first_coord});
     winches.push_back(std::move(w));
