@@ -60,21 +60,38 @@ Integrator ChooseIntegrator(MultibodyModel* model, const Scene& scene, std::stri
   if (may_switch != nullptr) *may_switch = false;
   if (const std::string need = ImplicitNeed(*model, scene); !need.empty())
     return Choose(Integrator::kHht, need, reason);
+  if (may_switch != nullptr) *may_switch = true;
   if (s.adaptive) {
     // Measured (docs/honest-runs.md): adaptive DORMAND_PRINCE is held to
     // its stable step (six force evaluations a step) and was 2-7 times
     // slower than adaptive CENTRAL_DIFFERENCE on the two pendulums.
+    // Whether the stable step or the accuracy limits the step is known
+    // once the controller has run a while: RunDynamic weighs the two by
+    // the cost model and may change to HHT (and back).
     return Choose(Integrator::kCentralDifference,
                   "no constraint rows, winch, contact or fluid; adaptive steps hold its error "
-                  "(and its stability: a growing mode's error is rejected)",
+                  "(and its stability: a growing mode's error is rejected); the run changes "
+                  "to HHT if the cost model finds the stable step makes it costlier",
                   reason);
   }
-  if (may_switch != nullptr) *may_switch = true;
   std::string why;
   if (TryExplicit(model, s, &why) == nullptr) {
     return Choose(Integrator::kHht,
                   absl::StrCat(std::string(IntegratorName(Integrator::kCentralDifference)),
                                " does not fit: ", why),
+                  reason);
+  }
+  // Both would take solver.step: the cheaper step wins (by the cost model,
+  // an explicit step with many constraint rows can cost more than an
+  // implicit one).
+  const int rows = model->multipliers();
+  if (const CostEstimate c = EstimateCosts(1, rows, 1, kNewtonIterationsPerStep);
+      c.explicit_cost > c.implicit_cost) {
+    return Choose(Integrator::kHht,
+                  absl::StrFormat("at solver.step (%g s) a CENTRAL_DIFFERENCE step with %d "
+                                  "constraint rows costs %.3g units against %.3g for an HHT step "
+                                  "(AUTO's cost model, auto_integrator.h)",
+                                  s.step_s, rows, c.explicit_cost, c.implicit_cost),
                   reason);
   }
   return Choose(Integrator::kCentralDifference,

@@ -59,6 +59,60 @@ namespace cablesim {
 
 class Stepper;
 
+// AUTO's cost model: counted operations, not wall time (a choice that
+// depended on a clock would make runs irreproducible). The unit is one
+// unconstrained central-difference step: one force evaluation a = M^-1 f
+// with the constant mass factored once, plus the step's vector updates and
+// its error estimate. Every term below is linear in the coordinates (the
+// cables' matrices are banded), so the ratios hold per coordinate and do not
+// depend on the scene's size. Measured with `cablesim run` on scenes/
+// spatial-pendulum.json (114 coordinates) and the pendulum with a body of
+// bench/work_precision_constrained.json (9 rows), wall time per operation:
+//  - a central-difference step without rows: 3.3 to 4.0 us (fixed h = 1e-4,
+//    and adaptive, per attempt);
+//  - with 9 constraint rows (RATTLE's projections and G M^-1 G^T): 25 us,
+//    so each row adds about 0.7 of a step (kExplicitRowCost);
+//  - an HHT Newton iteration (residual and tangent assembly, the banded
+//    factorisation, one solve): 10.4 to 12.6 us, 3 steps (kNewtonIterationCost);
+//  - Newton iterations per accepted HHT step: 5.4 to 7.9 at tolerances
+//    1e-3 and 1e-4 m (22 at 1e-2 m on the spatial pendulum, where the steps
+//    are long); kNewtonIterationsPerStep is the default before any HHT step
+//    of the run has counted its own.
+inline constexpr double kExplicitRowCost = 0.7;
+inline constexpr double kNewtonIterationCost = 3.0;
+inline constexpr double kNewtonIterationsPerStep = 5.0;
+// The other stepper must be this much cheaper by the model before AUTO
+// changes to it (the model is good to tens of per cent, and a change back
+// and forth costs a power iteration and a restart).
+inline constexpr double kSwitchMargin = 1.25;
+// Adaptive runs weigh the two after this many accepted steps, then after
+// twice as many as the last window each time the stepper stays (a
+// logarithmic number of trial starts), back to this after a change.
+inline constexpr int kFirstCostWindow = 32;
+
+// One central-difference step with `rows` constraint rows, in the model's
+// unit.
+inline double ExplicitStepCost(int rows) { return 1.0 + kExplicitRowCost * rows; }
+// One implicit (HHT) step of `newton_iterations` Newton iterations.
+inline double ImplicitStepCost(double newton_iterations) {
+  return kNewtonIterationCost * newton_iterations;
+}
+
+// The two ways over a stretch of time T: `explicit_steps` central-difference
+// steps (T over the smaller of the stable step and the step the accuracy
+// allows) with `rows` constraint rows, against `implicit_steps` HHT steps
+// (T over the step the accuracy, or solver.step, allows) of
+// `newton_per_step` iterations each. Their costs in the model's unit.
+struct CostEstimate {
+  double explicit_cost = 0;
+  double implicit_cost = 0;
+};
+inline CostEstimate EstimateCosts(double explicit_steps, int rows, double implicit_steps,
+                                  double newton_per_step) {
+  return {explicit_steps * ExplicitStepCost(rows),
+          implicit_steps * ImplicitStepCost(newton_per_step)};
+}
+
 // The stepper AUTO runs `scene` with, and in *reason why (one sentence).
 // Leaves `model` as it found it (a trial stepper is started on it).
 // *may_switch (when given): the run may change stepper (see above).

@@ -160,6 +160,27 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   };
   const bool may_switch = settings.auto_integrator && settings.auto_may_switch;
   const bool ran_explicit = TraitsOf(stepping.integrator).is_explicit;
+  // AUTO with adaptive steps: over windows of accepted steps, the cost
+  // model (auto_integrator.h) weighs the stepper that runs against the
+  // other. On CENTRAL_DIFFERENCE the step HHT would take is the step the
+  // error controller allows, h / sqrt(err) without the stable step's cap:
+  // its estimate, h^2/6 (a - a_old), grows as h^2 where the undamped stiff
+  // modes ring (HHT damps them), so this is the optimistic guess for HHT,
+  // and HHT's own window below corrects it with its real steps and Newton
+  // iterations (on the spatial pendulum at 1e-3 m, h err^(-1/3) guessed
+  // 2e-3 s for HHT's 4.5e-3 s). On HHT the explicit steps are the window's
+  // time over the stable step of a trial start (or one per HHT step where
+  // that is shorter), and HHT's cost its own Newton iterations. The windows
+  // double each time, whichever stepper runs, so that a scene at the edge
+  // pays a logarithmic number of trial starts and changes.
+  const bool adaptive_switch = may_switch && settings.adaptive;
+  struct CostWindow {
+    int64_t accepted = 0, attempts = 0;
+    double time = 0, newton = 0, implicit_steps = 0;
+  } window;
+  int64_t window_length = kFirstCostWindow;
+  double newton_per_step = kNewtonIterationsPerStep;  // HHT's own, once it has run
+  if (settings.adaptive) h = std::min(h, stepper->stable_step());
   // A step cut to end on a release time leaves the fixed steps' grid; the
   // step after it ends where the uncut step would have (grid_end), so that
   // the frames on the grid stay step ends.
@@ -201,6 +222,10 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       return;
     }
     summary->newton_iterations += st.newton_iterations;
+    if (adaptive_switch) {
+      ++window.attempts;
+      window.newton += st.newton_iterations;
+    }
     summary->linear_iterations += st.linear_iterations;
     summary->factorizations += st.factorizations;
     summary->direct_fallbacks += st.direct_fallbacks;
@@ -246,7 +271,8 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     };
     // AUTO: an explicit step whose error estimate exceeds the run's
     // tolerance is taken back, and HHT goes on from the step's start.
-    if (st.converged && may_switch && TraitsOf(stepping.integrator).is_explicit) {
+    if (st.converged && may_switch && !settings.adaptive &&
+        TraitsOf(stepping.integrator).is_explicit) {
       EstimateStepError();
       const double ratio = error_ratio;
       if (!(ratio <= 1)) {
@@ -287,6 +313,16 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
           return;
         }
         continue;
+      }
+      if (adaptive_switch) {
+        ++window.accepted;
+        window.time += h_try;
+        if (TraitsOf(stepping.integrator).is_explicit) {
+          const int k = TraitsOf(Integrator::kHht).local_error_order;
+          const double h_accurate =
+              err > 0 ? std::min(duration, h_try * 0.9 * std::pow(err, -1.0 / k)) : duration;
+          window.implicit_steps += h_try / h_accurate;
+        }
       }
       // (A step cut to end on a release time keeps the step planned before.)
       h = std::min(h_try < h_step ? h_step : h_try * factor, stepper->stable_step());
@@ -359,8 +395,53 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       // Only a run that was explicit before tries (one that started on HHT
       // because the step was beyond the stable step is not expected to
       // soften that far, and a trial start would touch its model's caches).
-      if (may_switch && ran_explicit && !TraitsOf(stepping.integrator).is_explicit &&
-          h == h_nominal && ++hht_steps >= next_explicit_try) {
+      if (adaptive_switch && window.accepted >= window_length) {
+        const CostWindow w = window;
+        window = CostWindow{};
+        window_length *= 2;
+        const int rows = model->multipliers();
+        if (TraitsOf(stepping.integrator).is_explicit) {
+          const CostEstimate c =
+              EstimateCosts(static_cast<double>(w.attempts), rows, w.implicit_steps, newton_per_step);
+          if (c.implicit_cost * kSwitchMargin < c.explicit_cost) {
+            if (!SwitchTo(Integrator::kHht, nullptr,
+                          absl::StrFormat("AUTO's cost model at t = %.9g s: over the last %.4g s "
+                                          "CENTRAL_DIFFERENCE took %d step attempts (%.4g units), "
+                                          "where HHT would take about %.3g steps (%.4g units): "
+                                          "its stable step, not its accuracy, held the step",
+                                          t, w.time, static_cast<int>(w.attempts), c.explicit_cost,
+                                          w.implicit_steps, c.implicit_cost),
+                          t))
+              return;
+          }
+        } else {
+          newton_per_step = w.newton / static_cast<double>(w.accepted);
+          model->SetInitialState(stepper->z(), stepper->v(), model->external_work(), t);
+          std::string why;
+          std::unique_ptr<Stepper> trial = TryExplicit(model, stepping, &why);
+          if (trial != nullptr) {
+            const double explicit_steps =
+                std::max(static_cast<double>(w.accepted), w.time / trial->stable_step());
+            const CostEstimate c = EstimateCosts(explicit_steps, rows, w.accepted, newton_per_step);
+            if (c.explicit_cost * kSwitchMargin < c.implicit_cost) {
+              if (!SwitchTo(Integrator::kCentralDifference, std::move(trial),
+                            absl::StrFormat("AUTO's cost model at t = %.9g s: over the last %.4g "
+                                            "s HHT took %d steps and %d Newton iterations (%.4g "
+                                            "units), where CENTRAL_DIFFERENCE would take about "
+                                            "%.4g steps (%.4g units)",
+                                            t, w.time, static_cast<int>(w.accepted),
+                                            static_cast<int>(w.newton), c.implicit_cost,
+                                            explicit_steps, c.explicit_cost),
+                            t))
+                return;
+              h = std::min(h, stepper->stable_step());
+            }
+          }
+        }
+      }
+      if (may_switch && !settings.adaptive && ran_explicit &&
+          !TraitsOf(stepping.integrator).is_explicit && h == h_nominal &&
+          ++hht_steps >= next_explicit_try) {
         next_explicit_try *= 2;
         hht_steps = 0;
         model->SetInitialState(stepper->z(), stepper->v(), model->external_work(), t);
