@@ -177,6 +177,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   struct CostWindow {
     int64_t accepted = 0, attempts = 0;
     double time = 0, newton = 0, implicit_steps = 0;
+    double h_accurate = 0;  // the last step's (CENTRAL_DIFFERENCE only)
   } window;
   int64_t window_length = kFirstCostWindow;
   double newton_per_step = kNewtonIterationsPerStep;  // HHT's own, once it has run
@@ -322,6 +323,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
           const double h_accurate =
               err > 0 ? std::min(duration, h_try * 0.9 * std::pow(err, -1.0 / k)) : duration;
           window.implicit_steps += h_try / h_accurate;
+          window.h_accurate = h_accurate;
         }
       }
       // (A step cut to end on a release time keeps the step planned before.)
@@ -413,6 +415,9 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
                                           w.implicit_steps, c.implicit_cost),
                           t))
               return;
+            // HHT starts at the step the accuracy allows, not at the
+            // stable step it would otherwise double up from.
+            h = std::max(h, w.h_accurate);
           }
         } else {
           newton_per_step = w.newton / static_cast<double>(w.accepted);
