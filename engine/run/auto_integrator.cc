@@ -81,19 +81,6 @@ Integrator ChooseIntegrator(MultibodyModel* model, const Scene& scene, std::stri
                                " does not fit: ", why),
                   reason);
   }
-  // Both would take solver.step: the cheaper step wins (by the cost model,
-  // an explicit step with many constraint rows can cost more than an
-  // implicit one).
-  const int rows = model->multipliers();
-  if (const CostEstimate c = EstimateCosts(1, rows, 1, kNewtonIterationsPerStep);
-      c.explicit_cost > c.implicit_cost) {
-    return Choose(Integrator::kHht,
-                  absl::StrFormat("at solver.step (%g s) a CENTRAL_DIFFERENCE step with %d "
-                                  "constraint rows costs %.3g units against %.3g for an HHT step "
-                                  "(AUTO's cost model, auto_integrator.h)",
-                                  s.step_s, rows, c.explicit_cost, c.implicit_cost),
-                  reason);
-  }
   return Choose(Integrator::kCentralDifference,
                 absl::StrFormat("%s, and solver.step "
                                 "(%g s) is within its stable step at the initial state "

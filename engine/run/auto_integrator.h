@@ -45,6 +45,14 @@
 //    logarithmic number of power iterations and switches; back to 64 after
 //    an explicit stretch of at least four times the interval (the choice
 //    was right there).
+// During an adaptive run (no constraint rows), the cost model below weighs
+// the two over windows of accepted steps (32, then doubling): on
+// CENTRAL_DIFFERENCE, its attempts against the HHT steps the error
+// controller says the accuracy allows (h err^(-1/3), without the stable
+// step's cap); on HHT, its Newton iterations against the window's time
+// over the stable step of a trial start. The other must be kSwitchMargin
+// cheaper. Adaptive central difference stays below 0.9 of its stable step
+// (CentralDifferenceStepper::stable_step).
 // The switch carries the state (z, v) exactly, as a joint's release does;
 // the summary lists each stepper's stretch (RunSummary::
 // integrator_segments).
@@ -63,55 +71,53 @@ class Stepper;
 // depended on a clock would make runs irreproducible). The unit is one
 // unconstrained central-difference step: one force evaluation a = M^-1 f
 // with the constant mass factored once, plus the step's vector updates and
-// its error estimate. Every term below is linear in the coordinates (the
-// cables' matrices are banded), so the ratios hold per coordinate and do not
-// depend on the scene's size. Measured with `cablesim run` on scenes/
-// spatial-pendulum.json (114 coordinates) and the pendulum with a body of
-// bench/work_precision_constrained.json (9 rows), wall time per operation:
-//  - a central-difference step without rows: 3.3 to 4.0 us (fixed h = 1e-4,
-//    and adaptive, per attempt);
-//  - with 9 constraint rows (RATTLE's projections and G M^-1 G^T): 25 us,
-//    so each row adds about 0.7 of a step (kExplicitRowCost);
+// its error estimate. Every term is linear in the coordinates (the cables'
+// matrices are banded), so the ratios hold per coordinate, whatever the
+// scene's size. Measured with `cablesim run` on scenes/spatial-pendulum.json
+// (114 coordinates), wall time per operation:
+//  - a central-difference step: 3.3 us at h = 1e-4 (fixed), 4.0 us per
+//    attempt with adaptive steps;
 //  - an HHT Newton iteration (residual and tangent assembly, the banded
-//    factorisation, one solve): 10.4 to 12.6 us, 3 steps (kNewtonIterationCost);
+//    factorisation, one solve, the step's share of its predictor and error
+//    estimate): 12.6 us at tolerance 1e-3 m (10.4 us on the pendulum with
+//    a body of bench/work_precision_constrained.json): 3 units
+//    (kNewtonIterationCost);
 //  - Newton iterations per accepted HHT step: 5.4 to 7.9 at tolerances
-//    1e-3 and 1e-4 m (22 at 1e-2 m on the spatial pendulum, where the steps
-//    are long); kNewtonIterationsPerStep is the default before any HHT step
-//    of the run has counted its own.
-inline constexpr double kExplicitRowCost = 0.7;
+//    1e-3 and 1e-4 m on the two pendulums (22 at 1e-2 m on the spatial
+//    pendulum, whose steps are then long); kNewtonIterationsPerStep is the
+//    guess before an HHT stretch of the run has counted its own.
+// At a fixed step within the stable step both would take the same steps,
+// and a central-difference step costs less than one Newton iteration, with
+// constraint rows too (RATTLE's projections cost about as much as the rows
+// add to HHT's system: per step 2.7 times cheaper on the end cylinder, 2.6
+// times on the pendulum with a body, issue 32's note); so the model only
+// weighs adaptive runs, where the stable step may hold the explicit step
+// far below the one HHT's accuracy allows.
 inline constexpr double kNewtonIterationCost = 3.0;
 inline constexpr double kNewtonIterationsPerStep = 5.0;
 // The other stepper must be this much cheaper by the model before AUTO
-// changes to it (the model is good to tens of per cent, and a change back
-// and forth costs a power iteration and a restart).
+// changes to it (the model is good to tens of per cent, and a change costs
+// a power iteration and a restart).
 inline constexpr double kSwitchMargin = 1.25;
-// Adaptive runs weigh the two after this many accepted steps, then after
-// twice as many as the last window each time the stepper stays (a
-// logarithmic number of trial starts), back to this after a change.
-inline constexpr int kFirstCostWindow = 32;
 
-// One central-difference step with `rows` constraint rows, in the model's
-// unit.
-inline double ExplicitStepCost(int rows) { return 1.0 + kExplicitRowCost * rows; }
-// One implicit (HHT) step of `newton_iterations` Newton iterations.
-inline double ImplicitStepCost(double newton_iterations) {
-  return kNewtonIterationCost * newton_iterations;
-}
-
-// The two ways over a stretch of time T: `explicit_steps` central-difference
-// steps (T over the smaller of the stable step and the step the accuracy
-// allows) with `rows` constraint rows, against `implicit_steps` HHT steps
-// (T over the step the accuracy, or solver.step, allows) of
-// `newton_per_step` iterations each. Their costs in the model's unit.
+// Covering a stretch of time: `explicit_steps` central-difference steps
+// (the stretch over the smaller of the stable step and the step the
+// accuracy allows) against `implicit_steps` HHT steps (over the step the
+// accuracy allows) of `newton_per_step` Newton iterations each. Their costs
+// in the model's unit.
 struct CostEstimate {
   double explicit_cost = 0;
   double implicit_cost = 0;
 };
-inline CostEstimate EstimateCosts(double explicit_steps, int rows, double implicit_steps,
+inline CostEstimate EstimateCosts(double explicit_steps, double implicit_steps,
                                   double newton_per_step) {
-  return {explicit_steps * ExplicitStepCost(rows),
-          implicit_steps * ImplicitStepCost(newton_per_step)};
+  return {explicit_steps, implicit_steps * kNewtonIterationCost * newton_per_step};
 }
+
+// Adaptive runs weigh the two after this many accepted steps, then after
+// twice as many as the last window each time the stepper stays (a
+// logarithmic number of trial starts; RunDynamic).
+inline constexpr int kFirstCostWindow = 32;
 
 // The stepper AUTO runs `scene` with, and in *reason why (one sentence).
 // Leaves `model` as it found it (a trial stepper is started on it).

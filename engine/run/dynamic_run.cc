@@ -401,10 +401,9 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
         const CostWindow w = window;
         window = CostWindow{};
         window_length *= 2;
-        const int rows = model->multipliers();
         if (TraitsOf(stepping.integrator).is_explicit) {
           const CostEstimate c =
-              EstimateCosts(static_cast<double>(w.attempts), rows, w.implicit_steps, newton_per_step);
+              EstimateCosts(static_cast<double>(w.attempts), w.implicit_steps, newton_per_step);
           if (c.implicit_cost * kSwitchMargin < c.explicit_cost) {
             if (!SwitchTo(Integrator::kHht, nullptr,
                           absl::StrFormat("AUTO's cost model at t = %.9g s: over the last %.4g s "
@@ -427,7 +426,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
           if (trial != nullptr) {
             const double explicit_steps =
                 std::max(static_cast<double>(w.accepted), w.time / trial->stable_step());
-            const CostEstimate c = EstimateCosts(explicit_steps, rows, w.accepted, newton_per_step);
+            const CostEstimate c = EstimateCosts(explicit_steps, static_cast<double>(w.accepted), newton_per_step);
             if (c.explicit_cost * kSwitchMargin < c.implicit_cost) {
               if (!SwitchTo(Integrator::kCentralDifference, std::move(trial),
                             absl::StrFormat("AUTO's cost model at t = %.9g s: over the last %.4g "
