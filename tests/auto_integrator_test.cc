@@ -314,12 +314,14 @@ TEST(AutoIntegratorTest, AdaptiveChangesToHhtWhereTheStableStepMakesExplicitCost
             2 * std::max(TipError(hht, reference), TipError(cd, reference)));
 }
 
-// A soft rope (E = 1e6 Pa: a stable step of about 2e-3 s) held to 1e-4 m:
-// the accuracy, not the stable step, holds central difference's step, and
-// HHT would take as many steps at several Newton iterations each
-// (measured: 420 units against 2,880). AUTO must stay explicit, the same
-// run as the named stepper's; had it gone implicit, the run would differ
-// and cost HHT's.
+// A soft rope (E = 1e6 Pa: a stable step of about 1.2e-3 s) held to 1e-4
+// m: the accuracy holds central difference's step through most of the
+// fall, and HHT would take as many steps at several Newton iterations each
+// (measured: 420 units against 2,880). AUTO must end explicit and cost
+// about central difference's run: where its step sits at the stable step
+// (the fall from rest is smooth) it tries HHT for a few steps, and a trial
+// lost puts the next one eight times further off. Had it gone implicit,
+// its cost would be HHT's.
 TEST(AutoIntegratorTest, AdaptiveStaysExplicitWhereItsAccuracyHoldsTheStep) {
   const double tol = 1e-4;
   const Result cd = RunJson(FallingRope(1e6, "CENTRAL_DIFFERENCE", tol));
@@ -331,11 +333,22 @@ TEST(AutoIntegratorTest, AdaptiveStaysExplicitWhereItsAccuracyHoldsTheStep) {
 
   const Result chosen = RunJson(FallingRope(1e6, "AUTO_STEPPER", tol));
   ASSERT_EQ(chosen.summary.status, "ok") << chosen.summary.error;
-  ASSERT_EQ(chosen.summary.integrator_segments.size(), 1u)
-      << chosen.summary.integrator_segments.back().reason;
-  EXPECT_EQ(chosen.summary.integrator_segments[0].integrator, "CENTRAL_DIFFERENCE");
-  EXPECT_EQ(ModelCost(chosen.summary), ModelCost(cd.summary));
-  ExpectSameFrames(chosen, cd);
+  const std::vector<IntegratorSegment>& seg = chosen.summary.integrator_segments;
+  EXPECT_EQ(seg.back().integrator, "CENTRAL_DIFFERENCE") << seg.back().reason;
+  int64_t implicit_steps = 0;
+  for (const IntegratorSegment& g : seg)
+    if (g.integrator == "HHT") implicit_steps += g.steps;
+  EXPECT_LE(implicit_steps, chosen.summary.steps / 20);  // the trials only
+  // A trial's few HHT steps are what AUTO pays beyond central difference's
+  // run: within the switch margin.
+  EXPECT_LE(ModelCost(chosen.summary),
+            kSwitchMargin * std::min(ModelCost(cd.summary), ModelCost(hht.summary)))
+      << ModelCost(chosen.summary);
+  EXPECT_LE(chosen.summary.local_error_estimate_m, tol);
+  const Result reference = RunJson(FallingRope(1e6, "HHT", 0, 1e-5));
+  ASSERT_EQ(reference.summary.status, "ok");
+  EXPECT_LE(TipError(chosen, reference),
+            2 * std::max(TipError(hht, reference), TipError(cd, reference)));
 }
 
 }  // namespace

@@ -46,12 +46,21 @@
 //    an explicit stretch of at least four times the interval (the choice
 //    was right there).
 // During an adaptive run (no constraint rows), the cost model below weighs
-// the two over windows of accepted steps (32, then doubling): on
-// CENTRAL_DIFFERENCE, its attempts against the HHT steps the error
-// controller says the accuracy allows (h err^(-1/3), without the stable
-// step's cap); on HHT, its Newton iterations against the window's time
-// over the stable step of a trial start. The other must be kSwitchMargin
-// cheaper. Adaptive central difference stays below 0.9 of its stable step
+// the two (RunDynamic):
+//  - on CENTRAL_DIFFERENCE, after a window of accepted steps (32), if its
+//    stable step held most of them, HHT is tried for kTrialSteps steps
+//    from the step central difference's error estimate suggests; HHT is
+//    kept if its Newton iterations a step at the step its own estimate
+//    allows cost less per second of the run than one unit per stable step
+//    (by kSwitchMargin), else central difference resumes where HHT got to
+//    (Stepper::Restart: no new power iteration) and the next trial is
+//    kTrialSpacing times further off. Central difference's own estimate
+//    cannot tell HHT's step: the undamped stiff modes ring in it.
+//  - on HHT, after windows that double, a trial start of central
+//    difference gives the stable step at the current state; it takes over
+//    if the window's time over that step costs less than HHT's Newton
+//    iterations did.
+// Adaptive central difference stays below 0.9 of its stable step
 // (CentralDifferenceStepper::stable_step).
 // The switch carries the state (z, v) exactly, as a joint's release does;
 // the summary lists each stepper's stretch (RunSummary::
@@ -118,6 +127,11 @@ inline CostEstimate EstimateCosts(double explicit_steps, double implicit_steps,
 // twice as many as the last window each time the stepper stays (a
 // logarithmic number of trial starts; RunDynamic).
 inline constexpr int kFirstCostWindow = 32;
+// HHT's trial on an adaptive run: this many accepted steps; a lost trial
+// puts the next one this many times further off (so that a scene where
+// central difference wins pays for few trials: two on the falling pendulum).
+inline constexpr int kTrialSteps = 4;
+inline constexpr int kTrialSpacing = 8;
 
 // The stepper AUTO runs `scene` with, and in *reason why (one sentence).
 // Leaves `model` as it found it (a trial stepper is started on it).
