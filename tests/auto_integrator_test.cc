@@ -274,44 +274,59 @@ std::string FallingRope(double e, const std::string& integrator, double toleranc
                                   : std::string()}});
 }
 
+// The falling rope of Young's modulus `e` held to `tol` run three ways:
+// named CENTRAL_DIFFERENCE and HHT (adaptive), and AUTO; and HHT at a fixed
+// 1e-5 s, the independent reference. The premise checked: by the model,
+// the stepper `cheaper` names costs less than the other by more than the
+// switch margin.
+struct ThreeRuns {
+  Result cd, hht, chosen, reference;
+};
+ThreeRuns RunThreeWays(double e, double tol, const std::string& cheaper) {
+  ThreeRuns r{RunJson(FallingRope(e, "CENTRAL_DIFFERENCE", tol)),
+              RunJson(FallingRope(e, "HHT", tol)), RunJson(FallingRope(e, "AUTO_STEPPER", tol)),
+              RunJson(FallingRope(e, "HHT", 0, 1e-5))};
+  EXPECT_EQ(r.cd.summary.status, "ok");
+  EXPECT_EQ(r.hht.summary.status, "ok");
+  EXPECT_EQ(r.chosen.summary.status, "ok") << r.chosen.summary.error;
+  EXPECT_EQ(r.reference.summary.status, "ok");
+  const double cd = ModelCost(r.cd.summary), hht = ModelCost(r.hht.summary);
+  EXPECT_LT(kSwitchMargin * (cheaper == "HHT" ? hht : cd), cheaper == "HHT" ? cd : hht)
+      << "central difference " << cd << ", HHT " << hht;
+  return r;
+}
+
+// What AUTO pays beyond the cheaper stepper's run (a window of explicit
+// steps, or a trial's few HHT steps) is within the switch margin of that
+// run's modelled cost; and its answer is held as the named steppers' are:
+// the estimate within the tolerance, the tip against the reference within
+// twice the worse of theirs (both second order, their error constants
+// differ).
+void ExpectCheapAndHeld(const ThreeRuns& r, double tol) {
+  EXPECT_LE(ModelCost(r.chosen.summary),
+            kSwitchMargin * std::min(ModelCost(r.cd.summary), ModelCost(r.hht.summary)))
+      << ModelCost(r.chosen.summary);
+  EXPECT_LE(r.chosen.summary.local_error_estimate_m, tol);
+  EXPECT_LE(TipError(r.chosen, r.reference),
+            2 * std::max(TipError(r.hht, r.reference), TipError(r.cd, r.reference)));
+}
+
 // A stiff rope (E = 1e8 Pa: omega_max about 1e4 rad/s, a stable step of
 // 2e-4 s) held to 1e-3 m: the accuracy allows HHT steps of several
 // milliseconds, so central difference, held to its stable step, costs
 // more by the model (measured: 4,194 units against 1,314). AUTO starts
-// explicit, must see it within its first window and go on with HHT; were it
-// to stay explicit, its cost would be central difference's and the test
+// explicit, must try HHT after its first window and keep it; were it to
+// stay explicit, its cost would be central difference's and the test
 // fails.
 TEST(AutoIntegratorTest, AdaptiveChangesToHhtWhereTheStableStepMakesExplicitCostlier) {
   const double tol = 1e-3;
-  const Result cd = RunJson(FallingRope(1e8, "CENTRAL_DIFFERENCE", tol));
-  const Result hht = RunJson(FallingRope(1e8, "HHT", tol));
-  ASSERT_EQ(cd.summary.status, "ok");
-  ASSERT_EQ(hht.summary.status, "ok");
-  // The premise, by the model: HHT cheaper by more than the switch margin.
-  ASSERT_LT(kSwitchMargin * ModelCost(hht.summary), ModelCost(cd.summary))
-      << ModelCost(hht.summary) << " against " << ModelCost(cd.summary);
-
-  const Result chosen = RunJson(FallingRope(1e8, "AUTO_STEPPER", tol));
-  ASSERT_EQ(chosen.summary.status, "ok") << chosen.summary.error;
-  const std::vector<IntegratorSegment>& seg = chosen.summary.integrator_segments;
+  const ThreeRuns r = RunThreeWays(1e8, tol, "HHT");
+  const std::vector<IntegratorSegment>& seg = r.chosen.summary.integrator_segments;
   ASSERT_GE(seg.size(), 2u);
   EXPECT_EQ(seg[0].integrator, "CENTRAL_DIFFERENCE");
   EXPECT_EQ(seg.back().integrator, "HHT");
   EXPECT_TRUE(absl::StrContains(seg[1].reason, "cost model")) << seg[1].reason;
-  // The first window (32 explicit steps) is all AUTO pays beyond HHT's run:
-  // within the switch margin of the cheaper stepper.
-  EXPECT_LE(ModelCost(chosen.summary),
-            kSwitchMargin * std::min(ModelCost(cd.summary), ModelCost(hht.summary)))
-      << ModelCost(chosen.summary);
-  // The answer is held as HHT's is: the estimate within the tolerance, and
-  // the tip against HHT at a fixed 1e-5 s (independent reference) within
-  // twice the worse of the named steppers' (both second order, their
-  // error constants differ).
-  EXPECT_LE(chosen.summary.local_error_estimate_m, tol);
-  const Result reference = RunJson(FallingRope(1e8, "HHT", 0, 1e-5));
-  ASSERT_EQ(reference.summary.status, "ok");
-  EXPECT_LE(TipError(chosen, reference),
-            2 * std::max(TipError(hht, reference), TipError(cd, reference)));
+  ExpectCheapAndHeld(r, tol);
 }
 
 // A soft rope (E = 1e6 Pa: a stable step of about 1.2e-3 s) held to 1e-4
@@ -320,35 +335,18 @@ TEST(AutoIntegratorTest, AdaptiveChangesToHhtWhereTheStableStepMakesExplicitCost
 // (measured: 420 units against 2,880). AUTO must end explicit and cost
 // about central difference's run: where its step sits at the stable step
 // (the fall from rest is smooth) it tries HHT for a few steps, and a trial
-// lost puts the next one eight times further off. Had it gone implicit,
-// its cost would be HHT's.
+// lost puts the next one eight times further off. Had it kept HHT, its
+// cost would be HHT's.
 TEST(AutoIntegratorTest, AdaptiveStaysExplicitWhereItsAccuracyHoldsTheStep) {
   const double tol = 1e-4;
-  const Result cd = RunJson(FallingRope(1e6, "CENTRAL_DIFFERENCE", tol));
-  const Result hht = RunJson(FallingRope(1e6, "HHT", tol));
-  ASSERT_EQ(cd.summary.status, "ok");
-  ASSERT_EQ(hht.summary.status, "ok");
-  ASSERT_LT(kSwitchMargin * ModelCost(cd.summary), ModelCost(hht.summary))
-      << ModelCost(cd.summary) << " against " << ModelCost(hht.summary);
-
-  const Result chosen = RunJson(FallingRope(1e6, "AUTO_STEPPER", tol));
-  ASSERT_EQ(chosen.summary.status, "ok") << chosen.summary.error;
-  const std::vector<IntegratorSegment>& seg = chosen.summary.integrator_segments;
+  const ThreeRuns r = RunThreeWays(1e6, tol, "CENTRAL_DIFFERENCE");
+  const std::vector<IntegratorSegment>& seg = r.chosen.summary.integrator_segments;
   EXPECT_EQ(seg.back().integrator, "CENTRAL_DIFFERENCE") << seg.back().reason;
   int64_t implicit_steps = 0;
   for (const IntegratorSegment& g : seg)
     if (g.integrator == "HHT") implicit_steps += g.steps;
-  EXPECT_LE(implicit_steps, chosen.summary.steps / 20);  // the trials only
-  // A trial's few HHT steps are what AUTO pays beyond central difference's
-  // run: within the switch margin.
-  EXPECT_LE(ModelCost(chosen.summary),
-            kSwitchMargin * std::min(ModelCost(cd.summary), ModelCost(hht.summary)))
-      << ModelCost(chosen.summary);
-  EXPECT_LE(chosen.summary.local_error_estimate_m, tol);
-  const Result reference = RunJson(FallingRope(1e6, "HHT", 0, 1e-5));
-  ASSERT_EQ(reference.summary.status, "ok");
-  EXPECT_LE(TipError(chosen, reference),
-            2 * std::max(TipError(hht, reference), TipError(cd, reference)));
+  EXPECT_LE(implicit_steps, r.chosen.summary.steps / 20);  // the trials only
+  ExpectCheapAndHeld(r, tol);
 }
 
 }  // namespace
