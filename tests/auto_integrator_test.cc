@@ -13,6 +13,7 @@
 #include "absl/strings/str_replace.h"
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
+#include "engine/run/auto_integrator.h"
 #include "engine/run/simulation.h"
 
 namespace cablesim {
@@ -240,6 +241,112 @@ TEST(AutoIntegratorTest, SwitchesToHhtWhenTheSceneStiffensAndBackWhenItSoftens) 
   const double auto_error = TipError(chosen, reference);
   EXPECT_LE(auto_error, chosen.summary.error_tolerance_m);
   EXPECT_LE(auto_error, 2 * TipError(implicit_only, reference));
+}
+
+// AUTO's cost model on adaptive runs (auto_integrator.h). A run's cost in
+// the model's unit, from its own counts: one a central-difference step
+// attempt, kNewtonIterationCost a Newton iteration (a rejected HHT attempt
+// counts one more unit beyond its iterations: a slight overcount).
+double ModelCost(const RunSummary& s) {
+  double explicit_steps = 0;
+  for (const IntegratorSegment& g : s.integrator_segments)
+    if (g.integrator == "CENTRAL_DIFFERENCE") explicit_steps += g.steps;
+  return explicit_steps + s.rejected_steps + kNewtonIterationCost * s.newton_iterations;
+}
+
+// The 2 m rope of Rope() with Young's modulus `e` [Pa], falling for 0.5 s
+// with adaptive steps held to `tolerance` [m] (or fixed steps of `step`).
+std::string FallingRope(double e, const std::string& integrator, double tolerance,
+                        double step = 1e-3) {
+  return absl::StrReplaceAll(
+      R"({"name": "rope", "gravity": {"y": -9.81},
+    "cables": [{"name": "rope", "start": {"x": 0, "y": 0}, "direction": {"x": 1},
+                "length": 2, "elements": 10, "density": 1000, "youngs_modulus": E,
+                "diameter": 0.01}],
+    "joints": [{"type": "PIN", "a": {"cable": "rope", "s": 0}}],
+    "probes": [{"name": "tip", "cable": "rope", "s": 2}],
+    "solver": {"analysis": "DYNAMIC", "duration": 0.5, "output_interval": 0.005,
+               "step": STEP, "integrator": "INTEGRATOR" ADAPTIVE}})",
+      {{"E", absl::StrCat(e)},
+       {"STEP", absl::StrCat(step)},
+       {"INTEGRATOR", integrator},
+       {"ADAPTIVE", tolerance > 0 ? absl::StrCat(R"(, "adaptive": true, "tolerance": )", tolerance)
+                                  : std::string()}});
+}
+
+// The falling rope of Young's modulus `e` held to `tol` run three ways:
+// named CENTRAL_DIFFERENCE and HHT (adaptive), and AUTO; and HHT at a fixed
+// 1e-5 s, the independent reference. The premise checked: by the model,
+// the stepper `cheaper` names costs less than the other by more than the
+// switch margin.
+struct ThreeRuns {
+  Result cd, hht, chosen, reference;
+};
+ThreeRuns RunThreeWays(double e, double tol, const std::string& cheaper) {
+  ThreeRuns r{RunJson(FallingRope(e, "CENTRAL_DIFFERENCE", tol)),
+              RunJson(FallingRope(e, "HHT", tol)), RunJson(FallingRope(e, "AUTO_STEPPER", tol)),
+              RunJson(FallingRope(e, "HHT", 0, 1e-5))};
+  EXPECT_EQ(r.cd.summary.status, "ok");
+  EXPECT_EQ(r.hht.summary.status, "ok");
+  EXPECT_EQ(r.chosen.summary.status, "ok") << r.chosen.summary.error;
+  EXPECT_EQ(r.reference.summary.status, "ok");
+  const double cd = ModelCost(r.cd.summary), hht = ModelCost(r.hht.summary);
+  EXPECT_LT(kSwitchMargin * (cheaper == "HHT" ? hht : cd), cheaper == "HHT" ? cd : hht)
+      << "central difference " << cd << ", HHT " << hht;
+  return r;
+}
+
+// What AUTO pays beyond the cheaper stepper's run (a window of explicit
+// steps, or a trial's few HHT steps) is within the switch margin of that
+// run's modelled cost; and its answer is held as the named steppers' are:
+// the estimate within the tolerance, the tip against the reference within
+// twice the worse of theirs (both second order, their error constants
+// differ).
+void ExpectCheapAndHeld(const ThreeRuns& r, double tol) {
+  EXPECT_LE(ModelCost(r.chosen.summary),
+            kSwitchMargin * std::min(ModelCost(r.cd.summary), ModelCost(r.hht.summary)))
+      << ModelCost(r.chosen.summary);
+  EXPECT_LE(r.chosen.summary.local_error_estimate_m, tol);
+  EXPECT_LE(TipError(r.chosen, r.reference),
+            2 * std::max(TipError(r.hht, r.reference), TipError(r.cd, r.reference)));
+}
+
+// A stiff rope (E = 1e8 Pa: omega_max about 1e4 rad/s, a stable step of
+// 2e-4 s) held to 1e-3 m: the accuracy allows HHT steps of several
+// milliseconds, so central difference, held to its stable step, costs
+// more by the model (measured: 4,194 units against 1,314). AUTO starts
+// explicit, must try HHT after its first window and keep it; were it to
+// stay explicit, its cost would be central difference's and the test
+// fails.
+TEST(AutoIntegratorTest, AdaptiveChangesToHhtWhereTheStableStepMakesExplicitCostlier) {
+  const double tol = 1e-3;
+  const ThreeRuns r = RunThreeWays(1e8, tol, "HHT");
+  const std::vector<IntegratorSegment>& seg = r.chosen.summary.integrator_segments;
+  ASSERT_GE(seg.size(), 2u);
+  EXPECT_EQ(seg[0].integrator, "CENTRAL_DIFFERENCE");
+  EXPECT_EQ(seg.back().integrator, "HHT");
+  EXPECT_TRUE(absl::StrContains(seg[1].reason, "cost model")) << seg[1].reason;
+  ExpectCheapAndHeld(r, tol);
+}
+
+// A soft rope (E = 1e6 Pa: a stable step of about 1.2e-3 s) held to 1e-4
+// m: the accuracy holds central difference's step through most of the
+// fall, and HHT would take as many steps at several Newton iterations each
+// (measured: 420 units against 2,880). AUTO must end explicit and cost
+// about central difference's run: where its step sits at the stable step
+// (the fall from rest is smooth) it tries HHT for a few steps, and a trial
+// lost puts the next one eight times further off. Had it kept HHT, its
+// cost would be HHT's.
+TEST(AutoIntegratorTest, AdaptiveStaysExplicitWhereItsAccuracyHoldsTheStep) {
+  const double tol = 1e-4;
+  const ThreeRuns r = RunThreeWays(1e6, tol, "CENTRAL_DIFFERENCE");
+  const std::vector<IntegratorSegment>& seg = r.chosen.summary.integrator_segments;
+  EXPECT_EQ(seg.back().integrator, "CENTRAL_DIFFERENCE") << seg.back().reason;
+  int64_t implicit_steps = 0;
+  for (const IntegratorSegment& g : seg)
+    if (g.integrator == "HHT") implicit_steps += g.steps;
+  EXPECT_LE(implicit_steps, r.chosen.summary.steps / 20);  // the trials only
+  ExpectCheapAndHeld(r, tol);
 }
 
 }  // namespace

@@ -60,16 +60,20 @@ Integrator ChooseIntegrator(MultibodyModel* model, const Scene& scene, std::stri
   if (may_switch != nullptr) *may_switch = false;
   if (const std::string need = ImplicitNeed(*model, scene); !need.empty())
     return Choose(Integrator::kHht, need, reason);
+  if (may_switch != nullptr) *may_switch = true;
   if (s.adaptive) {
     // Measured (docs/honest-runs.md): adaptive DORMAND_PRINCE is held to
     // its stable step (six force evaluations a step) and was 2-7 times
     // slower than adaptive CENTRAL_DIFFERENCE on the two pendulums.
+    // Whether the stable step or the accuracy limits the step is known
+    // once the controller has run a while: RunDynamic weighs the two by
+    // the cost model and may change to HHT (and back).
     return Choose(Integrator::kCentralDifference,
                   "no constraint rows, winch, contact or fluid; adaptive steps hold its error "
-                  "(and its stability: a growing mode's error is rejected)",
+                  "(and its stability: a growing mode's error is rejected); the run changes "
+                  "to HHT if the cost model finds the stable step makes it costlier",
                   reason);
   }
-  if (may_switch != nullptr) *may_switch = true;
   std::string why;
   if (TryExplicit(model, s, &why) == nullptr) {
     return Choose(Integrator::kHht,

@@ -30,6 +30,9 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   // The stepper's settings: the scene's, with the stepper AUTO runs now.
   SolverSettings stepping = settings;
   std::unique_ptr<Stepper> stepper = MakeStepper(model, stepping);
+  // AUTO, adaptive steps, while HHT is on trial: the central-difference
+  // stepper it replaced, resumed (Stepper::Restart) if the trial loses.
+  std::unique_ptr<Stepper> parked;
   std::string reason;
   if (!stepper->Initialize(&reason)) {
     Fail(summary, 0, reason);
@@ -135,6 +138,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       return false;
     }
     if (!*let) return true;
+    parked.reset();  // built on the model before the release
     stepper = MakeStepper(model, stepping);
     std::string why;
     if (!stepper->Initialize(&why)) {
@@ -174,6 +178,29 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   };
   const bool may_switch = settings.auto_integrator && settings.auto_may_switch;
   const bool ran_explicit = TraitsOf(stepping.integrator).is_explicit;
+  // AUTO with adaptive steps: over windows of accepted steps, the cost
+  // model (auto_integrator.h) weighs the stepper that runs against the
+  // other. On CENTRAL_DIFFERENCE the step HHT would take is the step the
+  // error controller allows, h / sqrt(err) without the stable step's cap:
+  // its estimate, h^2/6 (a - a_old), grows as h^2 where the undamped stiff
+  // modes ring (HHT damps them), so this is the optimistic guess for HHT,
+  // and HHT's own window below corrects it with its real steps and Newton
+  // iterations (on the spatial pendulum at 1e-3 m, h err^(-1/3) guessed
+  // 2e-3 s for HHT's 4.5e-3 s). On HHT the explicit steps are the window's
+  // time over the stable step of a trial start (or one per HHT step where
+  // that is shorter), and HHT's cost its own Newton iterations. The windows
+  // double each time, whichever stepper runs, so that a scene at the edge
+  // pays a logarithmic number of trial starts and changes.
+  const bool adaptive_switch = may_switch && settings.adaptive;
+  struct CostWindow {
+    int64_t accepted = 0, attempts = 0;
+    int64_t capped = 0;  // explicit steps held by the stable step
+    double time = 0, newton = 0;
+    double h_accurate = 0;  // the last step's h err^(-1/3)
+  } window;
+  int64_t window_length = kFirstCostWindow;       // the next window, accepted steps
+  int64_t explicit_window = kFirstCostWindow;     // the next explicit one after a trial
+  if (settings.adaptive) h = std::min(h, stepper->stable_step());
   // A step cut to end on a release time leaves the fixed steps' grid; the
   // step after it ends where the uncut step would have (grid_end), so that
   // the frames on the grid stay step ends.
@@ -215,6 +242,10 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       return;
     }
     summary->newton_iterations += st.newton_iterations;
+    if (adaptive_switch) {
+      ++window.attempts;
+      window.newton += st.newton_iterations;
+    }
     summary->linear_iterations += st.linear_iterations;
     summary->factorizations += st.factorizations;
     summary->direct_fallbacks += st.direct_fallbacks;
@@ -260,7 +291,8 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     };
     // AUTO: an explicit step whose error estimate exceeds the run's
     // tolerance is taken back, and HHT goes on from the step's start.
-    if (st.converged && may_switch && TraitsOf(stepping.integrator).is_explicit) {
+    if (st.converged && may_switch && !settings.adaptive &&
+        TraitsOf(stepping.integrator).is_explicit) {
       EstimateStepError();
       const double ratio = error_ratio;
       if (!(ratio <= 1)) {
@@ -301,6 +333,15 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
           return;
         }
         continue;
+      }
+      if (adaptive_switch) {
+        ++window.accepted;
+        window.time += h_try;
+        const int k = TraitsOf(Integrator::kHht).local_error_order;
+        window.h_accurate =
+            err > 0 ? std::min(duration, h_try * 0.9 * std::pow(err, -1.0 / k)) : duration;
+        if (TraitsOf(stepping.integrator).is_explicit && h_try >= 0.999 * stepper->stable_step())
+          ++window.capped;
       }
       // (A step cut to end on a release time keeps the step planned before.)
       h = std::min(h_try < h_step ? h_step : h_try * factor, stepper->stable_step());
@@ -369,12 +410,99 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       summary->end_time_s = t;
       if (grid_end >= 0 && t >= grid_end - 1e-9 * h_nominal) grid_end = -1;
       if (!LetGo(t)) return;
+      if (adaptive_switch && parked != nullptr && window.accepted >= kTrialSteps) {
+        // HHT's trial is over: its cost per second of the run (its Newton
+        // iterations at the step its last error estimate allows) against
+        // central difference's (one unit per stable step).
+        const CostWindow w = window;
+        window = CostWindow{};
+        const double newton = w.newton / static_cast<double>(w.accepted);
+        const double implicit_rate = kNewtonIterationCost * newton / w.h_accurate;
+        const double explicit_rate = 1 / parked->stable_step();
+        if (explicit_rate * kSwitchMargin < implicit_rate &&
+            parked->Restart(stepper->z(), stepper->v(), t)) {
+          if (!SwitchTo(Integrator::kCentralDifference, std::move(parked),
+                        absl::StrFormat("AUTO's cost model at t = %.9g s: HHT on trial took %.3g "
+                                        "Newton iterations a step at steps of about %.3g s "
+                                        "(%.4g units/s), CENTRAL_DIFFERENCE's stable step %.3g s "
+                                        "(%.4g units/s)",
+                                        t, newton, w.h_accurate, implicit_rate,
+                                        1 / explicit_rate, explicit_rate),
+                        t))
+            return;
+          h = std::min(h, stepper->stable_step());
+          explicit_window *= kTrialSpacing;
+          window_length = explicit_window;
+        } else {
+          parked.reset();
+          window_length = 2 * kFirstCostWindow;
+        }
+      } else if (adaptive_switch && parked == nullptr && window.accepted >= window_length) {
+        const CostWindow w = window;
+        window = CostWindow{};
+        window_length *= 2;
+        if (TraitsOf(stepping.integrator).is_explicit) {
+          // Held by its stable step over most of the window: the accuracy
+          // would allow longer steps, which HHT may take. CENTRAL_DIFFERENCE's
+          // own estimate cannot say how long (the undamped stiff modes ring
+          // in it, HHT damps them: h err^(-1/3) guessed 0.5 to 2 times HHT's
+          // steps on the pendulums, 0.1 times on the 1,000-element rope), so
+          // HHT is tried for kTrialSteps steps, from that guess.
+          if (2 * w.capped >= w.accepted) {
+            model->SetInitialState(stepper->z(), stepper->v(), model->external_work(), t);
+            SolverSettings trial = stepping;
+            trial.integrator = Integrator::kHht;
+            std::unique_ptr<Stepper> next = MakeStepper(model, trial);
+            std::string failed;
+            if (next->Initialize(&failed)) {
+              parked = std::move(stepper);
+              if (!SwitchTo(Integrator::kHht, std::move(next),
+                            absl::StrFormat("AUTO's cost model at t = %.9g s: CENTRAL_DIFFERENCE's "
+                                            "stable step (%.3g s) held %d of its last %d steps; "
+                                            "HHT on trial for %d steps",
+                                            t, parked->stable_step(), static_cast<int>(w.capped),
+                                            static_cast<int>(w.accepted), kTrialSteps),
+                            t))
+                return;
+              // From the step the accuracy may allow, not from the stable
+              // step it would double up from.
+              h = std::max(h, w.h_accurate);
+            }
+          }
+        } else {
+          const double newton_per_step = w.newton / static_cast<double>(w.accepted);
+          model->SetInitialState(stepper->z(), stepper->v(), model->external_work(), t);
+          std::string why;
+          std::unique_ptr<Stepper> trial = TryExplicit(model, stepping, &why);
+          if (trial != nullptr) {
+            const double explicit_steps =
+                std::max(static_cast<double>(w.accepted), w.time / trial->stable_step());
+            const CostEstimate c =
+                EstimateCosts(explicit_steps, static_cast<double>(w.accepted), newton_per_step);
+            if (c.explicit_cost * kSwitchMargin < c.implicit_cost) {
+              if (!SwitchTo(Integrator::kCentralDifference, std::move(trial),
+                            absl::StrFormat("AUTO's cost model at t = %.9g s: over the last %.4g "
+                                            "s HHT took %d steps and %d Newton iterations (%.4g "
+                                            "units), where CENTRAL_DIFFERENCE would take about "
+                                            "%.4g steps (%.4g units)",
+                                            t, w.time, static_cast<int>(w.accepted),
+                                            static_cast<int>(w.newton), c.implicit_cost,
+                                            explicit_steps, c.explicit_cost),
+                            t))
+                return;
+              h = std::min(h, stepper->stable_step());
+              window_length = explicit_window;
+            }
+          }
+        }
+      }
       // AUTO: HHT back to CENTRAL_DIFFERENCE once the scene admits it.
       // Only a run that was explicit before tries (one that started on HHT
       // because the step was beyond the stable step is not expected to
       // soften that far, and a trial start would touch its model's caches).
-      if (may_switch && ran_explicit && !TraitsOf(stepping.integrator).is_explicit &&
-          h == h_nominal && ++hht_steps >= next_explicit_try) {
+      if (may_switch && !settings.adaptive && ran_explicit &&
+          !TraitsOf(stepping.integrator).is_explicit && h == h_nominal &&
+          ++hht_steps >= next_explicit_try) {
         next_explicit_try *= 2;
         hht_steps = 0;
         model->SetInitialState(stepper->z(), stepper->v(), model->external_work(), t);

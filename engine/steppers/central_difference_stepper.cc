@@ -21,6 +21,7 @@ bool CentralDifferenceStepper::Initialize(std::string* reason) {
   double omega_max = 0;
   if (!Start("CENTRAL_DIFFERENCE", 2.0, "2 / omega_max", /*takes_rows=*/true, &omega_max, reason))
     return false;
+  if (omega_max > 0) stable_step_ = 0.9 * 2.0 / omega_max;
   if (rows_.rows() == 0) return true;
   // The consistent start: a from [M G^T; G 0][a; lambda] = [f; gamma].
   lambda_.setZero(rows_.rows());

@@ -73,6 +73,7 @@
 //
 // Step() allocates nothing.
 
+#include <limits>
 #include <string>
 
 #include <Eigen/Core>
@@ -92,8 +93,17 @@ class CentralDifferenceStepper final : public ExplicitStepper {
   StepStats Step(double h) override;
   double LocalErrorNorm(double h, double atol, double rtol) const override;
   void Restore() override;
+  // Adaptive steps stay below 0.9 of the stable step 2 / omega_max, with
+  // omega_max from the initial state's power iteration (Initialize): the
+  // controller would otherwise grow the step past it, see the stiffest mode
+  // grow and reject the step, about one attempt in three on the spatial
+  // pendulum. Tension that raises omega_max later is still caught by the
+  // error estimate. Infinite before Initialize or for a model without
+  // stiffness.
+  double stable_step() const override { return stable_step_; }
 
  private:
+  double stable_step_ = std::numeric_limits<double>::infinity();
   Eigen::VectorXd z1_, v1_, a1_, v_pred_;  // the step's end and the damping's predictor
   Eigen::VectorXd lambda1_;                 // the end's multipliers (rows only)
   ConstraintProjection rows_;

@@ -31,6 +31,20 @@ bool ExplicitStepper::Start(const char* stepper, double limit, const char* limit
   return true;
 }
 
+bool ExplicitStepper::Restart(const Eigen::VectorXd& z, const Eigen::VectorXd& v, double t) {
+  if (lambda_.size() > 0 || z.size() != n_ || v.size() != n_) return false;
+  z_ = z;
+  v_ = v;
+  t_ = t;
+  model_->SetTime(t_);
+  if (!acceleration_.Evaluate(t_, z_, v_, &a_)) return false;
+  z_old_ = z_;
+  v_old_ = v_;
+  a_old_ = a_;
+  t_old_ = t_;
+  return true;
+}
+
 void ExplicitStepper::Accept(double h, Eigen::VectorXd* z1, Eigen::VectorXd* v1,
                              Eigen::VectorXd* a1, Eigen::VectorXd* lambda1) {
   if (lambda1 != nullptr) {

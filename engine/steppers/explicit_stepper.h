@@ -25,6 +25,8 @@ namespace cablesim {
 class ExplicitStepper : public Stepper {
  public:
   void Restore() override;
+  // Unconstrained only: the state, then a = M^-1 f there (one evaluation).
+  bool Restart(const Eigen::VectorXd& z, const Eigen::VectorXd& v, double t) override;
 
   const Eigen::VectorXd& z() const final { return z_; }
   const Eigen::VectorXd& v() const final { return v_; }

@@ -94,6 +94,13 @@ class Stepper {
   // is small for a mode that grows just beyond its stability limit, so the
   // error controller alone lets such a mode grow to many tolerances first.
   virtual double stable_step() const { return std::numeric_limits<double>::infinity(); }
+  // Goes on from state (z, v) at time t [s], reached by another stepper
+  // (AUTO's return from a trial of HHT), keeping what was set up at the
+  // start (the factored mass, the stable step). False: this stepper cannot
+  // (the implicit ones, and any with constraint rows); then make a new one.
+  virtual bool Restart(const Eigen::VectorXd& z, const Eigen::VectorXd& v, double t) {
+    return false;
+  }
 
   virtual const Eigen::VectorXd& z() const = 0;
   virtual const Eigen::VectorXd& v() const = 0;
