@@ -611,7 +611,10 @@ class DeckReader {
     }
     const std::string& key = it->second;
     if (key == "seafloor") {
-      return Error(n, field, "a seafloor file (bathymetry) is not read yet");
+      // Read in Build (ReadSeafloor): the file's name and this row.
+      seafloor_file_ = std::string(w[0]);
+      seafloor_line_ = n;
+      return absl::OkStatus();
     }
     absl::StatusOr<double> v = Number(n, field, w[0]);
     if (!v.ok()) return v.status();
@@ -845,6 +848,10 @@ class DeckReader {
     const double mu = OptionOr("mu", 0);
     bed->set_friction_axial(OptionOr("mu_a", mu));
     bed->set_friction_transverse(OptionOr("mu_t", mu));
+    if (!seafloor_file_.empty()) {
+      if (absl::Status s = ReadSeafloor(bed->mutable_bathymetry()); !s.ok()) return s;
+      bed->set_depth(0);  // the grid's depths are below the origin
+    }
     scene.mutable_solver()->set_analysis(v1::STATIC);
 
     // The points where free points become bodies (mass or volume) or where
@@ -1032,6 +1039,110 @@ class DeckReader {
     if (absl::Status s = BuildBodiesAndRods(&scene); !s.ok()) return s;
     scene.mutable_solver()->set_analysis(v1::STATIC);
     return scene;
+  }
+
+  // SeafloorFile: MoorDyn's 3D seafloor file, relative to the deck's
+  // directory: "nx ny", the nx x ticks, the ny y ticks, then one node a
+  // row, "x y z" with z the bed's height (negative below the surface).
+  // It becomes seabed.bathymetry (depths -z), which needs a regular grid:
+  // evenly spaced ticks and every node given once.
+  absl::Status ReadSeafloor(v1::Bathymetry* grid) const {
+    const int n = seafloor_line_;
+    const std::string field = "OPTIONS SeafloorFile";
+    const std::string& name = seafloor_file_;
+    if (!read_file_) {
+      return Error(n, field,
+                   absl::StrCat("\"", name,
+                                "\": a seafloor file cannot be read here (a deck's text alone, "
+                                "as the service takes it, has no directory): give the scene with "
+                                "seabed.bathymetry, or run the deck's file"));
+    }
+    absl::StatusOr<std::string> text = read_file_(std::string_view(name.data(), name.size()));
+    if (!text.ok()) {
+      return Error(n, field, absl::StrCat("\"", name, "\": cannot read the seafloor file: ",
+                                          text.status().message()));
+    }
+    auto bad = [&](int row, absl::string_view message) {
+      return Error(n, field, absl::StrCat(name, ":", row, ": ", message));
+    };
+    std::vector<std::vector<double>> rows;
+    std::vector<int> row_line;
+    int row = 0;
+    for (absl::string_view raw : absl::StrSplit(*text, '\n')) {
+      ++row;
+      const std::vector<absl::string_view> w =
+          absl::StrSplit(raw, absl::ByAnyChar(" \t\r,"), absl::SkipEmpty());
+      if (w.empty()) continue;
+      std::vector<double> v;
+      for (absl::string_view word : w) {
+        double x = 0;
+        if (!absl::SimpleAtod(word, &x) || !std::isfinite(x))
+          return bad(row, absl::StrCat("\"", word, "\" is not a number"));
+        v.push_back(x);
+      }
+      rows.push_back(std::move(v));
+      row_line.push_back(row);
+    }
+    if (rows.size() < 4 || rows[0].size() != 2) {
+      return bad(rows.empty() ? 1 : row_line[0],
+                 "expected \"nx ny\", the x ticks, the y ticks and a node per row");
+    }
+    const int nx = static_cast<int>(rows[0][0]), ny = static_cast<int>(rows[0][1]);
+    if (nx < 1 || ny < 1 || nx != rows[0][0] || ny != rows[0][1])
+      return bad(row_line[0], "nx and ny must be whole numbers >= 1");
+    std::vector<double> spacing(2, 0.0);
+    for (int axis = 0; axis < 2; ++axis) {
+      const std::vector<double>& ticks = rows[1 + axis];
+      const int count = axis == 0 ? nx : ny;
+      if (static_cast<int>(ticks.size()) != count) {
+        return bad(row_line[1 + axis], absl::StrCat("expected ", count, " ticks, got ",
+                                                    ticks.size()));
+      }
+      if (count > 1) spacing[axis] = (ticks.back() - ticks.front()) / (count - 1);
+      for (int i = 0; i < count; ++i) {
+        if (count > 1 && !(spacing[axis] > 0)) return bad(row_line[1 + axis], "ticks must increase");
+        if (std::abs(ticks[i] - (ticks.front() + i * spacing[axis])) > 1e-6 * spacing[axis]) {
+          return bad(row_line[1 + axis],
+                     absl::StrCat("tick ", ticks[i],
+                                  " is off the even spacing: a non-rectangular (unevenly "
+                                  "spaced) grid cannot be expressed (seabed.bathymetry is a "
+                                  "regular grid)"));
+        }
+      }
+    }
+    std::vector<double> depths(static_cast<size_t>(nx) * ny, std::nan(""));
+    auto index = [&](int axis, double x, int count) {
+      if (count == 1) return std::abs(x - rows[1 + axis][0]) <= 1e-9 * (1 + std::abs(x)) ? 0 : -1;
+      const double f = (x - rows[1 + axis][0]) / spacing[axis];
+      const long i = std::lround(f);
+      return i >= 0 && i < count && std::abs(f - i) <= 1e-6 ? static_cast<int>(i) : -1;
+    };
+    for (size_t k = 3; k < rows.size(); ++k) {
+      if (rows[k].size() != 3) return bad(row_line[k], "expected a node \"x y z\"");
+      const int i = index(0, rows[k][0], nx), j = index(1, rows[k][1], ny);
+      if (i < 0 || j < 0) {
+        return bad(row_line[k], "the node is not on the grid's ticks (a non-rectangular grid "
+                                "cannot be expressed)");
+      }
+      double& d = depths[static_cast<size_t>(j) * nx + i];
+      if (!std::isnan(d)) return bad(row_line[k], "a node given twice");
+      d = -rows[k][2];
+    }
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i)
+        if (std::isnan(depths[static_cast<size_t>(j) * nx + i])) {
+          return Error(n, field, absl::StrCat(name, ": the node (", rows[1][i], ", ", rows[2][j],
+                                              ") is missing (a non-rectangular grid cannot be "
+                                              "expressed)"));
+        }
+    grid->set_origin_x(rows[1][0]);
+    grid->set_origin_y(rows[2][0]);
+    if (nx > 1) grid->set_dx(spacing[0]);
+    if (ny > 1) grid->set_dy(spacing[1]);
+    grid->set_nx(nx);
+    grid->set_ny(ny);
+    for (double d : depths) grid->add_depths(d);
+    return absl::OkStatus();
   }
 
   // ---- MoorDyn rods and bodies (docs/moordyn-files.md, "Bodies and rods") ----
@@ -1602,6 +1713,8 @@ class DeckReader {
   // The POINTS (BODIES, RODS) row of each body Build made, in scene order
   // (for Located).
   mutable std::vector<int> body_points_;
+  std::string seafloor_file_;  // OPTIONS SeafloorFile, empty: a flat bed
+  int seafloor_line_ = 0;
   std::vector<RodType> rod_types_;
   std::vector<MdBody> md_bodies_;  // in ID order, from 1
   std::vector<Rod> rods_;          // in ID order, from 1
