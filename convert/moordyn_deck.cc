@@ -828,19 +828,11 @@ class DeckReader {
     scene.mutable_fluid()->set_free_surface(true);
 
     // The seabed: kBot [Pa/m] and cBot [Pa s/m] act on the line's
-    // diameter, cablesim's per unit length: one value per scene, so every
-    // line type must share a diameter (else refused).
+    // diameter, cablesim's per unit length: the scene's from the first
+    // line type's diameter, and a line of another diameter gets its own
+    // (cables[].seabed_stiffness, seabed_damping; Build's line loop).
     if (line_types_.empty()) return BuildRigidOnly(scene);
     const double d0 = line_types_.front().diameter;
-    for (const LineType& t : line_types_) {
-      if (std::abs(t.diameter - d0) > 1e-12 * d0) {
-        const auto k = options_.find("kbot");
-        return Error(k != options_.end() ? k->second.line : t.line, "OPTIONS kBot",
-                     absl::StrCat("line types \"", line_types_.front().name, "\" and \"", t.name,
-                                  "\" differ in diameter, and cablesim's seabed has one "
-                                  "stiffness per unit length (kBot times the diameter) per scene"));
-      }
-    }
     v1::Seabed* bed = scene.mutable_seabed();
     bed->set_depth(depth);
     bed->set_stiffness(OptionOr("kbot", kDefaultKBot) * d0);
@@ -940,6 +932,10 @@ class DeckReader {
       h->set_added_mass(t.ca);
       h->set_axial_added_mass(t.ca_axial);
       h->set_diameter(t.diameter);
+      if (std::abs(t.diameter - d0) > 1e-12 * d0) {
+        c->set_seabed_stiffness(OptionOr("kbot", kDefaultKBot) * t.diameter);
+        c->set_seabed_damping(OptionOr("cbot", kDefaultCBot) * t.diameter);
+      }
       for (const auto& [end, pid] : {std::pair{0.0, l.a}, std::pair{l.length, l.b}}) {
         const Point& p = points_.at(pid);
         if (const auto h = holders_.find(pid); h != holders_.end() && !h->second.ground) {

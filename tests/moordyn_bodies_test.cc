@@ -506,6 +506,74 @@ TEST(MoorDynBodiesTest, ChainLiesOnTheSeafloorFilesBed) {
   EXPECT_NEAR(z, expected, 1e-6);
 }
 
+// Two lines of different diameters on a flat bed (kBot 3e6 Pa/m, cBot
+// 3e5 Pa s/m): MoorDyn's bed pressure acts on each line's diameter, so each
+// sinks by its own weight in water per length over kBot d.
+std::string TwoDiameterDeck() {
+  return Deck(R"(----------------------- LINE TYPES ------------------------------------------
+TypeName   Diam    Mass/m     EA         BA/-zeta    EI         Cd     Ca     CdAx    CaAx
+(name)     (m)     (kg/m)     (N)        (N-s/-)     (N-m^2)    (-)    (-)    (-)     (-)
+chain      0.1     100        1.0e9      -0.5        0          1.2    1.0    0.4     0.0
+rope       0.2     60         1.0e8      -0.5        0          1.2    1.0    0.4     0.0
+---------------------- POINTS --------------------------------
+ID    Type      X       Y       Z       Mass   Volume  CdA    Ca
+(#)   (-)       (m)     (m)     (m)     (kg)   (m^3)   (m^2)  (-)
+1     Fixed     -100    0       -200    0      0       0      0
+2     Fixed     0       0       -200    0      0       0      0
+3     Fixed     100     0       -200    0      0       0      0
+---------------------- LINES ----------------------------------------
+ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
+(#)   (name)     (#)      (#)       (m)       (-)     (-)
+1     chain      1        2         100       10      -
+2     rope       2        3         100       10      -
+---------------------- OPTIONS -----------------------------------------
+3.0e6         kBot          bottom stiffness (Pa/m)
+3.0e5         cBot          bottom damping (Pa-s/m)
+)");
+}
+
+TEST(MoorDynBodiesTest, LinesOfDifferentDiametersPressOnTheBedByTheirOwnDiameter) {
+  v1::Scene s = Read(TwoDiameterDeck());
+  ASSERT_EQ(s.cables_size(), 2);
+  // The scene's bed from the first type's diameter; the rope its own.
+  EXPECT_DOUBLE_EQ(s.seabed().stiffness(), 3.0e6 * 0.1);
+  EXPECT_DOUBLE_EQ(s.seabed().damping(), 3.0e5 * 0.1);
+  EXPECT_FALSE(s.cables(0).has_seabed_stiffness());
+  EXPECT_DOUBLE_EQ(s.cables(1).seabed_stiffness(), 3.0e6 * 0.2);
+  EXPECT_DOUBLE_EQ(s.cables(1).seabed_damping(), 3.0e5 * 0.2);
+  for (const auto& [name, cable] : {std::pair{"chain", "line1"}, std::pair{"rope", "line2"}}) {
+    v1::Probe* p = s.add_probes();
+    p->set_name(name);
+    p->set_cable(cable);
+    p->set_s(50);
+  }
+  const absl::StatusOr<Scene> scene = SceneFromProto(s);
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  CollectingSink sink;
+  RunOk(*scene, &sink);
+  ASSERT_FALSE(sink.frames().empty());
+  const Frame& last = sink.frames().back();
+  const double chain = -200 - kG * (100 - kRho * kPi * 0.01 / 4) / (3.0e6 * 0.1);
+  const double rope = -200 - kG * (60 - kRho * kPi * 0.04 / 4) / (3.0e6 * 0.2);
+  std::printf("chain's middle %.9g m (by hand %.9g), rope's %.9g m (by hand %.9g)\n",
+              last.probes[0].position_m.z(), chain, last.probes[1].position_m.z(), rope);
+  // 50 m from the ends (held at the bed's undisturbed level, which lifts
+  // the line near them) the bed carries the line's weight alone: measured
+  // within 0.1 % of each penetration (2.8e-6 m of the chain's 3.0e-3 m);
+  // tolerance 1 % of it. With the scene's stiffness for both, the rope's
+  // penetration would be twice as deep (9.1e-4 m, 100 % off).
+  EXPECT_NEAR(last.probes[0].position_m.z(), chain, 0.01 * (-200 - chain));
+  EXPECT_NEAR(last.probes[1].position_m.z(), rope, 0.01 * (-200 - rope));
+  // A cable's own bed needs a seabed.
+  v1::Scene dry = s;
+  dry.clear_seabed();
+  EXPECT_EQ(SceneFromProto(dry).status().message(), "cables[1].seabed_stiffness: needs a seabed");
+  v1::Scene soft = s;
+  soft.mutable_cables(1)->set_seabed_stiffness(0);
+  EXPECT_EQ(SceneFromProto(soft).status().message().substr(0, 35),
+            "cables[1].seabed_stiffness: must be");
+}
+
 std::string WriteTemp(const std::string& dir, const std::string& name, const std::string& text) {
   std::filesystem::create_directories(dir);
   const std::string path = dir + "/" + name;
@@ -530,7 +598,8 @@ TEST(MoorDynBodiesTest, CliImportsAndRunsTheDecks) {
       {"floating_rod.txt", Deck(kFloatingRod)},
       {"hanging_rod.dat", Deck(kHangingRod)},
       {"body_with_rod.dat", Deck(kBodyWithRod)},
-      {"seafloor.dat", SeafloorDeck()}};
+      {"seafloor.dat", SeafloorDeck()},
+      {"two_diameters.dat", TwoDiameterDeck()}};
   for (const auto& [name, text] : decks) {
     SCOPED_TRACE(name);
     const std::string deck = WriteTemp(dir, name, text);

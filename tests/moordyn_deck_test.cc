@@ -266,8 +266,6 @@ TEST(MoorDynDeckTest, RefusalsNameTheLineAndField) {
        "bad.dat:25: OPTIONS NotAnOption"},
       {"Point4Pz", "Line1N3T", "bad.dat:33: OUTPUTS Line1N3T: only point positions (Point<n>Px, Py, Pz) and line-end tensions"},
       {"Point4Pz", "FairTen7", "bad.dat:33: OUTPUTS FairTen7: line 7 does not exist"},
-      {"rope       0.1 ", "rope       0.2 ",
-       "OPTIONS kBot: line types \"chain\" and \"rope\" differ"},
       {"100           WtrDpth       water depth (m)\n", "", "OPTIONS WtrDpth: required"},
       {"4     Free      -200", "4     Body1     -200", "bad.dat:14: POINTS Volume: a point on a body with volume"},
       {"5     Free      -100    0       -30     0      0       0      0",

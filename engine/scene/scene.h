@@ -105,6 +105,11 @@ struct CableSpec {
   double axial_added_mass = 0;
   double hydro_diameter_m = 0;
   WinchSpec winch;  // disabled: the length is fixed
+  // The seabed's normal stiffness [N/m^2] and damping [N s/m^2] per unit
+  // length of this cable when it has its own (a mooring deck's kBot and
+  // cBot act on each line's diameter); negative: the scene's SeabedSpec's.
+  double seabed_stiffness_n_m2 = -1;
+  double seabed_damping_n_s_m2 = -1;
 };
 
 struct BodySpec {
