@@ -1434,10 +1434,13 @@ class DeckReader {
   };
 
   // Sets `h` from the one wet part of a free scene body whose centre of
-  // mass is `com`, or refuses what BodyHydrodynamics (a vertical cylinder
-  // centred at the centre of mass, forces only) cannot express.
+  // mass is `com`, or refuses what BodyHydrodynamics (a cylinder centred at
+  // the centre of mass, buoyed as a vertical one, forces only) cannot
+  // express.
+  // `along_axis`: the body's x axis is the (one) rod's, so its loads split
+  // along it (BodyHydrodynamics.along_axis).
   absl::Status SetHydrodynamics(const std::vector<Wet>& wet, const Eigen::Vector3d& com,
-                                v1::Body* body) const {
+                                v1::Body* body, bool along_axis = false) const {
     if (wet.empty()) return absl::OkStatus();
     if (wet.size() > 1) {
       return Error(wet[1].line, wet[1].rod ? "RODS RodType" : "BODIES Volume",
@@ -1471,18 +1474,21 @@ class DeckReader {
     const RodType& t = *p.rod;
     const bool vertical = std::abs(std::abs(p.axis.z()) - 1) < 1e-9;
     const bool loads = t.cd > 0 || t.ca > 0 || t.cd_end > 0 || t.ca_end > 0;
-    if (!vertical && loads) {
+    if (!vertical && loads && !along_axis) {
       return Error(p.line, "RODS Xb",
-                   "a rod that is not vertical with drag or added mass (its type's Cd, Ca, "
-                   "CdEnd or CaEnd > 0) cannot be expressed: cablesim's body fluid loads are "
-                   "those of a vertical cylinder");
+                   "a rod on a body that is not vertical with drag or added mass (its type's "
+                   "Cd, Ca, CdEnd or CaEnd > 0) cannot be expressed: a body's fluid loads split "
+                   "across and along its vertical, or along its x axis for a rod of its own");
     }
-    if (!vertical && p.centre.z() + p.length / 2 > -1e-9 * p.length &&
-        p.centre.z() - p.length / 2 < 0) {
+    // A tilted rod's buoyancy is the vertical cylinder's of its length:
+    // the same while both are wholly under water (or above it).
+    if (!vertical && p.centre.z() + p.length / 2 >= 0 && p.centre.z() - p.length / 2 <= 0) {
       return Error(p.line, "RODS Zb",
-                   "a rod that is not vertical and pierces the water surface cannot be "
-                   "expressed: cablesim's body buoyancy is that of a vertical cylinder");
+                   "a rod that is not vertical within half its length of the water surface "
+                   "cannot be expressed: cablesim's body buoyancy is that of a vertical cylinder "
+                   "(exact for a tilted rod only while it is wholly under water or above it)");
     }
+    if (along_axis) h->set_along_axis(true);
     h->set_diameter(t.diameter);
     h->set_height(p.length);
     const double area = kPi * t.diameter * t.diameter / 4;
@@ -1492,8 +1498,8 @@ class DeckReader {
     // area and on rho V_ref (V_ref the submerged volume where the body is
     // placed), so they take the ends wet there.
     const double submerged = std::clamp(p.length / 2 - p.centre.z(), 0.0, p.length);
-    const int ends = (p.centre.z() - p.length / 2 < 0 ? 1 : 0) +
-                     (p.centre.z() + p.length / 2 < 0 ? 1 : 0);
+    const double half_rise = p.length / 2 * std::abs(p.axis.z());
+    const int ends = (p.centre.z() - half_rise < 0 ? 1 : 0) + (p.centre.z() + half_rise < 0 ? 1 : 0);
     h->set_drag_coefficient(t.cd);
     h->set_added_mass(t.ca);
     h->set_heave_drag_coefficient(ends * t.cd_end);
@@ -1661,7 +1667,8 @@ class DeckReader {
         body->set_coupled(true);
       } else {
         absl::Status s = SetHydrodynamics(
-            {Wet{*com, axis, r.type->diameter, length, r.type, nullptr, r.line}}, *com, body);
+            {Wet{*com, axis, r.type->diameter, length, r.type, nullptr, r.line}}, *com, body,
+            /*along_axis=*/true);
         if (!s.ok()) return s;
       }
       if (r.mount == Mount::kPinned || r.mount == Mount::kCoupledPinned) {

@@ -386,9 +386,19 @@ TEST(MoorDynBodiesTest, RefusalsNameTheLineAndField) {
             "bad.dat:22: LINES Attach: rod 2 does not exist (define it in RODS)");
   EXPECT_EQ(Refusal(edited("1    weight    Free", "2    weight    Free")).substr(0, 18),
             "bad.dat:14: RODS I");
-  // A horizontal rod with drag.
-  EXPECT_NE(Refusal(edited("0     0     -50  3", "6     0     -56  3"))
-                .find("bad.dat:14: RODS Xb: a rod that is not vertical with drag"),
+  // A horizontal rod with drag is read (its loads split along its axis);
+  // one within half its length of the surface is refused (its buoyancy
+  // would be the vertical cylinder's).
+  {
+    const v1::Scene horizontal = Read(edited("0     0     -50  3", "6     0     -56  3"));
+    ASSERT_EQ(horizontal.bodies_size(), 1);
+    EXPECT_TRUE(horizontal.bodies(0).hydrodynamics().along_axis());
+    EXPECT_DOUBLE_EQ(horizontal.bodies(0).axis().x(), 1);
+    EXPECT_DOUBLE_EQ(horizontal.bodies(0).hydrodynamics().heave_drag_coefficient(), 2 * 0.5);
+  }
+  EXPECT_NE(Refusal(edited("0     0     -56   0     0     -50  3", "0     0     -2    6     0     -2   3"))
+                .find("bad.dat:14: RODS Zb: a rod that is not vertical within half its length of "
+                      "the water surface"),
             std::string::npos);
   // A point on a body that does not exist.
   const std::string body = Deck(kBodyWithRod);
