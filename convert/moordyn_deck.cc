@@ -954,7 +954,9 @@ class DeckReader {
           // coupling host (couple/moordyn/MoorDyn2.h) find it; a Vessel
           // point is a coupled support (held where it is in a run).
           v1::Joint* j = scene.add_joints();
-          j->set_name(absl::StrCat("point", pid));
+          // A fixed rod's end: named by the rod and end.
+          j->set_name(p.rod > 0 ? absl::StrCat("rod", p.rod, p.rod_end_b ? "B" : "A")
+                                : absl::StrCat("point", pid));
           j->set_type(v1::PIN);
           j->mutable_a()->set_cable(name);
           j->mutable_a()->set_s(end);
@@ -1588,8 +1590,8 @@ class DeckReader {
         // A coupled body's mass, volume and loads are the host's (MoorDyn
         // ignores them too); the host drives the reference point. Rods on
         // it would have their fluid loads reported to the host by MoorDyn.
-        for (int r : rods) {
-          return Error(rods_[r - 1].line, "RODS Attachment",
+        if (!rods.empty()) {
+          return Error(rods_[rods.front() - 1].line, "RODS Attachment",
                        "a rod on a coupled body cannot be expressed (its fluid loads, which "
                        "MoorDyn reports to the host, would be dropped)");
         }

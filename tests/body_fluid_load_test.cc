@@ -65,6 +65,20 @@ std::string Hydro(double cd = 0, double cdv = 0, double ca = 0, double cav = kCa
       kD, kH, cd, cdv, ca, cav);
 }
 
+// The generalized force f (on the model's z) on the first body's centre,
+// the first 3 full coordinates: f . dz/dr_c (S^T maps r_c to z).
+Eigen::Vector3d ForceOnCentre(const MultibodyModel& model, const Eigen::VectorXd& f) {
+  const int n = model.dofs(), nq = model.coordinates();
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+  for (int j = 0; j < n; ++j) {
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(n), col(nq);
+    e(j) = 1;
+    model.RateToFull(e, &col);
+    force += f(j) * col.head<3>();
+  }
+  return force;
+}
+
 // Statics from the centre at the still level (too much buoyancy): the body
 // settles where buoyancy balances weight. Buoyancy is linear in the height
 // while the body pierces the surface, so Newton lands on it to rounding.
@@ -157,14 +171,7 @@ TEST(BodyFluidLoadTest, HeldBodyFeelsTheClosedFormMorisonForceInAnAiryWave) {
       model->SetTime(t);
       f.setZero();
       model->DampingForce(q, qd, &f);
-      // The generalized force on r_c: f . dz/dr_c (S^T maps r_c to z).
-      Eigen::Vector3d force = Eigen::Vector3d::Zero();
-      for (int j = 0; j < n; ++j) {
-        Eigen::VectorXd e = Eigen::VectorXd::Zero(n), col(nq);
-        e(j) = 1;
-        model->RateToFull(e, &col);
-        force += f(j) * col.head<3>();
-      }
+      const Eigen::Vector3d force = ForceOnCentre(*model, f);
       const double theta = k * kX - omega * t + kPhase;
       const double ux = kU + a * omega * ch * std::cos(theta);
       const double uz = a * omega * sh * std::sin(theta);
@@ -238,17 +245,11 @@ TEST(BodyFluidLoadTest, RodDragSplitsAlongItsAxis) {
                                   "heave_drag_coefficient": 0.4, "along_axis": true}}],
     "solver": {"duration": 1}})"));
   ASSERT_TRUE(model.ok()) << model.status();
-  const int nq = model->coordinates(), n = model->dofs();
-  Eigen::VectorXd q(nq), qd = Eigen::VectorXd::Zero(nq), f = Eigen::VectorXd::Zero(n);
+  const int nq = model->coordinates();
+  Eigen::VectorXd q(nq), qd = Eigen::VectorXd::Zero(nq), f = Eigen::VectorXd::Zero(model->dofs());
   model->ToFull(model->initial_z(), &q);
   model->DampingForce(q, qd, &f);
-  Eigen::Vector3d force = Eigen::Vector3d::Zero();
-  for (int j = 0; j < n; ++j) {
-    Eigen::VectorXd e = Eigen::VectorXd::Zero(n), col(nq);
-    e(j) = 1;
-    model->RateToFull(e, &col);
-    force += f(j) * col.head<3>();
-  }
+  const Eigen::Vector3d force = ForceOnCentre(*model, f);
   // The current (0.7, 0, 0.2) against the axis (1, 0, 1)/sqrt(2): along
   // it 0.9/sqrt(2) m/s, across it the rest; the drag on 0.5 x 4 m across
   // and on the end area along.

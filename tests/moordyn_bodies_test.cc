@@ -343,8 +343,12 @@ ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
   EXPECT_NEAR(s.cables(0).points(0).y(), 10, 1e-12);
   EXPECT_EQ(BodyNamed(s, "body2").coupled(), true);
   EXPECT_FALSE(BodyNamed(s, "body3").coupled());
-  // Rod 2 is fixed: line 2 starts on the ground at its end B.
+  // Rod 2 is fixed: line 2 starts on the ground at its end B (a joint
+  // named by the rod's end).
   EXPECT_DOUBLE_EQ(s.cables(1).points(0).z(), -140);
+  bool rod_end = false;
+  for (const v1::Joint& j : s.joints()) rod_end = rod_end || j.name() == "rod2B";
+  EXPECT_TRUE(rod_end);
   int coupled_pins = 0, ground_pins = 0;
   for (const v1::Joint& j : s.joints()) {
     if (j.name() == "body3") {
