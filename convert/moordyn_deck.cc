@@ -17,6 +17,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
@@ -29,6 +30,17 @@ constexpr double kPi = std::numbers::pi;
 using Eigen3 = std::array<double, 3>;  // a point [m]
 // A sagging line is laid this much longer than it is (a stretch).
 constexpr double kSagLayStretch = 1e-3;
+// Units that cannot be right in a line type, refused: a diameter above
+// kMaxDiameterM [m] (millimetres given), a density (mass per length over
+// the diameter's area) or a modulus (EA over that area) outside these
+// bounds. They are ten times wider than the scene's plausibility warnings
+// (convert/plausibility_warnings.h: 10 to 25,000 kg/m^3, 1e5 to 1e12 Pa),
+// which still warn when the deck runs: MoorDyn's own test decks hold
+// synthetic lines (a beam of 51,000 kg/m^3, a line of EA 500 N on 0.1 m)
+// that are legal and must be read.
+constexpr double kMaxDiameterM = 10;
+constexpr double kDeckDensityLo = 1, kDeckDensityHi = 1e5;  // [kg/m^3]
+constexpr double kDeckModulusLo = 1e3, kDeckModulusHi = 1e13;  // [Pa]
 
 // MoorDyn's defaults (its MoorDyn2.cpp), used when OPTIONS omits them.
 constexpr double kDefaultGravity = 9.80665;
@@ -336,8 +348,32 @@ class DeckReader {
     };
     if (absl::Status s = column(1, true, &t.diameter); !s.ok()) return s;
     if (absl::Status s = column(2, true, &t.mass_per_length); !s.ok()) return s;
+    // Units that cannot be right (a deck's numbers are SI): a diameter in
+    // millimetres, a mass per length that makes no material's density, an
+    // EA in kN or MN that makes no material's modulus. Refused, naming the
+    // column, as a deck cannot carry a warning to whoever reads its scene.
+    const double area = kPi * t.diameter * t.diameter / 4;
+    if (t.diameter > kMaxDiameterM) {
+      return Error(n, col(1),
+                   absl::StrFormat("%g m: diameters are in metres (a line of 76 mm is 0.076); "
+                                   "above %g m is taken for a unit slip",
+                                   t.diameter, kMaxDiameterM));
+    }
+    if (const double rho = t.mass_per_length / area; rho < kDeckDensityLo || rho > kDeckDensityHi) {
+      return Error(n, col(2),
+                   absl::StrFormat("%g kg/m on a diameter of %g m is a density of %.3g kg/m^3, "
+                                   "outside %g to %g: the mass per length is in kg/m and the "
+                                   "diameter (volume-equivalent) in m",
+                                   t.mass_per_length, t.diameter, rho, kDeckDensityLo, kDeckDensityHi));
+    }
     if (absl::SimpleAtod(w[3], &v)) {
       if (absl::Status s = column(3, true, &t.ea); !s.ok()) return s;
+      if (const double e = t.ea / area; e < kDeckModulusLo || e > kDeckModulusHi) {
+        return Error(n, col(3),
+                     absl::StrFormat("%g N over the area of a %g m diameter is a Young's modulus "
+                                     "of %.3g Pa, outside %g to %g Pa: EA is in N",
+                                     t.ea, t.diameter, e, kDeckModulusLo, kDeckModulusHi));
+      }
     } else if (absl::StrContains(w[3], "|") || absl::StartsWith(w[3], "SYROPE:")) {
       return Error(n, col(3),
                    absl::StrCat("\"", w[3],

@@ -135,6 +135,38 @@ TEST(CableAddedMassTest, StraightLineAcceleratedAlongAndAcrossCarriesItsOwnCoeff
   EXPECT_NEAR((got.force - expected).norm(), 0, 1e-12 * expected.norm());
 }
 
+// The kinetic energy reported (energy.kinetic) counts the added mass as
+// the inertia force does: a straight 10 m line translating at v along
+// itself carries 1/2 (mu + rho A C_a,ax) L v^2, across itself
+// 1/2 (mu + rho A C_a) L v^2, and out of the water (above the surface)
+// 1/2 mu L v^2. Before, it was 1/2 (mu + rho A C_a) L v^2 in every case.
+// Exact for a straight line (the velocity is uniform) to rounding.
+TEST(CableAddedMassTest, KineticEnergyCountsTheAddedMassAlongAcrossAndOutOfTheWater) {
+  const double length = 10, ca = 1, ca_axial = 0.2;
+  struct Case {
+    Eigen::Vector2d a, b, v;
+    double c;  // the added mass coefficient the motion carries
+    std::string fluid;
+  };
+  const Case cases[] = {
+      {{0, -5}, {length, -5}, {1.5, 0}, ca_axial, ""},
+      {{0, -5}, {length, -5}, {0, -0.7}, ca, ""},
+      {{0, 5}, {length, 5}, {0, -0.7}, 0, R"(, "free_surface": true)"},
+  };
+  for (const Case& c : cases) {
+    auto built = MultibodyModel::Build(SceneFromJson(
+        LineJson(c.a, c.b, 8, c.fluid, R"("added_mass": 1, "axial_added_mass": 0.2)", kDynamic)));
+    ASSERT_TRUE(built.ok()) << built.status();
+    const int n = built->coordinates();
+    Eigen::VectorXd q(n), qdot = Eigen::VectorXd::Zero(n);
+    built->ToFull(built->initial_z(), &q);
+    for (int i = 0; i < n; i += 4) qdot.segment<2>(i) = c.v;
+    const double expected = 0.5 * (kMu + kRhoA * c.c) * length * c.v.squaredNorm();
+    const double got = built->Energy(q, qdot, 1.0, nullptr).kinetic;
+    EXPECT_NEAR(got, expected, 1e-12 * expected) << "v " << c.v.transpose() << " C " << c.c;
+  }
+}
+
 TEST(CableAddedMassTest, WithoutTheAxialFieldTheAddedMassIsIsotropicAsBefore) {
   const Scene scene =
       SceneFromJson(LineJson({0, -5}, {10, -5}, 8, "", R"("added_mass": 1)", kDynamic));

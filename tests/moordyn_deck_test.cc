@@ -283,6 +283,16 @@ TEST(MoorDynDeckTest, RefusalsNameTheLineAndField) {
        "---------------------- WHATEVER ----\n---------------------- OPTIONS",
        "bad.dat:23: section"},
       {"0.4     0.0\n", "0.4     0.0     0.7   0.08  0.18\n", "bad.dat:6: LINE TYPES Cl: \"0.7\""},
+      // Units that cannot be right: a diameter in millimetres, a mass per
+      // length or an EA no material has on the type's diameter.
+      {"chain      0.1     100 ", "chain      76      100 ",
+       "bad.dat:6: LINE TYPES Diam: 76 m: diameters are in metres"},
+      {"rope       0.1     10 ", "rope       0.1     0.001 ",
+       "bad.dat:7: LINE TYPES Mass/m: 0.001 kg/m on a diameter of 0.1 m is a density of 0.127 "
+       "kg/m^3, outside 1 to 100000"},
+      {"2.0e8      3.0e6", "2.0       3.0e6",
+       "bad.dat:7: LINE TYPES EA: 2 N over the area of a 0.1 m diameter is a Young's modulus "
+       "of 255 Pa, outside 1000 to 1e+13 Pa"},
       // Values the deck's syntax allows but the scene's ranges refuse: the
       // scene's message, led by the deck's line.
       {"450       30 ", "450       3000000 ",

@@ -245,5 +245,32 @@ TEST(MoorDynJumperSlowTest, Case6WavesAcrossTheJumperWithinOneKilonewton) {
   EXPECT_LT(RunCase(6, kStep).max_kn, kTolerance);
 }
 
+// The deck's points are not an equilibrium: the reader lays the 170 m
+// line through a sag point, and the ANCF nodes at the kink start with
+// 1.06e7 J of strain energy. A DYNAMIC run from them as given fails on its
+// energy guard within the first steps; the failure says how to start from
+// equilibrium, as MoorDyn starts its decks, and that start runs.
+TEST(MoorDynJumperSlowTest, AStartFromTheDecksPointsSaysHowToStartFromEquilibrium) {
+  v1::Scene proto = JumperProto();
+  v1::Solver* s = proto.mutable_solver();
+  s->set_analysis(v1::DYNAMIC);
+  s->set_duration(0.2);
+  s->set_step(0.01);
+  absl::StatusOr<Scene> as_given = SceneFromProto(proto);
+  ASSERT_TRUE(as_given.ok()) << as_given.status();
+  testing::CollectingSink sink;
+  const absl::StatusOr<RunSummary> failed = RunScene(*as_given, &sink);
+  ASSERT_TRUE(failed.ok()) << failed.status();
+  EXPECT_EQ(failed->status, "failed");
+  EXPECT_NE(failed->error.find("solver.initial_state: STATIC starts from one"),
+            std::string::npos)
+      << failed->error;
+  s->set_initial_state(v1::Solver::STATIC);
+  absl::StatusOr<Scene> from_rest = SceneFromProto(proto);
+  ASSERT_TRUE(from_rest.ok()) << from_rest.status();
+  testing::CollectingSink rest_sink;
+  testing::RunOk(*from_rest, &rest_sink);
+}
+
 }  // namespace
 }  // namespace cablesim

@@ -11,6 +11,8 @@
 //   const client = cablesim.connect('127.0.0.1:50051');
 //   const check = await cablesim.validate(client, fs.readFileSync('scene.json', 'utf8'));
 //   const run = await cablesim.run(client, sceneText);   // {columns, rows, summary}
+//   const session = await cablesim.couple(client, sceneText, {points});
+//   const reply = await session.step(0.05, points);      // reply.forces [N]
 
 'use strict';
 
@@ -91,7 +93,54 @@ function run(client, sceneJson) {
   });
 }
 
-module.exports = {connect, readToken, validate, run};
+// Couple: opens a coupling session (the Couple stream) of `sceneJson`, a
+// DYNAMIC scene with coupled supports or bodies, with the coupled points
+// at `points` ([{position: {x, y, z}, velocity: {x, y, z}}, ...], one per
+// coupled support in the scene's order of its joints) and the coupled
+// bodies at `bodies` ([{position, orientation: {w, x, y, z}, velocity,
+// angular_velocity}, ...]). Resolves to a session once the server has
+// answered the open message:
+//   session.open        the first CoupleResponse (the forces at t = 0, the
+//                       model, scene_positions, max_jump_m, end_time_s ...)
+//   session.step(dt_s, points, bodies)
+//                       resolves to the step's CoupleResponse (forces: the
+//                       mean over the step [N], end_forces, body_forces,
+//                       host_work_j ...). A bad step (a wrong count of
+//                       points, a jump too long) resolves with `error` set
+//                       ({code, path, message}) and leaves the session as it
+//                       was; a step the lines cannot take rejects (ABORTED).
+//   session.close()     ends the session (the client's side of the stream).
+// Rejects with the gRPC error when the scene is refused (code 3,
+// INVALID_ARGUMENT, naming the field). Replies come in order, one per
+// message, so each step's promise takes the next reply.
+function couple(client, sceneJson, {points = [], bodies = [], lines = false, strict = false} = {}) {
+  const call = client.Couple(metadataFor(client));
+  const waiting = [];  // {resolve, reject} per message sent, in order
+  let failure = null;
+  call.on('data', (response) => {
+    const next = waiting.shift();
+    if (next) next.resolve(response);
+  });
+  const failAll = (error) => {
+    failure = error;
+    while (waiting.length) waiting.shift().reject(error);
+  };
+  call.on('error', failAll);
+  call.on('end', () => failAll(failure || new Error('cablesim: the Couple stream ended')));
+  const send = (request) => new Promise((resolve, reject) => {
+    if (failure) return reject(failure);
+    waiting.push({resolve, reject});
+    call.write(request);
+  });
+  return send({open: {scene_json: sceneJson, points, bodies, lines, strict}}).then((open) => ({
+    open,
+    step: (dt_s, stepPoints = [], stepBodies = []) =>
+      send({step: {dt_s, points: stepPoints, bodies: stepBodies}}),
+    close: () => call.end(),
+  }));
+}
+
+module.exports = {connect, readToken, validate, run, couple};
 
 // As a program: node cablesim_client.js (validate | run) SCENE.json
 //   --server HOST:PORT [--tls-ca CA.pem] [--token-file FILE]

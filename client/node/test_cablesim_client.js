@@ -35,6 +35,52 @@ async function waitForPortFile(file, server) {
   }
 }
 
+// The Couple stream from Node: the three-line floater's fairleads held at
+// the scene's points. The forces at t = 0 (lines from their static
+// equilibrium) must be minus the support reactions of the same scene solved
+// by a STATIC Run (the reaction is the support's force on the line; the
+// Couple force the line's on the point), to 1e-6 of their size (two Newton
+// solves to their tolerance from different starts); a step advances the
+// time; a step with a wrong count of points is answered with an error
+// naming `points` and leaves the session usable.
+async function checkCouple(client) {
+  const scene = JSON.parse(
+      fs.readFileSync(path.join(SOURCE, 'tests', 'data', 'couple_floater_coupled.json'), 'utf8'));
+  const fairleads = scene.cables.map((c) => c.points[c.points.length - 1]);
+  const points = fairleads.map((p) => ({position: {x: p.x || 0, y: p.y || 0, z: p.z || 0}}));
+  const session = await cablesim.couple(client, JSON.stringify(scene), {points});
+  assert.strictEqual(session.open.forces.length, 3);
+  assert.strictEqual(session.open.error, null);
+
+  const statics = JSON.parse(JSON.stringify(scene));
+  statics.solver = {analysis: 'STATIC', load_steps: scene.solver.load_steps};
+  statics.output = {reactions: true};
+  statics.joints.forEach((j) => delete j.coupled);
+  const solved = await cablesim.run(client, JSON.stringify(statics));
+  assert.strictEqual(solved.summary.status, 'ok');
+  const last = solved.rows[solved.rows.length - 1];
+  session.open.coupled_joints.forEach((joint, k) => {
+    const f = session.open.forces[k];
+    const r = ['x', 'y', 'z'].map((a) => last[solved.columns.indexOf(`joints[${joint}].f${a}`)]);
+    const size = Math.hypot(...r);
+    assert.ok(size > 1e3, `joints[${joint}]: reaction ${r}`);
+    ['x', 'y', 'z'].forEach((a, i) => assert.ok(Math.abs(f[a] + r[i]) <= 1e-6 * size,
+                                                `fairlead ${k} ${a}: ${f[a]} against ${-r[i]}`));
+  });
+
+  const step = await session.step(0.05, points);
+  assert.strictEqual(step.error, null);
+  assert.ok(Math.abs(step.time_s - 0.05) < 1e-12, `time ${step.time_s}`);
+  assert.ok(step.steps > 0);
+  const bad = await session.step(0.05, points.slice(0, 2));
+  assert.strictEqual(bad.error.code, 'INVALID_ARGUMENT');
+  assert.match(bad.error.path, /points/);
+  const again = await session.step(0.05, points);
+  assert.strictEqual(again.error, null);
+  assert.ok(Math.abs(again.time_s - 0.1) < 1e-12, `time ${again.time_s}`);
+  session.close();
+}
+
 async function main() {
   const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'cablesim-node-'));
   const portFile = path.join(dir, 'port');
@@ -72,6 +118,7 @@ async function main() {
       assert.match(error.details, /cables: must be a list/);
       return true;
     });
+    await checkCouple(client);
     client.close();
     console.log('node client: ok');
   } finally {

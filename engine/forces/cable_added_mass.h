@@ -32,9 +32,11 @@
 // Only the alpha-family steppers (GENERALIZED_ALPHA, HHT) take this term
 // (ModelBuilder::CheckIntegratorFits refuses the others): they solve for
 // the accelerations, so an acceleration-dependent force joins their
-// residual as the mass does. The kinetic energy reported stays 1/2 qdot^T
-// M qdot with the constant M (the difference, 1/2 v^T D v, is not in the
-// energy columns).
+// residual as the mass does. The kinetic energy reported is 1/2 qdot^T
+// (M + int S^T D S dx) qdot (engine/model/model_outputs.cc). The inertia
+// force's power, -qdot^T (int S^T D S dx) qdd, leaves out the rate of D
+// (t turning, a point crossing the surface): the energy balance carries
+// 1/2 qdot^T Ddot qdot, as a line's energy does in MoorDyn's lumped model.
 //
 // Units SI. Allocates nothing.
 

@@ -47,6 +47,9 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     summary->error = std::string(s.message());
     return;
   }
+  // Strain energy the scene starts with: a start far from equilibrium (a
+  // deck's or a hand-drawn polyline, a kink) releases it in the first steps.
+  const double strain_initial_j = rec->frame().energy.axial + rec->frame().energy.bending;
   const double h_nominal = settings.step_s;
   const double h_min = std::ldexp(h_nominal, -settings.max_step_halvings);
   const double interval =
@@ -83,12 +86,23 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   auto EnergyHolds = [&](const EnergySample& e, double t_state) {
     if (guard.Fails(e, rec->energy_scale())) {
       const double rise = guard.Rise(e), scale = EnergyGuard::Scale(e, rec->energy_scale());
-      Fail(summary, t_state,
-           absl::StrFormat("the total energy rose by %.3g J (more than %g %% of the largest "
-                           "energy term, %.3g J) by t = %.9g s: the stepper is unstable at this "
-                           "step; use a smaller solver.step, adaptive steps or a smaller "
-                           "rho_infinity",
-                           rise, 100 * EnergyGuard::kRiseLimit, scale, t_state));
+      std::string error =
+          absl::StrFormat("the total energy rose by %.3g J (more than %g %% of the largest "
+                          "energy term, %.3g J) by t = %.9g s: the stepper is unstable at this "
+                          "step; use a smaller solver.step, adaptive steps or a smaller "
+                          "rho_infinity",
+                          rise, 100 * EnergyGuard::kRiseLimit, scale, t_state);
+      // A start as given that stores most of the largest energy term as
+      // strain is likely not an equilibrium the scene meant (a MoorDyn
+      // deck's points, a polyline's kink): say how to start from one.
+      if (settings.initial_state == InitialState::kAsGiven && strain_initial_j > 0.5 * scale) {
+        absl::StrAppendFormat(
+            &error,
+            "; the run started from the scene's points as given, which store %.3g J of strain "
+            "energy: if they are not an equilibrium, solver.initial_state: STATIC starts from one",
+            strain_initial_j);
+      }
+      Fail(summary, t_state, error);
       return false;
     }
     return true;
