@@ -11,6 +11,8 @@
 #include <utility>
 #include <vector>
 
+#include <Eigen/Dense>
+
 #include "absl/status/status.h"
 #include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
@@ -71,6 +73,62 @@ struct Point {
   PointKind kind = PointKind::kFixed;
   double x = 0, y = 0, z = 0;
   double mass = 0, volume = 0, cda = 0, ca = 0;
+  // A point on a MoorDyn body ("Body<N>"): the body's ID (0: none) and
+  // the point in the body's frame relative to its reference point (x, y,
+  // z become its place in the world once the bodies are read). A rod's
+  // end ("R<N>A", "R<N>B"): the rod's ID (0: none), which end, and the
+  // LINES row that named it (x, y, z: the end's place).
+  int body = 0;
+  Eigen::Vector3d relative = Eigen::Vector3d::Zero();
+  int rod = 0;
+  bool rod_end_b = false;
+};
+
+// A MoorDyn rod type (ROD TYPES): its diameter [m], mass per length in
+// air [kg/m], drag and added-mass coefficients across it and at its ends.
+struct RodType {
+  std::string name;
+  int line = 0;
+  double diameter = 0, mass_per_length = 0, cd = 0, ca = 0, cd_end = 0, ca_end = 0;
+};
+
+// How a MoorDyn body or rod is held: fixed, free, coupled (driven by a
+// host), coupled-pinned (its reference point or end A driven, its
+// rotation free), pinned (end A on the ground or a body, rotation free),
+// or (rods) rigidly on a body.
+enum class Mount { kFixed, kFree, kCoupled, kCoupledPinned, kPinned, kOnBody };
+
+struct MdBody {
+  int id = 0;
+  int line = 0;
+  Mount mount = Mount::kFree;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  // the reference point [m]
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  double mass = 0, volume = 0, cda = 0, ca = 0;
+  Eigen::Vector3d cg = Eigen::Vector3d::Zero();       // body frame, from the reference [m]
+  Eigen::Vector3d inertia = Eigen::Vector3d::Zero();  // about the CG, body axes [kg m^2]
+};
+
+struct Rod {
+  int id = 0;
+  int line = 0;
+  const RodType* type = nullptr;
+  Mount mount = Mount::kFree;
+  int body = 0;  // kOnBody, or kPinned to a body: the body's ID (0: the ground)
+  Eigen::Vector3d a = Eigen::Vector3d::Zero(), b = Eigen::Vector3d::Zero();  // world [m]
+  Eigen::Vector3d a_rel = Eigen::Vector3d::Zero(), b_rel = Eigen::Vector3d::Zero();
+  int segments = 0;
+  double length() const { return (b - a).norm(); }
+};
+
+// What a line end at a body point or rod end is joined to: the ground
+// (a fixed body or rod; coupled for a coupled one's), or a scene body at
+// a point in its axes relative to its centre of mass.
+struct Holder {
+  bool ground = true;
+  bool coupled = false;
+  std::string body;
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
 };
 
 struct Line {
@@ -206,7 +264,8 @@ class DeckReader {
         if (section == Section::kUnsupported) {
           return Error(n, "section", absl::StrCat("\"", raw,
                                                   "\" is not a section cablesim reads (it reads "
-                                                  "LINE TYPES, POINTS, LINES, OPTIONS, OUTPUTS)"));
+                                                  "LINE TYPES, ROD TYPES, BODIES, RODS, POINTS, "
+                                                  "LINES, OPTIONS, OUTPUTS)"));
         }
         // Tables start with a line of column names and one of units.
         const bool table = section == Section::kLineTypes || section == Section::kRodTypes ||
@@ -236,21 +295,20 @@ class DeckReader {
         case Section::kLines: s = ParseLine(n, w); break;
         case Section::kOptions: s = ParseOption(n, w); break;
         case Section::kOutputs: s = ParseOutput(n, w); break;
-        case Section::kRodTypes:
-        case Section::kRods:
-          s = Error(n, "rods", "MoorDyn rods (rigid or pinned cylinders) are not read yet");
-          break;
-        case Section::kBodies:
-          s = Error(n, "bodies",
-                    "MoorDyn bodies are not read yet (give the points as Fixed, Vessel or Free)");
-          break;
+        case Section::kRodTypes: s = ParseRodType(n, w); break;
+        case Section::kRods: s = ParseRod(n, w); break;
+        case Section::kBodies: s = ParseBody(n, w); break;
         default: break;
       }
       if (!s.ok()) return s;
     }
-    if (line_types_.empty()) return Error(1, "LINE TYPES", "the deck defines no line type");
-    if (lines_.empty()) return Error(1, "LINES", "the deck defines no line");
-    return absl::OkStatus();
+    // A deck of rods or bodies alone (MoorDyn's RodPinnedFloating.txt)
+    // needs no line.
+    const bool rigid = !rods_.empty() || !md_bodies_.empty();
+    if (line_types_.empty() && !rigid)
+      return Error(1, "LINE TYPES", "the deck defines no line type");
+    if (lines_.empty() && !rigid) return Error(1, "LINES", "the deck defines no line");
+    return ResolveBodiesAndRods();
   }
 
   absl::Status ParseLineType(int n, const std::vector<absl::string_view>& w) {
@@ -446,11 +504,15 @@ class DeckReader {
       p.kind = PointKind::kCoupled;
     } else if (type == "free" || type == "connect" || type == "con" || type == "point") {
       p.kind = PointKind::kFree;
+    } else if (absl::StartsWith(type, "body") &&
+               absl::SimpleAtoi(absl::string_view(type).substr(4), &p.body) && p.body > 0) {
+      // On a body: its coordinates are in the body's frame.
+      p.kind = PointKind::kFixed;
     } else if (absl::StartsWith(type, "body") || absl::StartsWith(type, "b") ||
                absl::StartsWith(type, "turbine")) {
       return Error(n, col(1), absl::StrCat("\"", w[1],
-                                           "\": points on MoorDyn bodies or turbines are not "
-                                           "read yet"));
+                                           "\": points on MoorDyn turbines cannot be expressed "
+                                           "(Body<N> names a body of BODIES)"));
     } else {
       return Error(n, col(1), absl::StrCat("unknown point type \"", w[1],
                                            "\" (Fixed, Vessel, Coupled or Free)"));
@@ -461,11 +523,42 @@ class DeckReader {
       if (!v.ok()) return v.status();
       *values[k - 2] = *v;
     }
+    if (p.body > 0) {
+      p.relative = Eigen::Vector3d(p.x, p.y, p.z);
+      if (p.volume > 0 || p.cda > 0 || p.ca > 0) {
+        return Error(n, col(p.volume > 0 ? 6 : p.cda > 0 ? 7 : 8),
+                     "a point on a body with volume, drag or added mass cannot be expressed "
+                     "(its mass joins the body's; give the volume to the body)");
+      }
+    }
     points_[p.id] = p;
     return absl::OkStatus();
   }
 
-  absl::StatusOr<int> PointRef(int n, absl::string_view field, absl::string_view word) const {
+  absl::StatusOr<int> PointRef(int n, absl::string_view field, absl::string_view word) {
+    // A rod's end, R<N>A or R<N>B (also Rod<N>A): a point of its own,
+    // placed once the rods are read (ResolveBodiesAndRods).
+    {
+      const std::string upper = absl::AsciiStrToUpper(word);
+      absl::string_view r = upper;
+      if (absl::ConsumePrefix(&r, "ROD") || absl::ConsumePrefix(&r, "R")) {
+        int rod = 0;
+        const bool end_b = absl::EndsWith(r, "B");
+        if ((absl::EndsWith(r, "A") || end_b) && absl::SimpleAtoi(r.substr(0, r.size() - 1), &rod) &&
+            rod > 0) {
+          const int id = -(2 * rod + (end_b ? 1 : 0));  // below every deck's point ID
+          if (!points_.count(id)) {
+            Point p;
+            p.id = id;
+            p.line = n;
+            p.rod = rod;
+            p.rod_end_b = end_b;
+            points_[id] = p;
+          }
+          return id;
+        }
+      }
+    }
     absl::string_view id = word;
     if (absl::StartsWithIgnoreCase(id, "point")) {
       id.remove_prefix(5);
@@ -475,8 +568,9 @@ class DeckReader {
     int k = 0;
     if (!absl::SimpleAtoi(id, &k)) {
       return Error(n, field, absl::StrCat("\"", word,
-                                          "\": only points can be line ends (rods and bodies "
-                                          "are not read yet)"));
+                                          "\": a line end is a point (N or PN) or a rod's end "
+                                          "(R<N>A, R<N>B); a line on a body ends at a point "
+                                          "of type Body<N>"));
     }
     if (!points_.count(k)) {
       return Error(n, field, absl::StrCat("point ", k, " does not exist (define it in POINTS "
@@ -557,7 +651,10 @@ class DeckReader {
     }
     const std::string& key = it->second;
     if (key == "seafloor") {
-      return Error(n, field, "a seafloor file (bathymetry) is not read yet");
+      // Read in Build (ReadSeafloor): the file's name and this row.
+      seafloor_file_ = std::string(w[0]);
+      seafloor_line_ = n;
+      return absl::OkStatus();
     }
     absl::StatusOr<double> v = Number(n, field, w[0]);
     if (!v.ok()) return v.status();
@@ -1102,18 +1199,11 @@ class DeckReader {
     if (absl::Status s = WaterKinematics(scene.mutable_fluid()); !s.ok()) return s;
 
     // The seabed: kBot [Pa/m] and cBot [Pa s/m] act on the line's
-    // diameter, cablesim's per unit length: one value per scene, so every
-    // line type must share a diameter (else refused).
+    // diameter, cablesim's per unit length: the scene's from the first
+    // line type's diameter, and a line of another diameter gets its own
+    // (cables[].seabed_stiffness, seabed_damping; Build's line loop).
+    if (line_types_.empty()) return BuildRigidOnly(scene);
     const double d0 = line_types_.front().diameter;
-    for (const LineType& t : line_types_) {
-      if (std::abs(t.diameter - d0) > 1e-12 * d0) {
-        const auto k = options_.find("kbot");
-        return Error(k != options_.end() ? k->second.line : t.line, "OPTIONS kBot",
-                     absl::StrCat("line types \"", line_types_.front().name, "\" and \"", t.name,
-                                  "\" differ in diameter, and cablesim's seabed has one "
-                                  "stiffness per unit length (kBot times the diameter) per scene"));
-      }
-    }
     v1::Seabed* bed = scene.mutable_seabed();
     bed->set_depth(depth);
     bed->set_stiffness(OptionOr("kbot", kDefaultKBot) * d0);
@@ -1122,6 +1212,10 @@ class DeckReader {
     bed->set_friction_axial(OptionOr("mu_a", mu));
     bed->set_friction_transverse(OptionOr("mu_t", mu));
     if (absl::Status s = MoorDynFriction(bed); !s.ok()) return s;
+    if (!seafloor_file_.empty()) {
+      if (absl::Status s = ReadSeafloor(bed->mutable_bathymetry()); !s.ok()) return s;
+      bed->set_depth(0);  // the grid's depths are below the origin
+    }
     scene.mutable_solver()->set_analysis(v1::STATIC);
 
     // The points where free points become bodies (mass or volume) or where
@@ -1164,6 +1258,8 @@ class DeckReader {
         h->set_heave_added_mass(p.ca);
       }
     }
+
+    if (absl::Status s = BuildBodiesAndRods(&scene); !s.ok()) return s;
 
     std::map<int, std::pair<std::string, double>> first_end_at;  // free point -> (cable, s)
     for (const Line& l : lines_) {
@@ -1208,14 +1304,31 @@ class DeckReader {
       h->set_added_mass(t.ca);
       h->set_axial_added_mass(t.ca_axial);
       h->set_diameter(t.diameter);
+      if (std::abs(t.diameter - d0) > 1e-12 * d0) {
+        c->set_seabed_stiffness(OptionOr("kbot", kDefaultKBot) * t.diameter);
+        c->set_seabed_damping(OptionOr("cbot", kDefaultCBot) * t.diameter);
+      }
       for (const auto& [end, pid] : {std::pair{0.0, l.a}, std::pair{l.length, l.b}}) {
         const Point& p = points_.at(pid);
+        if (const auto h = holders_.find(pid); h != holders_.end() && !h->second.ground) {
+          // On a body or rod: pinned to its point.
+          v1::Joint* j = scene.add_joints();
+          j->set_type(v1::PIN);
+          j->mutable_a()->set_cable(name);
+          j->mutable_a()->set_s(end);
+          j->mutable_b()->set_body(h->second.body);
+          const Eigen::Vector3d& q = h->second.point;
+          SetVec(j->mutable_b()->mutable_point(), q.x(), q.y(), q.z());
+          continue;
+        }
         if (p.kind != PointKind::kFree) {
           // Named by the point, so that the reactions' columns and a
           // coupling host (couple/moordyn/MoorDyn2.h) find it; a Vessel
           // point is a coupled support (held where it is in a run).
           v1::Joint* j = scene.add_joints();
-          j->set_name(absl::StrCat("point", pid));
+          // A fixed rod's end: named by the rod and end.
+          j->set_name(p.rod > 0 ? absl::StrCat("rod", p.rod, p.rod_end_b ? "B" : "A")
+                                : absl::StrCat("point", pid));
           j->set_type(v1::PIN);
           j->mutable_a()->set_cable(name);
           j->mutable_a()->set_s(end);
@@ -1249,6 +1362,12 @@ class DeckReader {
       const Point& p = points_.at(id);
       v1::Probe* probe = scene.add_probes();
       probe->set_name(absl::StrCat("Point", id));
+      if (const auto h = holders_.find(id); h != holders_.end() && !h->second.ground) {
+        probe->set_body(h->second.body);
+        SetVec(probe->mutable_point(), h->second.point.x(), h->second.point.y(),
+               h->second.point.z());
+        continue;
+      }
       if (const auto body = body_of.find(id); body != body_of.end()) {
         probe->set_body(body->second);
         continue;
@@ -1283,6 +1402,682 @@ class DeckReader {
     return scene;
   }
 
+  // A deck of rods or bodies alone (no line types): the environment, the
+  // bodies and rods (MoorDyn's RodPinnedFloating.txt). No seabed: bodies
+  // do not touch it, as MoorDyn's.
+  absl::StatusOr<v1::Scene> BuildRigidOnly(v1::Scene scene) const {
+    if (absl::Status s = BuildBodiesAndRods(&scene); !s.ok()) return s;
+    scene.mutable_solver()->set_analysis(v1::STATIC);
+    return scene;
+  }
+
+  // SeafloorFile: MoorDyn's 3D seafloor file, relative to the deck's
+  // directory: "nx ny", the nx x ticks, the ny y ticks, then one node a
+  // row, "x y z" with z the bed's height (negative below the surface).
+  // It becomes seabed.bathymetry (depths -z), which needs a regular grid:
+  // evenly spaced ticks and every node given once.
+  absl::Status ReadSeafloor(v1::Bathymetry* grid) const {
+    const int n = seafloor_line_;
+    const std::string field = "OPTIONS SeafloorFile";
+    const std::string& name = seafloor_file_;
+    if (!read_file_) {
+      return Error(n, field,
+                   absl::StrCat("\"", name,
+                                "\": a seafloor file cannot be read here (a deck's text alone, "
+                                "as the service takes it, has no directory): give the scene with "
+                                "seabed.bathymetry, or run the deck's file"));
+    }
+    absl::StatusOr<std::string> text = read_file_(std::string_view(name.data(), name.size()));
+    if (!text.ok()) {
+      return Error(n, field, absl::StrCat("\"", name, "\": cannot read the seafloor file: ",
+                                          text.status().message()));
+    }
+    auto bad = [&](int row, absl::string_view message) {
+      return Error(n, field, absl::StrCat(name, ":", row, ": ", message));
+    };
+    std::vector<std::vector<double>> rows;
+    std::vector<int> row_line;
+    int row = 0;
+    for (absl::string_view raw : absl::StrSplit(*text, '\n')) {
+      ++row;
+      const std::vector<absl::string_view> w =
+          absl::StrSplit(raw, absl::ByAnyChar(" \t\r,"), absl::SkipEmpty());
+      if (w.empty()) continue;
+      std::vector<double> v;
+      for (absl::string_view word : w) {
+        double x = 0;
+        if (!absl::SimpleAtod(word, &x) || !std::isfinite(x))
+          return bad(row, absl::StrCat("\"", word, "\" is not a number"));
+        v.push_back(x);
+      }
+      rows.push_back(std::move(v));
+      row_line.push_back(row);
+    }
+    if (rows.size() < 4 || rows[0].size() != 2) {
+      return bad(rows.empty() ? 1 : row_line[0],
+                 "expected \"nx ny\", the x ticks, the y ticks and a node per row");
+    }
+    const int nx = static_cast<int>(rows[0][0]), ny = static_cast<int>(rows[0][1]);
+    if (nx < 1 || ny < 1 || nx != rows[0][0] || ny != rows[0][1])
+      return bad(row_line[0], "nx and ny must be whole numbers >= 1");
+    std::vector<double> spacing(2, 0.0);
+    for (int axis = 0; axis < 2; ++axis) {
+      const std::vector<double>& ticks = rows[1 + axis];
+      const int count = axis == 0 ? nx : ny;
+      if (static_cast<int>(ticks.size()) != count) {
+        return bad(row_line[1 + axis], absl::StrCat("expected ", count, " ticks, got ",
+                                                    ticks.size()));
+      }
+      if (count > 1) spacing[axis] = (ticks.back() - ticks.front()) / (count - 1);
+      for (int i = 0; i < count; ++i) {
+        if (count > 1 && !(spacing[axis] > 0)) return bad(row_line[1 + axis], "ticks must increase");
+        if (std::abs(ticks[i] - (ticks.front() + i * spacing[axis])) > 1e-6 * spacing[axis]) {
+          return bad(row_line[1 + axis],
+                     absl::StrCat("tick ", ticks[i],
+                                  " is off the even spacing: a non-rectangular (unevenly "
+                                  "spaced) grid cannot be expressed (seabed.bathymetry is a "
+                                  "regular grid)"));
+        }
+      }
+    }
+    std::vector<double> depths(static_cast<size_t>(nx) * ny, std::nan(""));
+    auto index = [&](int axis, double x, int count) {
+      if (count == 1) return std::abs(x - rows[1 + axis][0]) <= 1e-9 * (1 + std::abs(x)) ? 0 : -1;
+      const double f = (x - rows[1 + axis][0]) / spacing[axis];
+      const long i = std::lround(f);
+      return i >= 0 && i < count && std::abs(f - i) <= 1e-6 ? static_cast<int>(i) : -1;
+    };
+    for (size_t k = 3; k < rows.size(); ++k) {
+      if (rows[k].size() != 3) return bad(row_line[k], "expected a node \"x y z\"");
+      const int i = index(0, rows[k][0], nx), j = index(1, rows[k][1], ny);
+      if (i < 0 || j < 0) {
+        return bad(row_line[k], "the node is not on the grid's ticks (a non-rectangular grid "
+                                "cannot be expressed)");
+      }
+      double& d = depths[static_cast<size_t>(j) * nx + i];
+      if (!std::isnan(d)) return bad(row_line[k], "a node given twice");
+      d = -rows[k][2];
+    }
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i)
+        if (std::isnan(depths[static_cast<size_t>(j) * nx + i])) {
+          return Error(n, field, absl::StrCat(name, ": the node (", rows[1][i], ", ", rows[2][j],
+                                              ") is missing (a non-rectangular grid cannot be "
+                                              "expressed)"));
+        }
+    grid->set_origin_x(rows[1][0]);
+    grid->set_origin_y(rows[2][0]);
+    if (nx > 1) grid->set_dx(spacing[0]);
+    if (ny > 1) grid->set_dy(spacing[1]);
+    grid->set_nx(nx);
+    grid->set_ny(ny);
+    for (double d : depths) grid->add_depths(d);
+    return absl::OkStatus();
+  }
+
+  // ---- MoorDyn rods and bodies (docs/moordyn-files.md, "Bodies and rods") ----
+
+  // A word of numbers separated by '|' (MoorDyn's CG, I, CdA and Ca
+  // columns): 1 or `many` of them.
+  absl::StatusOr<std::vector<double>> Numbers(int n, absl::string_view field,
+                                              absl::string_view word, int many) const {
+    std::vector<double> out;
+    for (absl::string_view part : absl::StrSplit(word, '|')) {
+      absl::StatusOr<double> v = Number(n, field, part);
+      if (!v.ok()) return v.status();
+      out.push_back(*v);
+    }
+    if (out.size() != 1 && static_cast<int>(out.size()) != many) {
+      return Error(n, field, absl::StrCat("\"", word, "\": 1 or ", many,
+                                          " numbers separated by '|' can be expressed"));
+    }
+    return out;
+  }
+
+  absl::Status ParseRodType(int n, const std::vector<absl::string_view>& w) {
+    static constexpr const char* kColumns[] = {"TypeName", "Diam", "Mass/m", "Cd",
+                                               "Ca",       "CdEnd", "CaEnd"};
+    if (w.size() != 7) {
+      return Error(n, "ROD TYPES",
+                   absl::StrCat("expected the 7 columns TypeName Diam Mass/m Cd Ca CdEnd CaEnd, "
+                                "got ",
+                                w.size()));
+    }
+    RodType t;
+    t.name = std::string(w[0]);
+    t.line = n;
+    for (const RodType& o : rod_types_)
+      if (o.name == t.name)
+        return Error(n, "ROD TYPES TypeName",
+                     absl::StrCat("\"", t.name, "\" already defined on line ", o.line));
+    double* values[] = {&t.diameter, &t.mass_per_length, &t.cd, &t.ca, &t.cd_end, &t.ca_end};
+    for (int k = 1; k < 7; ++k) {
+      const std::string field = absl::StrCat("ROD TYPES ", kColumns[k]);
+      absl::StatusOr<double> v = k == 1 ? Positive(n, field, w[k]) : NonNegative(n, field, w[k]);
+      if (!v.ok()) return v.status();
+      *values[k - 1] = *v;
+    }
+    rod_types_.push_back(t);
+    return absl::OkStatus();
+  }
+
+  // Rotation of MoorDyn's roll, pitch and yaw [deg]: about x, then the
+  // new y, then the new z (R = Rx Ry Rz).
+  static Eigen::Matrix3d Rotation(double roll, double pitch, double yaw) {
+    const double k = kPi / 180;
+    return (Eigen::AngleAxisd(roll * k, Eigen::Vector3d::UnitX()) *
+            Eigen::AngleAxisd(pitch * k, Eigen::Vector3d::UnitY()) *
+            Eigen::AngleAxisd(yaw * k, Eigen::Vector3d::UnitZ()))
+        .toRotationMatrix();
+  }
+
+  absl::Status ParseBody(int n, const std::vector<absl::string_view>& w) {
+    static constexpr const char* kColumns[] = {"ID", "Attachment", "X0", "Y0", "Z0", "r0", "p0",
+                                               "y0", "Mass", "CG",  "I",  "Volume", "CdA",
+                                               "Ca"};
+    if (w.size() != 14) {
+      return Error(n, "BODIES",
+                   absl::StrCat("expected the 14 columns ID Attachment X0 Y0 Z0 r0 p0 y0 Mass CG "
+                                "I Volume CdA Ca, got ",
+                                w.size()));
+    }
+    auto col = [&](int k) { return absl::StrCat("BODIES ", kColumns[k]); };
+    MdBody b;
+    b.line = n;
+    if (!absl::SimpleAtoi(w[0], &b.id) || b.id != static_cast<int>(md_bodies_.size()) + 1) {
+      return Error(n, col(0), absl::StrCat("\"", w[0], "\": bodies are numbered 1, 2, ... in "
+                                           "order (MoorDyn's rule); expected ",
+                                           md_bodies_.size() + 1));
+    }
+    const std::string type = absl::AsciiStrToLower(w[1]);
+    if (type == "fixed" || type == "fix" || type == "anchor") {
+      b.mount = Mount::kFixed;
+    } else if (type == "vessel" || type == "ves" || type == "coupled" || type == "cpld") {
+      b.mount = Mount::kCoupled;
+    } else if (type == "vesselpinned" || type == "vespin" || type == "cpldpin" ||
+               type == "coupledpinned") {
+      b.mount = Mount::kCoupledPinned;
+    } else if (type == "free" || type == "point" || type == "con") {
+      b.mount = Mount::kFree;
+    } else {
+      return Error(n, col(1), absl::StrCat("unknown body type \"", w[1],
+                                           "\" (Fixed, Free, Coupled or CoupledPinned)"));
+    }
+    double r6[6];
+    for (int k = 2; k < 8; ++k) {
+      absl::StatusOr<double> v = Number(n, col(k), w[k]);
+      if (!v.ok()) return v.status();
+      r6[k - 2] = *v;
+    }
+    b.position = Eigen::Vector3d(r6[0], r6[1], r6[2]);
+    b.rotation = Rotation(r6[3], r6[4], r6[5]);
+    absl::StatusOr<double> mass = NonNegative(n, col(8), w[8]);
+    if (!mass.ok()) return mass.status();
+    b.mass = *mass;
+    absl::StatusOr<std::vector<double>> cg = Numbers(n, col(9), w[9], 3);
+    if (!cg.ok()) return cg.status();
+    // One number: the CG's z (MoorDyn's rule).
+    b.cg = cg->size() == 1 ? Eigen::Vector3d(0, 0, (*cg)[0])
+                           : Eigen::Vector3d((*cg)[0], (*cg)[1], (*cg)[2]);
+    absl::StatusOr<std::vector<double>> inertia = Numbers(n, col(10), w[10], 3);
+    if (!inertia.ok()) return inertia.status();
+    for (double v : *inertia)
+      if (v < 0) return Error(n, col(10), absl::StrCat("must be >= 0 (got ", w[10], ")"));
+    b.inertia = inertia->size() == 1 ? Eigen::Vector3d::Constant((*inertia)[0])
+                                     : Eigen::Vector3d((*inertia)[0], (*inertia)[1], (*inertia)[2]);
+    absl::StatusOr<double> volume = NonNegative(n, col(11), w[11]);
+    if (!volume.ok()) return volume.status();
+    b.volume = *volume;
+    // Drag areas and added mass per body axis (MoorDyn: 2, 3 or 6 drag
+    // areas, 3 added masses): cablesim's body fluid loads are one drag
+    // and one added mass across the vertical and one along it, so only
+    // one number each (the same in every direction) is expressed.
+    if (absl::StrContains(w[12], "|")) {
+      return Error(n, col(12), absl::StrCat("\"", w[12], "\": drag areas per axis cannot be "
+                                            "expressed (one CdA, the same in every direction)"));
+    }
+    absl::StatusOr<double> cda = NonNegative(n, col(12), w[12]);
+    if (!cda.ok()) return cda.status();
+    b.cda = *cda;
+    absl::StatusOr<std::vector<double>> ca = Numbers(n, col(13), w[13], 3);
+    if (!ca.ok()) return ca.status();
+    for (double v : *ca) {
+      if (v < 0) return Error(n, col(13), absl::StrCat("must be >= 0 (got ", w[13], ")"));
+      if (v != (*ca)[0]) {
+        return Error(n, col(13), absl::StrCat("\"", w[13], "\": added mass per axis cannot be "
+                                              "expressed (one Ca, the same in every direction)"));
+      }
+    }
+    b.ca = (*ca)[0];
+    md_bodies_.push_back(b);
+    return absl::OkStatus();
+  }
+
+  absl::Status ParseRod(int n, const std::vector<absl::string_view>& w) {
+    if (w.size() != 11) {
+      return Error(n, "RODS",
+                   absl::StrCat("expected the 11 columns ID RodType Attachment Xa Ya Za Xb Yb Zb "
+                                "NumSegs RodOutputs, got ",
+                                w.size()));
+    }
+    Rod r;
+    r.line = n;
+    if (!absl::SimpleAtoi(w[0], &r.id) || r.id != static_cast<int>(rods_.size()) + 1) {
+      return Error(n, "RODS ID", absl::StrCat("\"", w[0], "\": rods are numbered 1, 2, ... in "
+                                              "order (MoorDyn's rule); expected ",
+                                              rods_.size() + 1));
+    }
+    for (const RodType& t : rod_types_)
+      if (t.name == w[1]) r.type = &t;
+    if (r.type == nullptr) {
+      return Error(n, "RODS RodType", absl::StrCat("unknown rod type \"", w[1],
+                                                   "\" (define it in ROD TYPES before RODS)"));
+    }
+    const std::string type = absl::AsciiStrToLower(w[2]);
+    absl::string_view rest = type;
+    if (type == "fixed" || type == "fix" || type == "anchor") {
+      r.mount = Mount::kFixed;
+    } else if (type == "pinned" || type == "pin") {
+      r.mount = Mount::kPinned;
+    } else if (type == "vessel" || type == "ves" || type == "coupled" || type == "cpld") {
+      r.mount = Mount::kCoupled;
+    } else if (type == "vesselpinned" || type == "vespin" || type == "cpldpin" ||
+               type == "coupledpinned") {
+      r.mount = Mount::kCoupledPinned;
+    } else if (type == "free" || type == "point" || type == "con") {
+      r.mount = Mount::kFree;
+    } else if (absl::ConsumePrefix(&rest, "body")) {
+      const size_t digits = rest.find_first_not_of("0123456789");
+      const absl::string_view suffix =
+          digits == absl::string_view::npos ? absl::string_view() : rest.substr(digits);
+      if (!absl::SimpleAtoi(rest.substr(0, digits), &r.body) || r.body < 1) {
+        return Error(n, "RODS Attachment",
+                     absl::StrCat("\"", w[2], "\": Body<N> needs the body's number"));
+      }
+      if (r.body > static_cast<int>(md_bodies_.size())) {
+        return Error(n, "RODS Attachment",
+                     absl::StrCat("body ", r.body,
+                                  " does not exist (define it in BODIES before RODS)"));
+      }
+      if (suffix.empty()) {
+        r.mount = Mount::kOnBody;
+      } else if (suffix == "pinned" || suffix == "pin") {
+        r.mount = Mount::kPinned;
+      } else {
+        return Error(n, "RODS Attachment",
+                     absl::StrCat("\"", w[2], "\": Body<N> or Body<N>Pinned"));
+      }
+    } else {
+      return Error(n, "RODS Attachment",
+                   absl::StrCat("unknown rod attachment \"", w[2],
+                                "\" (Fixed, Pinned, Free, Coupled, CoupledPinned, Body<N>, "
+                                "Body<N>Pinned)"));
+    }
+    double e[6];
+    for (int k = 3; k < 9; ++k) {
+      static constexpr const char* kEnds[] = {"Xa", "Ya", "Za", "Xb", "Yb", "Zb"};
+      absl::StatusOr<double> v = Number(n, absl::StrCat("RODS ", kEnds[k - 3]), w[k]);
+      if (!v.ok()) return v.status();
+      e[k - 3] = *v;
+    }
+    r.a_rel = Eigen::Vector3d(e[0], e[1], e[2]);
+    r.b_rel = Eigen::Vector3d(e[3], e[4], e[5]);
+    if (!((r.b_rel - r.a_rel).norm() > 0)) {
+      return Error(n, "RODS Xb",
+                   "a rod of zero length (MoorDyn's point-like rod) cannot be expressed");
+    }
+    // NumSegs only divides a MoorDyn rod's loads along it (the rod is
+    // rigid either way); 0 makes a point-like rod of end loads only.
+    if (!absl::SimpleAtoi(w[9], &r.segments) || r.segments < 1) {
+      return Error(n, "RODS NumSegs",
+                   absl::StrCat("must be a whole number >= 1 (got ", w[9],
+                                "; 0, MoorDyn's rod of end loads alone, cannot be expressed)"));
+    }
+    rods_.push_back(r);
+    return absl::OkStatus();
+  }
+
+  // After parsing: rods and points on bodies placed in the world, rod-end
+  // points placed on their rods.
+  absl::Status ResolveBodiesAndRods() {
+    for (Rod& r : rods_) {
+      if (r.body > 0 && (r.mount == Mount::kOnBody || r.mount == Mount::kPinned)) {
+        const MdBody& b = md_bodies_[r.body - 1];
+        r.a = b.position + b.rotation * r.a_rel;
+        r.b = b.position + b.rotation * r.b_rel;
+      } else {
+        r.a = r.a_rel;
+        r.b = r.b_rel;
+      }
+    }
+    for (auto& [id, p] : points_) {
+      if (p.body > 0) {
+        if (p.body > static_cast<int>(md_bodies_.size())) {
+          return Error(p.line, "POINTS Type",
+                       absl::StrCat("body ", p.body, " does not exist (define it in BODIES)"));
+        }
+        const MdBody& b = md_bodies_[p.body - 1];
+        const Eigen::Vector3d world = b.position + b.rotation * p.relative;
+        p.x = world.x();
+        p.y = world.y();
+        p.z = world.z();
+      }
+      if (p.rod > 0) {
+        if (p.rod > static_cast<int>(rods_.size())) {
+          return Error(p.line, "LINES Attach",
+                       absl::StrCat("rod ", p.rod, " does not exist (define it in RODS)"));
+        }
+        const Rod& r = rods_[p.rod - 1];
+        const Eigen::Vector3d& end = p.rod_end_b ? r.b : r.a;
+        p.x = end.x();
+        p.y = end.y();
+        p.z = end.z();
+      }
+    }
+    return absl::OkStatus();
+  }
+
+  // A rigid part of a scene body: its mass [kg], centre of mass and
+  // inertia about it in world axes.
+  struct Part {
+    double mass = 0;
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
+  };
+  static Part RodPart(const Rod& r) {
+    const double length = r.length();
+    const double m = r.type->mass_per_length * length;
+    const double radius = r.type->diameter / 2;
+    // A solid cylinder of uniform line density.
+    const double axial = m * radius * radius / 2;
+    const double transverse = m * (3 * radius * radius + length * length) / 12;
+    const Eigen::Vector3d u = (r.b - r.a) / length;
+    return Part{m, (r.a + r.b) / 2,
+                transverse * Eigen::Matrix3d::Identity() + (axial - transverse) * u * u.transpose()};
+  }
+
+  // The cylinder a wet part displaces: centre, unit axis, diameter,
+  // length, and the rod type's coefficients (null for a body's own
+  // volume: MoorDyn's Volume, CdA and Ca), the deck's line.
+  struct Wet {
+    Eigen::Vector3d centre, axis;
+    double diameter = 0, length = 0;
+    const RodType* rod = nullptr;
+    const MdBody* body = nullptr;
+    int line = 0;
+  };
+
+  // Sets `h` from the one wet part of a free scene body whose centre of
+  // mass is `com`, or refuses what BodyHydrodynamics (a cylinder centred at
+  // the centre of mass, buoyed as a vertical one, forces only) cannot
+  // express.
+  // `along_axis`: the body's x axis is the (one) rod's, so its loads split
+  // along it (BodyHydrodynamics.along_axis).
+  absl::Status SetHydrodynamics(const std::vector<Wet>& wet, const Eigen::Vector3d& com,
+                                v1::Body* body, bool along_axis = false) const {
+    if (wet.empty()) return absl::OkStatus();
+    if (wet.size() > 1) {
+      return Error(wet[1].line, wet[1].rod ? "RODS RodType" : "BODIES Volume",
+                   absl::StrCat("a second part with volume on one rigid body (the first on line ",
+                                wet[0].line,
+                                "): cablesim's body fluid loads are those of one vertical "
+                                "cylinder per body"));
+    }
+    const Wet& p = wet[0];
+    const double size = std::max(p.length, p.diameter);
+    if ((p.centre - com).norm() > 1e-6 * size) {
+      return Error(p.line, p.rod ? "RODS Attachment" : "BODIES CG",
+                   absl::StrCat("the displaced volume's centre lies ", (p.centre - com).norm(),
+                                " m from the body's centre of mass: cablesim's body fluid loads "
+                                "act on a cylinder centred at the centre of mass (forces only)"));
+    }
+    v1::BodyHydrodynamics* h = body->mutable_hydrodynamics();
+    if (p.body != nullptr) {
+      // A body's volume: a vertical cylinder as tall as wide, as a free
+      // point's (MoorDyn buoys it by rho g V at its CG, drags it by
+      // 1/2 rho CdA |v| v and adds Ca rho V).
+      const double d = std::cbrt(4 * p.body->volume / kPi);
+      h->set_diameter(d);
+      h->set_height(d);
+      h->set_drag_coefficient(p.body->cda / (d * d));
+      h->set_heave_drag_coefficient(p.body->cda / (kPi * d * d / 4));
+      h->set_added_mass(p.body->ca);
+      h->set_heave_added_mass(p.body->ca);
+      return absl::OkStatus();
+    }
+    const RodType& t = *p.rod;
+    const bool vertical = std::abs(std::abs(p.axis.z()) - 1) < 1e-9;
+    const bool loads = t.cd > 0 || t.ca > 0 || t.cd_end > 0 || t.ca_end > 0;
+    if (!vertical && loads && !along_axis) {
+      return Error(p.line, "RODS Xb",
+                   "a rod on a body that is not vertical with drag or added mass (its type's "
+                   "Cd, Ca, CdEnd or CaEnd > 0) cannot be expressed: a body's fluid loads split "
+                   "across and along its vertical, or along its x axis for a rod of its own");
+    }
+    // A tilted rod's buoyancy is the vertical cylinder's of its length:
+    // the same while both are wholly under water (or above it).
+    if (!vertical && p.centre.z() + p.length / 2 >= 0 && p.centre.z() - p.length / 2 <= 0) {
+      return Error(p.line, "RODS Zb",
+                   "a rod that is not vertical within half its length of the water surface "
+                   "cannot be expressed: cablesim's body buoyancy is that of a vertical cylinder "
+                   "(exact for a tilted rod only while it is wholly under water or above it)");
+    }
+    if (along_axis) h->set_along_axis(true);
+    h->set_diameter(t.diameter);
+    h->set_height(p.length);
+    const double area = kPi * t.diameter * t.diameter / 4;
+    // Across: MoorDyn's Cd on d per length and Ca on the section, as the
+    // body's. Along: CdEnd on the end area and CaEnd on the volume
+    // (2/3) pi r^3 of each wet end; cablesim's heave terms act on the end
+    // area and on rho V_ref (V_ref the submerged volume where the body is
+    // placed), so they take the ends wet there.
+    const double submerged = std::clamp(p.length / 2 - p.centre.z(), 0.0, p.length);
+    const double half_rise = p.length / 2 * std::abs(p.axis.z());
+    const int ends = (p.centre.z() - half_rise < 0 ? 1 : 0) + (p.centre.z() + half_rise < 0 ? 1 : 0);
+    h->set_drag_coefficient(t.cd);
+    h->set_added_mass(t.ca);
+    h->set_heave_drag_coefficient(ends * t.cd_end);
+    const double end_volume = 2.0 / 3.0 * kPi * std::pow(t.diameter / 2, 3);
+    if (submerged > 0) h->set_heave_added_mass(ends * t.ca_end * end_volume / (area * submerged));
+    return absl::OkStatus();
+  }
+
+  // One scene body of `parts` (mass, centre, inertia in world axes): its
+  // mass, position and inertia; axes the world's unless `axis` (a rod's)
+  // is given. Returns its centre of mass; refuses an inertia whose
+  // principal axes are not the body's.
+  absl::StatusOr<Eigen::Vector3d> SetRigid(const std::vector<Part>& parts, int line,
+                                           absl::string_view field, const Eigen::Vector3d* axis,
+                                           v1::Body* body) const {
+    double m = 0;
+    Eigen::Vector3d com = Eigen::Vector3d::Zero();
+    for (const Part& p : parts) {
+      m += p.mass;
+      com += p.mass * p.centre;
+    }
+    if (!(m > 0)) {
+      return Error(line, field,
+                   "a free body needs a mass > 0 (the body's, its points' and its rods')");
+    }
+    com /= m;
+    Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
+    for (const Part& p : parts) {
+      const Eigen::Vector3d c = p.centre - com;
+      inertia += p.inertia + p.mass * (c.squaredNorm() * Eigen::Matrix3d::Identity() -
+                                       c * c.transpose());
+    }
+    Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
+    if (axis != nullptr) {
+      // The scene's body frame from its x axis: y = normalize(e_z x x)
+      // (e_x x x when x is along z), z = x x y.
+      const Eigen::Vector3d x = *axis;
+      Eigen::Vector3d y = Eigen::Vector3d::UnitZ().cross(x);
+      if (y.norm() < 1e-9) y = Eigen::Vector3d::UnitX().cross(x);
+      y.normalize();
+      axes.col(0) = x;
+      axes.col(1) = y;
+      axes.col(2) = x.cross(y);
+      SetVec(body->mutable_axis(), x.x(), x.y(), x.z());
+    }
+    const Eigen::Matrix3d local = axes.transpose() * inertia * axes;
+    const double off = std::max({std::abs(local(0, 1)), std::abs(local(0, 2)),
+                                 std::abs(local(1, 2))});
+    if (off > 1e-9 * local.trace()) {
+      return Error(line, "BODIES I",
+                   "with its rods and points the body's principal axes are not the world's "
+                   "axes at the start (cablesim takes principal moments of inertia)");
+    }
+    body->set_mass(m);
+    SetVec(body->mutable_inertia(), local(0, 0), local(1, 1), local(2, 2));
+    SetVec(body->mutable_position(), com.x(), com.y(), com.z());
+    return com;
+  }
+
+  // The scene bodies and joints of the deck's bodies and rods, and what
+  // each body point and rod end is joined to (holders_).
+  absl::Status BuildBodiesAndRods(v1::Scene* scene) const {
+    // On a fixed body or rod: held by the ground where it is.
+    auto held = [] { return Holder{}; };
+    auto rod_ends = [&](int rod_id, auto&& holder_of_end) {
+      for (const auto& [id, p] : points_)
+        if (p.rod == rod_id) holders_[id] = holder_of_end(p);
+    };
+    // Bodies.
+    for (const MdBody& b : md_bodies_) {
+      std::vector<int> rods;  // rigidly on the body
+      for (const Rod& r : rods_)
+        if (r.mount == Mount::kOnBody && r.body == b.id) rods.push_back(r.id);
+      if (b.mount == Mount::kFixed) {
+        for (const auto& [id, p] : points_)
+          if (p.body == b.id) holders_[id] = held();
+        for (int r : rods) rod_ends(r, [&](const Point&) { return held(); });
+        continue;
+      }
+      v1::Body* body = scene->add_bodies();
+      body_points_.push_back(b.line);
+      const std::string name = absl::StrCat("body", b.id);
+      body->set_name(name);
+      Eigen::Vector3d com;
+      if (b.mount == Mount::kCoupled) {
+        // A coupled body's mass, volume and loads are the host's (MoorDyn
+        // ignores them too); the host drives the reference point. Rods on
+        // it would have their fluid loads reported to the host by MoorDyn.
+        if (!rods.empty()) {
+          return Error(rods_[rods.front() - 1].line, "RODS Attachment",
+                       "a rod on a coupled body cannot be expressed (its fluid loads, which "
+                       "MoorDyn reports to the host, would be dropped)");
+        }
+        body->set_coupled(true);
+        body->set_mass(b.mass > 0 ? b.mass : 1.0);
+        SetVec(body->mutable_inertia(), 1, 1, 1);
+        com = b.position;
+        SetVec(body->mutable_position(), com.x(), com.y(), com.z());
+      } else {
+        std::vector<Part> parts;
+        std::vector<Wet> wet;
+        const Eigen::Vector3d cg = b.position + b.rotation * b.cg;
+        parts.push_back(Part{b.mass, cg,
+                             b.rotation * b.inertia.asDiagonal() * b.rotation.transpose()});
+        if (b.volume > 0) {
+          wet.push_back(Wet{cg, Eigen::Vector3d::UnitZ(), 0, 0, nullptr, &b, b.line});
+        } else if (b.cda > 0 || b.ca > 0) {
+          return Error(b.line, b.cda > 0 ? "BODIES CdA" : "BODIES Ca",
+                       "a body with drag or added mass needs a volume > 0 (it sizes the "
+                       "body's fluid loads)");
+        }
+        for (const auto& [id, p] : points_)
+          if (p.body == b.id && p.mass > 0)
+            parts.push_back(Part{p.mass, Eigen::Vector3d(p.x, p.y, p.z),
+                                 Eigen::Matrix3d::Zero()});
+        for (int id : rods) {
+          const Rod& r = rods_[id - 1];
+          parts.push_back(RodPart(r));
+          wet.push_back(Wet{(r.a + r.b) / 2, (r.b - r.a) / r.length(), r.type->diameter,
+                            r.length(), r.type, nullptr, r.line});
+        }
+        absl::StatusOr<Eigen::Vector3d> c = SetRigid(parts, b.line, "BODIES Mass", nullptr, body);
+        if (!c.ok()) return c.status();
+        com = *c;
+        if (absl::Status s = SetHydrodynamics(wet, com, body); !s.ok()) return s;
+        if (b.mount == Mount::kCoupledPinned) {
+          // Its reference point driven by the host, its rotation free.
+          v1::Joint* j = scene->add_joints();
+          j->set_name(absl::StrCat("body", b.id));
+          j->set_type(v1::PIN);
+          j->mutable_a()->set_body(name);
+          const Eigen::Vector3d rel = b.position - com;
+          SetVec(j->mutable_a()->mutable_point(), rel.x(), rel.y(), rel.z());
+          j->set_coupled(true);
+        }
+      }
+      for (const auto& [id, p] : points_) {
+        if (p.body != b.id) continue;
+        holders_[id] = Holder{false, false, name, Eigen::Vector3d(p.x, p.y, p.z) - com};
+      }
+      for (int r : rods) {
+        rod_ends(r, [&](const Point& p) {
+          return Holder{false, false, name, Eigen::Vector3d(p.x, p.y, p.z) - com};
+        });
+      }
+    }
+    // Rods of their own.
+    for (const Rod& r : rods_) {
+      if (r.mount == Mount::kOnBody) continue;
+      const bool on_fixed_body = r.body > 0 && md_bodies_[r.body - 1].mount == Mount::kFixed;
+      if (r.mount == Mount::kFixed) {
+        rod_ends(r.id, [&](const Point&) { return held(); });
+        continue;
+      }
+      v1::Body* body = scene->add_bodies();
+      body_points_.push_back(r.line);
+      const std::string name = absl::StrCat("rod", r.id);
+      body->set_name(name);
+      const double length = r.length();
+      const Eigen::Vector3d axis = (r.b - r.a) / length;
+      absl::StatusOr<Eigen::Vector3d> com =
+          SetRigid({RodPart(r)}, r.line, "ROD TYPES Mass/m", &axis, body);
+      if (!com.ok()) return com.status();
+      if (r.mount == Mount::kCoupled) {
+        body->set_coupled(true);
+      } else {
+        absl::Status s = SetHydrodynamics(
+            {Wet{*com, axis, r.type->diameter, length, r.type, nullptr, r.line}}, *com, body,
+            /*along_axis=*/true);
+        if (!s.ok()) return s;
+      }
+      if (r.mount == Mount::kPinned || r.mount == Mount::kCoupledPinned) {
+        // End A pinned: to the ground, a fixed body, or a body's point.
+        v1::Joint* j = scene->add_joints();
+        j->set_name(absl::StrCat("rod", r.id, "A"));
+        j->set_type(v1::PIN);
+        j->mutable_a()->set_body(name);
+        SetVec(j->mutable_a()->mutable_point(), -length / 2, 0, 0);
+        if (r.mount == Mount::kCoupledPinned) j->set_coupled(true);
+        if (r.body > 0 && !on_fixed_body) {
+          const MdBody& b = md_bodies_[r.body - 1];
+          if (b.mount == Mount::kCoupled) {
+            return Error(r.line, "RODS Attachment",
+                         "a rod pinned to a coupled body cannot be expressed yet");
+          }
+          // The body's scene name and centre of mass: from the scene.
+          const std::string body_name = absl::StrCat("body", b.id);
+          for (const v1::Body& o : scene->bodies()) {
+            if (o.name() != body_name) continue;
+            const Eigen::Vector3d rel =
+                r.a - Eigen::Vector3d(o.position().x(), o.position().y(), o.position().z());
+            j->mutable_b()->set_body(body_name);
+            SetVec(j->mutable_b()->mutable_point(), rel.x(), rel.y(), rel.z());
+          }
+        }
+      }
+      rod_ends(r.id, [&](const Point& p) {
+        return Holder{false, false, name,
+                      Eigen::Vector3d(p.rod_end_b ? length / 2 : -length / 2, 0, 0)};
+      });
+    }
+    return absl::OkStatus();
+  }
+
   absl::string_view text_;
   std::string file_;
   MoorDynFileReader read_file_;  // null: files the deck names cannot be read
@@ -1292,8 +2087,16 @@ class DeckReader {
   std::map<std::string, Option> options_;
   std::vector<int> probe_points_;
   std::vector<TensionChannel> tension_channels_;
-  // The POINTS row of each body Build made, in scene order (for Located).
+  // The POINTS (BODIES, RODS) row of each body Build made, in scene order
+  // (for Located).
   mutable std::vector<int> body_points_;
+  std::string seafloor_file_;  // OPTIONS SeafloorFile, empty: a flat bed
+  int seafloor_line_ = 0;
+  std::vector<RodType> rod_types_;
+  std::vector<MdBody> md_bodies_;  // in ID order, from 1
+  std::vector<Rod> rods_;          // in ID order, from 1
+  // What each body point and rod end (by point ID) is joined to (Build).
+  mutable std::map<int, Holder> holders_;
 };
 
 }  // namespace

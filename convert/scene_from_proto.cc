@@ -116,6 +116,13 @@ absl::StatusOr<Scene> ConvertScene(const v1::Scene& proto) {
   CABLESIM_RETURN_IF_ERROR(scene_convert::ConvertFluid(&state));
   CABLESIM_RETURN_IF_ERROR(scene_convert::ConvertSeabed(&state));
   const Scene& scene = state.scene;
+  for (int i = 0; i < static_cast<int>(scene.cables.size()); ++i) {
+    if (scene.seabed.enabled) break;
+    if (scene.cables[i].seabed_stiffness_n_m2 >= 0)
+      return Invalid(Sub(Indexed("", "cables", i), "seabed_stiffness"), "needs a seabed");
+    if (scene.cables[i].seabed_damping_n_s_m2 >= 0)
+      return Invalid(Sub(Indexed("", "cables", i), "seabed_damping"), "needs a seabed");
+  }
   for (int i = 0; i < static_cast<int>(scene.bodies.size()); ++i)
     if (!scene.bodies[i].contact_points_m.empty() && !scene.seabed.enabled)
       return Invalid(Sub(Indexed("", "bodies", i), "seabed_contact"), "needs a seabed");

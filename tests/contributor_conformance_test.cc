@@ -575,14 +575,15 @@ struct ElementCase {
 
 void PrintTo(const ElementCase& c, std::ostream* os) { *os << c.label; }
 
-std::string SeabedChain(const char* model, const char* bed) {
+// `cable_extra`: more of the cable's fields (its own bed's).
+std::string SeabedChain(const char* model, const char* bed, const char* cable_extra = "") {
   return absl::StrFormat(R"({
     "model": "%s", "gravity": {"y": -9.81},
     "cables": [{"name": "c", "points": [{"x": 0, "y": -20}, {"x": 8, "y": -20}], "density": 7850,
-                "youngs_modulus": 2e11, "diameter": 0.05, "elements": 4}],
+                "youngs_modulus": 2e11, "diameter": 0.05, "elements": 4 %s}],
     "seabed": {"depth": 20, %s},
     "solver": {"duration": 1}})",
-                         model, bed);
+                         model, cable_extra, bed);
 }
 
 // A cable lying in the fluid (planar: y up; spatial: z up) with
@@ -636,6 +637,20 @@ const ElementCase kElementCases[] = {
        return SceneFromJson(SeabedChain(
            "SPATIAL",
            R"("stiffness": 3e5, "damping": 1e4, "friction_axial": 0.5, "friction_transverse": 1)"));
+     },
+     kSymmetricBound},
+    // A cable on a bed of its own (cables[].seabed_stiffness, seabed_damping).
+    {"CableOwnSeabedDamperPlanar", "cable_seabed",
+     [] {
+       return SceneFromJson(SeabedChain("PLANAR", R"("stiffness": 3e5, "damping": 1e4)",
+                                        R"(, "seabed_stiffness": 6e5, "seabed_damping": 2e4)"));
+     }},
+    {"CableOwnSeabedFrictionSpatial", "cable_seabed",
+     [] {
+       return SceneFromJson(SeabedChain(
+           "SPATIAL",
+           R"("stiffness": 3e5, "damping": 1e4, "friction_axial": 0.5, "friction_transverse": 1)",
+           R"(, "seabed_stiffness": 6e5, "seabed_damping": 2e4)"));
      },
      kSymmetricBound},
 };

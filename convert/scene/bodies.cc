@@ -69,6 +69,7 @@ absl::Status ConvertBodyHydrodynamics(const ConversionState& state, int i, const
     CABLESIM_RETURN_IF_ERROR(CheckRange(Sub(path, name), value, plausible::kHydroCoefficient));
     *out = value;
   }
+  body->hydro_along_axis = h.along_axis();
   body->has_hydrodynamics = true;
   return absl::OkStatus();
 }

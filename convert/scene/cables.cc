@@ -270,6 +270,18 @@ absl::Status ConvertCable(ConversionState* state, int i, CableSpec* cable) {
   } else if (c.has_tension_table()) {
     return Invalid(Sub(path, "tension_table"), "only with axial_law TABLE");
   }
+  // A bed of its own: checked for a seabed in ConvertScene (after ConvertSeabed).
+  if (c.has_seabed_stiffness()) {
+    CABLESIM_RETURN_IF_ERROR(CheckPositiveInRange(Sub(path, "seabed_stiffness"),
+                                                  c.seabed_stiffness(), plausible::kStiffness));
+    cable->seabed_stiffness_n_m2 = c.seabed_stiffness();
+  }
+  if (c.has_seabed_damping()) {
+    CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(path, "seabed_damping"), c.seabed_damping()));
+    CABLESIM_RETURN_IF_ERROR(CheckRange(Sub(path, "seabed_damping"), c.seabed_damping(),
+                                        plausible::kDampingCoefficient));
+    cable->seabed_damping_n_s_m2 = c.seabed_damping();
+  }
   if (c.has_winch()) {
     if (cable->axial_law != AxialLaw::kGreenLagrange) {
       return Invalid(Sub(path, "axial_law"),

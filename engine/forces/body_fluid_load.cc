@@ -21,6 +21,15 @@ BodyFluidLoad::BodyFluidLoad(const Params& p, int coord, int dim)
   up_.normalize();
 }
 
+Vector3d BodyFluidLoad::Axis(const VectorXd& q) const {
+  if (!p_.along_axis) return up_;
+  // The body's natural coordinates: [r_c, u, ...], u its x axis (D each).
+  Vector3d a = Vector3d::Zero();
+  a.head(dim_) = q.segment(coord_ + dim_, dim_);
+  const double n = a.norm();
+  return n > 0 ? Vector3d(a / n) : up_;
+}
+
 double BodyFluidLoad::Submerged(double z) const {
   return std::clamp(p_.height_m / 2 - z, 0.0, p_.height_m);
 }
@@ -33,7 +42,8 @@ double BodyFluidLoad::Height(const VectorXd& q) const {
 
 Matrix3d BodyFluidLoad::AddedMass(const VectorXd& q0) const {
   const double v = p_.density_kg_m3 * area_ * Submerged(Height(q0));
-  const Matrix3d vertical = up_ * up_.transpose();
+  const Vector3d axis = Axis(q0);
+  const Matrix3d vertical = axis * axis.transpose();
   Matrix3d m = v * (p_.added_mass * (Matrix3d::Identity() - vertical) +
                     p_.heave_added_mass * vertical);
   // Planar: only the plane's block is used; zero the rest for clarity.
@@ -79,6 +89,8 @@ Vector3d BodyFluidLoad::DynamicForce(const VectorXd& q, const VectorXd& qdot, do
   const double rho = p_.density_kg_m3;
   const double z = Height(q);
   const double s = Submerged(z);
+  // The split's direction: the vertical, or the body's axis.
+  const Vector3d axis = Axis(q);
   Vector3d u = p_.current_m_s, dudt = Vector3d::Zero();
   Vector3d force = Vector3d::Zero();
   if (waves != nullptr) {
@@ -88,25 +100,26 @@ Vector3d BodyFluidLoad::DynamicForce(const VectorXd& q, const VectorXd& qdot, do
     // The wave's change of the buoyancy: the level rises by eta.
     force += rho * p_.g_m_s2 * area_ * (Submerged(z - k.elevation_m) - s) * up_;
     // Froude-Krylov and added-mass inertia on the wetted volume.
-    const double a_up = up_.dot(dudt);
-    const Vector3d a_h = dudt - a_up * up_;
-    force += rho * area_ * s * ((1 + p_.added_mass) * a_h + (1 + p_.heave_added_mass) * a_up * up_);
+    const double a_up = axis.dot(dudt);
+    const Vector3d a_h = dudt - a_up * axis;
+    force +=
+        rho * area_ * s * ((1 + p_.added_mass) * a_h + (1 + p_.heave_added_mass) * a_up * axis);
   }
   if (damping != nullptr) damping->setZero();
   if (s > 0 && (p_.drag != 0 || p_.heave_drag != 0)) {
     const Vector3d vr = u - v;
-    const double vr_up = up_.dot(vr);
-    const Vector3d vh = vr - vr_up * up_;
+    const double vr_up = axis.dot(vr);
+    const Vector3d vh = vr - vr_up * axis;
     const double kh = 0.5 * rho * p_.drag * p_.diameter_m * s;
     const double kv = 0.5 * rho * p_.heave_drag * area_;
     const double nh = vh.norm();
-    force += kh * nh * vh + kv * std::abs(vr_up) * vr_up * up_;
+    force += kh * nh * vh + kv * std::abs(vr_up) * vr_up * axis;
     if (damping != nullptr) {
       if (nh > 0) {
-        const Matrix3d horizontal = Matrix3d::Identity() - up_ * up_.transpose();
-        *damping += kh * (nh * horizontal + vh * vh.transpose() / nh);
+        const Matrix3d across = Matrix3d::Identity() - axis * axis.transpose();
+        *damping += kh * (nh * across + vh * vh.transpose() / nh);
       }
-      *damping += 2 * kv * std::abs(vr_up) * up_ * up_.transpose();
+      *damping += 2 * kv * std::abs(vr_up) * axis * axis.transpose();
     }
   }
   if (dim_ == 2) force.z() = 0;
@@ -179,6 +192,7 @@ std::unique_ptr<BodyFluidForces> MakeBodyFluidForces(const Scene& scene,
     p.heave_drag = body.hydro_heave_drag;
     p.added_mass = body.hydro_added_mass;
     p.heave_added_mass = body.hydro_heave_added_mass;
+    p.along_axis = body.hydro_along_axis;
     p.current_m_s = fluid.current_m_s;
     loads.emplace_back(p, body_coord[b], dim);
   }

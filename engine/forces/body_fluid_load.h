@@ -65,6 +65,18 @@
 // semi-definite. The derivatives in r_c (through s, eta and the flow's
 // dependence on position) are left out, as for the cables' WaveLoad.
 //
+// Along the body's axis (Params::along_axis, a rod): the same drag and
+// inertia with the body's x axis a = u / |u| (from the body's natural
+// coordinates at q) in place of `up` in the split: v_h the relative
+// velocity across the axis, v_v along it, C_d on d s across, C_dv on A
+// along, C_a = C_ah (I - a a^T) + C_av a a^T; the added mass on the body's
+// own acceleration takes a at the body's `position` (the constant mass
+// matrix: exact while the rod keeps its initial direction). The tangents
+// in a (a moment's) are left out with those in r_c. Buoyancy stays the
+// vertical cylinder's of the same length: exact while the rod is wholly
+// under water or wholly above it (a scene built from a MoorDyn deck
+// refuses a tilted rod piercing the surface where it starts).
+//
 // Energy: F_d + F_i + F_w is not a potential's force; its power -F . rdot_c
 // joins the damping power (MultibodyModel::DampingPower), so energy.damped
 // counts the drag's dissipation and the waves' work, and energy.total +
@@ -94,6 +106,8 @@ class BodyFluidLoad {
     double diameter_m = 0, height_m = 0;
     double drag = 0, heave_drag = 0;              // C_d, C_dv [-]
     double added_mass = 0, heave_added_mass = 0;  // C_ah, C_av [-]
+    // The split across/along the body's x axis instead of the vertical.
+    bool along_axis = false;
     Eigen::Vector3d current_m_s = Eigen::Vector3d::Zero();
   };
 
@@ -103,6 +117,10 @@ class BodyFluidLoad {
   int coord() const { return coord_; }
   int dim() const { return dim_; }
   double waterplane_area() const { return area_; }
+
+  // The unit direction the loads split along at q: the vertical, or the
+  // body's x axis (along_axis).
+  Eigen::Vector3d Axis(const Eigen::VectorXd& q) const;
 
   // The submerged length s(z) [m] at the centre's height z above a level.
   double Submerged(double z) const;

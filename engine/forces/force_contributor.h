@@ -311,6 +311,21 @@ class ElementTerm {
   }
 
   virtual bool has_static_friction() const { return false; }
+  // AddStaticFriction on the element of index `index` in the model's
+  // element list (what the model calls): a term whose data is per element
+  // overrides these; the default forwards.
+  virtual void AddElementStaticFriction(int index, const ElementCoords<2>& e,
+                                        const ElementCoords<2>& e0, double length,
+                                        ElementCoords<2>* force, ElementMatrix<2>* matrix) const {
+    (void)index;
+    AddStaticFriction(e, e0, length, force, matrix);
+  }
+  virtual void AddElementStaticFriction(int index, const ElementCoords<3>& e,
+                                        const ElementCoords<3>& e0, double length,
+                                        ElementCoords<3>* force, ElementMatrix<3>* matrix) const {
+    (void)index;
+    AddStaticFriction(e, e0, length, force, matrix);
+  }
   // STATIC analyses: adds the static friction force (e0 where the analysis
   // started) to `force` and its matrix to `matrix` (may be null).
   virtual void AddStaticFriction(const ElementCoords<2>& e, const ElementCoords<2>& e0,

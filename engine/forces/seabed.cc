@@ -540,45 +540,122 @@ CABLESIM_SEABED_INSTANTIATE(3)
 double CableSeabed::AddPotential(const ElementCoords<2>& e, double length,
                                  ElementCoords<2>* gradient, ElementMatrix<2>* hessian,
                                  ElementCoords<2>* roundoff) const {
-  return bed_.AddPotential<2>(e, length, gradient, hessian, roundoff);
+  return bed().AddPotential<2>(e, length, gradient, hessian, roundoff);
 }
 
 double CableSeabed::AddPotential(const ElementCoords<3>& e, double length,
                                  ElementCoords<3>* gradient, ElementMatrix<3>* hessian,
                                  ElementCoords<3>* roundoff) const {
-  return bed_.AddPotential<3>(e, length, gradient, hessian, roundoff);
+  return bed().AddPotential<3>(e, length, gradient, hessian, roundoff);
 }
 
 double CableSeabed::Energy(const ElementCoords<2>& e, double length) const {
-  return bed_.Energy<2>(e, length);
+  return bed().Energy<2>(e, length);
 }
 
 double CableSeabed::Energy(const ElementCoords<3>& e, double length) const {
-  return bed_.Energy<3>(e, length);
+  return bed().Energy<3>(e, length);
+}
+
+double CableSeabed::AddElementPotential(const ElementAt<2>& at, const ElementCoords<2>& e,
+                                        ElementCoords<2>* gradient, ElementMatrix<2>* hessian,
+                                        ElementCoords<2>* roundoff) const {
+  return BedOf(at.index).AddPotential<2>(e, at.element.length(), gradient, hessian, roundoff);
+}
+
+double CableSeabed::AddElementPotential(const ElementAt<3>& at, const ElementCoords<3>& e,
+                                        ElementCoords<3>* gradient, ElementMatrix<3>* hessian,
+                                        ElementCoords<3>* roundoff) const {
+  return BedOf(at.index).AddPotential<3>(e, at.element.length(), gradient, hessian, roundoff);
+}
+
+void CableSeabed::AddElementEnergy(const ElementAt<2>& at, const ElementCoords<2>& e,
+                                   double* energy) const {
+  *energy += BedOf(at.index).Energy<2>(e, at.element.length());
+}
+
+void CableSeabed::AddElementEnergy(const ElementAt<3>& at, const ElementCoords<3>& e,
+                                   double* energy) const {
+  *energy += BedOf(at.index).Energy<3>(e, at.element.length());
+}
+
+bool CableSeabed::dissipates() const {
+  for (const Seabed& b : beds_)
+    if (b.dissipates()) return true;
+  return false;
 }
 
 double CableSeabed::AddDissipation(const ElementCoords<2>& e, const ElementCoords<2>& edot,
                                    double length, ElementCoords<2>* force,
                                    ElementMatrix<2>* c) const {
-  return bed_.AddDissipation<2>(e, edot, length, force, c);
+  return bed().AddDissipation<2>(e, edot, length, force, c);
 }
 
 double CableSeabed::AddDissipation(const ElementCoords<3>& e, const ElementCoords<3>& edot,
                                    double length, ElementCoords<3>* force,
                                    ElementMatrix<3>* c) const {
-  return bed_.AddDissipation<3>(e, edot, length, force, c);
+  return bed().AddDissipation<3>(e, edot, length, force, c);
+}
+
+double CableSeabed::AddElementDissipation(const ElementAt<2>& at, const ElementCoords<2>& e,
+                                          const ElementCoords<2>& edot, ElementCoords<2>* force,
+                                          ElementMatrix<2>* c) const {
+  return BedOf(at.index).AddDissipation<2>(e, edot, at.element.length(), force, c);
+}
+
+double CableSeabed::AddElementDissipation(const ElementAt<3>& at, const ElementCoords<3>& e,
+                                          const ElementCoords<3>& edot, ElementCoords<3>* force,
+                                          ElementMatrix<3>* c) const {
+  return BedOf(at.index).AddDissipation<3>(e, edot, at.element.length(), force, c);
 }
 
 void CableSeabed::AddStaticFriction(const ElementCoords<2>& e, const ElementCoords<2>& e0,
                                     double length, ElementCoords<2>* force,
                                     ElementMatrix<2>* matrix) const {
-  bed_.AddStaticFriction<2>(e, e0, length, force, matrix);
+  bed().AddStaticFriction<2>(e, e0, length, force, matrix);
 }
 
 void CableSeabed::AddStaticFriction(const ElementCoords<3>& e, const ElementCoords<3>& e0,
                                     double length, ElementCoords<3>* force,
                                     ElementMatrix<3>* matrix) const {
-  bed_.AddStaticFriction<3>(e, e0, length, force, matrix);
+  bed().AddStaticFriction<3>(e, e0, length, force, matrix);
+}
+
+void CableSeabed::AddElementStaticFriction(int index, const ElementCoords<2>& e,
+                                           const ElementCoords<2>& e0, double length,
+                                           ElementCoords<2>* force,
+                                           ElementMatrix<2>* matrix) const {
+  BedOf(index).AddStaticFriction<2>(e, e0, length, force, matrix);
+}
+
+void CableSeabed::AddElementStaticFriction(int index, const ElementCoords<3>& e,
+                                           const ElementCoords<3>& e0, double length,
+                                           ElementCoords<3>* force,
+                                           ElementMatrix<3>* matrix) const {
+  BedOf(index).AddStaticFriction<3>(e, e0, length, force, matrix);
+}
+
+std::unique_ptr<CableSeabed> MakeCableSeabed(const Scene& scene,
+                                             const std::vector<int>& cable_element_begin) {
+  if (!scene.seabed.enabled) return nullptr;
+  bool own = false;
+  for (const CableSpec& c : scene.cables)
+    own = own || c.seabed_stiffness_n_m2 >= 0 || c.seabed_damping_n_s_m2 >= 0;
+  if (!own || cable_element_begin.size() != scene.cables.size() + 1)
+    return std::make_unique<CableSeabed>(scene.seabed);
+  std::vector<Seabed> beds{Seabed(scene.seabed)};
+  std::vector<int> bed_of(cable_element_begin.back(), 0);
+  for (size_t c = 0; c < scene.cables.size(); ++c) {
+    const CableSpec& cable = scene.cables[c];
+    if (cable.seabed_stiffness_n_m2 < 0 && cable.seabed_damping_n_s_m2 < 0) continue;
+    SeabedSpec spec = scene.seabed;
+    if (cable.seabed_stiffness_n_m2 >= 0) spec.stiffness_n_m2 = cable.seabed_stiffness_n_m2;
+    if (cable.seabed_damping_n_s_m2 >= 0) spec.damping_n_s_m2 = cable.seabed_damping_n_s_m2;
+    beds.emplace_back(spec);
+    for (int k = cable_element_begin[c]; k < cable_element_begin[c + 1]; ++k)
+      bed_of[k] = static_cast<int>(beds.size()) - 1;
+  }
+  return std::make_unique<CableSeabed>(std::move(beds), std::move(bed_of));
 }
 
 }  // namespace cablesim

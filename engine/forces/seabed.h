@@ -290,10 +290,17 @@ class Seabed {
 
 // The seabed under the scene's cables as an ElementTerm: the bed's energy
 // and force (energy.contact), its damping and friction, its static friction.
+// A cable with its own stiffness and damping (CableSpec::seabed_*) lies on
+// a bed of its own with those (the same plane or grid and friction).
 class CableSeabed : public ElementTerm {
  public:
-  explicit CableSeabed(const SeabedSpec& spec) : bed_(spec) {}
-  const Seabed& bed() const { return bed_; }
+  explicit CableSeabed(const SeabedSpec& spec) { beds_.emplace_back(spec); }
+  // `bed_of_element[k]`: the index in `beds` of element k's bed (every
+  // element's; beds[0] the scene's).
+  CableSeabed(std::vector<Seabed> beds, std::vector<int> bed_of_element)
+      : beds_(std::move(beds)), bed_of_(std::move(bed_of_element)) {}
+  // The scene's bed.
+  const Seabed& bed() const { return beds_.front(); }
 
   std::string_view name() const override { return "cable_seabed"; }
   double AddPotential(const ElementCoords<2>& e, double length, ElementCoords<2>* gradient,
@@ -302,26 +309,53 @@ class CableSeabed : public ElementTerm {
                       ElementMatrix<3>* hessian, ElementCoords<3>* roundoff) const override;
   double Energy(const ElementCoords<2>& e, double length) const override;
   double Energy(const ElementCoords<3>& e, double length) const override;
-  bool dissipates() const override { return bed_.dissipates(); }
+  double AddElementPotential(const ElementAt<2>& at, const ElementCoords<2>& e,
+                             ElementCoords<2>* gradient, ElementMatrix<2>* hessian,
+                             ElementCoords<2>* roundoff) const override;
+  double AddElementPotential(const ElementAt<3>& at, const ElementCoords<3>& e,
+                             ElementCoords<3>* gradient, ElementMatrix<3>* hessian,
+                             ElementCoords<3>* roundoff) const override;
+  void AddElementEnergy(const ElementAt<2>& at, const ElementCoords<2>& e,
+                        double* energy) const override;
+  void AddElementEnergy(const ElementAt<3>& at, const ElementCoords<3>& e,
+                        double* energy) const override;
+  bool dissipates() const override;
   double AddDissipation(const ElementCoords<2>& e, const ElementCoords<2>& edot, double length,
                         ElementCoords<2>* force, ElementMatrix<2>* c) const override;
   double AddDissipation(const ElementCoords<3>& e, const ElementCoords<3>& edot, double length,
                         ElementCoords<3>* force, ElementMatrix<3>* c) const override;
-  bool has_static_friction() const override { return bed_.has_friction(); }
+  double AddElementDissipation(const ElementAt<2>& at, const ElementCoords<2>& e,
+                               const ElementCoords<2>& edot, ElementCoords<2>* force,
+                               ElementMatrix<2>* c) const override;
+  double AddElementDissipation(const ElementAt<3>& at, const ElementCoords<3>& e,
+                               const ElementCoords<3>& edot, ElementCoords<3>* force,
+                               ElementMatrix<3>* c) const override;
+  bool has_static_friction() const override { return bed().has_friction(); }
   void AddStaticFriction(const ElementCoords<2>& e, const ElementCoords<2>& e0, double length,
                          ElementCoords<2>* force, ElementMatrix<2>* matrix) const override;
   void AddStaticFriction(const ElementCoords<3>& e, const ElementCoords<3>& e0, double length,
                          ElementCoords<3>* force, ElementMatrix<3>* matrix) const override;
+  void AddElementStaticFriction(int index, const ElementCoords<2>& e, const ElementCoords<2>& e0,
+                                double length, ElementCoords<2>* force,
+                                ElementMatrix<2>* matrix) const override;
+  void AddElementStaticFriction(int index, const ElementCoords<3>& e, const ElementCoords<3>& e0,
+                                double length, ElementCoords<3>* force,
+                                ElementMatrix<3>* matrix) const override;
 
  private:
-  Seabed bed_;
+  // Element `index`'s bed.
+  const Seabed& BedOf(int index) const {
+    return bed_of_.empty() ? beds_.front() : beds_[bed_of_[index]];
+  }
+  std::vector<Seabed> beds_;
+  std::vector<int> bed_of_;  // empty: every element on beds_[0]
 };
 
 // The term for the scene's seabed under its cables, or null without one.
-inline std::unique_ptr<CableSeabed> MakeCableSeabed(const Scene& scene) {
-  if (!scene.seabed.enabled) return nullptr;
-  return std::make_unique<CableSeabed>(scene.seabed);
-}
+// `cable_element_begin[c]`: cable c's first element in the model's element
+// list (and its size the list's), for the cables with a bed of their own.
+std::unique_ptr<CableSeabed> MakeCableSeabed(const Scene& scene,
+                                             const std::vector<int>& cable_element_begin);
 
 }  // namespace cablesim
 

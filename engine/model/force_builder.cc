@@ -265,7 +265,7 @@ void ModelBuilder::BuildElements() {
   if (scene_.solver.analysis == Analysis::kDynamic)
     model_.cable_added_mass_ =
         MakeCableAddedMass(std::move(added_mass_elements_), surface, model_.waves_);
-  if (auto bed = MakeCableSeabed(scene_)) {
+  if (auto bed = MakeCableSeabed(scene_, model_.cable_element_begin_)) {
     model_.cable_seabed_ = bed.get();
     model_.element_terms_.push_back(std::move(bed));
   }

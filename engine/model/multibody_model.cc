@@ -456,9 +456,9 @@ void MultibodyModel::StaticFriction(const VectorXd& q, const VectorXd& q_start, 
       const ElementData<D>& e = elements[k];
       fe.setZero();
       if (matrix) me.setZero();
-      term->AddStaticFriction(q.segment<kN>(e.first_coord),
-                                              q_start.segment<kN>(e.first_coord),
-                                              e.element.length(), &fe, matrix ? &me : nullptr);
+      term->AddElementStaticFriction(static_cast<int>(k), q.segment<kN>(e.first_coord),
+                                     q_start.segment<kN>(e.first_coord), e.element.length(), &fe,
+                                     matrix ? &me : nullptr);
       full.segment<kN>(e.first_coord) += fe;
       if (!matrix) continue;
       ScatterElementMatrix<kN2>(k, me.data(), scale, values);

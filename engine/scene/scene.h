@@ -105,6 +105,11 @@ struct CableSpec {
   double axial_added_mass = 0;
   double hydro_diameter_m = 0;
   WinchSpec winch;  // disabled: the length is fixed
+  // The seabed's normal stiffness [N/m^2] and damping [N s/m^2] per unit
+  // length of this cable when it has its own (a mooring deck's kBot and
+  // cBot act on each line's diameter); negative: the scene's SeabedSpec's.
+  double seabed_stiffness_n_m2 = -1;
+  double seabed_damping_n_s_m2 = -1;
 };
 
 struct BodySpec {
@@ -140,6 +145,10 @@ struct BodySpec {
   double hydro_diameter_m = 0, hydro_height_m = 0;
   double hydro_drag = 0, hydro_heave_drag = 0;
   double hydro_added_mass = 0, hydro_heave_added_mass = 0;
+  // The drag and added mass split across and along the body's x axis (a
+  // rod) instead of the vertical (the buoyancy stays the vertical
+  // cylinder's).
+  bool hydro_along_axis = false;
   // Driven by a coupling host (engine/run/coupling.h): its pose (centre of
   // mass and axes) is the host's, step by step; the scene holds it by a
   // driver joint (CoupledBodyDriver, appended to the joints). In an

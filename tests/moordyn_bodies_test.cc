@@ -1,0 +1,634 @@
+// MoorDyn decks' BODIES, ROD TYPES, RODS and SeafloorFile
+// (convert/moordyn_deck.cc, docs/moordyn-files.md "Bodies and rods" and
+// "Seafloor file"): each translation against a hand calculation, statics
+// of floating and hanging rods and bodies against Archimedes, the refusals
+// naming the deck's line and field, and the CLI's import and run. The
+// decks are written here.
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_replace.h"
+#include "client/cli.h"
+#include "convert/moordyn_deck.h"
+#include "convert/scene_file.h"
+#include "convert/scene_from_proto.h"
+#include "tests/test_util.h"
+
+namespace cablesim {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kG = 9.81, kRho = 1025;
+
+using testing::CollectingSink;
+using testing::RunOk;
+
+// The deck's text with its sections: a header, then `body`, then options
+// (g 9.81, rho 1025, depth 200).
+std::string Deck(const std::string& body) {
+  return absl::StrCat(R"(--------------------- MoorDyn Input File ------------------------------------
+A deck written for cablesim's tests
+)",
+                      body, R"(---------------------- OPTIONS -----------------------------------------
+9.81          g             gravity
+1025          WtrDnsty      water density (kg/m^3)
+200           WtrDpth       water depth (m)
+------------------------- need this line --------------------------------------
+)");
+}
+
+v1::Scene Read(const std::string& text, MoorDynFileReader files = nullptr) {
+  absl::StatusOr<v1::Scene> scene = SceneFromMoorDyn(text, "test.dat", std::move(files));
+  EXPECT_TRUE(scene.ok()) << scene.status();
+  return scene.ok() ? *scene : v1::Scene{};
+}
+
+std::string Refusal(const std::string& text, MoorDynFileReader files = nullptr) {
+  absl::StatusOr<v1::Scene> scene = SceneFromMoorDyn(text, "bad.dat", std::move(files));
+  EXPECT_FALSE(scene.ok());
+  if (scene.ok()) return "";
+  EXPECT_EQ(scene.status().code(), absl::StatusCode::kInvalidArgument);
+  return std::string(scene.status().message());
+}
+
+const v1::Body& BodyNamed(const v1::Scene& s, const std::string& name) {
+  for (const v1::Body& b : s.bodies())
+    if (b.name() == name) return b;
+  ADD_FAILURE() << "no body " << name;
+  return s.bodies(0);
+}
+
+// The scene's statics with a probe on `body`'s centre; the last frame.
+Frame Statics(v1::Scene proto, const std::string& body, CollectingSink* sink) {
+  v1::Probe* p = proto.add_probes();
+  p->set_name("centre");
+  p->set_body(body);
+  const absl::StatusOr<Scene> scene = SceneFromProto(proto);
+  EXPECT_TRUE(scene.ok()) << scene.status();
+  if (!scene.ok()) return Frame{};
+  RunOk(*scene, sink);
+  EXPECT_FALSE(sink->frames().empty());
+  if (sink->frames().empty()) return Frame{};
+  // The probe "centre" first (the deck's own probes after it).
+  Frame last = sink->frames().back();
+  const int k = testing::ProbeIndex(sink->info(), "centre");
+  EXPECT_GE(k, 0);
+  if (k > 0) std::swap(last.probes[0], last.probes[k]);
+  return last;
+}
+
+// A free vertical rod (d 1 m, 10 m long, 400 kg/m) placed with its centre
+// at -1 m: it floats at the draft s where its mass equals the displaced
+// water's, w L = rho (pi d^2 / 4) s (Archimedes), so its centre settles at
+// L / 2 - s. A deck of a rod alone (no line types).
+constexpr char kFloatingRod[] = R"(---------------------- ROD TYPES ------------------------------------
+TypeName      Diam     Mass/m    Cd     Ca      CdEnd    CaEnd
+(name)        (m)      (kg/m)    (-)    (-)     (-)      (-)
+spar          1.0      400       0.8    1.0     0.6      0.7
+---------------------- RODS ----------------------------------------
+ID   RodType  Attachment  Xa    Ya    Za    Xb    Yb    Zb   NumSegs  RodOutputs
+(#)  (name)    (#/key)    (m)   (m)   (m)   (m)   (m)   (m)  (-)       (-)
+1    spar      Free       3     0     -6    3     0     4    5         p
+)";
+
+TEST(MoorDynBodiesTest, FreeVerticalRodFloatsAtItsDraft) {
+  const v1::Scene s = Read(Deck(kFloatingRod));
+  ASSERT_EQ(s.bodies_size(), 1);
+  const v1::Body& rod = s.bodies(0);
+  const double area = kPi / 4, length = 10, mass = 400 * length;
+  EXPECT_EQ(rod.name(), "rod1");
+  EXPECT_DOUBLE_EQ(rod.mass(), mass);
+  EXPECT_DOUBLE_EQ(rod.position().z(), -1);
+  EXPECT_DOUBLE_EQ(rod.axis().z(), 1);
+  // A solid cylinder: m r^2 / 2 about its axis, m (3 r^2 + L^2) / 12 across.
+  EXPECT_DOUBLE_EQ(rod.inertia().x(), mass * 0.25 / 2);
+  EXPECT_DOUBLE_EQ(rod.inertia().y(), mass * (3 * 0.25 + 100) / 12);
+  const v1::BodyHydrodynamics& h = rod.hydrodynamics();
+  EXPECT_DOUBLE_EQ(h.diameter(), 1);
+  EXPECT_DOUBLE_EQ(h.height(), length);
+  EXPECT_DOUBLE_EQ(h.drag_coefficient(), 0.8);
+  EXPECT_DOUBLE_EQ(h.added_mass(), 1.0);
+  // One end (A) under water where it is placed: CdEnd on the end area;
+  // CaEnd on that end's (2/3) pi r^3 over the submerged volume (6 m).
+  EXPECT_DOUBLE_EQ(h.heave_drag_coefficient(), 0.6);
+  EXPECT_NEAR(h.heave_added_mass(), 0.7 * (2.0 / 3 * kPi * 0.125) / (area * 6), 1e-15);
+
+  CollectingSink sink;
+  const Frame last = Statics(s, "rod1", &sink);
+  ASSERT_EQ(last.probes.size(), 1u);
+  const double draft = mass / (kRho * area);
+  const double z = last.probes[0].position_m.z();
+  std::printf("rod centre %.12g m, Archimedes %.12g m (draft %.9g m)\n", z, length / 2 - draft,
+              draft);
+  // Buoyancy is linear in the height while the rod pierces the surface:
+  // Newton lands on the balance to its tolerance (1e-9 of the length).
+  EXPECT_NEAR(z, length / 2 - draft, 1e-9 * length);
+  EXPECT_NEAR(last.probes[0].position_m.x(), 3, 1e-9);
+}
+
+// A free body (BODIES) of volume 8 m^3 and 5000 kg with its CG 0.5 m
+// below its reference point: a vertical cylinder as tall as wide
+// (d = (4 V / pi)^(1/3)) at the CG, floating where m = rho A s.
+TEST(MoorDynBodiesTest, FreeBodyFloatsAtItsDraft) {
+  const v1::Scene s = Read(Deck(R"(---------------------------- BODIES -----------------------------------------------------
+ID   Attachment  X0     Y0    Z0     r0      p0     y0     Mass  CG*   I*      Volume   CdA*   Ca
+(#)     (-)      (m)    (m)   (m)   (deg)   (deg)  (deg)   (kg)  (m)  (kg-m^2)  (m^3)   (m^2)  (-)
+1       free      0     0      0     0       0      0      5000  -0.5  2000    8        1.5    0.8
+)"));
+  ASSERT_EQ(s.bodies_size(), 1);
+  const v1::Body& b = s.bodies(0);
+  EXPECT_EQ(b.name(), "body1");
+  EXPECT_DOUBLE_EQ(b.mass(), 5000);
+  EXPECT_DOUBLE_EQ(b.position().z(), -0.5);  // CG = z only
+  EXPECT_DOUBLE_EQ(b.inertia().x(), 2000);
+  const double d = std::cbrt(4 * 8 / kPi), area = kPi * d * d / 4;
+  EXPECT_DOUBLE_EQ(b.hydrodynamics().diameter(), d);
+  EXPECT_DOUBLE_EQ(b.hydrodynamics().height(), d);
+  EXPECT_DOUBLE_EQ(b.hydrodynamics().drag_coefficient(), 1.5 / (d * d));
+  EXPECT_DOUBLE_EQ(b.hydrodynamics().heave_drag_coefficient(), 1.5 / area);
+  EXPECT_DOUBLE_EQ(b.hydrodynamics().added_mass(), 0.8);
+  CollectingSink sink;
+  const Frame last = Statics(s, "body1", &sink);
+  ASSERT_EQ(last.probes.size(), 1u);
+  const double z = last.probes[0].position_m.z(), expected = d / 2 - 5000 / (kRho * area);
+  std::printf("body centre %.12g m, Archimedes %.12g m\n", z, expected);
+  EXPECT_NEAR(z, expected, 1e-9 * d);
+}
+
+// A vertical rod (d 0.3 m, 6 m, 150 kg/m) hanging from a rope (EA 1e9 N,
+// 20 kg/m, 30 m) from a fixed point at -20 m by its end B: at rest the
+// rope's tension at the rod is the rod's weight less its buoyancy,
+// g (w L - rho (pi d^2 / 4) L), and its top end hangs below the fixed point
+// by the rope's stretched length.
+constexpr char kHangingRod[] = R"(----------------------- LINE TYPES ------------------------------------------
+TypeName   Diam    Mass/m     EA         BA/-zeta    EI         Cd     Ca     CdAx    CaAx
+(name)     (m)     (kg/m)     (N)        (N-s/-)     (N-m^2)    (-)    (-)    (-)     (-)
+rope       0.05    20         1.0e9      -0.5        0          1.2    1.0    0.0     0.0
+---------------------- ROD TYPES ------------------------------------
+TypeName      Diam     Mass/m    Cd     Ca      CdEnd    CaEnd
+(name)        (m)      (kg/m)    (-)    (-)     (-)      (-)
+weight        0.3      150       1.0    1.0     0.5      0.5
+---------------------- RODS ----------------------------------------
+ID   RodType  Attachment  Xa    Ya    Za    Xb    Yb    Zb   NumSegs  RodOutputs
+(#)  (name)    (#/key)    (m)   (m)   (m)   (m)   (m)   (m)  (-)       (-)
+1    weight    Free       0     0     -56   0     0     -50  3         -
+---------------------- POINTS --------------------------------
+ID    Type      X       Y       Z       Mass   Volume  CdA    Ca
+(#)   (-)       (m)     (m)     (m)     (kg)   (m^3)   (m^2)  (-)
+1     Fixed     0       0       -20     0      0       0      0
+---------------------- LINES ----------------------------------------
+ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
+(#)   (name)     (#)      (#)       (m)       (-)     (-)
+1     rope       1        R1B       30        10      -
+----------------------- OUTPUTS -----------------------------------------
+FairTen1
+)";
+
+TEST(MoorDynBodiesTest, RodHangingFromALineAtRestCarriesItsWeightLessBuoyancy) {
+  const v1::Scene s = Read(Deck(kHangingRod));
+  ASSERT_EQ(s.bodies_size(), 1);
+  // The rope's end B is pinned to the rod's end B, (L / 2, 0, 0) in its axes.
+  bool joined = false;
+  for (const v1::Joint& j : s.joints()) {
+    if (j.b().body() != "rod1") continue;
+    joined = true;
+    EXPECT_EQ(j.a().cable(), "line1");
+    EXPECT_DOUBLE_EQ(j.a().s(), 30);
+    EXPECT_DOUBLE_EQ(j.b().point().x(), 3);
+  }
+  EXPECT_TRUE(joined);
+  CollectingSink sink;
+  const Frame last = Statics(s, "rod1", &sink);
+  ASSERT_EQ(last.probe_tensions.size(), 1u);
+  const double volume = kPi * 0.3 * 0.3 / 4 * 6;
+  const double net = kG * (150 * 6 - kRho * volume);
+  std::printf("tension at the rod %.9g N, by hand %.9g N\n", last.probe_tensions[0], net);
+  // The end tension is the element's axial force at its end: rounding of
+  // the strain of a 1e9 N rope (1e-16 x 1e9 / 1e4 N ~ 1e-11 relative),
+  // Newton's tolerance, and the engineering law's exactness; 1e-6.
+  EXPECT_NEAR(last.probe_tensions[0], net, 1e-6 * net);
+  // The rope hangs straight: its tension grows by its own weight in water
+  // per metre, so it stretches by (T_bottom L + w' L^2 / 2) / EA.
+  const double rope_wet = kG * (20 - kRho * kPi * 0.05 * 0.05 / 4);
+  const double stretch = (net * 30 + rope_wet * 30 * 30 / 2) / 1e9;
+  const double centre = -20 - 30 - stretch - 3;
+  std::printf("rod centre %.12g m, by hand %.12g m\n", last.probes[0].position_m.z(), centre);
+  EXPECT_NEAR(last.probes[0].position_m.z(), centre, 1e-6);
+  EXPECT_NEAR(last.probes[0].position_m.x(), 0, 1e-6);
+}
+
+// A body with a vertical rod rigidly on it (Body1), two 50 kg points on it
+// holding lines, turned by yaw 90 degrees: one scene body of the sum of
+// the masses at their common centre, inertia by the parallel-axis theorem,
+// the points where the rotation puts them.
+constexpr char kBodyWithRod[] = R"(----------------------- LINE TYPES ------------------------------------------
+TypeName   Diam    Mass/m     EA         BA/-zeta    EI         Cd     Ca     CdAx    CaAx
+(name)     (m)     (kg/m)     (N)        (N-s/-)     (N-m^2)    (-)    (-)    (-)     (-)
+chain      0.1     100        1.0e9      -0.5        0          1.2    1.0    0.4     0.0
+---------------------- ROD TYPES ------------------------------------
+TypeName      Diam     Mass/m    Cd     Ca      CdEnd    CaEnd
+(name)        (m)      (kg/m)    (-)    (-)     (-)      (-)
+can           2        500       0.6    1.0     1.2      1.0
+---------------------------- BODIES -----------------------------------------------------
+ID   Attachment  X0     Y0    Z0     r0      p0     y0     Mass  CG*   I*      Volume   CdA*   Ca
+(#)     (-)      (m)    (m)   (m)   (deg)   (deg)  (deg)   (kg)  (m)  (kg-m^2)  (m^3)   (m^2)  (-)
+1       free      0     0      -40   0       0      90     1e4   0    5e4     0        0      0
+---------------------- RODS ----------------------------------------
+ID   RodType  Attachment  Xa    Ya    Za    Xb    Yb    Zb   NumSegs  RodOutputs
+(#)  (name)    (#/key)    (m)   (m)   (m)   (m)   (m)   (m)  (-)       (-)
+1    can       Body1      0     0     -5    0     0     5    4         -
+---------------------- POINTS --------------------------------
+ID    Type      X       Y       Z       Mass   Volume  CdA    Ca
+(#)   (-)       (m)     (m)     (m)     (kg)   (m^3)   (m^2)  (-)
+1     Body1     2       0       0       50     0       0      0
+2     Body1     -2      0       0       50     0       0      0
+3     Fixed     0       300     -200    0      0       0      0
+4     Fixed     0       -300    -200    0      0       0      0
+---------------------- LINES ----------------------------------------
+ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
+(#)   (name)     (#)      (#)       (m)       (-)     (-)
+1     chain      3        1         340       20      -
+2     chain      4        2         340       20      -
+----------------------- OUTPUTS -----------------------------------------
+Point1Pz
+)";
+
+TEST(MoorDynBodiesTest, BodyWithRodAndPointsIsOneRigidBody) {
+  const v1::Scene s = Read(Deck(kBodyWithRod));
+  ASSERT_EQ(s.bodies_size(), 1);
+  const v1::Body& b = BodyNamed(s, "body1");
+  const double rod = 500 * 10, total = 1e4 + rod + 100;
+  EXPECT_DOUBLE_EQ(b.mass(), total);
+  EXPECT_NEAR(b.position().z(), -40, 1e-12);
+  EXPECT_NEAR(b.position().x(), 0, 1e-12);
+  // About z (the rod's axis): the body's 5e4, the rod's m r^2 / 2, the
+  // points' 2 x 50 x 2^2; about x: the rod's m (3 r^2 + L^2) / 12, and the
+  // points (on the world's y axis after the yaw) 2 x 50 x 2^2; about y: no
+  // point term.
+  const double rod_axial = rod * 1.0 / 2, rod_across = rod * (3 * 1.0 + 100) / 12;
+  EXPECT_NEAR(b.inertia().z(), 5e4 + rod_axial + 400, 1e-8);
+  EXPECT_NEAR(b.inertia().x(), 5e4 + rod_across + 400, 1e-8);
+  EXPECT_NEAR(b.inertia().y(), 5e4 + rod_across, 1e-8);
+  // The rod's cylinder, centred at the centre of mass.
+  EXPECT_DOUBLE_EQ(b.hydrodynamics().diameter(), 2);
+  EXPECT_DOUBLE_EQ(b.hydrodynamics().height(), 10);
+  // Both ends under water: twice CdEnd.
+  EXPECT_DOUBLE_EQ(b.hydrodynamics().heave_drag_coefficient(), 2.4);
+  // Point 1 at (2, 0, 0) in the body frame is at (0, 2, -40) after the yaw.
+  int pinned = 0;
+  for (const v1::Joint& j : s.joints()) {
+    if (j.b().body() != "body1") continue;
+    ++pinned;
+    EXPECT_NEAR(std::abs(j.b().point().y()), 2, 1e-12);
+    EXPECT_NEAR(j.b().point().x(), 0, 1e-12);
+  }
+  EXPECT_EQ(pinned, 2);
+  ASSERT_EQ(s.cables_size(), 2);
+  EXPECT_NEAR(s.cables(0).points(s.cables(0).points_size() - 1).y(), 2, 1e-12);
+  // The output channel Point1Pz: a probe on the body's point.
+  ASSERT_EQ(s.probes_size(), 1);
+  EXPECT_EQ(s.probes(0).body(), "body1");
+}
+
+// Fixed, coupled and coupled-pinned bodies; pinned, fixed and coupled
+// rods.
+TEST(MoorDynBodiesTest, MountsBecomeSupportsCoupledBodiesAndPins) {
+  const v1::Scene s = Read(Deck(R"(----------------------- LINE TYPES ------------------------------------------
+TypeName   Diam    Mass/m     EA         BA/-zeta    EI         Cd     Ca     CdAx    CaAx
+(name)     (m)     (kg/m)     (N)        (N-s/-)     (N-m^2)    (-)    (-)    (-)     (-)
+chain      0.1     100        1.0e9      -0.5        0          1.2    1.0    0.4     0.0
+---------------------- ROD TYPES ------------------------------------
+TypeName      Diam     Mass/m    Cd     Ca      CdEnd    CaEnd
+(name)        (m)      (kg/m)    (-)    (-)     (-)      (-)
+bar           0.2      50        0      0       0        0
+---------------------------- BODIES -----------------------------------------------------
+ID   Attachment  X0     Y0    Z0     r0      p0     y0     Mass  CG*   I*      Volume   CdA*   Ca
+(#)     (-)      (m)    (m)   (m)   (deg)   (deg)  (deg)   (kg)  (m)  (kg-m^2)  (m^3)   (m^2)  (-)
+1       Fixed     0     0      -200  0       0      90     0     0    0       0        0      0
+2       Coupled   100   0      -10   0       0      0      0     0    0       0        0      0
+3       CoupledPinned 0 100    -20   0       0      0      1e3   0    1e3     0        0      0
+---------------------- RODS ----------------------------------------
+ID   RodType  Attachment  Xa    Ya    Za    Xb    Yb    Zb   NumSegs  RodOutputs
+(#)  (name)    (#/key)    (m)   (m)   (m)   (m)   (m)   (m)  (-)       (-)
+1    bar       Pinned     50    50    -100  52    50    -100 1         -
+2    bar       Fixed      -50   0     -150  -50   0     -140 1         -
+3    bar       Body3Pinned 0    0     -1    0     0     -3   1         -
+---------------------- POINTS --------------------------------
+ID    Type      X       Y       Z       Mass   Volume  CdA    Ca
+(#)   (-)       (m)     (m)     (m)     (kg)   (m^3)   (m^2)  (-)
+1     Body1     10      0       0       0      0       0      0
+2     Body2     0       0       -1      0      0       0      0
+---------------------- LINES ----------------------------------------
+ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
+(#)   (name)     (#)      (#)       (m)       (-)     (-)
+1     chain      1        2         250       20      -
+2     chain      R2B      R1B       130       20      -
+)"));
+  // Body 1 is fixed: no body; line 1's end A is a ground pin where the yaw
+  // puts (10, 0, 0): the line starts at (0, 10, -200).
+  EXPECT_NEAR(s.cables(0).points(0).x(), 0, 1e-12);
+  EXPECT_NEAR(s.cables(0).points(0).y(), 10, 1e-12);
+  EXPECT_EQ(BodyNamed(s, "body2").coupled(), true);
+  EXPECT_FALSE(BodyNamed(s, "body3").coupled());
+  // Rod 2 is fixed: line 2 starts on the ground at its end B (a joint
+  // named by the rod's end).
+  EXPECT_DOUBLE_EQ(s.cables(1).points(0).z(), -140);
+  bool rod_end = false;
+  for (const v1::Joint& j : s.joints()) rod_end = rod_end || j.name() == "rod2B";
+  EXPECT_TRUE(rod_end);
+  int coupled_pins = 0, ground_pins = 0;
+  for (const v1::Joint& j : s.joints()) {
+    if (j.name() == "body3") {
+      EXPECT_TRUE(j.coupled());
+      EXPECT_EQ(j.a().body(), "body3");
+      ++coupled_pins;
+    }
+    if (j.name() == "rod1A") {
+      EXPECT_FALSE(j.has_b());
+      EXPECT_DOUBLE_EQ(j.a().point().x(), -1);  // end A of a 2 m rod
+      ++ground_pins;
+    }
+    if (j.name() == "rod3A") {
+      // End A of rod 3 on body 3's point (0, 0, -1) from its reference.
+      EXPECT_EQ(j.b().body(), "body3");
+      EXPECT_NEAR(j.b().point().z(), -1, 1e-12);
+    }
+  }
+  EXPECT_EQ(coupled_pins, 1);
+  EXPECT_EQ(ground_pins, 1);
+  // The scene is valid.
+  EXPECT_TRUE(SceneFromProto(s).ok()) << SceneFromProto(s).status();
+}
+
+TEST(MoorDynBodiesTest, RefusalsNameTheLineAndField) {
+  const std::string rod = Deck(kHangingRod);
+  // Deck(...) puts the deck's first row on line 3: the rod type on line
+  // 10, the rod on 14, the line on 22.
+  auto edited = [&](const std::string& from, const std::string& to) {
+    EXPECT_NE(rod.find(from), std::string::npos) << from;
+    return absl::StrReplaceAll(rod, {{from, to}});
+  };
+  EXPECT_EQ(Refusal(edited("1    weight    Free", "1    heavy     Free")),
+            "bad.dat:14: RODS RodType: unknown rod type \"heavy\" (define it in ROD TYPES before "
+            "RODS)");
+  EXPECT_EQ(Refusal(edited("1    weight    Free", "1    weight    Body2")),
+            "bad.dat:14: RODS Attachment: body 2 does not exist (define it in BODIES before RODS)");
+  EXPECT_EQ(Refusal(edited("R1B", "R2B")),
+            "bad.dat:22: LINES Attach: rod 2 does not exist (define it in RODS)");
+  EXPECT_EQ(Refusal(edited("1    weight    Free", "2    weight    Free")).substr(0, 18),
+            "bad.dat:14: RODS I");
+  // A horizontal rod with drag is read (its loads split along its axis);
+  // one within half its length of the surface is refused (its buoyancy
+  // would be the vertical cylinder's).
+  {
+    const v1::Scene horizontal = Read(edited("0     0     -50  3", "6     0     -56  3"));
+    ASSERT_EQ(horizontal.bodies_size(), 1);
+    EXPECT_TRUE(horizontal.bodies(0).hydrodynamics().along_axis());
+    EXPECT_DOUBLE_EQ(horizontal.bodies(0).axis().x(), 1);
+    EXPECT_DOUBLE_EQ(horizontal.bodies(0).hydrodynamics().heave_drag_coefficient(), 2 * 0.5);
+  }
+  EXPECT_NE(Refusal(edited("0     0     -56   0     0     -50  3", "0     0     -2    6     0     -2   3"))
+                .find("bad.dat:14: RODS Zb: a rod that is not vertical within half its length of "
+                      "the water surface"),
+            std::string::npos);
+  // A point on a body that does not exist.
+  const std::string body = Deck(kBodyWithRod);
+  EXPECT_EQ(Refusal(absl::StrReplaceAll(body, {{"1     Body1     2", "1     Body4     2"}})),
+            "bad.dat:22: POINTS Type: body 4 does not exist (define it in BODIES)");
+  // A second part with volume on one body.
+  EXPECT_NE(Refusal(absl::StrReplaceAll(body, {{"5e4     0        0", "5e4     3        0"}}))
+                .find("bad.dat:18: RODS RodType: a second part with volume"),
+            std::string::npos);
+  // The rod's cylinder off the centre of mass (the points' masses moved).
+  EXPECT_NE(Refusal(absl::StrReplaceAll(body, {{"2     Body1     -2      0       0       50",
+                                               "2     Body1     -2      0       0       0"}}))
+                .find("bad.dat:18: RODS Attachment: the displaced volume's centre lies"),
+            std::string::npos);
+  EXPECT_NE(Refusal(absl::StrReplaceAll(body, {{"-5    0     0     5    4",
+                                               "-5    0     0     5    0"}}))
+                .find("bad.dat:18: RODS NumSegs"),
+            std::string::npos);
+  EXPECT_NE(Refusal(absl::StrReplaceAll(body, {{"5e4     0        0      0",
+                                               "5e4     0        1|2|3  0"}}))
+                .find("bad.dat:14: BODIES CdA: \"1|2|3\": drag areas per axis"),
+            std::string::npos);
+}
+
+// MoorDyn's 3D seafloor file: nx ny, the ticks, then x y z per node.
+std::string SeafloorFile(const std::string& nodes) {
+  return absl::StrCat("3 2\n-100 0 100\n-50 50\n", nodes);
+}
+const char kFlatNodes[] =
+    "-100 -50 -60\n0 -50 -60\n100 -50 -60\n-100 50 -60\n0 50 -60\n100 50 -60\n";
+
+// A chain from (-80, 0) to (80, 0) at the bed, 200 m long, two ends on a
+// flat grid bed at 60 m below a 200 m deep water: it lies on the grid bed,
+// sunk by its weight in water per length over the stiffness per length.
+std::string SeafloorDeck() {
+  return Deck(R"(----------------------- LINE TYPES ------------------------------------------
+TypeName   Diam    Mass/m     EA         BA/-zeta    EI         Cd     Ca     CdAx    CaAx
+(name)     (m)     (kg/m)     (N)        (N-s/-)     (N-m^2)    (-)    (-)    (-)     (-)
+chain      0.1     100        1.0e9      -0.5        0          1.2    1.0    0.4     0.0
+---------------------- POINTS --------------------------------
+ID    Type      X       Y       Z       Mass   Volume  CdA    Ca
+(#)   (-)       (m)     (m)     (m)     (kg)   (m^3)   (m^2)  (-)
+1     Fixed     -80     0       -60     0      0       0      0
+2     Fixed     80      0       -60     0      0       0      0
+---------------------- LINES ----------------------------------------
+ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
+(#)   (name)     (#)      (#)       (m)       (-)     (-)
+1     chain      1        2         160       16      -
+---------------------- OPTIONS -----------------------------------------
+bed.txt       SeafloorFile  the bed
+3.0e6         kBot          bottom stiffness (Pa/m)
+)");
+}
+
+MoorDynFileReader Files(const std::string& bed) {
+  return [bed](std::string_view name) -> absl::StatusOr<std::string> {
+    if (name == "bed.txt") return bed;
+    return absl::NotFoundError(absl::StrCat("no file ", std::string(name)));
+  };
+}
+
+TEST(MoorDynBodiesTest, SeafloorFileBecomesTheBathymetryGrid) {
+  const v1::Scene s = Read(SeafloorDeck(), Files(SeafloorFile(
+      "-100 -50 -60\n0 -50 -61\n100 -50 -62\n-100 50 -63\n0 50 -64\n100 50 -65\n")));
+  const v1::Bathymetry& g = s.seabed().bathymetry();
+  EXPECT_EQ(g.nx(), 3);
+  EXPECT_EQ(g.ny(), 2);
+  EXPECT_DOUBLE_EQ(g.origin_x(), -100);
+  EXPECT_DOUBLE_EQ(g.origin_y(), -50);
+  EXPECT_DOUBLE_EQ(g.dx(), 100);
+  EXPECT_DOUBLE_EQ(g.dy(), 100);
+  ASSERT_EQ(g.depths_size(), 6);
+  for (int k = 0; k < 6; ++k) EXPECT_DOUBLE_EQ(g.depths(k), 60 + k);  // row-major, -z
+  EXPECT_DOUBLE_EQ(s.seabed().depth(), 0);
+  EXPECT_DOUBLE_EQ(s.fluid().water_depth(), 200);
+
+  // Refusals name the deck's line (17: the option) and the file's row.
+  const std::string deck = SeafloorDeck();
+  EXPECT_NE(Refusal(deck, Files(absl::StrCat("3 2\n-100 0 150\n-50 50\n", kFlatNodes)))
+                .find("bad.dat:17: OPTIONS SeafloorFile: bed.txt:2: tick 0 is off the even "
+                      "spacing: a non-rectangular"),
+            std::string::npos);
+  EXPECT_NE(Refusal(deck, Files(SeafloorFile("-100 -50 -60\n0 -50 -60\n100 -50 -60\n")))
+                .find("the node (-100, 50) is missing"),
+            std::string::npos);
+  EXPECT_NE(Refusal(deck, Files(SeafloorFile("-100 -50 -60\n-100 -50 -60\n")))
+                .find("bed.txt:5: a node given twice"),
+            std::string::npos);
+  EXPECT_NE(Refusal(deck, Files(SeafloorFile("-100 -20 -60\n"))).find("bed.txt:4: the node is "
+                                                                      "not on the grid"),
+            std::string::npos);
+  EXPECT_NE(Refusal(deck).find("bad.dat:17: OPTIONS SeafloorFile: \"bed.txt\": a seafloor file "
+                               "cannot be read here"),
+            std::string::npos);
+}
+
+TEST(MoorDynBodiesTest, ChainLiesOnTheSeafloorFilesBed) {
+  v1::Scene s = Read(SeafloorDeck(), Files(SeafloorFile(kFlatNodes)));
+  v1::Probe* p = s.add_probes();
+  p->set_name("mid");
+  p->set_cable("line1");
+  p->set_s(80);
+  const absl::StatusOr<Scene> scene = SceneFromProto(s);
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  CollectingSink sink;
+  RunOk(*scene, &sink);
+  ASSERT_FALSE(sink.frames().empty());
+  const double z = sink.frames().back().probes[0].position_m.z();
+  // Penetration = weight in water per length / (kBot d).
+  const double wet = kG * (100 - kRho * kPi * 0.01 / 4);
+  const double expected = -60 - wet / (3.0e6 * 0.1);
+  std::printf("chain's middle at %.9g m, on the grid bed %.9g m\n", z, expected);
+  // The element's cubic follows the uniform sinking exactly; Newton's
+  // tolerance; 1e-6 m.
+  EXPECT_NEAR(z, expected, 1e-6);
+}
+
+// Two lines of different diameters on a flat bed (kBot 3e6 Pa/m, cBot
+// 3e5 Pa s/m): MoorDyn's bed pressure acts on each line's diameter, so each
+// sinks by its own weight in water per length over kBot d.
+std::string TwoDiameterDeck() {
+  return Deck(R"(----------------------- LINE TYPES ------------------------------------------
+TypeName   Diam    Mass/m     EA         BA/-zeta    EI         Cd     Ca     CdAx    CaAx
+(name)     (m)     (kg/m)     (N)        (N-s/-)     (N-m^2)    (-)    (-)    (-)     (-)
+chain      0.1     100        1.0e9      -0.5        0          1.2    1.0    0.4     0.0
+rope       0.2     60         1.0e8      -0.5        0          1.2    1.0    0.4     0.0
+---------------------- POINTS --------------------------------
+ID    Type      X       Y       Z       Mass   Volume  CdA    Ca
+(#)   (-)       (m)     (m)     (m)     (kg)   (m^3)   (m^2)  (-)
+1     Fixed     -100    0       -200    0      0       0      0
+2     Fixed     0       0       -200    0      0       0      0
+3     Fixed     100     0       -200    0      0       0      0
+---------------------- LINES ----------------------------------------
+ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
+(#)   (name)     (#)      (#)       (m)       (-)     (-)
+1     chain      1        2         100       10      -
+2     rope       2        3         100       10      -
+---------------------- OPTIONS -----------------------------------------
+3.0e6         kBot          bottom stiffness (Pa/m)
+3.0e5         cBot          bottom damping (Pa-s/m)
+)");
+}
+
+TEST(MoorDynBodiesTest, LinesOfDifferentDiametersPressOnTheBedByTheirOwnDiameter) {
+  v1::Scene s = Read(TwoDiameterDeck());
+  ASSERT_EQ(s.cables_size(), 2);
+  // The scene's bed from the first type's diameter; the rope its own.
+  EXPECT_DOUBLE_EQ(s.seabed().stiffness(), 3.0e6 * 0.1);
+  EXPECT_DOUBLE_EQ(s.seabed().damping(), 3.0e5 * 0.1);
+  EXPECT_FALSE(s.cables(0).has_seabed_stiffness());
+  EXPECT_DOUBLE_EQ(s.cables(1).seabed_stiffness(), 3.0e6 * 0.2);
+  EXPECT_DOUBLE_EQ(s.cables(1).seabed_damping(), 3.0e5 * 0.2);
+  for (const auto& [name, cable] : {std::pair{"chain", "line1"}, std::pair{"rope", "line2"}}) {
+    v1::Probe* p = s.add_probes();
+    p->set_name(name);
+    p->set_cable(cable);
+    p->set_s(50);
+  }
+  const absl::StatusOr<Scene> scene = SceneFromProto(s);
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  CollectingSink sink;
+  RunOk(*scene, &sink);
+  ASSERT_FALSE(sink.frames().empty());
+  const Frame& last = sink.frames().back();
+  const double chain = -200 - kG * (100 - kRho * kPi * 0.01 / 4) / (3.0e6 * 0.1);
+  const double rope = -200 - kG * (60 - kRho * kPi * 0.04 / 4) / (3.0e6 * 0.2);
+  std::printf("chain's middle %.9g m (by hand %.9g), rope's %.9g m (by hand %.9g)\n",
+              last.probes[0].position_m.z(), chain, last.probes[1].position_m.z(), rope);
+  // 50 m from the ends (held at the bed's undisturbed level, which lifts
+  // the line near them) the bed carries the line's weight alone: measured
+  // within 0.1 % of each penetration (2.8e-6 m of the chain's 3.0e-3 m);
+  // tolerance 1 % of it. With the scene's stiffness for both, the rope's
+  // penetration would be twice as deep (9.1e-4 m, 100 % off).
+  EXPECT_NEAR(last.probes[0].position_m.z(), chain, 0.01 * (-200 - chain));
+  EXPECT_NEAR(last.probes[1].position_m.z(), rope, 0.01 * (-200 - rope));
+  // A cable's own bed needs a seabed.
+  v1::Scene dry = s;
+  dry.clear_seabed();
+  EXPECT_EQ(SceneFromProto(dry).status().message(), "cables[1].seabed_stiffness: needs a seabed");
+  v1::Scene soft = s;
+  soft.mutable_cables(1)->set_seabed_stiffness(0);
+  EXPECT_EQ(SceneFromProto(soft).status().message().substr(0, 35),
+            "cables[1].seabed_stiffness: must be");
+}
+
+std::string WriteTemp(const std::string& dir, const std::string& name, const std::string& text) {
+  std::filesystem::create_directories(dir);
+  const std::string path = dir + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+int Cli(const std::vector<std::string>& args, std::string* out, std::string* err) {
+  std::ostringstream o, e;
+  const int code = RunCli(args, o, e);
+  *out = o.str();
+  *err = e.str();
+  return code;
+}
+
+// Each deck of this file through the CLI: import writes a scene, run
+// solves it; a bad deck exits 2 naming the line.
+TEST(MoorDynBodiesTest, CliImportsAndRunsTheDecks) {
+  const std::string dir = absl::StrCat(::testing::TempDir(), "/moordyn_bodies_", ::getpid());
+  WriteTemp(dir, "bed.txt", SeafloorFile(kFlatNodes));
+  const std::vector<std::pair<std::string, std::string>> decks = {
+      {"floating_rod.txt", Deck(kFloatingRod)},
+      {"hanging_rod.dat", Deck(kHangingRod)},
+      {"body_with_rod.dat", Deck(kBodyWithRod)},
+      {"seafloor.dat", SeafloorDeck()},
+      {"two_diameters.dat", TwoDiameterDeck()}};
+  for (const auto& [name, text] : decks) {
+    SCOPED_TRACE(name);
+    const std::string deck = WriteTemp(dir, name, text);
+    std::string out, err;
+    EXPECT_EQ(Cli({"import", deck, "--out", deck + ".json"}, &out, &err), 0) << err;
+    EXPECT_TRUE(ReadSceneFile(deck + ".json").ok());
+    EXPECT_EQ(Cli({"run", deck, "--out", deck + ".csv"}, &out, &err), 0) << err;
+    EXPECT_NE(out.find("\"status\":\"ok\""), std::string::npos) << out;
+  }
+  const std::string bad =
+      WriteTemp(dir, "bad.dat", absl::StrReplaceAll(Deck(kHangingRod), {{"R1B", "R7B"}}));
+  std::string out, err;
+  EXPECT_EQ(Cli({"run", bad}, &out, &err), 2);
+  EXPECT_NE(err.find("bad.dat:22: LINES Attach: rod 7 does not exist"), std::string::npos) << err;
+}
+
+}  // namespace
+}  // namespace cablesim
