@@ -22,6 +22,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
 #include "client/cli.h"
+#include "tests/cli_test_util.h"
 #include "convert/moordyn_deck.h"
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
@@ -595,13 +596,7 @@ std::string WriteTemp(const std::string& dir, const std::string& name, const std
   return path;
 }
 
-int Cli(const std::vector<std::string>& args, std::string* out, std::string* err) {
-  std::ostringstream o, e;
-  const int code = RunCli(args, o, e);
-  *out = o.str();
-  *err = e.str();
-  return code;
-}
+using testing::Cli;
 
 // Each deck of this file through the CLI: import writes a scene, run
 // solves it; a bad deck exits 2 naming the line.

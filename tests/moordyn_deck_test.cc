@@ -23,6 +23,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
 #include "client/cli.h"
+#include "tests/cli_test_util.h"
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
 #include "server/request_checks.h"
@@ -432,13 +433,7 @@ std::string WriteTemp(const std::string& name, const std::string& text) {
   return path;
 }
 
-int Cli(const std::vector<std::string>& args, std::string* out, std::string* err) {
-  std::ostringstream o, e;
-  const int code = RunCli(args, o, e);
-  *out = o.str();
-  *err = e.str();
-  return code;
-}
+using testing::Cli;
 
 TEST(MoorDynDeckTest, CliImportWritesTheSceneAndRefusesABadDeckWithExit2) {
   const std::string deck = WriteTemp("deck.dat", kDeck);
