@@ -153,15 +153,23 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   // `next` (already started at that state, or null: made and started
   // here). False (the summary failed) when it cannot start.
   int64_t hht_steps = 0, next_explicit_try = 64;
+  // A stepper of `to` started at the state the stepper holds (time
+  // t_state), or null with the reason in `failed`.
+  auto StartAt = [&](Integrator to, double t_state,
+                     std::string* failed) -> std::unique_ptr<Stepper> {
+    model->SetInitialState(stepper->z(), stepper->v(), model->external_work(), t_state);
+    SolverSettings trial = stepping;
+    trial.integrator = to;
+    std::unique_ptr<Stepper> next = MakeStepper(model, trial);
+    if (!next->Initialize(failed)) return nullptr;
+    return next;
+  };
   auto SwitchTo = [&](Integrator to, std::unique_ptr<Stepper> next, const std::string& why,
                       double t_state) {
     if (next == nullptr) {
-      model->SetInitialState(stepper->z(), stepper->v(), model->external_work(), t_state);
-      SolverSettings trial = stepping;
-      trial.integrator = to;
-      next = MakeStepper(model, trial);
       std::string failed;
-      if (!next->Initialize(&failed)) {
+      next = StartAt(to, t_state, &failed);
+      if (next == nullptr) {
         Fail(summary, t_state,
              absl::StrFormat("AUTO could not change to %s at t = %.9g s: %s",
                              std::string(IntegratorName(to)), t_state, failed));
@@ -449,12 +457,8 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
           // steps on the pendulums, 0.1 times on the 1,000-element rope), so
           // HHT is tried for kTrialSteps steps, from that guess.
           if (2 * w.capped >= w.accepted) {
-            model->SetInitialState(stepper->z(), stepper->v(), model->external_work(), t);
-            SolverSettings trial = stepping;
-            trial.integrator = Integrator::kHht;
-            std::unique_ptr<Stepper> next = MakeStepper(model, trial);
             std::string failed;
-            if (next->Initialize(&failed)) {
+            if (std::unique_ptr<Stepper> next = StartAt(Integrator::kHht, t, &failed)) {
               parked = std::move(stepper);
               if (!SwitchTo(Integrator::kHht, std::move(next),
                             absl::StrFormat("AUTO's cost model at t = %.9g s: CENTRAL_DIFFERENCE's "
