@@ -21,7 +21,10 @@
 // Error [m]: the largest distance between a probe of the run and the same
 // probe of the reference run at every common output frame
 // (engine/output/probe_trajectory.h). Wall time [s]: RunScene, model build
-// included, frames kept in memory; median of `repeats` runs. The reference
+// included, frames kept in memory; median of `repeats` runs. CPU time [s]
+// (cpu_s_median): the process's CPU time over the same runs, median; on a
+// shared machine it is the steadier of the two (other processes' load
+// stretches wall time, not this process's CPU time). The reference
 // is the first of the scene's `reference` patches that runs; its own error
 // is estimated by rerunning it at twice its step (reference_self_error_m:
 // for a first-order reference about its error, for a second-order one about
@@ -29,6 +32,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -126,6 +130,7 @@ struct Outcome {
   std::string status;  // "ok", "failed" (numerically), "skipped" (rejected)
   std::string note;
   std::vector<double> walls;
+  std::vector<double> cpus;  // process CPU time of each run [s]
   RunSummary summary;
   ProbeTrajectory trajectory;
 };
@@ -134,6 +139,13 @@ struct Outcome {
 // past it is stopped and reported as failed, so one pathological variant
 // cannot stall the report.
 double g_max_run_seconds = 60;
+
+// CPU time of this process so far [s] (all its threads).
+double ProcessCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
 
 // Merges `patches` into `scene_json` in order and runs it `repeats` times.
 Outcome RunVariant(const std::string& scene_json, const std::vector<std::string>& patches,
@@ -164,12 +176,14 @@ Outcome RunVariant(const std::string& scene_json, const std::vector<std::string>
   for (int r = 0; r < std::max(1, repeats); ++r) {
     ProbeTrajectory trajectory;
     const auto start = Clock::now();
+    const double cpu_start = ProcessCpuSeconds();
     RunControl control;
     control.should_stop = [start] {
       return std::chrono::duration<double>(Clock::now() - start).count() > g_max_run_seconds;
     };
     absl::StatusOr<RunSummary> summary = RunScene(*scene, &trajectory, control);
     const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+    const double cpu = ProcessCpuSeconds() - cpu_start;
     if (!summary.ok()) {
       out.status = "skipped";
       out.note = std::string(summary.status().message());
@@ -186,6 +200,7 @@ Outcome RunVariant(const std::string& scene_json, const std::vector<std::string>
       return out;
     }
     out.walls.push_back(wall);
+    out.cpus.push_back(cpu);
   }
   out.status = "ok";
   return out;
@@ -200,7 +215,7 @@ std::string SolverPatch(const std::string& fields) {
 constexpr char kHeader[] =
     "scene,integrator,linear_solver,mode,step_s,tolerance,status,wall_s_median,wall_s_min,"
     "wall_s_max,repeats,steps,rejected_steps,newton_iterations,linear_iterations,"
-    "max_probe_error_m,reference,reference_self_error_m,note";
+    "max_probe_error_m,reference,reference_self_error_m,note,cpu_s_median";
 
 struct Reference {
   std::string label;
@@ -348,7 +363,8 @@ class Report {
         ran ? absl::StrCat(o.summary.newton_iterations) : "", ",",
         ran ? absl::StrCat(o.summary.linear_iterations) : "", ",",
         std::isfinite(error) ? Num(error) : "", ",", Csv(ref.label), ",",
-        std::isfinite(ref.self_error) ? Num(ref.self_error) : "", ",", Csv(note));
+        std::isfinite(ref.self_error) ? Num(ref.self_error) : "", ",", Csv(note), ",",
+        o.cpus.empty() ? "" : Num(Median(o.cpus)));
     *csv_ << line << "\n";
     csv_->flush();
     std::cerr << absl::StrFormat("  %-16s %-28s %-7s %-8s h=%-8g tol=%-8g %-7s %9.4f s  err %.3g m %s\n",
