@@ -51,7 +51,7 @@ double CableSurfaceBuoyancy<D>::ElementEnergy(const ForceState& s, const Element
   double u = 0;
   for (int g = 0; g < element.gauss_points(); ++g) {
     r.head<D>() = element.GaussPosition(e, g);
-    const double eta = waves ? waves->At(r, s.time).elevation_m : 0.0;
+    const double eta = waves ? waves->ElevationAt(r, s.time) : 0.0;
     // U = rho_f A |g| int max(h - eta, 0) dx.
     u += el.buoyancy_n_m * element.GaussLength(g) * std::max(surface_.Height(r) - eta, 0.0);
   }

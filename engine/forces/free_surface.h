@@ -52,7 +52,7 @@ struct FreeSurface {
         continue;
       }
       r.template head<D>() = element.GaussPosition(e, g);
-      wet[g] = Wet(r, waves ? waves->At(r, t).elevation_m : 0.0);
+      wet[g] = Wet(r, waves ? waves->ElevationAt(r, t) : 0.0);
     }
   }
 };

@@ -79,6 +79,7 @@ void WaveField::AddJonswap(double hs_m, double tp_s, double gamma,
     c.direction = d;
     // 53 random bits, uniform in [0, 1).
     c.phase_rad = 2 * std::numbers::pi * static_cast<double>(random() >> 11) * 0x1.0p-53;
+    c.depth_decay = std::exp(-2 * c.wavenumber_1_m * depth_);
     components_.push_back(c);
   }
 }
@@ -91,6 +92,7 @@ void WaveField::AddComponent(double amplitude_m, double omega_rad_s,
   c.wavenumber_1_m = Wavenumber(omega_rad_s, depth_, g_);
   c.direction = Horizontal(direction);
   c.phase_rad = phase_rad;
+  c.depth_decay = std::exp(-2 * c.wavenumber_1_m * depth_);
   components_.push_back(c);
 }
 
@@ -151,7 +153,7 @@ WaveField::Kinematics WaveField::At(const Eigen::Vector3d& r, double t) const {
     // cosh(k (z + h)) / sinh(k h) and sinh(k (z + h)) / sinh(k h) in a form
     // that neither overflows in deep water nor loses digits.
     const double e1 = std::exp(k * z), e2 = std::exp(-2 * k * (z + depth_)),
-                 e3 = std::exp(-2 * k * depth_);
+                 e3 = c.depth_decay;
     const double ch = e1 * (1 + e2) / (1 - e3), sh = e1 * (1 - e2) / (1 - e3);
     const double aw = c.amplitude_m * w;
     eta += c.amplitude_m * cs;
@@ -162,6 +164,21 @@ WaveField::Kinematics WaveField::At(const Eigen::Vector3d& r, double t) const {
   out.velocity_m_s = ramp * u;
   out.acceleration_m_s2 = ramp * a + ramp_rate * u;
   return out;
+}
+
+double WaveField::ElevationAt(const Eigen::Vector3d& r, double t) const {
+  double ramp = 1;
+  if (ramp_s_ > 0 && t < ramp_s_) {
+    if (t <= 0) return 0;
+    ramp = 0.5 * (1 - std::cos(std::numbers::pi * t / ramp_s_));
+  }
+  double eta = mean_elevation_m_;
+  for (const Component& c : components_) {
+    const double theta =
+        c.wavenumber_1_m * c.direction.dot(r) - c.omega_rad_s * t + c.phase_rad;
+    eta += c.amplitude_m * std::cos(theta);
+  }
+  return ramp * eta;
 }
 
 }  // namespace cablesim

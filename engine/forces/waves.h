@@ -81,6 +81,9 @@ class WaveField {
     double wavenumber_1_m = 0;
     Eigen::Vector3d direction = Eigen::Vector3d::UnitX();  // horizontal, unit
     double phase_rad = 0;
+    // exp(-2 k h) for the field's depth h, set when the component is added
+    // (At's deep-water-safe cosh and sinh ratios use it at every point).
+    double depth_decay = 0;
   };
   struct Kinematics {
     Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();
@@ -137,6 +140,12 @@ class WaveField {
 
   // The kinematics at point r [m] and time t [s]. Allocates nothing.
   Kinematics At(const Eigen::Vector3d& r, double t) const;
+
+  // At(r, t).elevation_m alone, to the bit, without the velocities and
+  // accelerations (one cosine per component instead of a cosine, a sine
+  // and two exponentials): the free surface's wet test and the buoyancy
+  // need only the elevation.
+  double ElevationAt(const Eigen::Vector3d& r, double t) const;
 
  private:
   Eigen::Vector3d Horizontal(const Eigen::Vector3d& direction) const;
