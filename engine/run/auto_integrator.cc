@@ -15,14 +15,6 @@ std::string ImplicitNeed(const MultibodyModel& model, const Scene& scene) {
   const SolverSettings& s = scene.solver;
   if (!s.auto_keep_implicit.empty())
     return absl::StrCat(s.auto_keep_implicit, " is given, which applies to implicit steppers only");
-  // CENTRAL_DIFFERENCE holds constraint rows (RATTLE); with them AUTO takes
-  // it at fixed steps only (its stable step checked below): adaptive steps
-  // with rows are not yet measured.
-  if (model.multipliers() > 0 && s.adaptive)
-    return absl::StrFormat(
-        "the scene has %d constraint rows (bodies, joints between parts or moving supports) "
-        "and asks for adaptive steps, which CENTRAL_DIFFERENCE is not yet measured with there",
-        model.multipliers());
   for (int c = 0; c < static_cast<int>(scene.cables.size()); ++c)
     if (scene.cables[c].winch.enabled)
       return absl::StrFormat("cables[%d] has a winch (a mass that changes with time)", c);
@@ -69,9 +61,14 @@ Integrator ChooseIntegrator(MultibodyModel* model, const Scene& scene, std::stri
     // once the controller has run a while: RunDynamic weighs the two by
     // the cost model and may change to HHT (and back).
     return Choose(Integrator::kCentralDifference,
-                  "no constraint rows, winch, contact or fluid; adaptive steps hold its error "
+                  absl::StrCat(model->multipliers() > 0
+                                   ? absl::StrFormat("no winch, contact or fluid; its %d constraint "
+                                                     "rows held by RATTLE",
+                                                     model->multipliers())
+                                   : std::string("no constraint rows, winch, contact or fluid"),
+                               "; adaptive steps hold its error "
                   "(and its stability: a growing mode's error is rejected); the run changes "
-                  "to HHT if the cost model finds the stable step makes it costlier",
+                  "to HHT if the cost model finds the stable step makes it costlier"),
                   reason);
   }
   std::string why;
