@@ -140,6 +140,51 @@ TEST(MoorDynBodiesTest, FreeVerticalRodFloatsAtItsDraft) {
   EXPECT_NEAR(last.probes[0].position_m.x(), 3, 1e-9);
 }
 
+// MoorDyn's rod_tests/AddedMass.txt: a free horizontal rod (d 0.5 m, 2 m
+// long, 100 kg/m) placed 10 m down, lighter than the water it displaces,
+// rises to the surface. Its buoyancy is the vertical cylinder's of the same
+// length (BodyFluidLoad), so it floats where w L = rho (pi d^2 / 4) s, its
+// centre at L / 2 - s, and nothing moves it across: x and y stay where the
+// deck put them. At that draft the buoyancy cancels the weight in the
+// same entries, and Newton measured its residual against that rounding
+// (relative residual 1 after 500 iterations at load factor 0.7) until the
+// terms' own size set the scale (MultibodyModel::NetForce).
+TEST(MoorDynBodiesTest, FreeHorizontalRodRisesToItsDraftWhereItIs) {
+  // The deck's own rows and options (MoorDyn's default g, 9.80665).
+  const v1::Scene s = Read(R"(--------------------- MoorDyn Input File ------------------------------------
+Put a buoyant rod with no drag but added mass 10 meters under water.
+---------------------- ROD TYPES ------------------------------------
+TypeName   Diam   Mass/m    Cd     Ca    CdEnd      CaEnd
+(name)    (m)    (kg/m)    (-)    (-)   (-)        (-)
+floatRod   0.5  100.0      0.0    1.0    0.0       0.0
+---------------------- RODS ----------------------------------------
+ID     RodType   Attachment  Xa    Ya    Za    Xb    Yb    Zb   NumSegs   RodOutputs
+(#)    (name)    (#/key)     (m)   (m)   (m)   (m)   (m)   (m)  (-)       (-)
+1      floatRod  free        0     -1    -10   0   1.0   -10    4       -
+-------------------------- SOLVER    OPTIONS-----------------------------------
+3.0e6     kb           - bottom stiffness
+3.0e5     cb           - bottom damping
+16.0      WtrDpth      - water depth
+0         TmaxIC       - max time for ic gen (s)
+------------------------- need this line --------------------------------------
+)");
+  ASSERT_EQ(s.bodies_size(), 1);
+  CollectingSink sink;
+  const Frame last = Statics(s, "rod1", &sink);
+  ASSERT_EQ(last.probes.size(), 1u);
+  const double length = 2, mass = 100 * length, area = kPi * 0.25 / 4;
+  const double expected = length / 2 - mass / (kRho * area);
+  const Eigen::Vector3d r = last.probes[0].position_m;
+  std::printf("rod centre (%.3g, %.3g, %.12g) m, Archimedes z %.12g m\n", r.x(), r.y(), r.z(),
+              expected);
+  // Buoyancy is linear in the height while the rod pierces the surface:
+  // Newton lands on the balance to its tolerance (1e-9 of the length).
+  EXPECT_NEAR(r.z(), expected, 1e-9 * length);
+  // Nothing acts across: the centre stays at x = y = 0 exactly.
+  EXPECT_EQ(r.x(), 0);
+  EXPECT_EQ(r.y(), 0);
+}
+
 // A free body (BODIES) of volume 8 m^3 and 5000 kg with its CG 0.5 m
 // below its reference point: a vertical cylinder as tall as wide
 // (d = (4 V / pi)^(1/3)) at the CG, floating where m = rho A s.
