@@ -1,11 +1,146 @@
 #include "engine/forces/cable_buoyancy.h"
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <utility>
 
 #include "engine/elements/gauss_quadrature.h"
+#include "engine/elements/hermite_shape.h"
 
 namespace cablesim {
+namespace {
+
+// The height above the still level along an element, h(xi) = a0 + a1 xi
+// + a2 xi^2 + a3 xi^3, xi = x / l in [0, 1], from the heights of its ends
+// h0, h1 [m] and the vertical components of their slopes d0, d1 [-] (the
+// Hermite cubic of the element's position, dotted with `up`).
+struct HeightCubic {
+  double a[4];
+  HeightCubic(double h0, double d0, double h1, double d1, double l) {
+    a[0] = h0;
+    a[1] = l * d0;
+    a[2] = -3 * h0 - 2 * l * d0 + 3 * h1 - l * d1;
+    a[3] = 2 * h0 + l * d0 - 2 * h1 + l * d1;
+  }
+  double operator()(double xi) const { return a[0] + xi * (a[1] + xi * (a[2] + xi * a[3])); }
+  double Slope(double xi) const { return a[1] + xi * (2 * a[2] + xi * 3 * a[3]); }
+};
+
+// The points of [0, 1] where h - c changes sign, in order: the cubic is
+// split at its turning points into monotone pieces, and each piece whose
+// ends differ in sign holds one root, found by bisection to rounding.
+// Returns how many (at most 3).
+int SignChanges(const HeightCubic& h, double c, double roots[3]) {
+  double cut[4];
+  int cuts = 0;
+  cut[cuts++] = 0;
+  // h' = a1 + 2 a2 xi + 3 a3 xi^2 = 0 inside (0, 1).
+  const double qa = 3 * h.a[3], qb = 2 * h.a[2], qc = h.a[1];
+  double turning[2];
+  int nt = 0;
+  if (qa != 0) {
+    const double disc = qb * qb - 4 * qa * qc;
+    if (disc > 0) {
+      const double sq = std::sqrt(disc);
+      // The stable pair of roots of a quadratic.
+      const double t = -0.5 * (qb + (qb >= 0 ? sq : -sq));
+      turning[nt++] = t / qa;
+      if (t != 0) turning[nt++] = qc / t;
+    }
+  } else if (qb != 0) {
+    turning[nt++] = -qc / qb;
+  }
+  if (nt == 2 && turning[0] > turning[1]) std::swap(turning[0], turning[1]);
+  for (int i = 0; i < nt; ++i)
+    if (turning[i] > 0 && turning[i] < 1) cut[cuts++] = turning[i];
+  cut[cuts++] = 1;
+  int n = 0;
+  for (int i = 0; i + 1 < cuts; ++i) {
+    double lo = cut[i], hi = cut[i + 1];
+    const bool above = h(lo) > c;
+    if (above == (h(hi) > c)) continue;
+    for (int k = 0; k < 200; ++k) {
+      const double mid = 0.5 * (lo + hi);
+      if (mid <= lo || mid >= hi) break;
+      if ((h(mid) > c) == above) {
+        lo = mid;
+      } else {
+        hi = mid;
+      }
+    }
+    roots[n++] = 0.5 * (lo + hi);
+  }
+  return n;
+}
+
+// A circular section of radius R whose centre is at height h above the
+// level, u = h / R in [-1, 1]: its dry fraction (the area above the level
+// over pi R^2), g(u) = (acos(-u) + u sqrt(1 - u^2)) / pi, and the
+// integral of g from -1, G(u) = (u acos(-u) + sqrt(1 - u^2)
+// - (1 - u^2)^(3/2) / 3) / pi (G(1) = 1).
+double DryFraction(double u) {
+  u = std::clamp(u, -1.0, 1.0);
+  return (std::acos(-u) + u * std::sqrt(1 - u * u)) / std::numbers::pi;
+}
+double DryFractionIntegral(double u) {
+  u = std::clamp(u, -1.0, 1.0);
+  const double c = 1 - u * u;
+  return (u * std::acos(-u) + std::sqrt(c) - c * std::sqrt(c) / 3) / std::numbers::pi;
+}
+
+}  // namespace
+
+template <int D>
+int CableSurfaceBuoyancy<D>::DryPoints(const Element& el, const AncfCableElement<D>& element,
+                                       const Eigen::Matrix<double, 4 * D, 1>& e,
+                                       DryPoint* points) const {
+  const Eigen::Matrix<double, D, 1> up = surface_.up.head<D>();
+  const double l = element.length(), r = el.radius_m;
+  Eigen::Vector3d ra = Eigen::Vector3d::Zero(), rb = Eigen::Vector3d::Zero();
+  ra.head<D>() = e.template segment<D>(0);
+  rb.head<D>() = e.template segment<D>(2 * D);
+  const HeightCubic h(surface_.Height(ra), up.dot(e.template segment<D>(D)), surface_.Height(rb),
+                      up.dot(e.template segment<D>(3 * D)), l);
+  // Breaks of [0, 1] where the section starts to leave the water (h = -R)
+  // and is wholly out of it (h = R).
+  double cut[8];
+  int cuts = 0;
+  cut[cuts++] = 0;
+  cuts += SignChanges(h, -r, cut + cuts);
+  if (r > 0) cuts += SignChanges(h, r, cut + cuts);
+  cut[cuts++] = 1;
+  std::sort(cut, cut + cuts);
+  static const GaussRule two = MakeGaussRule(2), band = MakeGaussRule(kBandPoints);
+  int n = 0;
+  for (int i = 0; i + 1 < cuts; ++i) {
+    const double a = cut[i], b = cut[i + 1];
+    if (!(b > a)) continue;
+    const double mid = h(0.5 * (a + b));
+    if (mid <= -r) continue;  // wet: nothing taken back
+    // Wholly dry: g = 1, and two points integrate the cubic exactly; else
+    // the section pierces the level along the whole piece.
+    const bool dry = mid >= r;
+    const GaussRule& rule = dry ? two : band;
+    for (int g = 0; g < rule.n; ++g) {
+      DryPoint& p = points[n++];
+      p.xi = a + (b - a) * rule.xi[g];
+      p.weight = (b - a) * rule.weight[g] * l;
+      const double height = h(p.xi);
+      if (dry) {
+        p.fraction = 1;
+        p.rate = 0;
+        p.potential = height;
+      } else {
+        const double u = height / r;
+        p.fraction = DryFraction(u);
+        p.rate = 2 / (std::numbers::pi * r) * std::sqrt(std::max(0.0, 1 - u * u));
+        p.potential = r * DryFractionIntegral(u);
+      }
+    }
+  }
+  return n;
+}
 
 template <int D>
 void CableSurfaceBuoyancy<D>::AddAppliedLoad(const ForceState& s, ForceOutput* out) const {
@@ -14,8 +149,38 @@ void CableSurfaceBuoyancy<D>::AddAppliedLoad(const ForceState& s, ForceOutput* o
   const WaveField* waves = use_waves_ ? s.waves : nullptr;
   bool wet[GaussRule::kMaxPoints];
   typename AncfCableElement<D>::Coords fe;
+  typename AncfCableElement<D>::Matrix ke;
+  DryPoint points[kMaxDryPoints];
   for (const Element& el : elements_) {
     const auto e = s.q->template segment<kN>(el.first_coord);
+    if (!use_waves_) {
+      // STATIC (the still level): each section's dry fraction (DryPoints).
+      const int n = DryPoints(el, el.element, e, points);
+      if (n == 0) continue;
+      const double w = s.load_factor * el.buoyancy_n_m;
+      const Eigen::Matrix<double, D, 1> up = surface_.up.head<D>();
+      fe.setZero();
+      if (out->matrix) ke.setZero();
+      double sh[4];
+      for (int g = 0; g < n; ++g) {
+        const DryPoint& p = points[g];
+        HermiteShape(p.xi, el.element.length(), sh);
+        for (int k = 0; k < 4; ++k)
+          fe.template segment<D>(k * D) -= (p.weight * w * p.fraction * sh[k]) * up;
+        // -dF/de = w g'(h) s s^T (x) up up^T: over a piercing section the
+        // waterplane stiffness rho_f g A / |dh/dx| of the line there.
+        if (out->matrix && p.rate > 0)
+          for (int j = 0; j < 4; ++j)
+            for (int k = 0; k < 4; ++k)
+              ke.template block<D, D>(j * D, k * D) +=
+                  (p.weight * w * p.rate * sh[j] * sh[k]) * up * up.transpose();
+      }
+      out->full->template segment<kN>(el.first_coord) += fe;
+      out->size = std::max(out->size, fe.template lpNorm<Eigen::Infinity>());
+      if (out->matrix)
+        out->map.ScatterRange(el.first_coord, kN, ke.data(), kN, out->scale, out->matrix);
+      continue;
+    }
     surface_.WetPoints<D>(el.element, e, waves, s.time, wet);
     // q = -rho_f A |g| up on the dry points [N/m], scaled with gravity.
     const typename AncfCableElement<D>::Point q =
@@ -47,8 +212,14 @@ double CableSurfaceBuoyancy<D>::ElementEnergy(const ForceState& s, const Element
   constexpr int kN = 4 * D;
   const WaveField* waves = use_waves_ ? s.waves : nullptr;
   const auto e = s.q->template segment<kN>(el.first_coord);
-  Eigen::Vector3d r = Eigen::Vector3d::Zero();
   double u = 0;
+  if (!use_waves_) {
+    DryPoint points[kMaxDryPoints];
+    const int n = DryPoints(el, element, e, points);
+    for (int g = 0; g < n; ++g) u += el.buoyancy_n_m * points[g].weight * points[g].potential;
+    return u;
+  }
+  Eigen::Vector3d r = Eigen::Vector3d::Zero();
   for (int g = 0; g < element.gauss_points(); ++g) {
     r.head<D>() = element.GaussPosition(e, g);
     const double eta = waves ? waves->At(r, s.time).elevation_m : 0.0;
