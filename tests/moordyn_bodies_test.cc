@@ -185,6 +185,51 @@ ID     RodType   Attachment  Xa    Ya    Za    Xb    Yb    Zb   NumSegs   RodOut
   EXPECT_EQ(r.y(), 0);
 }
 
+// MoorDyn's seafloor.txt without its seafloor: a 10 kg point on a
+// neutrally buoyant line (the water's density, EA 1e9 N, 32 m) from a
+// fixed point, placed 29.7 m away and 10 m to the side. The line is laid
+// with a corner (a slack chord), stretched 0.1 % (a tension of 1e6 N at
+// the layout), and must swing under the point to relax; at rest the point
+// hangs straight below the fixed point, the line's tension its weight m g
+// all along, so at z = -L (1 + m g / EA). The first load increment took
+// 748 Newton iterations (StaticSolver::kLayoutIterations), and failed
+// after 500 at each of its 12 bisections. Tolerances: the axial position
+// to 1e-9 m (the line's axial stiffness EA / L = 3e7 N/m against the
+// solve's residual), across to 1e-6 m (the pendulum's m g / L = 3 N/m).
+TEST(MoorDynBodiesTest, PointOnANeutrallyBuoyantLineSwingsUnderItsFixedPoint) {
+  const v1::Scene s = Read(R"(--------------------- MoorDyn Input File ------------------------------------
+A pendulum on a line as dense as the water
+----------------------- LINE TYPES ------------------------------------------
+TypeName   Diam    Mass/m     EA         BA/-zeta    EI         Cd     Ca     CdAx    CaAx
+(name)     (m)     (kg/m)     (N)        (N-s/-)     (N-m^2)    (-)    (-)    (-)     (-)
+main       0.1     7.853981634  1.0E9      -0.01       0          0.0    0.0    0.0     0.0
+---------------------- POINT PROPERTIES --------------------------------
+ID    Type      X       Y       Z       Mass   Volume  CdA    Ca
+(#)   (-)       (m)     (m)     (m)     (kg)   (m^3)   (m^2)  (-)
+1     Fixed     0       -1       0       0      0       0      0
+2     Free      10      -1       -28    1E1    0       0      0
+---------------------- LINES ----------------------------------------
+ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
+(#)   (name)     (#)      (#)       (m)       (-)     (-)
+1     main       1        2         32.0      20      p
+---------------------- OPTIONS -----------------------------------------
+1000.0        WtrDnsty      water density (kg/m^3)
+500           WtrDpth       water depth (m)
+------------------------- need this line --------------------------------------
+)");
+  ASSERT_EQ(s.bodies_size(), 1);
+  CollectingSink sink;
+  const Frame last = Statics(s, "point2", &sink);
+  ASSERT_EQ(last.probes.size(), 1u);
+  const double weight = 10 * 9.80665, z = -32 * (1 + weight / 1e9);
+  const Eigen::Vector3d r = last.probes[0].position_m;
+  std::printf("point (%.9g, %.9g, %.12g) m, below the fixed point at z %.12g m\n", r.x(), r.y(),
+              r.z(), z);
+  EXPECT_NEAR(r.z(), z, 1e-9);
+  EXPECT_NEAR(r.x(), 0, 1e-6);
+  EXPECT_NEAR(r.y(), -1, 1e-6);
+}
+
 // A free body (BODIES) of volume 8 m^3 and 5000 kg with its CG 0.5 m
 // below its reference point: a vertical cylinder as tall as wide
 // (d = (4 V / pi)^(1/3)) at the CG, floating where m = rho A s.
