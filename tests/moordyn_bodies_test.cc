@@ -7,6 +7,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -228,6 +229,104 @@ ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
   EXPECT_NEAR(r.z(), z, 1e-9);
   EXPECT_NEAR(r.x(), 0, 1e-6);
   EXPECT_NEAR(r.y(), -1, 1e-6);
+}
+
+// A float in the surface (MoorDyn's tripod.txt's kind): a short, thick,
+// buoyant line (d 0.8 m, 0.6 m, 130 kg/m) whose top end is free, on a
+// tether (1.1 m) from a junction held by three legs (20.2 m, taut under
+// the float's lift) to anchors 16 m down (the bed 4 m below them: no line
+// touches it), laid tilted and off-centre. The float's section pierces the surface, so its buoyancy
+// above the level is STATIC's dry fraction of the section (cable_buoyancy.h),
+// which under the point-wise switch had no equilibrium (Newton hopped
+// between a Gauss point wet and dry for 500 iterations at each of 12
+// bisections). At rest the anchors hold the lines' weight in water less the
+// float's buoyancy, and what the float loses above the level is, for its
+// straight axis (EI 9e9 N m^2: it bends by under 1e-8 m) between its end
+// nodes at heights h0, h1 over a length L, rho A g L (R G(h1 / R) -
+// R G(h0 / R)) / (h1 - h0) (G the dry fraction's integral; its level
+// limit g(h0 / R) L). Tolerance 1e-6 of the float's buoyancy: the
+// solve's residual (8e-9 relative) and the float's bending.
+TEST(MoorDynBodiesTest, FloatInTheSurfaceOnATetheredTripodBalancesItsWeights) {
+  v1::Scene s = Read(R"(--------------------- MoorDyn Input File ------------------------------------
+A float on a tether and three legs
+----------------------- LINE TYPES ------------------------------------------
+TypeName   Diam    Mass/m     EA         BA/-zeta    EI         Cd     Ca     CdAx    CaAx
+(name)     (m)     (kg/m)     (N)        (N-s/-)     (N-m^2)    (-)    (-)    (-)     (-)
+float      0.8     130        2.0E9      -0.5        9.0E9      1.2    1.0    0.4     1.0
+tether     0.025   3.8        2.5E7      -0.5        990        1.2    1.0    0.08    1.0
+leg        0.01    0.195      5.0E6      -0.5        31         1.2    1.0    0.08    1.0
+---------------------- POINTS --------------------------------
+ID    Type      X       Y       Z       Mass   Volume  CdA    Ca
+(#)   (-)       (m)     (m)     (m)     (kg)   (m^3)   (m^2)  (-)
+1     Free      0       0       -0.2    0      0       0      0
+2     Free      0.55    0.1     0.1     0      0       0      0
+3     Free      -0.1    0       -1.3    0      0       0      0
+4     Fixed     14      0       -16     0      0       0      0
+5     Fixed     -5.9    12.7    -16     0      0       0      0
+6     Fixed     -8.0    -11.5   -16     0      0       0      0
+---------------------- LINES ----------------------------------------
+ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
+(#)   (name)     (#)      (#)       (m)       (-)     (-)
+1     float      1        2         0.6       3       p
+2     tether     3        1         1.1       5       p
+3     leg        3        4         20.2      14      p
+4     leg        3        5         20.2      14      p
+5     leg        3        6         20.2      14      p
+---------------------- OPTIONS -----------------------------------------
+20.0          WtrDpth       water depth (m)
+------------------------- need this line --------------------------------------
+)");
+  s.mutable_output()->set_shape(true);
+  s.mutable_output()->set_reactions(true);
+  const absl::StatusOr<Scene> scene = SceneFromProto(s);
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  CollectingSink sink;
+  const RunSummary summary = RunOk(*scene, &sink);
+  ASSERT_FALSE(sink.frames().empty());
+  const Frame& last = sink.frames().back();
+  // The float's end nodes (cable 0, 3 elements: nodes 0 to 3).
+  ASSERT_GE(last.nodes.size(), 4u);
+  const Eigen::Vector3d a = last.nodes[0], b = last.nodes[3];
+  const double g = 9.80665, rho = 1025, r = 0.4, area = kPi * r * r;
+  const double float_length = 0.6, h0 = a.z(), h1 = b.z();
+  auto big_g = [](double u) {
+    u = std::clamp(u, -1.0, 1.0);
+    const double c = 1 - u * u;
+    return (u * std::acos(-u) + std::sqrt(c) - c * std::sqrt(c) / 3) / kPi;
+  };
+  auto dry_fraction = [](double u) {
+    u = std::clamp(u, -1.0, 1.0);
+    return (std::acos(-u) + u * std::sqrt(1 - u * u)) / kPi;
+  };
+  const double dry_length = std::abs(h1 - h0) > 1e-9
+                                ? float_length * r * (big_g(h1 / r) - big_g(h0 / r)) / (h1 - h0)
+                                : float_length * dry_fraction(h0 / r);
+  // Weights in water [N] (down): mu - rho A per length, times g L.
+  auto wet = [&](double mu, double d, double length) {
+    return (mu - rho * kPi * d * d / 4) * g * length;
+  };
+  const double weights = wet(130, 0.8, 0.6) + wet(3.8, 0.025, 1.1) + 3 * wet(0.195, 0.01, 20.2);
+  const double lost = rho * area * g * dry_length;
+  // The anchors: the joints to ground (the others join line ends). A
+  // joint's reaction is the force on its side a, the line.
+  ASSERT_EQ(last.reactions.size(), static_cast<size_t>(s.joints_size()));
+  double held = 0;  // the anchors' upward force on the lines
+  int anchors = 0;
+  for (int j = 0; j < s.joints_size(); ++j) {
+    if (s.joints(j).has_b()) continue;
+    held += last.reactions[j].force.z();
+    ++anchors;
+  }
+  EXPECT_EQ(anchors, 3);
+  std::printf("float from z %.6f to %.6f m (dry %.6f m); anchors hold %.9g N, weights %.9g N "
+              "+ buoyancy lost %.9g N = %.9g N; residual %.3g\n",
+              h0, h1, dry_length, held, weights, lost, weights + lost,
+              summary.max_newton_residual);
+  // The float pierces the surface (else the test tests nothing new).
+  EXPECT_LT(std::min(h0, h1), r);
+  EXPECT_GT(std::max(h0, h1), -r);
+  // The anchors pull the lines down by their loads: held = weights + lost.
+  EXPECT_NEAR(held, weights + lost, 1e-6 * rho * area * g * float_length);
 }
 
 // A free body (BODIES) of volume 8 m^3 and 5000 kg with its CG 0.5 m
