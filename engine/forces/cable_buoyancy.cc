@@ -7,72 +7,10 @@
 
 #include "engine/elements/gauss_quadrature.h"
 #include "engine/elements/hermite_shape.h"
+#include "engine/forces/element_cubic.h"
 
 namespace cablesim {
 namespace {
-
-// The height above the still level along an element, h(xi) = a0 + a1 xi
-// + a2 xi^2 + a3 xi^3, xi = x / l in [0, 1], from the heights of its ends
-// h0, h1 [m] and the vertical components of their slopes d0, d1 [-] (the
-// Hermite cubic of the element's position, dotted with `up`).
-struct HeightCubic {
-  double a[4];
-  HeightCubic(double h0, double d0, double h1, double d1, double l) {
-    a[0] = h0;
-    a[1] = l * d0;
-    a[2] = -3 * h0 - 2 * l * d0 + 3 * h1 - l * d1;
-    a[3] = 2 * h0 + l * d0 - 2 * h1 + l * d1;
-  }
-  double operator()(double xi) const { return a[0] + xi * (a[1] + xi * (a[2] + xi * a[3])); }
-  double Slope(double xi) const { return a[1] + xi * (2 * a[2] + xi * 3 * a[3]); }
-};
-
-// The points of [0, 1] where h - c changes sign, in order: the cubic is
-// split at its turning points into monotone pieces, and each piece whose
-// ends differ in sign holds one root, found by bisection to rounding.
-// Returns how many (at most 3).
-int SignChanges(const HeightCubic& h, double c, double roots[3]) {
-  double cut[4];
-  int cuts = 0;
-  cut[cuts++] = 0;
-  // h' = a1 + 2 a2 xi + 3 a3 xi^2 = 0 inside (0, 1).
-  const double qa = 3 * h.a[3], qb = 2 * h.a[2], qc = h.a[1];
-  double turning[2];
-  int nt = 0;
-  if (qa != 0) {
-    const double disc = qb * qb - 4 * qa * qc;
-    if (disc > 0) {
-      const double sq = std::sqrt(disc);
-      // The stable pair of roots of a quadratic.
-      const double t = -0.5 * (qb + (qb >= 0 ? sq : -sq));
-      turning[nt++] = t / qa;
-      if (t != 0) turning[nt++] = qc / t;
-    }
-  } else if (qb != 0) {
-    turning[nt++] = -qc / qb;
-  }
-  if (nt == 2 && turning[0] > turning[1]) std::swap(turning[0], turning[1]);
-  for (int i = 0; i < nt; ++i)
-    if (turning[i] > 0 && turning[i] < 1) cut[cuts++] = turning[i];
-  cut[cuts++] = 1;
-  int n = 0;
-  for (int i = 0; i + 1 < cuts; ++i) {
-    double lo = cut[i], hi = cut[i + 1];
-    const bool above = h(lo) > c;
-    if (above == (h(hi) > c)) continue;
-    for (int k = 0; k < 200; ++k) {
-      const double mid = 0.5 * (lo + hi);
-      if (mid <= lo || mid >= hi) break;
-      if ((h(mid) > c) == above) {
-        lo = mid;
-      } else {
-        hi = mid;
-      }
-    }
-    roots[n++] = 0.5 * (lo + hi);
-  }
-  return n;
-}
 
 // A circular section of radius R whose centre is at height h above the
 // level, u = h / R in [-1, 1]: its dry fraction (the area above the level
@@ -100,17 +38,21 @@ int CableSurfaceBuoyancy<D>::DryPoints(const Element& el, const AncfCableElement
   Eigen::Vector3d ra = Eigen::Vector3d::Zero(), rb = Eigen::Vector3d::Zero();
   ra.head<D>() = e.template segment<D>(0);
   rb.head<D>() = e.template segment<D>(2 * D);
-  const HeightCubic h(surface_.Height(ra), up.dot(e.template segment<D>(D)), surface_.Height(rb),
-                      up.dot(e.template segment<D>(3 * D)), l);
+  // The height h(xi) along the element.
+  const ElementCubic h =
+      ElementCubic::FromEnds(surface_.Height(ra), up.dot(e.template segment<D>(D)),
+                             surface_.Height(rb), up.dot(e.template segment<D>(3 * D)), l);
   // Breaks of [0, 1] where the section starts to leave the water (h = -R)
   // and is wholly out of it (h = R).
   double cut[8];
   int cuts = 0;
   cut[cuts++] = 0;
-  cuts += SignChanges(h, -r, cut + cuts);
-  if (r > 0) cuts += SignChanges(h, r, cut + cuts);
+  cuts += SignChanges(ElementCubic{{h.c[0] + r, h.c[1], h.c[2], h.c[3]}}, cut + cuts);
+  if (r > 0) cuts += SignChanges(ElementCubic{{h.c[0] - r, h.c[1], h.c[2], h.c[3]}}, cut + cuts);
   cut[cuts++] = 1;
-  std::sort(cut, cut + cuts);
+  // In order (insertion: at most 8 entries).
+  for (int i = 1; i < cuts; ++i)
+    for (int j = i; j > 0 && cut[j] < cut[j - 1]; --j) std::swap(cut[j], cut[j - 1]);
   static const GaussRule two = MakeGaussRule(2), band = MakeGaussRule(kBandPoints);
   int n = 0;
   for (int i = 0; i + 1 < cuts; ++i) {
