@@ -85,6 +85,42 @@ int CableSurfaceBuoyancy<D>::DryPoints(const Element& el, const AncfCableElement
 }
 
 template <int D>
+bool CableSurfaceBuoyancy<D>::StaticElementLoad(const Element& el, const ForceState& s,
+                                                typename AncfCableElement<D>::Coords* fe,
+                                                typename AncfCableElement<D>::Matrix* ke) const {
+  constexpr int kN = 4 * D;
+  DryPoint points[kMaxDryPoints];
+  const int n = DryPoints(el, el.element, s.q->template segment<kN>(el.first_coord), points);
+  if (n == 0) return false;
+  const double w = s.load_factor * el.buoyancy_n_m;
+  const Eigen::Matrix<double, D, 1> up = surface_.up.head<D>();
+  fe->setZero();
+  if (ke) ke->setZero();
+  double sh[4];
+  for (int g = 0; g < n; ++g) {
+    const DryPoint& p = points[g];
+    HermiteShape(p.xi, el.element.length(), sh);
+    for (int k = 0; k < 4; ++k)
+      fe->template segment<D>(k * D) -= (p.weight * w * p.fraction * sh[k]) * up;
+    // -dF/de = w g'(h) s s^T (x) up up^T: over a piercing section the
+    // waterplane stiffness rho_f g A / |dh/dx| of the line there.
+    if (ke && p.rate > 0)
+      for (int j = 0; j < 4; ++j)
+        for (int k = 0; k < 4; ++k)
+          ke->template block<D, D>(j * D, k * D) +=
+              (p.weight * w * p.rate * sh[j] * sh[k]) * up * up.transpose();
+  }
+  return true;
+}
+
+template <int D>
+bool CableSurfaceBuoyancy<D>::StaticLoadOfElement(int k, const ForceState& s,
+                                                  typename AncfCableElement<D>::Coords* fe) const {
+  if (use_waves_ || k < 0 || k >= static_cast<int>(elements_.size())) return false;
+  return StaticElementLoad(elements_[k], s, fe, nullptr);
+}
+
+template <int D>
 void CableSurfaceBuoyancy<D>::AddAppliedLoad(const ForceState& s, ForceOutput* out) const {
   constexpr int kN = 4 * D;
   if (!out->full) return;
@@ -92,31 +128,11 @@ void CableSurfaceBuoyancy<D>::AddAppliedLoad(const ForceState& s, ForceOutput* o
   bool wet[GaussRule::kMaxPoints];
   typename AncfCableElement<D>::Coords fe;
   typename AncfCableElement<D>::Matrix ke;
-  DryPoint points[kMaxDryPoints];
   for (const Element& el : elements_) {
     const auto e = s.q->template segment<kN>(el.first_coord);
     if (!use_waves_) {
-      // STATIC (the still level): each section's dry fraction (DryPoints).
-      const int n = DryPoints(el, el.element, e, points);
-      if (n == 0) continue;
-      const double w = s.load_factor * el.buoyancy_n_m;
-      const Eigen::Matrix<double, D, 1> up = surface_.up.head<D>();
-      fe.setZero();
-      if (out->matrix) ke.setZero();
-      double sh[4];
-      for (int g = 0; g < n; ++g) {
-        const DryPoint& p = points[g];
-        HermiteShape(p.xi, el.element.length(), sh);
-        for (int k = 0; k < 4; ++k)
-          fe.template segment<D>(k * D) -= (p.weight * w * p.fraction * sh[k]) * up;
-        // -dF/de = w g'(h) s s^T (x) up up^T: over a piercing section the
-        // waterplane stiffness rho_f g A / |dh/dx| of the line there.
-        if (out->matrix && p.rate > 0)
-          for (int j = 0; j < 4; ++j)
-            for (int k = 0; k < 4; ++k)
-              ke.template block<D, D>(j * D, k * D) +=
-                  (p.weight * w * p.rate * sh[j] * sh[k]) * up * up.transpose();
-      }
+      // STATIC (the still level): each section's dry fraction.
+      if (!StaticElementLoad(el, s, &fe, out->matrix ? &ke : nullptr)) continue;
       out->full->template segment<kN>(el.first_coord) += fe;
       out->size = std::max(out->size, fe.template lpNorm<Eigen::Infinity>());
       if (out->matrix)

@@ -106,6 +106,12 @@ class CableSurfaceBuoyancy : public ForceContributor {
   double StoredEnergy(const ForceState& s) const override;
   // The winch elements' ldot dU/dl at fixed coordinates [W].
   void AddExternalPower(const ForceState& s, double* power) const override;
+  // STATIC: element k's load (the model's element order) at s, the
+  // buoyancy its sections' dry fractions lose, into fe; false (fe
+  // untouched) when it has none or the analysis is DYNAMIC. For the
+  // outputs' section forces (MultibodyModel::ElementEndForces).
+  bool StaticLoadOfElement(int k, const ForceState& s,
+                           typename AncfCableElement<D>::Coords* fe) const;
 
  private:
   // STATIC: the quadrature points of an element's dry part at the still
@@ -122,6 +128,11 @@ class CableSurfaceBuoyancy : public ForceContributor {
   };
   int DryPoints(const Element& el, const AncfCableElement<D>& element,
                 const Eigen::Matrix<double, 4 * D, 1>& e, DryPoint* points) const;
+  // An element's STATIC load fe and its matrix -dfe/de into ke (may be
+  // null); false when the element has no dry part.
+  bool StaticElementLoad(const Element& el, const ForceState& s,
+                         typename AncfCableElement<D>::Coords* fe,
+                         typename AncfCableElement<D>::Matrix* ke) const;
   // One element's U / load factor [J] at its coordinates in s.
   double ElementEnergy(const ForceState& s, const Element& el,
                        const AncfCableElement<D>& element) const;
