@@ -7,6 +7,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -138,6 +139,194 @@ TEST(MoorDynBodiesTest, FreeVerticalRodFloatsAtItsDraft) {
   // Newton lands on the balance to its tolerance (1e-9 of the length).
   EXPECT_NEAR(z, length / 2 - draft, 1e-9 * length);
   EXPECT_NEAR(last.probes[0].position_m.x(), 3, 1e-9);
+}
+
+// MoorDyn's rod_tests/AddedMass.txt: a free horizontal rod (d 0.5 m, 2 m
+// long, 100 kg/m) placed 10 m down, lighter than the water it displaces,
+// rises to the surface. Its buoyancy is the vertical cylinder's of the same
+// length (BodyFluidLoad), so it floats where w L = rho (pi d^2 / 4) s, its
+// centre at L / 2 - s, and nothing moves it across: x and y stay where the
+// deck put them. At that draft the buoyancy cancels the weight in the
+// same entries, and Newton measured its residual against that rounding
+// (relative residual 1 after 500 iterations at load factor 0.7) until the
+// terms' own size set the scale (MultibodyModel::NetForce).
+TEST(MoorDynBodiesTest, FreeHorizontalRodRisesToItsDraftWhereItIs) {
+  // The deck's own rows and options (MoorDyn's default g, 9.80665).
+  const v1::Scene s = Read(R"(--------------------- MoorDyn Input File ------------------------------------
+Put a buoyant rod with no drag but added mass 10 meters under water.
+---------------------- ROD TYPES ------------------------------------
+TypeName   Diam   Mass/m    Cd     Ca    CdEnd      CaEnd
+(name)    (m)    (kg/m)    (-)    (-)   (-)        (-)
+floatRod   0.5  100.0      0.0    1.0    0.0       0.0
+---------------------- RODS ----------------------------------------
+ID     RodType   Attachment  Xa    Ya    Za    Xb    Yb    Zb   NumSegs   RodOutputs
+(#)    (name)    (#/key)     (m)   (m)   (m)   (m)   (m)   (m)  (-)       (-)
+1      floatRod  free        0     -1    -10   0   1.0   -10    4       -
+-------------------------- SOLVER    OPTIONS-----------------------------------
+3.0e6     kb           - bottom stiffness
+3.0e5     cb           - bottom damping
+16.0      WtrDpth      - water depth
+0         TmaxIC       - max time for ic gen (s)
+------------------------- need this line --------------------------------------
+)");
+  ASSERT_EQ(s.bodies_size(), 1);
+  CollectingSink sink;
+  const Frame last = Statics(s, "rod1", &sink);
+  ASSERT_EQ(last.probes.size(), 1u);
+  const double length = 2, mass = 100 * length, area = kPi * 0.25 / 4;
+  const double expected = length / 2 - mass / (kRho * area);
+  const Eigen::Vector3d r = last.probes[0].position_m;
+  std::printf("rod centre (%.3g, %.3g, %.12g) m, Archimedes z %.12g m\n", r.x(), r.y(), r.z(),
+              expected);
+  // Buoyancy is linear in the height while the rod pierces the surface:
+  // Newton lands on the balance to its tolerance (1e-9 of the length).
+  EXPECT_NEAR(r.z(), expected, 1e-9 * length);
+  // Nothing acts across: the centre stays at x = y = 0 exactly.
+  EXPECT_EQ(r.x(), 0);
+  EXPECT_EQ(r.y(), 0);
+}
+
+// MoorDyn's seafloor.txt without its seafloor: a 10 kg point on a
+// neutrally buoyant line (the water's density, EA 1e9 N, 32 m) from a
+// fixed point, placed 29.7 m away and 10 m to the side. The line is laid
+// with a corner (a slack chord), stretched 0.1 % (a tension of 1e6 N at
+// the layout), and must swing under the point to relax; at rest the point
+// hangs straight below the fixed point, the line's tension its weight m g
+// all along, so at z = -L (1 + m g / EA). The first load increment took
+// 748 Newton iterations (StaticSolver::kLayoutIterations), and failed
+// after 500 at each of its 12 bisections. Tolerances: the axial position
+// to 1e-9 m (the line's axial stiffness EA / L = 3e7 N/m against the
+// solve's residual), across to 1e-6 m (the pendulum's m g / L = 3 N/m).
+TEST(MoorDynBodiesTest, PointOnANeutrallyBuoyantLineSwingsUnderItsFixedPoint) {
+  const v1::Scene s = Read(R"(--------------------- MoorDyn Input File ------------------------------------
+A pendulum on a line as dense as the water
+----------------------- LINE TYPES ------------------------------------------
+TypeName   Diam    Mass/m     EA         BA/-zeta    EI         Cd     Ca     CdAx    CaAx
+(name)     (m)     (kg/m)     (N)        (N-s/-)     (N-m^2)    (-)    (-)    (-)     (-)
+main       0.1     7.853981634  1.0E9      -0.01       0          0.0    0.0    0.0     0.0
+---------------------- POINT PROPERTIES --------------------------------
+ID    Type      X       Y       Z       Mass   Volume  CdA    Ca
+(#)   (-)       (m)     (m)     (m)     (kg)   (m^3)   (m^2)  (-)
+1     Fixed     0       -1       0       0      0       0      0
+2     Free      10      -1       -28    1E1    0       0      0
+---------------------- LINES ----------------------------------------
+ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
+(#)   (name)     (#)      (#)       (m)       (-)     (-)
+1     main       1        2         32.0      20      p
+---------------------- OPTIONS -----------------------------------------
+1000.0        WtrDnsty      water density (kg/m^3)
+500           WtrDpth       water depth (m)
+------------------------- need this line --------------------------------------
+)");
+  ASSERT_EQ(s.bodies_size(), 1);
+  CollectingSink sink;
+  const Frame last = Statics(s, "point2", &sink);
+  ASSERT_EQ(last.probes.size(), 1u);
+  const double weight = 10 * 9.80665, z = -32 * (1 + weight / 1e9);
+  const Eigen::Vector3d r = last.probes[0].position_m;
+  std::printf("point (%.9g, %.9g, %.12g) m, below the fixed point at z %.12g m\n", r.x(), r.y(),
+              r.z(), z);
+  EXPECT_NEAR(r.z(), z, 1e-9);
+  EXPECT_NEAR(r.x(), 0, 1e-6);
+  EXPECT_NEAR(r.y(), -1, 1e-6);
+}
+
+// A float in the surface (MoorDyn's tripod.txt's kind): a short, thick,
+// buoyant line (d 0.8 m, 0.6 m, 130 kg/m) whose top end is free, on a
+// tether (1.1 m) from a junction held by three legs (20.2 m, taut under
+// the float's lift) to anchors 16 m down (the bed 4 m below them: no line
+// touches it), laid tilted and off-centre. The float's section pierces the surface, so its buoyancy
+// above the level is STATIC's dry fraction of the section (cable_buoyancy.h),
+// which under the point-wise switch had no equilibrium (Newton hopped
+// between a Gauss point wet and dry for 500 iterations at each of 12
+// bisections). At rest the anchors hold the lines' weight in water less the
+// float's buoyancy, and what the float loses above the level is, for its
+// straight axis (EI 9e9 N m^2: it bends by under 1e-8 m) between its end
+// nodes at heights h0, h1 over a length L, rho A g L (R G(h1 / R) -
+// R G(h0 / R)) / (h1 - h0) (G the dry fraction's integral; its level
+// limit g(h0 / R) L). Tolerance 1e-6 of the float's buoyancy: the
+// solve's residual (8e-9 relative) and the float's bending.
+TEST(MoorDynBodiesTest, FloatInTheSurfaceOnATetheredTripodBalancesItsWeights) {
+  v1::Scene s = Read(R"(--------------------- MoorDyn Input File ------------------------------------
+A float on a tether and three legs
+----------------------- LINE TYPES ------------------------------------------
+TypeName   Diam    Mass/m     EA         BA/-zeta    EI         Cd     Ca     CdAx    CaAx
+(name)     (m)     (kg/m)     (N)        (N-s/-)     (N-m^2)    (-)    (-)    (-)     (-)
+float      0.8     130        2.0E9      -0.5        9.0E9      1.2    1.0    0.4     1.0
+tether     0.025   3.8        2.5E7      -0.5        990        1.2    1.0    0.08    1.0
+leg        0.01    0.195      5.0E6      -0.5        31         1.2    1.0    0.08    1.0
+---------------------- POINTS --------------------------------
+ID    Type      X       Y       Z       Mass   Volume  CdA    Ca
+(#)   (-)       (m)     (m)     (m)     (kg)   (m^3)   (m^2)  (-)
+1     Free      0       0       -0.2    0      0       0      0
+2     Free      0.55    0.1     0.1     0      0       0      0
+3     Free      -0.1    0       -1.3    0      0       0      0
+4     Fixed     14      0       -16     0      0       0      0
+5     Fixed     -5.9    12.7    -16     0      0       0      0
+6     Fixed     -8.0    -11.5   -16     0      0       0      0
+---------------------- LINES ----------------------------------------
+ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
+(#)   (name)     (#)      (#)       (m)       (-)     (-)
+1     float      1        2         0.6       3       p
+2     tether     3        1         1.1       5       p
+3     leg        3        4         20.2      14      p
+4     leg        3        5         20.2      14      p
+5     leg        3        6         20.2      14      p
+---------------------- OPTIONS -----------------------------------------
+20.0          WtrDpth       water depth (m)
+------------------------- need this line --------------------------------------
+)");
+  s.mutable_output()->set_shape(true);
+  s.mutable_output()->set_reactions(true);
+  const absl::StatusOr<Scene> scene = SceneFromProto(s);
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  CollectingSink sink;
+  const RunSummary summary = RunOk(*scene, &sink);
+  ASSERT_FALSE(sink.frames().empty());
+  const Frame& last = sink.frames().back();
+  // The float's end nodes (cable 0, 3 elements: nodes 0 to 3).
+  ASSERT_GE(last.nodes.size(), 4u);
+  const Eigen::Vector3d a = last.nodes[0], b = last.nodes[3];
+  const double g = 9.80665, rho = 1025, r = 0.4, area = kPi * r * r;
+  const double float_length = 0.6, h0 = a.z(), h1 = b.z();
+  auto big_g = [](double u) {
+    u = std::clamp(u, -1.0, 1.0);
+    const double c = 1 - u * u;
+    return (u * std::acos(-u) + std::sqrt(c) - c * std::sqrt(c) / 3) / kPi;
+  };
+  auto dry_fraction = [](double u) {
+    u = std::clamp(u, -1.0, 1.0);
+    return (std::acos(-u) + u * std::sqrt(1 - u * u)) / kPi;
+  };
+  const double dry_length = std::abs(h1 - h0) > 1e-9
+                                ? float_length * r * (big_g(h1 / r) - big_g(h0 / r)) / (h1 - h0)
+                                : float_length * dry_fraction(h0 / r);
+  // Weights in water [N] (down): mu - rho A per length, times g L.
+  auto wet = [&](double mu, double d, double length) {
+    return (mu - rho * kPi * d * d / 4) * g * length;
+  };
+  const double weights = wet(130, 0.8, 0.6) + wet(3.8, 0.025, 1.1) + 3 * wet(0.195, 0.01, 20.2);
+  const double lost = rho * area * g * dry_length;
+  // The anchors: the joints to ground (the others join line ends). A
+  // joint's reaction is the force on its side a, the line.
+  ASSERT_EQ(last.reactions.size(), static_cast<size_t>(s.joints_size()));
+  double held = 0;  // the anchors' upward force on the lines
+  int anchors = 0;
+  for (int j = 0; j < s.joints_size(); ++j) {
+    if (s.joints(j).has_b()) continue;
+    held += last.reactions[j].force.z();
+    ++anchors;
+  }
+  EXPECT_EQ(anchors, 3);
+  std::printf("float from z %.6f to %.6f m (dry %.6f m); anchors hold %.9g N, weights %.9g N "
+              "+ buoyancy lost %.9g N = %.9g N; residual %.3g\n",
+              h0, h1, dry_length, held, weights, lost, weights + lost,
+              summary.max_newton_residual);
+  // The float pierces the surface (else the test tests nothing new).
+  EXPECT_LT(std::min(h0, h1), r);
+  EXPECT_GT(std::max(h0, h1), -r);
+  // The anchors pull the lines down by their loads: held = weights + lost.
+  EXPECT_NEAR(held, weights + lost, 1e-6 * rho * area * g * float_length);
 }
 
 // A free body (BODIES) of volume 8 m^3 and 5000 kg with its CG 0.5 m

@@ -91,7 +91,9 @@ StaticSolver::IncrementStats StaticSolver::Solve(double alpha, double tolerance)
   double travel = 0;      // sum of the steps' |dz|_inf
   NewtonIterate iterate;
   const SkylineLdlt& mass = model_->mass();
-  for (int it = 0; it <= kMaxIterations; ++it) {
+  const int max_iterations = solved_once_ ? kMaxIterations : kLayoutIterations;
+  solved_once_ = true;
+  for (int it = 0; it <= max_iterations; ++it) {
     if (should_stop_ && should_stop_()) {
       st.stopped = true;
       st.reason = "stopped by the caller";
@@ -132,12 +134,12 @@ StaticSolver::IncrementStats StaticSolver::Solve(double alpha, double tolerance)
       st.residual_floor = iterate.floor;
       break;
     }
-    if (it == kMaxIterations || travel > kMaxTravel * zscale0) {
+    if (it == max_iterations || travel > kMaxTravel * zscale0) {
       st.reason = absl::StrFormat(
           "no static equilibrium found: %s (relative residual %.3g with a rounding floor of "
           "%.3g, constraint violation %.3g); the loads may have none: is a body or cable not "
           "held by the joints (a mechanism)?",
-          it == kMaxIterations
+          it == max_iterations
               ? absl::StrFormat("Newton did not converge in %d iterations", it)
               : absl::StrFormat("the scene moved %.3g times its size", travel / zscale0),
           iterate.residual, iterate.floor, iterate.violation);

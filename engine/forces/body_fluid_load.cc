@@ -129,7 +129,12 @@ Vector3d BodyFluidLoad::DynamicForce(const VectorXd& q, const VectorXd& qdot, do
 void BodyFluidForces::AddAppliedLoad(const ForceState& s, ForceOutput* out) const {
   for (const BodyFluidLoad& b : loads_) {
     Matrix3d k = Matrix3d::Zero();
-    b.AddHydrostatic(*s.q, s.load_factor, out->full, out->matrix ? &k : nullptr);
+    const double f = b.AddHydrostatic(*s.q, s.load_factor, out->full, out->matrix ? &k : nullptr);
+    // Its size and rounding on their own: at a floating body's draft F_s
+    // cancels the weight in the same entries (MultibodyModel::NetForce).
+    out->size = std::max(out->size, f);
+    if (out->roundoff)
+      for (int d = 0; d < b.dim(); ++d) (*out->roundoff)(b.coord() + d) += kSumRounding * f;
     if (out->matrix) out->map.ScatterBlock(b.coord(), k, out->scale, out->matrix);
   }
 }

@@ -8,7 +8,9 @@
 // waves): h < eta. Disabled, every point is wet (the fluid fills all
 // space, as before the option).
 //
-// The loads that use it switch point by point: at each Gauss point of an
+// The loads that use it switch point by point (but a STATIC analysis's
+// cable buoyancy, which takes each section's dry fraction:
+// cable_buoyancy.h): at each Gauss point of an
 // element the point is wet or dry by its own position, so an element that
 // pierces the surface carries the load of its wet points only, and the
 // force jumps by one point's share (w_g l times the load per length) when

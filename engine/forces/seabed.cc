@@ -6,15 +6,13 @@
 
 #include "engine/elements/gauss_quadrature.h"
 #include "engine/forces/contact_point.h"
+#include "engine/forces/element_cubic.h"
 #include "engine/elements/hermite_shape.h"
 
 namespace cablesim {
 namespace {
 
-struct Cubic {
-  double c[4];
-  double operator()(double x) const { return c[0] + x * (c[1] + x * (c[2] + x * c[3])); }
-};
+using Cubic = ElementCubic;
 
 // Calls f(wl, s, ds) at the 4 Gauss points of every contact piece: the
 // weight times the element length [m], the shape functions and their
@@ -294,42 +292,11 @@ int Seabed::ContactPieces(const Eigen::Matrix<double, 4 * D, 1>& e, double lengt
                  2 * a0 + l * b0 - 2 * a1 + l * b1}};
   // h >= c0 - |c1| - |c2| - |c3| on [0, 1]: most elements end here.
   if (h.c[0] - std::abs(h.c[1]) - std::abs(h.c[2]) - std::abs(h.c[3]) > 0) return 0;
-  // Monotone pieces: split at the roots of h' = c1 + 2 c2 x + 3 c3 x^2.
-  double br[4] = {0, 0, 0, 0};
-  int nbr = 0;
-  br[nbr++] = 0;
-  const double qa = 3 * h.c[3], qb = 2 * h.c[2], qc = h.c[1];
-  double crit[2];
-  int ncrit = 0;
-  if (qa != 0) {
-    const double disc = qb * qb - 4 * qa * qc;
-    if (disc > 0) {
-      // Stable quadratic roots.
-      const double t = -0.5 * (qb + std::copysign(std::sqrt(disc), qb));
-      crit[ncrit++] = t / qa;
-      if (t != 0) crit[ncrit++] = qc / t;
-    }
-  } else if (qb != 0) {
-    crit[ncrit++] = -qc / qb;
-  }
-  std::sort(crit, crit + ncrit);
-  for (int i = 0; i < ncrit; ++i)
-    if (crit[i] > 0 && crit[i] < 1 && crit[i] > br[nbr - 1]) br[nbr++] = crit[i];
-  // Roots of h on each monotone piece.
+  // Where h changes sign (monotone pieces split at the roots of h').
   double cuts[5];
   int ncuts = 0;
   cuts[ncuts++] = 0;
-  double prev = 0;
-  for (int i = 0; i < nbr; ++i) {
-    const double a = br[i], b = i + 1 < nbr ? br[i + 1] : 1.0;
-    if ((h(a) < 0) != (h(b) < 0)) {
-      const double r = BisectSign(h, a, b);
-      if (r > prev && r < 1) {
-        cuts[ncuts++] = r;
-        prev = r;
-      }
-    }
-  }
+  ncuts += SignChanges(h, cuts + 1);
   cuts[ncuts++] = 1;
   int count = 0;
   for (int i = 0; i + 1 < ncuts; ++i) {

@@ -331,7 +331,8 @@ std::unique_ptr<ForceContributor> ModelBuilder::SurfaceBuoyancy(
   for (size_t k = 0; k < elements.size(); ++k) {
     const CableSpec& cable = scene_.cables[element_cable_[k]];
     const double dh = HydroDiameter(cable);
-    out.push_back({elements[k].first_coord, elements[k].element, rho_f * kPi * dh * dh / 4 * g});
+    out.push_back(
+        {elements[k].first_coord, elements[k].element, rho_f * kPi * dh * dh / 4 * g, dh / 2});
   }
   // The waves' elevation in DYNAMIC runs only (STATIC sees the still level).
   return MakeCableSurfaceBuoyancy<D>(std::move(out), surface,

@@ -10,6 +10,8 @@
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
 
+#include "engine/forces/cable_buoyancy.h"
+
 namespace cablesim {
 
 
@@ -345,6 +347,15 @@ void MultibodyModel::ElementEndForces(const VectorXd& q, int k, double load_fact
   Eigen::Matrix<double, kN, 1> f = Eigen::Matrix<double, kN, 1>::Zero();  // ElasticForce adds
   e.element.ElasticForce(q.segment<kN>(e.first_coord), &f, nullptr);
   f -= load_factor * ElementWeight(e);
+  // STATIC with a free surface: the buoyancy the element's sections lose
+  // above the level is a load on it as its weight is (a line through the
+  // level at a fairlead: without it the tension there was off by that
+  // load, 13 N of 1 MN in tests/moordyn_chain_test.cc).
+  if (const auto* surface = dynamic_cast<const CableSurfaceBuoyancy<D>*>(
+          FindContributor("free_surface"))) {
+    Eigen::Matrix<double, kN, 1> dry;
+    if (surface->StaticLoadOfElement(k, StateAt(q, nullptr, load_factor), &dry)) f -= dry;
+  }
   start->setZero();
   end->setZero();
   // Rows of the end positions (r_i, r_j) in the element's coordinates

@@ -232,20 +232,28 @@ double MultibodyModel::NetForce(const VectorXd& q, double load_factor, VectorXd*
     full.setZero();
   }
   const ForceState state = StateAt(q, nullptr, load_factor);
-  ForceOutput out{&full, nullptr, stiffness, stiffness_scale, Map()};
-  for (const ForceContributor* c : varying_applied_) c->AddAppliedLoad(state, &out);
-  // The size of the applied terms counts only coordinates that move: a
-  // heavy body welded to ground must not loosen the tolerance elsewhere.
-  double size = 0;
-  const int n = coordinates();
-  for (int i = 0; i < n; ++i)
-    if (j_[i] >= 0) size = std::max(size, std::abs(full(i)));
-  // Rounding of the applied terms (torques included, through |full|).
+  // Rounding of the applied terms: the varying contributors add their own
+  // (a term that nearly cancels another in the same entry, a floating
+  // body's buoyancy against its weight, leaves its rounding behind), then
+  // eps times the sum (torques included, through |full|).
   VectorXd* full_roundoff = nullptr;
   if (roundoff) {
     full_roundoff = &scratch_roundoff_;
-    *full_roundoff = kEps * full.cwiseAbs();
+    full_roundoff->setZero();
   }
+  ForceOutput out{&full, full_roundoff, stiffness, stiffness_scale, Map()};
+  for (const ForceContributor* c : varying_applied_) c->AddAppliedLoad(state, &out);
+  // The size of the applied terms counts only coordinates that move: a
+  // heavy body welded to ground must not loosen the tolerance elsewhere.
+  // It is also at least the largest term a varying contributor added
+  // (out.size): where buoyancy balances weight the sum is rounding, and
+  // measured against the sum alone Newton's residual never looked small
+  // (a floating body at its draft, MoorDyn's rod_tests/AddedMass.txt).
+  double size = out.size;
+  const int n = coordinates();
+  for (int i = 0; i < n; ++i)
+    if (j_[i] >= 0) size = std::max(size, std::abs(full(i)));
+  if (roundoff) *full_roundoff += kEps * full.cwiseAbs();
   size = std::max(size, dim_ == 2 ? ElementForces<2>(q, &full, stiffness, stiffness_scale,
                                                      full_roundoff)
                                   : ElementForces<3>(q, &full, stiffness, stiffness_scale,
