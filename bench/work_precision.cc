@@ -334,7 +334,7 @@ class Report {
 
   void Note(const std::string& scene, const std::string& note) {
     std::cerr << scene << ": " << note << "\n";
-    *csv_ << Csv(scene) << ",,,,,,skipped,,,,,,,,,,,," << Csv(note) << "\n";
+    *csv_ << Csv(scene) << ",,,,,,skipped,,,,,,,,,,,," << Csv(note) << ",\n";
   }
 
   void Row(const std::string& scene, const std::string& integrator, const std::string& ls,
