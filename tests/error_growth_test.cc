@@ -11,6 +11,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -20,6 +22,7 @@
 #include <Eigen/Core>
 
 #include "absl/strings/str_format.h"
+#include "convert/json_merge.h"
 #include "engine/model/multibody_model.h"
 #include "engine/steppers/make_stepper.h"
 #include "tests/test_util.h"
@@ -35,18 +38,14 @@ using testing::SceneFromJson;
 // scenes/cable-with-end-cylinder.json over 2 s (the bench's patch,
 // bench/work_precision_auto.json) with the given solver fields.
 std::string EndCylinder(const std::string& solver) {
-  return absl::StrFormat(R"({
-    "gravity": {"y": -9.81},
-    "cables": [{"name": "cable", "length": 0.5, "elements": 20, "direction": {"x": 1},
-                "density": 1000, "youngs_modulus": 1e7, "diameter": 0.01}],
-    "bodies": [{"name": "cylinder", "cylinder": {"diameter": 0.04, "height": 0.1},
-                "density": 1000, "position": {"x": 0.55}, "axis": {"x": 1}}],
-    "joints": [{"type": "PIN", "a": {"cable": "cable", "s": 0}},
-               {"type": "FIXED", "a": {"cable": "cable", "s": 0.5},
-                "b": {"body": "cylinder", "point": {"x": -0.05}}}],
-    "probes": [{"name": "cylinder", "body": "cylinder"}],
-    "solver": {"duration": 2, "output_interval": 0.01, %s}})",
-                         solver);
+  std::ifstream in(std::string(CABLESIM_SOURCE_DIR) + "/scenes/cable-with-end-cylinder.json");
+  std::stringstream file;
+  file << in.rdbuf();
+  auto merged = MergeJson(
+      file.str(),
+      absl::StrFormat(R"({"solver": {"duration": 2, "output_interval": 0.01, %s}})", solver));
+  EXPECT_TRUE(merged.ok()) << merged.status();
+  return merged.ok() ? *merged : std::string();
 }
 
 double MaxProbeDistance(const CollectingSink& a, const CollectingSink& b) {
