@@ -102,6 +102,7 @@ std::string SummaryToJson(const RunSummary& summary) {
     // Every run's error estimate and what it is held to, and the
     // warnings (docs/honest-runs.md).
     json.Add("local_error_estimate_m", summary.local_error_estimate_m)
+        .Add("accumulated_error_estimate_m", summary.accumulated_error_estimate_m)
         .Add("error_tolerance_m", summary.error_tolerance_m)
         .Add("warnings", summary.warnings);
     // The joints that let go (Joint.release), an empty list when none did.

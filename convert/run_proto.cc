@@ -141,6 +141,7 @@ v1::RunSummary SummaryToProto(const RunSummary& s) {
   p.set_error_estimate_seconds(s.error_estimate_seconds);
   if (s.has_statistics) *p.mutable_statistics() = StatisticsToProto(s.statistics);
   p.set_local_error_estimate_m(s.local_error_estimate_m);
+  p.set_accumulated_error_estimate_m(s.accumulated_error_estimate_m);
   p.set_error_tolerance_m(s.error_tolerance_m);
   for (const std::string& w : s.warnings) p.add_warnings(w);
   p.set_integrator_requested(s.integrator_requested);
@@ -205,6 +206,7 @@ RunSummary SummaryFromProto(const v1::RunSummary& p) {
   s.has_statistics = p.has_statistics();
   if (s.has_statistics) s.statistics = StatisticsFromProto(p.statistics());
   s.local_error_estimate_m = p.local_error_estimate_m();
+  s.accumulated_error_estimate_m = p.accumulated_error_estimate_m();
   s.error_tolerance_m = p.error_tolerance_m();
   s.warnings.assign(p.warnings().begin(), p.warnings().end());
   s.integrator_requested = p.integrator_requested();

@@ -69,6 +69,7 @@ RunSummary EveryFieldSet() {
   s.statistics.rainflow = {{"tip.y", 4.5, 3, 0.51, 0.052}};
   s.local_error_estimate_m = 0.036;
   s.error_tolerance_m = 0.037;
+  s.accumulated_error_estimate_m = 0.0385;
   s.warnings = {"one", "two \"quoted\""};
   s.releases = {{1, "fairlead", 10.5, 1234.5, "time"}, {3, "", 12.25, 98.5, "breaking_load"}};
   s.integrator_segments = {{"CENTRAL_DIFFERENCE", 0, 120, "fits"}, {"HHT", 0.25, 64, "stiffer"}};

@@ -367,6 +367,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       external_work.After(stepper->z(), t, stepper->lambda(), 1, &stepper->v());
       if (error_m < 0) EstimateStepError();
       summary->local_error_estimate_m = std::max(summary->local_error_estimate_m, error_m);
+      summary->accumulated_error_estimate_m += error_m;
       summary->local_error_ratio = std::max(summary->local_error_ratio, error_ratio);
       ++summary->steps;
       ++summary->integrator_segments.back().steps;
