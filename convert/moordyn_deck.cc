@@ -152,6 +152,16 @@ struct TensionChannel {
   int line = 0;
 };
 
+// A body's channel (OUTPUTS Body<n>Px ...): the body's id, whether it is
+// a rotation's (R, RV: output.orientation) or the reference point's (P,
+// V, A: a probe), the channel as spelled, the deck's line.
+struct BodyChannel {
+  int body = 0;
+  bool rotation = false;
+  std::string name;
+  int line = 0;
+};
+
 struct Option {
   double value = 0;
   int line = 0;
@@ -1043,10 +1053,33 @@ class DeckReader {
             continue;
           }
         }
+        // Body<n> channels: the reference point's position, velocity and
+        // acceleration (P, V, A), the rotation and its rate (R, RV).
+        if (absl::StartsWith(lower, "body")) {
+          absl::string_view tail = absl::string_view(lower).substr(4);
+          const size_t digits = tail.find_first_not_of("0123456789");
+          int id = 0;
+          const absl::string_view kind =
+              digits == absl::string_view::npos ? absl::string_view() : tail.substr(digits);
+          static const char* const kPoint[] = {"px", "py", "pz", "vx", "vy", "vz", "ax", "ay", "az"};
+          static const char* const kTurn[] = {"rx", "ry", "rz", "rvx", "rvy", "rvz"};
+          bool point = false, turn = false;
+          for (const char* k : kPoint) point = point || kind == k;
+          for (const char* k : kTurn) turn = turn || kind == k;
+          if (digits != 0 && (point || turn) && absl::SimpleAtoi(tail.substr(0, digits), &id)) {
+            if (id < 1 || id > static_cast<int>(md_bodies_.size())) {
+              return Error(n, absl::StrCat("OUTPUTS ", c),
+                           absl::StrCat("body ", id, " does not exist (define it in BODIES)"));
+            }
+            body_channels_.push_back(BodyChannel{id, turn, std::string(c), n});
+            continue;
+          }
+        }
         return Error(n, absl::StrCat("OUTPUTS ", c),
-                     "only point positions (Point<n>Px, Py, Pz) and line-end tensions "
-                     "(FairTen<n>, AnchTen<n>, Line<n>TenA, Line<n>TenB) are translated (as "
-                     "probes)");
+                     "only point positions (Point<n>Px, Py, Pz), line-end tensions "
+                     "(FairTen<n>, AnchTen<n>, Line<n>TenA, Line<n>TenB) and a body's position, "
+                     "velocity, acceleration, rotation and its rate (Body<n>Px ... Az, Rx ... "
+                     "RVz) are translated (as probes and output.orientation)");
       }
     }
     return absl::OkStatus();
@@ -1400,6 +1433,7 @@ class DeckReader {
                      absl::StrCat("point ", id, " has an output channel but no line"));
       }
     }
+    if (absl::Status s = AddBodyChannels(&scene); !s.ok()) return s;
     for (const TensionChannel& t : tension_channels_) {
       const auto line = std::find_if(lines_.begin(), lines_.end(),
                                      [&](const Line& l) { return l.id == t.line_id; });
@@ -1416,11 +1450,50 @@ class DeckReader {
     return scene;
   }
 
+  // The body channels (OUTPUTS Body<n>...): a probe "Body<n>" on the
+  // scene body at the reference point (the columns Body<n>.x ... .az), and
+  // output.orientation for a rotation's (the scene body's axes are the
+  // world's at the start, so only a body that MoorDyn does not turn there).
+  absl::Status AddBodyChannels(v1::Scene* scene) const {
+    std::vector<int> probed;
+    for (const BodyChannel& c : body_channels_) {
+      const MdBody& b = md_bodies_[c.body - 1];
+      const std::string field = absl::StrCat("OUTPUTS ", c.name);
+      if (b.mount == Mount::kFixed) {
+        return Error(c.line, field, "a fixed body's channels cannot be expressed (it has no "
+                                    "scene body; it stays where the deck puts it)");
+      }
+      if (c.rotation) {
+        if (!b.rotation.isIdentity(0)) {
+          return Error(c.line, field,
+                       "a rotation channel of a body with r0, p0 or y0 cannot be expressed (its "
+                       "scene body's axes are the world's at the start, MoorDyn's turned)");
+        }
+        scene->mutable_output()->set_orientation(true);
+        continue;
+      }
+      if (std::find(probed.begin(), probed.end(), c.body) != probed.end()) continue;
+      probed.push_back(c.body);
+      const std::string name = absl::StrCat("body", c.body);
+      for (const v1::Body& o : scene->bodies()) {
+        if (o.name() != name) continue;
+        v1::Probe* probe = scene->add_probes();
+        probe->set_name(absl::StrCat("Body", c.body));
+        probe->set_body(name);
+        const Eigen::Vector3d rel =
+            b.position - Eigen::Vector3d(o.position().x(), o.position().y(), o.position().z());
+        SetVec(probe->mutable_point(), rel.x(), rel.y(), rel.z());
+      }
+    }
+    return absl::OkStatus();
+  }
+
   // A deck of rods or bodies alone (no line types): the environment, the
   // bodies and rods (MoorDyn's RodPinnedFloating.txt). No seabed: bodies
   // do not touch it, as MoorDyn's.
   absl::StatusOr<v1::Scene> BuildRigidOnly(v1::Scene scene) const {
     if (absl::Status s = BuildBodiesAndRods(&scene); !s.ok()) return s;
+    if (absl::Status s = AddBodyChannels(&scene); !s.ok()) return s;
     scene.mutable_solver()->set_analysis(v1::STATIC);
     return scene;
   }
@@ -2186,6 +2259,7 @@ class DeckReader {
   std::vector<Line> lines_;
   std::map<std::string, Option> options_;
   std::vector<int> probe_points_;
+  std::vector<BodyChannel> body_channels_;
   std::vector<TensionChannel> tension_channels_;
   // The POINTS (BODIES, RODS) row of each body Build made, in scene order
   // (for Located).

@@ -770,6 +770,38 @@ ID    Type      X       Y       Z       Mass   Volume  CdA    Ca
             std::string::npos);
 }
 
+// A body's channels (OUTPUTS Body<n>...: MoorDyn's body_tests/pinnedBody.txt):
+// the reference point's position, velocity and acceleration become a probe
+// "Body<n>" on the body at that point, a rotation's output.orientation
+// (refused for a body MoorDyn turns at the start: its scene body's axes
+// are the world's); a channel of no translation is refused by name.
+TEST(MoorDynBodiesTest, BodyChannelsBecomeAProbeAndTheOrientation) {
+  const std::string body = Deck(kBodyWithRod);
+  const std::string turned = "0      90     1e4", upright = "0      0      1e4";
+  ASSERT_NE(body.find(turned), std::string::npos);
+  const v1::Scene s = Read(absl::StrReplaceAll(
+      body, {{"Point1Pz", "Body1Px\nBODY1AY\nBody1RX"}, {turned, upright}}));
+  EXPECT_TRUE(s.output().orientation());
+  int probes = 0;
+  for (const v1::Probe& p : s.probes()) {
+    if (p.name() != "Body1") continue;
+    ++probes;
+    EXPECT_EQ(p.body(), "body1");
+    const v1::Body& b = BodyNamed(s, "body1");
+    // The reference point (0, 0, -40) from the centre of mass.
+    EXPECT_NEAR(b.position().z() + p.point().z(), -40, 1e-12);
+  }
+  EXPECT_EQ(probes, 1);
+  EXPECT_TRUE(SceneFromProto(s).ok()) << SceneFromProto(s).status();
+  EXPECT_NE(Refusal(absl::StrReplaceAll(body, {{"Point1Pz", "Body1RX"}}))
+                .find("bad.dat:32: OUTPUTS Body1RX: a rotation channel of a body with r0, p0 or "
+                      "y0"),
+            std::string::npos);
+  EXPECT_NE(Refusal(absl::StrReplaceAll(body, {{"Point1Pz", "Body1FX"}}))
+                .find("bad.dat:32: OUTPUTS Body1FX: only point positions"),
+            std::string::npos);
+}
+
 // A body with drag but no volume (MoorDyn's body_tests/bodyDrag.txt): its
 // drag areas alone, no cylinder (no buoyancy), and a valid scene.
 TEST(MoorDynBodiesTest, BodyDragWithoutVolume) {
