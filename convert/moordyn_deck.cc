@@ -1308,7 +1308,6 @@ class DeckReader {
     if (absl::Status s = BuildBodiesAndRods(&scene); !s.ok()) return s;
 
     std::map<int, std::pair<std::string, double>> first_end_at;  // free point -> (cable, s)
-    v1::Hydrodynamics dry;  // WtrDnsty 0: the lines' coefficients act on no fluid
     for (const Line& l : lines_) {
       const LineType& t = *l.type;
       v1::Cable* c = scene.add_cables();
@@ -1345,12 +1344,14 @@ class DeckReader {
       const double ba =
           t.ba < 0 ? -t.ba * (l.length / l.segments) * std::sqrt(t.ea * t.mass_per_length) : t.ba;
       if (ba > 0) c->mutable_damping()->set_axial_time(ba / t.ea);
-      v1::Hydrodynamics* h = rho > 0 ? c->mutable_hydrodynamics() : &dry;
-      h->set_normal_drag(t.cd);
-      h->set_tangential_drag(t.cd_axial);
-      h->set_added_mass(t.ca);
-      h->set_axial_added_mass(t.ca_axial);
-      h->set_diameter(t.diameter);
+      if (rho > 0) {  // WtrDnsty 0: no fluid for the coefficients to act in
+        v1::Hydrodynamics* h = c->mutable_hydrodynamics();
+        h->set_normal_drag(t.cd);
+        h->set_tangential_drag(t.cd_axial);
+        h->set_added_mass(t.ca);
+        h->set_axial_added_mass(t.ca_axial);
+        h->set_diameter(t.diameter);
+      }
       if (std::abs(t.diameter - d0) > 1e-12 * d0) {
         c->set_seabed_stiffness(OptionOr("kbot", kDefaultKBot) * t.diameter);
         c->set_seabed_damping(OptionOr("cbot", kDefaultCBot) * t.diameter);

@@ -377,27 +377,39 @@ std::string AreaBodyJson(const std::string& axis, const std::string& hydro,
                          kRho, axis, hydro, extra);
 }
 
+// The body of AreaBodyJson, its x axis along the world's x or (turned 90
+// degrees about z) y, and its initial full configuration into `q`.
+absl::StatusOr<MultibodyModel> AreaBodyModel(bool turned, const std::string& hydro,
+                                             Eigen::VectorXd* q) {
+  auto model = MultibodyModel::Build(
+      SceneFromJson(AreaBodyJson(turned ? R"({"y": 1})" : R"({"x": 1})", hydro)));
+  if (model.ok()) {
+    q->resize(model->coordinates());
+    model->ToFull(model->initial_z(), q);
+  }
+  return model;
+}
+// The body's axis along the world's axis k: k, or (turned) y for x and x
+// for y.
+constexpr int kBodyAxis[2][3] = {{0, 1, 2}, {1, 0, 2}};
+
 TEST(BodyFluidLoadTest, DragAreasActAlongTheBodysAxes) {
   const Eigen::Vector3d areas(1, 2, 3);
   const std::string hydro = R"({"drag_area": {"x": 1, "y": 2, "z": 3}})";
   for (const bool turned : {false, true}) {
     SCOPED_TRACE(turned ? "turned 90 degrees about z" : "world axes");
-    auto model = MultibodyModel::Build(
-        SceneFromJson(AreaBodyJson(turned ? R"({"y": 1})" : R"({"x": 1})", hydro)));
+    Eigen::VectorXd q;
+    auto model = AreaBodyModel(turned, hydro, &q);
     ASSERT_TRUE(model.ok()) << model.status();
     ASSERT_EQ(model->body_fluid_loads().size(), 1u);
     EXPECT_EQ(model->body_fluid_loads()[0].waterplane_area(), 0) << "no cylinder";
     const int nq = model->coordinates();
-    Eigen::VectorXd q(nq);
-    model->ToFull(model->initial_z(), &q);
-    // The world's axis k is the body's axis k, or (turned) y for x and x for y.
-    const int body_axis[2][3] = {{0, 1, 2}, {1, 0, 2}};
     for (int k = 0; k < 3; ++k) {
       Eigen::VectorXd qd = Eigen::VectorXd::Zero(nq), f = Eigen::VectorXd::Zero(model->dofs());
       qd(k) = 1.5;
       model->DampingForce(q, qd, &f);
       const Eigen::Vector3d force = ForceOnCentre(*model, f);
-      const double a = areas(body_axis[turned ? 1 : 0][k]);
+      const double a = areas(kBodyAxis[turned ? 1 : 0][k]);
       const Eigen::Vector3d expected = -0.5 * kRho * a * 1.5 * 1.5 * Eigen::Vector3d::Unit(k);
       EXPECT_LT((force - expected).norm(), 1e-12 * expected.norm())
           << "axis " << k << ": " << force.transpose() << " vs " << expected.transpose();
@@ -421,19 +433,16 @@ TEST(BodyFluidLoadTest, RotationalDragAreasActAboutTheBodysAxes) {
   const std::string hydro = R"({"rotational_drag_area": {"x": 4, "y": 5, "z": 6}})";
   for (const bool turned : {false, true}) {
     SCOPED_TRACE(turned ? "turned 90 degrees about z" : "world axes");
-    auto model = MultibodyModel::Build(
-        SceneFromJson(AreaBodyJson(turned ? R"({"y": 1})" : R"({"x": 1})", hydro)));
+    Eigen::VectorXd q;
+    auto model = AreaBodyModel(turned, hydro, &q);
     ASSERT_TRUE(model.ok()) << model.status();
     const int nq = model->coordinates();
-    Eigen::VectorXd q(nq);
-    model->ToFull(model->initial_z(), &q);
-    const int body_axis[2][3] = {{0, 1, 2}, {1, 0, 2}};
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d omega = 0.8 * Eigen::Vector3d::Unit(k);
       Eigen::VectorXd qd = Eigen::VectorXd::Zero(nq);
       // The axes' rates edot_a = omega x e_a (natural coordinates 3..11).
       for (int a = 0; a < 3; ++a) qd.segment<3>(3 + 3 * a) = omega.cross(q.segment<3>(3 + 3 * a));
-      const double expected = 0.5 * kRho * areas(body_axis[turned ? 1 : 0][k]) * std::pow(0.8, 3);
+      const double expected = 0.5 * kRho * areas(kBodyAxis[turned ? 1 : 0][k]) * std::pow(0.8, 3);
       EXPECT_NEAR(model->DampingPower(q, qd), expected, 1e-12 * expected) << "axis " << k;
     }
   }
