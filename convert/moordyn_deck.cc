@@ -104,7 +104,10 @@ struct MdBody {
   Mount mount = Mount::kFree;
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  // the reference point [m]
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
-  double mass = 0, volume = 0, cda = 0, ca = 0;
+  double mass = 0, volume = 0, ca = 0;
+  // Drag areas along and about the body's axes (CdA: MoorDyn's 1, 2, 3 or
+  // 6 numbers) [m^2, m^5].
+  Eigen::Vector3d cda = Eigen::Vector3d::Zero(), cda_rotation = Eigen::Vector3d::Zero();
   Eigen::Vector3d cg = Eigen::Vector3d::Zero();       // body frame, from the reference [m]
   Eigen::Vector3d inertia = Eigen::Vector3d::Zero();  // about the CG, body axes [kg m^2]
 };
@@ -146,6 +149,16 @@ struct TensionChannel {
   std::string name;
   int line_id = 0;
   bool end_b = false;
+  int line = 0;
+};
+
+// A body's channel (OUTPUTS Body<n>Px ...): the body's id, whether it is
+// a rotation's (R, RV: output.orientation) or the reference point's (P,
+// V, A: a probe), the channel as spelled, the deck's line.
+struct BodyChannel {
+  int body = 0;
+  bool rotation = false;
+  std::string name;
   int line = 0;
 };
 
@@ -680,7 +693,8 @@ class DeckReader {
       // MoorDyn's friction law (MoorDynFriction).
       if (!(*v > 0)) return Error(n, field, absl::StrCat("must be > 0 (got ", w[0], ")"));
     }
-    if (key == "g" || key == "rho" || key == "depth" || key == "kbot") {
+    // g 0 and WtrDnsty 0 are MoorDyn's weightless and dry scenes.
+    if (key == "depth" || key == "kbot") {
       if (!(*v > 0)) return Error(n, field, absl::StrCat("must be > 0 (got ", w[0], ")"));
     } else if (*v < 0) {
       return Error(n, field, absl::StrCat("must be >= 0 (got ", w[0], ")"));
@@ -1039,10 +1053,33 @@ class DeckReader {
             continue;
           }
         }
+        // Body<n> channels: the reference point's position, velocity and
+        // acceleration (P, V, A), the rotation and its rate (R, RV).
+        if (absl::StartsWith(lower, "body")) {
+          absl::string_view tail = absl::string_view(lower).substr(4);
+          const size_t digits = tail.find_first_not_of("0123456789");
+          int id = 0;
+          const absl::string_view kind =
+              digits == absl::string_view::npos ? absl::string_view() : tail.substr(digits);
+          static const char* const kPoint[] = {"px", "py", "pz", "vx", "vy", "vz", "ax", "ay", "az"};
+          static const char* const kTurn[] = {"rx", "ry", "rz", "rvx", "rvy", "rvz"};
+          bool point = false, turn = false;
+          for (const char* k : kPoint) point = point || kind == k;
+          for (const char* k : kTurn) turn = turn || kind == k;
+          if (digits != 0 && (point || turn) && absl::SimpleAtoi(tail.substr(0, digits), &id)) {
+            if (id < 1 || id > static_cast<int>(md_bodies_.size())) {
+              return Error(n, absl::StrCat("OUTPUTS ", c),
+                           absl::StrCat("body ", id, " does not exist (define it in BODIES)"));
+            }
+            body_channels_.push_back(BodyChannel{id, turn, std::string(c), n});
+            continue;
+          }
+        }
         return Error(n, absl::StrCat("OUTPUTS ", c),
-                     "only point positions (Point<n>Px, Py, Pz) and line-end tensions "
-                     "(FairTen<n>, AnchTen<n>, Line<n>TenA, Line<n>TenB) are translated (as "
-                     "probes)");
+                     "only point positions (Point<n>Px, Py, Pz), line-end tensions "
+                     "(FairTen<n>, AnchTen<n>, Line<n>TenA, Line<n>TenB) and a body's position, "
+                     "velocity, acceleration, rotation and its rate (Body<n>Px ... Az, Rx ... "
+                     "RVz) are translated (as probes and output.orientation)");
       }
     }
     return absl::OkStatus();
@@ -1194,8 +1231,10 @@ class DeckReader {
     const double depth = depth_it->second.value;
     scene.mutable_fluid()->set_water_depth(depth);
     // MoorDyn's lines carry buoyancy, drag and added mass only where they
-    // are under the (instantaneous) surface.
-    scene.mutable_fluid()->set_free_surface(true);
+    // are under the (instantaneous) surface: a level needs gravity (the
+    // vertical) and water (WtrDnsty 0 or g 0: MoorDyn's lines are wet
+    // everywhere or feel no fluid at all).
+    if (g > 0 && rho > 0) scene.mutable_fluid()->set_free_surface(true);
     if (absl::Status s = WaterKinematics(scene.mutable_fluid()); !s.ok()) return s;
 
     // The seabed: kBot [Pa/m] and cBot [Pa s/m] act on the line's
@@ -1211,6 +1250,7 @@ class DeckReader {
     const double mu = OptionOr("mu", 0);
     bed->set_friction_axial(OptionOr("mu_a", mu));
     bed->set_friction_transverse(OptionOr("mu_t", mu));
+    if (!(g > 0)) SetVec(bed->mutable_normal(), 0, 0, 1);  // g 0: MoorDyn's bed is still at -WtrDpth
     if (absl::Status s = MoorDynFriction(bed); !s.ok()) return s;
     if (!seafloor_file_.empty()) {
       if (absl::Status s = ReadSeafloor(bed->mutable_bathymetry()); !s.ok()) return s;
@@ -1229,10 +1269,11 @@ class DeckReader {
                      "a free point with volume, drag or added mass needs a mass > 0 (cablesim's "
                      "bodies have mass)");
       }
-      if (p.volume == 0 && (p.cda > 0 || p.ca > 0)) {
-        return Error(p.line, "POINTS Volume",
-                     "a free point with drag (CdA) or added mass (Ca) needs a volume > 0 (it "
-                     "sizes the body's fluid loads)");
+      if (p.volume > 0 && HasWater() && !HasGravity() && (p.cda > 0 || p.ca > 0)) {
+        return Error(p.line, p.cda > 0 ? "POINTS CdA" : "POINTS CA",
+                     "a point's drag or added mass with a volume but without gravity cannot be "
+                     "expressed (its fluid loads are a buoyed cylinder's, which needs the "
+                     "vertical)");
       }
       v1::Body* body = scene.add_bodies();
       body_points_.push_back(p.line);
@@ -1246,7 +1287,12 @@ class DeckReader {
       const double inertia = 0.4 * p.mass * r * r;
       SetVec(body->mutable_inertia(), inertia, inertia, inertia);
       SetVec(body->mutable_position(), p.x, p.y, p.z);
-      if (p.volume > 0) {
+      if (p.volume == 0 && p.cda > 0 && HasWater()) {
+        // MoorDyn's 1/2 rho CdA |v| v without a volume (no buoyancy; its
+        // added mass Ca rho V is nothing): drag areas alone.
+        SetVec(body->mutable_hydrodynamics()->mutable_drag_area(), p.cda, p.cda, p.cda);
+      }
+      if (p.volume > 0 && HasWater() && HasGravity()) {
         // A vertical cylinder as tall as wide with the point's volume.
         const double d = std::cbrt(4 * p.volume / kPi);
         v1::BodyHydrodynamics* h = body->mutable_hydrodynamics();
@@ -1298,12 +1344,14 @@ class DeckReader {
       const double ba =
           t.ba < 0 ? -t.ba * (l.length / l.segments) * std::sqrt(t.ea * t.mass_per_length) : t.ba;
       if (ba > 0) c->mutable_damping()->set_axial_time(ba / t.ea);
-      v1::Hydrodynamics* h = c->mutable_hydrodynamics();
-      h->set_normal_drag(t.cd);
-      h->set_tangential_drag(t.cd_axial);
-      h->set_added_mass(t.ca);
-      h->set_axial_added_mass(t.ca_axial);
-      h->set_diameter(t.diameter);
+      if (rho > 0) {  // WtrDnsty 0: no fluid for the coefficients to act in
+        v1::Hydrodynamics* h = c->mutable_hydrodynamics();
+        h->set_normal_drag(t.cd);
+        h->set_tangential_drag(t.cd_axial);
+        h->set_added_mass(t.ca);
+        h->set_axial_added_mass(t.ca_axial);
+        h->set_diameter(t.diameter);
+      }
       if (std::abs(t.diameter - d0) > 1e-12 * d0) {
         c->set_seabed_stiffness(OptionOr("kbot", kDefaultKBot) * t.diameter);
         c->set_seabed_damping(OptionOr("cbot", kDefaultCBot) * t.diameter);
@@ -1386,6 +1434,7 @@ class DeckReader {
                      absl::StrCat("point ", id, " has an output channel but no line"));
       }
     }
+    if (absl::Status s = AddBodyChannels(&scene); !s.ok()) return s;
     for (const TensionChannel& t : tension_channels_) {
       const auto line = std::find_if(lines_.begin(), lines_.end(),
                                      [&](const Line& l) { return l.id == t.line_id; });
@@ -1402,11 +1451,50 @@ class DeckReader {
     return scene;
   }
 
+  // The body channels (OUTPUTS Body<n>...): a probe "Body<n>" on the
+  // scene body at the reference point (the columns Body<n>.x ... .az), and
+  // output.orientation for a rotation's (the scene body's axes are the
+  // world's at the start, so only a body that MoorDyn does not turn there).
+  absl::Status AddBodyChannels(v1::Scene* scene) const {
+    std::vector<int> probed;
+    for (const BodyChannel& c : body_channels_) {
+      const MdBody& b = md_bodies_[c.body - 1];
+      const std::string field = absl::StrCat("OUTPUTS ", c.name);
+      if (b.mount == Mount::kFixed) {
+        return Error(c.line, field, "a fixed body's channels cannot be expressed (it has no "
+                                    "scene body; it stays where the deck puts it)");
+      }
+      if (c.rotation) {
+        if (!b.rotation.isIdentity(0)) {
+          return Error(c.line, field,
+                       "a rotation channel of a body with r0, p0 or y0 cannot be expressed (its "
+                       "scene body's axes are the world's at the start, MoorDyn's turned)");
+        }
+        scene->mutable_output()->set_orientation(true);
+        continue;
+      }
+      if (std::find(probed.begin(), probed.end(), c.body) != probed.end()) continue;
+      probed.push_back(c.body);
+      const std::string name = absl::StrCat("body", c.body);
+      for (const v1::Body& o : scene->bodies()) {
+        if (o.name() != name) continue;
+        v1::Probe* probe = scene->add_probes();
+        probe->set_name(absl::StrCat("Body", c.body));
+        probe->set_body(name);
+        const Eigen::Vector3d rel =
+            b.position - Eigen::Vector3d(o.position().x(), o.position().y(), o.position().z());
+        SetVec(probe->mutable_point(), rel.x(), rel.y(), rel.z());
+      }
+    }
+    return absl::OkStatus();
+  }
+
   // A deck of rods or bodies alone (no line types): the environment, the
   // bodies and rods (MoorDyn's RodPinnedFloating.txt). No seabed: bodies
   // do not touch it, as MoorDyn's.
   absl::StatusOr<v1::Scene> BuildRigidOnly(v1::Scene scene) const {
     if (absl::Status s = BuildBodiesAndRods(&scene); !s.ok()) return s;
+    if (absl::Status s = AddBodyChannels(&scene); !s.ok()) return s;
     scene.mutable_solver()->set_analysis(v1::STATIC);
     return scene;
   }
@@ -1518,18 +1606,25 @@ class DeckReader {
   // ---- MoorDyn rods and bodies (docs/moordyn-files.md, "Bodies and rods") ----
 
   // A word of numbers separated by '|' (MoorDyn's CG, I, CdA and Ca
-  // columns): 1 or `many` of them.
+  // columns): 1 or one of `many` of them.
   absl::StatusOr<std::vector<double>> Numbers(int n, absl::string_view field,
-                                              absl::string_view word, int many) const {
+                                              absl::string_view word, int many, int many2 = 0,
+                                              int many3 = 0) const {
     std::vector<double> out;
     for (absl::string_view part : absl::StrSplit(word, '|')) {
       absl::StatusOr<double> v = Number(n, field, part);
       if (!v.ok()) return v.status();
       out.push_back(*v);
     }
-    if (out.size() != 1 && static_cast<int>(out.size()) != many) {
-      return Error(n, field, absl::StrCat("\"", word, "\": 1 or ", many,
-                                          " numbers separated by '|' can be expressed"));
+    const int size = static_cast<int>(out.size());
+    if (size != 1 && size != many && (many2 == 0 || size != many2) &&
+        (many3 == 0 || size != many3)) {
+      std::string counts = absl::StrCat(many);
+      if (many2 > 0) counts = absl::StrCat(many, many3 > 0 ? ", " : " or ", many2);
+      if (many3 > 0) absl::StrAppend(&counts, " or ", many3);
+      return Error(n, field,
+                   absl::StrCat("\"", word, "\": 1", many2 > 0 ? ", " : " or ", counts,
+                                " numbers separated by '|' can be expressed"));
     }
     return out;
   }
@@ -1628,17 +1723,25 @@ class DeckReader {
     absl::StatusOr<double> volume = NonNegative(n, col(11), w[11]);
     if (!volume.ok()) return volume.status();
     b.volume = *volume;
-    // Drag areas and added mass per body axis (MoorDyn: 2, 3 or 6 drag
-    // areas, 3 added masses): cablesim's body fluid loads are one drag
-    // and one added mass across the vertical and one along it, so only
-    // one number each (the same in every direction) is expressed.
-    if (absl::StrContains(w[12], "|")) {
-      return Error(n, col(12), absl::StrCat("\"", w[12], "\": drag areas per axis cannot be "
-                                            "expressed (one CdA, the same in every direction)"));
-    }
-    absl::StatusOr<double> cda = NonNegative(n, col(12), w[12]);
+    // Drag areas per body axis, as MoorDyn's manual gives them: one for
+    // all six degrees of freedom; two, translation then rotation; three,
+    // x, y, z for both; six, x, y, z then about x, y, z.
+    absl::StatusOr<std::vector<double>> cda = Numbers(n, col(12), w[12], 2, 3, 6);
     if (!cda.ok()) return cda.status();
-    b.cda = *cda;
+    for (double v : *cda)
+      if (v < 0) return Error(n, col(12), absl::StrCat("must be >= 0 (got ", w[12], ")"));
+    const std::vector<double>& a = *cda;
+    switch (a.size()) {
+      case 1: b.cda = b.cda_rotation = Eigen::Vector3d::Constant(a[0]); break;
+      case 2:
+        b.cda = Eigen::Vector3d::Constant(a[0]);
+        b.cda_rotation = Eigen::Vector3d::Constant(a[1]);
+        break;
+      case 3: b.cda = b.cda_rotation = Eigen::Vector3d(a[0], a[1], a[2]); break;
+      default:
+        b.cda = Eigen::Vector3d(a[0], a[1], a[2]);
+        b.cda_rotation = Eigen::Vector3d(a[3], a[4], a[5]);
+    }
     absl::StatusOr<std::vector<double>> ca = Numbers(n, col(13), w[13], 3);
     if (!ca.ok()) return ca.status();
     for (double v : *ca) {
@@ -1834,13 +1937,11 @@ class DeckReader {
     v1::BodyHydrodynamics* h = body->mutable_hydrodynamics();
     if (p.body != nullptr) {
       // A body's volume: a vertical cylinder as tall as wide, as a free
-      // point's (MoorDyn buoys it by rho g V at its CG, drags it by
-      // 1/2 rho CdA |v| v and adds Ca rho V).
+      // point's (MoorDyn buoys it by rho g V at its CG and adds Ca rho V;
+      // its drag is SetDragAreas').
       const double d = std::cbrt(4 * p.body->volume / kPi);
       h->set_diameter(d);
       h->set_height(d);
-      h->set_drag_coefficient(p.body->cda / (d * d));
-      h->set_heave_drag_coefficient(p.body->cda / (kPi * d * d / 4));
       h->set_added_mass(p.body->ca);
       h->set_heave_added_mass(p.body->ca);
       return absl::OkStatus();
@@ -1879,6 +1980,59 @@ class DeckReader {
     h->set_heave_drag_coefficient(ends * t.cd_end);
     const double end_volume = 2.0 / 3.0 * kPi * std::pow(t.diameter / 2, 3);
     if (submerged > 0) h->set_heave_added_mass(ends * t.ca_end * end_volume / (area * submerged));
+    return absl::OkStatus();
+  }
+
+  // Whether the deck has water (WtrDnsty > 0) and weight (g > 0).
+  bool HasWater() const { return OptionOr("rho", kDefaultDensity) > 0; }
+  bool HasGravity() const { return OptionOr("g", kDefaultGravity) > 0; }
+
+  // Whether rod `r` gets fluid loads: in water; without gravity its
+  // buoyancy is nothing, and its drag and added mass, which cablesim splits
+  // about the vertical or a buoyed cylinder's axis, are refused.
+  absl::StatusOr<bool> RodWet(const Rod& r) const {
+    if (!HasWater()) return false;
+    if (HasGravity()) return true;
+    const RodType& t = *r.type;
+    if (t.cd > 0 || t.ca > 0 || t.cd_end > 0 || t.ca_end > 0) {
+      return Error(t.line, "ROD TYPES Cd",
+                   absl::StrCat("rod ", r.id, " (line ", r.line,
+                                "): drag or added mass without gravity cannot be expressed (a "
+                                "rod's fluid loads are those of a buoyed cylinder, which needs "
+                                "the vertical)"));
+    }
+    return false;
+  }
+
+  // MoorDyn's body drag (BODIES CdA): 1/2 rho R diag(CdA) R^T |v| v at the
+  // body's reference point and -1/2 rho R diag(CdA_rot) R^T |w| w, in the
+  // body's axes R, as BodyHydrodynamics.drag_area and rotational_drag_area
+  // (at the centre of mass, in the scene body's axes, the world's).
+  absl::Status SetDragAreas(const MdBody& b, const Eigen::Vector3d& com, v1::Body* body) const {
+    if (!HasWater() || (b.cda.isZero(0) && b.cda_rotation.isZero(0))) return absl::OkStatus();
+    if ((b.position - com).norm() > 1e-9 * std::max(1.0, b.position.norm())) {
+      return Error(b.line, "BODIES CG",
+                   absl::StrCat("drag (CdA) on a body whose centre of mass lies ",
+                                (b.position - com).norm(),
+                                " m from its reference point cannot be expressed (MoorDyn's body "
+                                "drag acts at the reference point, cablesim's at the centre of "
+                                "mass)"));
+    }
+    Eigen::Vector3d areas[2];
+    for (int k = 0; k < 2; ++k) {
+      const Eigen::Vector3d& a = k == 0 ? b.cda : b.cda_rotation;
+      const Eigen::Matrix3d world = b.rotation * a.asDiagonal() * b.rotation.transpose();
+      areas[k] = world.diagonal();
+      const Eigen::Matrix3d off = world - Eigen::Matrix3d(areas[k].asDiagonal());
+      if (off.cwiseAbs().maxCoeff() > 1e-9 * a.cwiseAbs().maxCoeff()) {
+        return Error(b.line, "BODIES CdA",
+                     "drag areas that differ between the axes of a body turned off the "
+                     "world's axes cannot be expressed (the scene body keeps the world's axes)");
+      }
+    }
+    v1::BodyHydrodynamics* h = body->mutable_hydrodynamics();
+    SetVec(h->mutable_drag_area(), areas[0].x(), areas[0].y(), areas[0].z());
+    SetVec(h->mutable_rotational_drag_area(), areas[1].x(), areas[1].y(), areas[1].z());
     return absl::OkStatus();
   }
 
@@ -1927,8 +2081,15 @@ class DeckReader {
                    "with its rods and points the body's principal axes are not the world's "
                    "axes at the start (cablesim takes principal moments of inertia)");
     }
+    // Mass all on a line through the centre (point masses on a body of
+    // I 0, MoorDyn's orbitalBody.txt) leaves no inertia about that line,
+    // where nothing turns it: there the parts get the sphere of 0.1 m a
+    // free point gets.
+    Eigen::Vector3d moments = local.diagonal();
+    for (int k = 0; k < 3; ++k)
+      if (!(local(k, k) > 1e-12 * local.trace())) moments(k) = 0.4 * m * 0.1 * 0.1;
     body->set_mass(m);
-    SetVec(body->mutable_inertia(), local(0, 0), local(1, 1), local(2, 2));
+    SetVec(body->mutable_inertia(), moments.x(), moments.y(), moments.z());
     SetVec(body->mutable_position(), com.x(), com.y(), com.z());
     return com;
   }
@@ -1978,12 +2139,18 @@ class DeckReader {
         const Eigen::Vector3d cg = b.position + b.rotation * b.cg;
         parts.push_back(Part{b.mass, cg,
                              b.rotation * b.inertia.asDiagonal() * b.rotation.transpose()});
-        if (b.volume > 0) {
-          wet.push_back(Wet{cg, Eigen::Vector3d::UnitZ(), 0, 0, nullptr, &b, b.line});
-        } else if (b.cda > 0 || b.ca > 0) {
-          return Error(b.line, b.cda > 0 ? "BODIES CdA" : "BODIES Ca",
-                       "a body with drag or added mass needs a volume > 0 (it sizes the "
-                       "body's fluid loads)");
+        // The volume buoys the body and carries its added mass Ca rho V
+        // (nothing in a dry deck; without gravity, nothing but the added
+        // mass, which needs the vertical of cablesim's buoyed cylinder).
+        // A body without volume has no added mass (MoorDyn's is Ca rho V).
+        if (b.volume > 0 && HasWater()) {
+          if (HasGravity()) {
+            wet.push_back(Wet{cg, Eigen::Vector3d::UnitZ(), 0, 0, nullptr, &b, b.line});
+          } else if (b.ca > 0) {
+            return Error(b.line, "BODIES Ca",
+                         "added mass without gravity cannot be expressed (a body's added mass "
+                         "is that of its buoyed cylinder, which needs the vertical)");
+          }
         }
         for (const auto& [id, p] : points_)
           if (p.body == b.id && p.mass > 0)
@@ -1992,13 +2159,18 @@ class DeckReader {
         for (int id : rods) {
           const Rod& r = rods_[id - 1];
           parts.push_back(RodPart(r));
-          wet.push_back(Wet{(r.a + r.b) / 2, (r.b - r.a) / r.length(), r.type->diameter,
-                            r.length(), r.type, nullptr, r.line});
+          absl::StatusOr<bool> rod_wet = RodWet(r);
+          if (!rod_wet.ok()) return rod_wet.status();
+          if (*rod_wet) {
+            wet.push_back(Wet{(r.a + r.b) / 2, (r.b - r.a) / r.length(), r.type->diameter,
+                              r.length(), r.type, nullptr, r.line});
+          }
         }
         absl::StatusOr<Eigen::Vector3d> c = SetRigid(parts, b.line, "BODIES Mass", nullptr, body);
         if (!c.ok()) return c.status();
         com = *c;
         if (absl::Status s = SetHydrodynamics(wet, com, body); !s.ok()) return s;
+        if (absl::Status s = SetDragAreas(b, com, body); !s.ok()) return s;
         if (b.mount == Mount::kCoupledPinned) {
           // Its reference point driven by the host, its rotation free.
           v1::Joint* j = scene->add_joints();
@@ -2037,9 +2209,11 @@ class DeckReader {
       absl::StatusOr<Eigen::Vector3d> com =
           SetRigid({RodPart(r)}, r.line, "ROD TYPES Mass/m", &axis, body);
       if (!com.ok()) return com.status();
+      absl::StatusOr<bool> rod_wet = r.mount == Mount::kCoupled ? absl::StatusOr<bool>(false) : RodWet(r);
+      if (!rod_wet.ok()) return rod_wet.status();
       if (r.mount == Mount::kCoupled) {
         body->set_coupled(true);
-      } else {
+      } else if (*rod_wet) {
         absl::Status s = SetHydrodynamics(
             {Wet{*com, axis, r.type->diameter, length, r.type, nullptr, r.line}}, *com, body,
             /*along_axis=*/true);
@@ -2086,6 +2260,7 @@ class DeckReader {
   std::vector<Line> lines_;
   std::map<std::string, Option> options_;
   std::vector<int> probe_points_;
+  std::vector<BodyChannel> body_channels_;
   std::vector<TensionChannel> tension_channels_;
   // The POINTS (BODIES, RODS) row of each body Build made, in scene order
   // (for Located).

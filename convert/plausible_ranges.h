@@ -56,6 +56,9 @@ inline constexpr PlausibleRange kTime{-1e9, 1e9, "s"};
 inline constexpr PlausibleRange kAngle{-1e6, 1e6, "rad"};
 // Drag and added-mass coefficients (about 1 in practice).
 inline constexpr PlausibleRange kHydroCoefficient{0, 1e3, "(dimensionless)"};
+// A body's drag areas [m^2] and rotational drag areas [m^5].
+inline constexpr PlausibleRange kDragArea{0, 1e6, "m^2"};
+inline constexpr PlausibleRange kRotationalDragArea{0, 1e12, "m^5"};
 // Friction coefficients (about 0.1 to 1 in practice).
 inline constexpr PlausibleRange kFrictionCoefficient{0, 1e3, "(dimensionless)"};
 // Cable damping times (axial_time, bending_time, rayleigh_beta) and

@@ -15,6 +15,7 @@
 #include <numbers>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -331,13 +332,15 @@ ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
 
 // A free body (BODIES) of volume 8 m^3 and 5000 kg with its CG 0.5 m
 // below its reference point: a vertical cylinder as tall as wide
-// (d = (4 V / pi)^(1/3)) at the CG, floating where m = rho A s.
-TEST(MoorDynBodiesTest, FreeBodyFloatsAtItsDraft) {
-  const v1::Scene s = Read(Deck(R"(---------------------------- BODIES -----------------------------------------------------
+// (d = (4 V / pi)^(1/3)) at the CG, floating where m = rho A s. (Its
+// drag, at the reference point, would be refused: BODIES CG below.)
+constexpr char kFloater[] = R"(---------------------------- BODIES -----------------------------------------------------
 ID   Attachment  X0     Y0    Z0     r0      p0     y0     Mass  CG*   I*      Volume   CdA*   Ca
 (#)     (-)      (m)    (m)   (m)   (deg)   (deg)  (deg)   (kg)  (m)  (kg-m^2)  (m^3)   (m^2)  (-)
-1       free      0     0      0     0       0      0      5000  -0.5  2000    8        1.5    0.8
-)"));
+1       free      0     0      0     0       0      0      5000  -0.5  2000    8        0      0.8
+)";
+TEST(MoorDynBodiesTest, FreeBodyFloatsAtItsDraft) {
+  const v1::Scene s = Read(Deck(kFloater));
   ASSERT_EQ(s.bodies_size(), 1);
   const v1::Body& b = s.bodies(0);
   EXPECT_EQ(b.name(), "body1");
@@ -347,8 +350,8 @@ ID   Attachment  X0     Y0    Z0     r0      p0     y0     Mass  CG*   I*      V
   const double d = std::cbrt(4 * 8 / kPi), area = kPi * d * d / 4;
   EXPECT_DOUBLE_EQ(b.hydrodynamics().diameter(), d);
   EXPECT_DOUBLE_EQ(b.hydrodynamics().height(), d);
-  EXPECT_DOUBLE_EQ(b.hydrodynamics().drag_coefficient(), 1.5 / (d * d));
-  EXPECT_DOUBLE_EQ(b.hydrodynamics().heave_drag_coefficient(), 1.5 / area);
+  EXPECT_DOUBLE_EQ(b.hydrodynamics().drag_coefficient(), 0);
+  EXPECT_FALSE(b.hydrodynamics().has_drag_area());
   EXPECT_DOUBLE_EQ(b.hydrodynamics().added_mass(), 0.8);
   CollectingSink sink;
   const Frame last = Statics(s, "body1", &sink);
@@ -611,10 +614,59 @@ TEST(MoorDynBodiesTest, RefusalsNameTheLineAndField) {
                                                "-5    0     0     5    0"}}))
                 .find("bad.dat:18: RODS NumSegs"),
             std::string::npos);
-  EXPECT_NE(Refusal(absl::StrReplaceAll(body, {{"5e4     0        0      0",
-                                               "5e4     0        1|2|3  0"}}))
-                .find("bad.dat:14: BODIES CdA: \"1|2|3\": drag areas per axis"),
+  // Drag areas per axis on a body turned off the world's axes (yaw 30).
+  EXPECT_NE(Refusal(Deck(absl::StrReplaceAll(
+                    kFloater, {{"0      5000  -0.5  2000    8        0 ",
+                                "30     5000  0     2000    8        1|2|3 "}})))
+                .find("bad.dat:6: BODIES CdA: drag areas that differ between the axes"),
             std::string::npos);
+  EXPECT_NE(Refusal(absl::StrReplaceAll(body, {{"5e4     0        0      0",
+                                               "5e4     0        1|2|3|4  0"}}))
+                .find("bad.dat:14: BODIES CdA: \"1|2|3|4\": 1, 2, 3 or 6 numbers"),
+            std::string::npos);
+  EXPECT_NE(Refusal(absl::StrReplaceAll(body, {{"5e4     0        0      0",
+                                               "5e4     0        -1     0"}}))
+                .find("bad.dat:14: BODIES CdA: must be >= 0"),
+            std::string::npos);
+  // Drag on a body whose CG is off its reference point (MoorDyn's drag
+  // acts there, cablesim's at the centre of mass).
+  EXPECT_NE(Refusal(Deck(absl::StrReplaceAll(kFloater, {{"8        0      0.8", "8        1.5    0.8"}})))
+                .find("bad.dat:6: BODIES CG: drag (CdA) on a body whose centre of mass lies 0.5 m"),
+            std::string::npos);
+}
+
+// MoorDyn's body drag areas (BODIES CdA): one number for all six degrees
+// of freedom, two for translation and rotation, three per axis for both,
+// six per axis then about each axis; in the body's axes, which MoorDyn's
+// yaw of 90 degrees turns (its x along the world's y): the scene's are
+// the world's, so x and y swap. A body without volume keeps its drag (no
+// cylinder, no buoyancy).
+TEST(MoorDynBodiesTest, DragAreasPerBodyAxis) {
+  const std::string body = Deck(kBodyWithRod);
+  const std::string row = "0      90     1e4   0    5e4     0        0      0";
+  ASSERT_NE(body.find(row), std::string::npos);
+  auto areas = [&](const std::string& cda) {
+    const v1::Scene s = Read(absl::StrReplaceAll(
+        body, {{row, absl::StrCat("0      90     1e4   0    5e4     0        ", cda, " 0")}}));
+    const v1::BodyHydrodynamics& h = BodyNamed(s, "body1").hydrodynamics();
+    return std::pair{Eigen::Vector3d(h.drag_area().x(), h.drag_area().y(), h.drag_area().z()),
+                     Eigen::Vector3d(h.rotational_drag_area().x(), h.rotational_drag_area().y(),
+                                     h.rotational_drag_area().z())};
+  };
+  for (const auto& [cda, along, about] :
+       {std::tuple{"0.5", Eigen::Vector3d(0.5, 0.5, 0.5), Eigen::Vector3d(0.5, 0.5, 0.5)},
+        std::tuple{"0.5|7", Eigen::Vector3d(0.5, 0.5, 0.5), Eigen::Vector3d(7, 7, 7)},
+        std::tuple{"1|2|3", Eigen::Vector3d(2, 1, 3), Eigen::Vector3d(2, 1, 3)},
+        std::tuple{"1|2|3|4|5|6", Eigen::Vector3d(2, 1, 3), Eigen::Vector3d(5, 4, 6)}}) {
+    SCOPED_TRACE(cda);
+    const auto [a, w] = areas(cda);
+    EXPECT_LT((a - along).norm(), 1e-12);
+    EXPECT_LT((w - about).norm(), 1e-12);
+  }
+  // The scene is valid.
+  const v1::Scene s = Read(absl::StrReplaceAll(
+      body, {{row, "0      90     1e4   0    5e4     0        1|2|3 0"}}));
+  EXPECT_TRUE(SceneFromProto(s).ok()) << SceneFromProto(s).status();
 }
 
 // MoorDyn's 3D seafloor file: nx ny, the ticks, then x y z per node.
@@ -812,6 +864,150 @@ TEST(MoorDynBodiesTest, CliImportsAndRunsTheDecks) {
   std::string out, err;
   EXPECT_EQ(Cli({"run", bad}, &out, &err), 2);
   EXPECT_NE(err.find("bad.dat:22: LINES Attach: rod 7 does not exist"), std::string::npos) << err;
+}
+
+}  // namespace
+}  // namespace cablesim
+
+namespace cablesim {
+namespace {
+
+// WtrDnsty 0: MoorDyn's dry deck (its body_tests/pinnedBody.txt). No
+// fluid loads anywhere: the rod of kHangingRod hangs on its rope with its
+// whole weight g (150 kg/m x 6 m) at the rope's end (1e-6, as in water).
+TEST(MoorDynBodiesTest, DryDeckCarriesTheWholeWeight) {
+  const std::string wet = Deck(kHangingRod);
+  const std::string option = "1025          WtrDnsty";
+  ASSERT_NE(wet.find(option), std::string::npos);
+  const v1::Scene s = Read(absl::StrReplaceAll(wet, {{option, "0             WtrDnsty"}}));
+  EXPECT_EQ(s.fluid().density(), 0);
+  EXPECT_FALSE(s.fluid().free_surface());
+  ASSERT_EQ(s.cables_size(), 1);
+  EXPECT_FALSE(s.cables(0).has_hydrodynamics());
+  ASSERT_EQ(s.bodies_size(), 1);
+  EXPECT_FALSE(s.bodies(0).has_hydrodynamics());
+  CollectingSink sink;
+  const Frame last = Statics(s, "rod1", &sink);
+  ASSERT_EQ(last.probe_tensions.size(), 1u);
+  const double weight = kG * 150 * 6;
+  std::printf("dry: tension at the rod %.9g N, by hand %.9g N\n", last.probe_tensions[0], weight);
+  EXPECT_NEAR(last.probe_tensions[0], weight, 1e-6 * weight);
+  // Negative stays refused.
+  EXPECT_NE(Refusal(absl::StrReplaceAll(wet, {{option, "-1            WtrDnsty"}}))
+                .find("OPTIONS WtrDnsty: must be >= 0"),
+            std::string::npos);
+}
+
+// g 0: MoorDyn's weightless deck (its body_tests/orbitalBody.txt checks
+// the same motion). A dumbbell of two 20 kg points 4 m apart on a body of
+// no mass, its CG 10 m from its reference point, turning at 0.2 rad/s
+// about its centre: the reference point orbits the centre at 10 m, its
+// angle 0.2 t. MoorDyn's test's tolerances, 1e-6 of the radius and of the
+// angular speed (measured: 1.3e-12 and 6.9e-9 of them at h = 1e-3 s over 10 s). The
+// dumbbell has no inertia about its own axis: the converter gives it the
+// 0.1 m sphere a free point gets (nothing turns it there).
+TEST(MoorDynBodiesTest, WeightlessDumbbellOrbitsItsCentre) {
+  const std::string deck = absl::StrReplaceAll(Deck(R"(---------------------------- BODIES -----------------------------------------------------
+ID   Attachment  X0     Y0    Z0     r0      p0     y0     Mass  CG*       I*      Volume   CdA*   Ca
+(#)     (-)      (m)    (m)   (m)   (deg)   (deg)  (deg)   (kg)  (m)       (kg-m^2)  (m^3)   (m^2)  (-)
+1       free      0     10    -20    0       0      0      0     0|-10|0   0       0        0      0
+----------------------- POINTS --------------------------------
+ID    Type      X       Y       Z       Mass   Volume  CdA    Ca
+(#)   (-)       (m)     (m)     (m)     (kg)   (m^3)   (m^2)  (-)
+1     Body1     0       -10     -2      20     0       0      0
+2     Body1     0       -10     2       20     0       0      0
+)"),
+                                               {{"9.81          g", "0             g"}});
+  v1::Scene s = Read(deck);
+  EXPECT_EQ(s.gravity().z(), 0);
+  ASSERT_EQ(s.bodies_size(), 1);
+  const v1::Body& b = s.bodies(0);
+  EXPECT_DOUBLE_EQ(b.mass(), 40);
+  EXPECT_NEAR(b.position().y(), 0, 1e-12);
+  EXPECT_DOUBLE_EQ(b.inertia().x(), 2 * 20 * 4);
+  EXPECT_DOUBLE_EQ(b.inertia().z(), 0.4 * 40 * 0.1 * 0.1);
+  s.mutable_solver()->set_analysis(v1::DYNAMIC);
+  s.mutable_solver()->set_integrator(v1::HHT);
+  s.mutable_solver()->set_duration(10);
+  s.mutable_solver()->set_step(1e-3);
+  s.mutable_solver()->set_output_interval(0.5);
+  s.mutable_initial_velocity()->mutable_angular()->set_x(0.2);
+  s.mutable_initial_velocity()->mutable_origin()->set_z(-20);
+  v1::Probe* p = s.add_probes();
+  p->set_name("reference");
+  p->set_body("body1");
+  p->mutable_point()->set_y(10);
+  const absl::StatusOr<Scene> scene = SceneFromProto(s);
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  CollectingSink sink;
+  RunOk(*scene, &sink);
+  ASSERT_GE(sink.frames().size(), 20u);
+  const int k = testing::ProbeIndex(sink.info(), "reference");
+  ASSERT_GE(k, 0);
+  double worst_r = 0, worst_w = 0;
+  for (const Frame& f : sink.frames()) {
+    if (f.t == 0) continue;
+    const Eigen::Vector3d r = f.probes[k].position_m - Eigen::Vector3d(0, 0, -20);
+    worst_r = std::max(worst_r, std::abs(r.norm() - 10));
+    worst_w = std::max(worst_w, std::abs(std::atan2(r.z(), r.y()) / f.t - 0.2));
+  }
+  std::printf("orbit: radius off by %.3g m, angular speed by %.3g rad/s\n", worst_r, worst_w);
+  EXPECT_LT(worst_r, 1e-6 * 10);
+  EXPECT_LT(worst_w, 1e-6 * 0.2);
+  EXPECT_NE(Refusal(absl::StrReplaceAll(deck, {{"0             g", "-9.81         g"}}))
+                .find("OPTIONS g: must be >= 0"),
+            std::string::npos);
+}
+
+// A body's channels (OUTPUTS Body<n>...: MoorDyn's body_tests/pinnedBody.txt):
+// the reference point's position, velocity and acceleration become a probe
+// "Body<n>" on the body at that point, a rotation's output.orientation
+// (refused for a body MoorDyn turns at the start: its scene body's axes
+// are the world's); a channel of no translation is refused by name.
+TEST(MoorDynBodiesTest, BodyChannelsBecomeAProbeAndTheOrientation) {
+  const std::string body = Deck(kBodyWithRod);
+  const std::string turned = "0      90     1e4", upright = "0      0      1e4";
+  ASSERT_NE(body.find(turned), std::string::npos);
+  const v1::Scene s = Read(absl::StrReplaceAll(
+      body, {{"Point1Pz", "Body1Px\nBODY1AY\nBody1RX"}, {turned, upright}}));
+  EXPECT_TRUE(s.output().orientation());
+  int probes = 0;
+  for (const v1::Probe& p : s.probes()) {
+    if (p.name() != "Body1") continue;
+    ++probes;
+    EXPECT_EQ(p.body(), "body1");
+    const v1::Body& b = BodyNamed(s, "body1");
+    // The reference point (0, 0, -40) from the centre of mass.
+    EXPECT_NEAR(b.position().z() + p.point().z(), -40, 1e-12);
+  }
+  EXPECT_EQ(probes, 1);
+  EXPECT_TRUE(SceneFromProto(s).ok()) << SceneFromProto(s).status();
+  EXPECT_NE(Refusal(absl::StrReplaceAll(body, {{"Point1Pz", "Body1RX"}}))
+                .find("bad.dat:32: OUTPUTS Body1RX: a rotation channel of a body with r0, p0 or "
+                      "y0"),
+            std::string::npos);
+  EXPECT_NE(Refusal(absl::StrReplaceAll(body, {{"Point1Pz", "Body1FX"}}))
+                .find("bad.dat:32: OUTPUTS Body1FX: only point positions"),
+            std::string::npos);
+}
+
+// A body with drag but no volume (MoorDyn's body_tests/bodyDrag.txt): its
+// drag areas alone, no cylinder (no buoyancy), and a valid scene.
+TEST(MoorDynBodiesTest, BodyDragWithoutVolume) {
+  const v1::Scene s = Read(Deck(absl::StrReplaceAll(
+      kFloater, {{"5000  -0.5  2000    8        0      0.8", "5000  0     2000    0        0.7    0.8"}})));
+  ASSERT_EQ(s.bodies_size(), 1);
+  const v1::BodyHydrodynamics& h = s.bodies(0).hydrodynamics();
+  EXPECT_FALSE(h.has_diameter());
+  EXPECT_FALSE(h.has_height());
+  EXPECT_DOUBLE_EQ(h.added_mass(), 0);  // MoorDyn's Ca rho V with V = 0
+  EXPECT_DOUBLE_EQ(h.drag_area().x(), 0.7);
+  EXPECT_DOUBLE_EQ(h.drag_area().z(), 0.7);
+  EXPECT_DOUBLE_EQ(h.rotational_drag_area().y(), 0.7);
+  auto model = MultibodyModel::Build(*SceneFromProto(s));
+  ASSERT_TRUE(model.ok()) << model.status();
+  ASSERT_EQ(model->body_fluid_loads().size(), 1u);
+  EXPECT_EQ(model->body_fluid_loads()[0].waterplane_area(), 0);
 }
 
 }  // namespace

@@ -39,7 +39,8 @@ absl::Status ConvertBodyContact(const std::string& path, const v1::Body& b, Body
 }
 
 // Body.hydrodynamics (BodyFluidLoad): the cylinder's size from the
-// body's cylinder unless given; coefficients >= 0.
+// body's cylinder unless given (none for drag areas alone); coefficients
+// and areas >= 0.
 absl::Status ConvertBodyHydrodynamics(const ConversionState& state, int i, const v1::Body& b,
                                       BodySpec* body) {
   if (!b.has_hydrodynamics()) return absl::OkStatus();
@@ -47,8 +48,22 @@ absl::Status ConvertBodyHydrodynamics(const ConversionState& state, int i, const
   const std::string path = Sub(Indexed("", "bodies", i), "hydrodynamics");
   if (!(state.proto.fluid().density() > 0))
     return Invalid(path, "needs a fluid around the body (fluid.density > 0)");
-  if (!(state.scene.gravity_m_s2.norm() > 0))
-    return Invalid(path, "needs gravity (it sets the vertical and the buoyancy)");
+  for (const auto& [name, v, range, out] :
+       {std::tuple{"drag_area", &h.drag_area(), &plausible::kDragArea, &body->hydro_drag_area_m2},
+        std::tuple{"rotational_drag_area", &h.rotational_drag_area(),
+                   &plausible::kRotationalDragArea, &body->hydro_rotational_drag_area_m5}}) {
+    CABLESIM_ASSIGN_OR_RETURN(*out, VectorInRange(Sub(path, name), *v, *range));
+  }
+  // Drag areas alone on a body given by mass: no cylinder (no buoyancy).
+  const bool cylinder = h.has_diameter() || h.has_height() || b.has_cylinder() ||
+                        h.drag_coefficient() != 0 || h.heave_drag_coefficient() != 0 ||
+                        h.added_mass() != 0 || h.heave_added_mass() != 0 || h.along_axis();
+  body->has_hydrodynamics = true;
+  if (!cylinder) return absl::OkStatus();
+  if (!(state.scene.gravity_m_s2.norm() > 0)) {
+    return Invalid(path, "needs gravity for its cylinder (it sets the vertical and the "
+                         "buoyancy; without gravity give drag_area alone)");
+  }
   for (const auto& [name, given, value, from_cylinder, out] :
        {std::tuple{"diameter", h.has_diameter(), h.diameter(), b.cylinder().diameter(),
                    &body->hydro_diameter_m},
@@ -70,7 +85,6 @@ absl::Status ConvertBodyHydrodynamics(const ConversionState& state, int i, const
     *out = value;
   }
   body->hydro_along_axis = h.along_axis();
-  body->has_hydrodynamics = true;
   return absl::OkStatus();
 }
 

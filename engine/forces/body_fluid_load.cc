@@ -5,6 +5,8 @@
 #include <numbers>
 #include <utility>
 
+#include <Eigen/Geometry>
+
 #include "engine/linear/rounding.h"
 
 namespace cablesim {
@@ -78,7 +80,91 @@ double BodyFluidLoad::HydrostaticEnergy(const VectorXd& q, double scale) const {
 }
 
 bool BodyFluidLoad::dynamic(bool has_waves) const {
-  return p_.drag != 0 || p_.heave_drag != 0 || has_waves;
+  return p_.drag != 0 || p_.heave_drag != 0 || has_area_drag() || has_waves;
+}
+
+namespace {
+
+// [e]x, the matrix of e x.
+Matrix3d CrossMatrix(const Vector3d& e) {
+  Matrix3d m;
+  m << 0, -e.z(), e.y(), e.z(), 0, -e.x(), -e.y(), e.x(), 0;
+  return m;
+}
+
+// k times the symmetric part of d(B |x| x)/dx = B (|x| I + x x^T / |x|).
+Matrix3d QuadraticTangent(double k, const Matrix3d& b, const Vector3d& x) {
+  const double n = x.norm();
+  if (!(n > 0)) return Matrix3d::Zero();
+  const Matrix3d c = k * b * (n * Matrix3d::Identity() + x * x.transpose() / n);
+  return 0.5 * (c + c.transpose());
+}
+
+}  // namespace
+
+void BodyFluidLoad::AreaDrag(const VectorXd& q, const VectorXd& qdot, double t,
+                             const WaveField* waves, Generalized* force,
+                             GeneralizedMatrix* damping) const {
+  force->setZero();
+  if (damping != nullptr) damping->setZero();
+  if (!has_area_drag()) return;
+  // The wetted fraction: the cylinder's, or all of a body without one.
+  const double f = p_.height_m > 0 ? Submerged(Height(q)) / p_.height_m : 1;
+  if (!(f > 0)) return;
+  const double k = 0.5 * p_.density_kg_m3 * f;
+  Vector3d r = Vector3d::Zero(), v = Vector3d::Zero();
+  r.head(dim_) = q.segment(coord_, dim_);
+  v.head(dim_) = qdot.segment(coord_, dim_);
+  Vector3d u = p_.current_m_s;
+  if (waves != nullptr) u += waves->At(r, t).velocity_m_s;
+  // The body's axes R = [e1 e2 e3] and angular velocity.
+  Matrix3d rot;
+  Vector3d omega = Vector3d::Zero();
+  Vector3d axis_u = Vector3d::Zero(), axis_udot = Vector3d::Zero();  // planar
+  if (dim_ == 2) {
+    axis_u.head(2) = q.segment(coord_ + 2, 2);
+    axis_udot.head(2) = qdot.segment(coord_ + 2, 2);
+    const Vector3d e1 = axis_u.normalized();
+    rot.col(0) = e1;
+    rot.col(1) = Vector3d::UnitZ().cross(e1);
+    rot.col(2) = Vector3d::UnitZ();
+    omega.z() = axis_u.cross(axis_udot).z() / axis_u.squaredNorm();
+  } else {
+    for (int a = 0; a < 3; ++a) {
+      rot.col(a) = q.segment<3>(coord_ + 3 + 3 * a);
+      omega += 0.5 * rot.col(a).cross(qdot.segment<3>(coord_ + 3 + 3 * a));
+    }
+  }
+  Vector3d vr = u - v;
+  if (dim_ == 2) vr.z() = 0;
+  const Matrix3d b = rot * p_.drag_area.asDiagonal() * rot.transpose();
+  const Vector3d drag = k * vr.norm() * (b * vr);
+  force->head(dim_) = drag.head(dim_);
+  if (damping != nullptr) {
+    damping->topLeftCorner(dim_, dim_) = QuadraticTangent(k, b, vr).topLeftCorner(dim_, dim_);
+  }
+  if (p_.rotational_drag_area.isZero(0)) return;
+  const Matrix3d bw = rot * p_.rotational_drag_area.asDiagonal() * rot.transpose();
+  const Vector3d moment = -k * omega.norm() * (bw * omega);
+  if (dim_ == 2) {
+    // T e_z x u / |u|^2 on u (omega = p . udot with the same p).
+    const Vector3d p = Vector3d::UnitZ().cross(axis_u) / axis_u.squaredNorm();
+    force->segment<2>(2) = moment.z() * p.head(2);
+    if (damping != nullptr) {
+      damping->block<2, 2>(2, 2) = 2 * k * p_.rotational_drag_area.z() * std::abs(omega.z()) *
+                                   p.head(2) * p.head(2).transpose();
+    }
+    return;
+  }
+  Eigen::Matrix<double, 3, 9> s;
+  for (int a = 0; a < 3; ++a) {
+    const Matrix3d sa = CrossMatrix(rot.col(a));
+    s.block<3, 3>(0, 3 * a) = sa;
+    force->segment<3>(3 + 3 * a) = -0.5 * sa * moment;  // (1/2) M x e_a
+  }
+  if (damping != nullptr) {
+    damping->block<9, 9>(3, 3) = 0.25 * s.transpose() * QuadraticTangent(k, bw, omega) * s;
+  }
 }
 
 Vector3d BodyFluidLoad::DynamicForce(const VectorXd& q, const VectorXd& qdot, double t,
@@ -153,6 +239,19 @@ void BodyFluidForces::AddDissipative(const ForceState& s, ForceOutput* out) cons
     }
     out->size = std::max(out->size, force.lpNorm<Eigen::Infinity>());
     if (out->matrix) out->map.ScatterBlock(b.coord(), c, out->scale, out->matrix);
+    if (!b.has_area_drag()) continue;
+    BodyFluidLoad::Generalized area;
+    BodyFluidLoad::GeneralizedMatrix area_c;
+    b.AreaDrag(*s.q, *s.qdot, s.time, s.waves, &area, out->matrix ? &area_c : nullptr);
+    const int n = b.stride();
+    for (int k = 0; k < n; ++k) {
+      (*out->full)(b.coord() + k) += area(k);
+      if (out->roundoff) (*out->roundoff)(b.coord() + k) += kSumRounding * std::abs(area(k));
+    }
+    out->size = std::max(out->size, area.head(n).lpNorm<Eigen::Infinity>());
+    if (out->matrix)
+      out->map.ScatterRange(b.coord(), n, area_c.data(), BodyFluidLoad::kMaxStride, out->scale,
+                            out->matrix);
   }
 }
 
@@ -167,6 +266,10 @@ void BodyFluidForces::AddDissipatedPower(const ForceState& s, double* power) con
     if (!b.dynamic(s.waves != nullptr)) continue;
     const Vector3d force = b.DynamicForce(*s.q, *s.qdot, s.time, s.waves, nullptr);
     for (int d = 0; d < b.dim(); ++d) *power -= force(d) * (*s.qdot)(b.coord() + d);
+    if (!b.has_area_drag()) continue;
+    BodyFluidLoad::Generalized area;
+    b.AreaDrag(*s.q, *s.qdot, s.time, s.waves, &area, nullptr);
+    for (int k = 0; k < b.stride(); ++k) *power -= area(k) * (*s.qdot)(b.coord() + k);
   }
 }
 
@@ -179,17 +282,19 @@ bool BodyFluidForces::dynamic(bool has_waves) const {
 std::unique_ptr<BodyFluidForces> MakeBodyFluidForces(const Scene& scene,
                                                      const std::vector<int>& body_coord, int dim,
                                                      bool has_waves) {
-  // SceneFromProto requires a fluid and gravity with body hydrodynamics.
+  // SceneFromProto requires a fluid with body hydrodynamics, and gravity
+  // with a cylinder (without gravity the vertical is z, unused).
   const FluidSpec& fluid = scene.fluid;
   const double g = scene.gravity_m_s2.norm();
   std::vector<BodyFluidLoad> loads;
   for (size_t b = 0; b < scene.bodies.size(); ++b) {
     const BodySpec& body = scene.bodies[b];
-    if (!body.has_hydrodynamics || !(fluid.density_kg_m3 > 0) || !(g > 0)) continue;
+    if (!body.has_hydrodynamics || !(fluid.density_kg_m3 > 0)) continue;
+    if (!(g > 0) && body.hydro_height_m > 0) continue;
     BodyFluidLoad::Params p;
     p.density_kg_m3 = fluid.density_kg_m3;
     p.g_m_s2 = g;
-    p.up = -scene.gravity_m_s2 / g;
+    p.up = g > 0 ? Vector3d(-scene.gravity_m_s2 / g) : Vector3d::UnitZ();
     p.still_level_m = fluid.still_water_level_m;
     p.diameter_m = body.hydro_diameter_m;
     p.height_m = body.hydro_height_m;
@@ -199,6 +304,8 @@ std::unique_ptr<BodyFluidForces> MakeBodyFluidForces(const Scene& scene,
     p.heave_added_mass = body.hydro_heave_added_mass;
     p.along_axis = body.hydro_along_axis;
     p.current_m_s = fluid.current_m_s;
+    p.drag_area = body.hydro_drag_area_m2;
+    p.rotational_drag_area = body.hydro_rotational_drag_area_m5;
     loads.emplace_back(p, body_coord[b], dim);
   }
   if (loads.empty()) return nullptr;

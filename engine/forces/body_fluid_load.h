@@ -77,7 +77,28 @@
 // under water or wholly above it (a scene built from a MoorDyn deck
 // refuses a tilted rod piercing the surface where it starts).
 //
-// Energy: F_d + F_i + F_w is not a potential's force; its power -F . rdot_c
+// Drag areas (Params::drag_area, rotational_drag_area; MoorDyn's body
+// CdA), in the body's own axes R = [e1 e2 e3] (its natural coordinates at
+// q; planar: e1 = u / |u|, e2 = e_z x e1): with B = R diag(A) R^T,
+//
+//   F_a = (1/2) rho f B |v_r| v_r            on the centre of mass,
+//   M_a = -(1/2) rho f B_w |omega| omega     about it,
+//
+// v_r = u - rdot_c the flow relative to the centre (u as above), omega the
+// body's angular velocity (1/2) sum_k e_k x edot_k (the flow does not
+// turn), A [m^2] and A_w [m^5] the areas about e1, e2, e3, f the wetted
+// fraction s / H of the cylinder, or 1 for a body without one (H = 0: no
+// buoyancy, no Morison terms, drag wherever the body is, as MoorDyn's).
+// A body moving along e_k feels (1/2) rho A_k |v| v. The moment acts on
+// the axes as Q_k = (1/2) M_a x e_k (its virtual work M_a . dtheta for
+// orthonormal axes); planar, as T e_z x u on u with T = M_a . e_z. Tangent
+// in qdot: on rdot_c, k sym(B (|v_r| I + v_r v_r^T / |v_r|)) (k = rho f /
+// 2; B is not isotropic, so its symmetric part: exact for equal areas);
+// on the axes, (1/4) S^T K S with S = [[e1]x [e2]x [e3]x] and K the same
+// symmetric part for omega (planar: 2 k A_wz |omega| (e_z x u)(e_z x u)^T),
+// positive semi-definite. Derivatives in q (through R and f) are left out.
+//
+// Energy: F_d + F_i + F_w (and F_a, M_a) is not a potential's force; its power -F . rdot_c
 // joins the damping power (MultibodyModel::DampingPower), so energy.damped
 // counts the drag's dissipation and the waves' work, and energy.total +
 // energy.damped stays what the exact solution conserves.
@@ -109,7 +130,15 @@ class BodyFluidLoad {
     // The split across/along the body's x axis instead of the vertical.
     bool along_axis = false;
     Eigen::Vector3d current_m_s = Eigen::Vector3d::Zero();
+    // Drag areas along the body's axes [m^2] and about them [m^5].
+    Eigen::Vector3d drag_area = Eigen::Vector3d::Zero();
+    Eigen::Vector3d rotational_drag_area = Eigen::Vector3d::Zero();
   };
+  // The body's natural coordinates per body: r_c and u (planar), r_c and
+  // e1, e2, e3 (spatial).
+  static constexpr int kMaxStride = 12;
+  using Generalized = Eigen::Matrix<double, kMaxStride, 1>;
+  using GeneralizedMatrix = Eigen::Matrix<double, kMaxStride, kMaxStride>;
 
   // `coord` the full index of the body's centre of mass, `dim` 2 or 3.
   BodyFluidLoad(const Params& p, int coord, int dim);
@@ -143,7 +172,17 @@ class BodyFluidLoad {
   // [N s/m] into `damping` when not null.
   Eigen::Vector3d DynamicForce(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, double t,
                                const WaveField* waves, Eigen::Matrix3d* damping) const;
-  // Whether DynamicForce can be nonzero (drag, or a flow that accelerates).
+  // F_a and M_a as generalised forces on the body's stride() natural
+  // coordinates into `force`, their tangent into `damping` when not null
+  // (stride x stride, top left). Zero without drag areas.
+  void AreaDrag(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, double t,
+                const WaveField* waves, Generalized* force, GeneralizedMatrix* damping) const;
+  bool has_area_drag() const {
+    return !p_.drag_area.isZero(0) || !p_.rotational_drag_area.isZero(0);
+  }
+  int stride() const { return dim_ == 2 ? 4 : 12; }
+  // Whether DynamicForce or AreaDrag can be nonzero (drag, or a flow that
+  // accelerates).
   bool dynamic(bool has_waves) const;
 
  private:
@@ -179,8 +218,9 @@ class BodyFluidForces : public ForceContributor {
   bool dissipates_ = false;
 };
 
-// The contributor for the scene's bodies with hydrodynamics (in a fluid,
-// under gravity), or null when none has any. `body_coord[b]`: body b's
+// The contributor for the scene's bodies with hydrodynamics (in a fluid;
+// a cylinder's buoyancy and vertical need gravity, SceneFromProto checks),
+// or null when none has any. `body_coord[b]`: body b's
 // first full coordinate; `has_waves`: the model built a wave field.
 std::unique_ptr<BodyFluidForces> MakeBodyFluidForces(const Scene& scene,
                                                      const std::vector<int>& body_coord, int dim,

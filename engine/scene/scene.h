@@ -149,6 +149,11 @@ struct BodySpec {
   // rod) instead of the vertical (the buoyancy stays the vertical
   // cylinder's).
   bool hydro_along_axis = false;
+  // Drag areas along the body's axes [m^2] and about them [m^5]
+  // (BodyFluidLoad::AreaDrag); a body with them alone has no cylinder
+  // (hydro_diameter_m = hydro_height_m = 0: no buoyancy, wet wherever it is).
+  Eigen::Vector3d hydro_drag_area_m2 = Eigen::Vector3d::Zero();
+  Eigen::Vector3d hydro_rotational_drag_area_m5 = Eigen::Vector3d::Zero();
   // Driven by a coupling host (engine/run/coupling.h): its pose (centre of
   // mass and axes) is the host's, step by step; the scene holds it by a
   // driver joint (CoupledBodyDriver, appended to the joints). In an
