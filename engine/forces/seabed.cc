@@ -391,9 +391,10 @@ template <int D>
 double Seabed::AddDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
                               const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
                               Eigen::Matrix<double, 4 * D, 1>* force,
-                              Eigen::Matrix<double, 4 * D, 4 * D>* c) const {
+                              Eigen::Matrix<double, 4 * D, 4 * D>* c,
+                              Eigen::Matrix<double, 4 * D, 4 * D>* position) const {
   if (grid_) return GridDissipation<D>(e, edot, length, force, c, c_, v_s_, moordyn_c_);
-  return PlaneDissipation<D>(e, edot, length, force, c, c_, v_s_, moordyn_c_);
+  return PlaneDissipation<D>(e, edot, length, force, c, c_, v_s_, moordyn_c_, position);
 }
 
 template <int D>
@@ -483,7 +484,8 @@ double Seabed::PlaneDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
                                 const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
                                 Eigen::Matrix<double, 4 * D, 1>* force,
                                 Eigen::Matrix<double, 4 * D, 4 * D>* c, double damping,
-                                double speed, double moordyn_damping) const {
+                                double speed, double moordyn_damping,
+                                Eigen::Matrix<double, 4 * D, 4 * D>* position) const {
   using Point = Eigen::Matrix<double, D, 1>;
   using Block = Eigen::Matrix<double, D, D>;
   double pieces[2][2];
@@ -508,6 +510,31 @@ double Seabed::PlaneDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
       for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s[k]) * q;
     if (c) AddShapeBlocks<D>(wl, s, h, c);
   });
+  // The damping's integrand -c (n . v) s_k n does not vanish where the
+  // element enters or leaves the bed, so the force moves with those ends
+  // (see the header): at an end x* (h(x*) = 0, inside the element) moved by
+  // dx*/de_m = -s_m n^T / (n . r'), Q_k changes by +-s_k q dx*, which is
+  // -dQ/de = -c (n . v) / |n . r'| s_k s_m n n^T at either end (symmetric;
+  // negative where the cable lifts off, n . v > 0). Friction vanishes there
+  // (N = k p = 0) and adds no such term.
+  if (position && damping != 0) {
+    for (int p = 0; p < count; ++p)
+      for (int end = 0; end < 2; ++end) {
+        const double xi = pieces[p][end];
+        if (!(xi > 0 && xi < 1)) continue;  // an element end, not a root of h
+        double s[4], ds[4];
+        HermiteShape(xi, length, s);
+        HermiteShapeD1(xi, length, ds);
+        double slope = 0, vn = 0;
+        for (int k = 0; k < 4; ++k) {
+          slope += ds[k] * n.dot(e.template segment<D>(k * D));
+          vn += s[k] * n.dot(edot.template segment<D>(k * D));
+        }
+        if (slope == 0) continue;
+        AddShapeBlocks<D>(-damping * vn / std::abs(slope), s, Block(n * n.transpose()),
+                          position);
+      }
+  }
   return power;
 }
 
@@ -520,7 +547,8 @@ double Seabed::PlaneDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
   template double Seabed::Energy<D>(const Eigen::Matrix<double, 4 * D, 1>&, double) const; \
   template double Seabed::AddDissipation<D>(                                               \
       const Eigen::Matrix<double, 4 * D, 1>&, const Eigen::Matrix<double, 4 * D, 1>&,      \
-      double, Eigen::Matrix<double, 4 * D, 1>*, Eigen::Matrix<double, 4 * D, 4 * D>*) const; \
+      double, Eigen::Matrix<double, 4 * D, 1>*, Eigen::Matrix<double, 4 * D, 4 * D>*,      \
+      Eigen::Matrix<double, 4 * D, 4 * D>*) const;                                         \
   template void Seabed::AddStaticFriction<D>(                                            \
       const Eigen::Matrix<double, 4 * D, 1>&, const Eigen::Matrix<double, 4 * D, 1>&,      \
       double, Eigen::Matrix<double, 4 * D, 1>*, Eigen::Matrix<double, 4 * D, 4 * D>*) const; \
@@ -600,13 +628,15 @@ double CableSeabed::AddDissipation(const ElementCoords<3>& e, const ElementCoord
 double CableSeabed::AddElementDissipation(const ElementAt<2>& at, const ElementCoords<2>& e,
                                           const ElementCoords<2>& edot, ElementCoords<2>* force,
                                           ElementMatrix<2>* c) const {
-  return BedOf(at.index).AddDissipation<2>(e, edot, at.element.length(), force, c);
+  return BedOf(at.index).AddDissipation<2>(e, edot, at.element.length(), force, c,
+                                            at.position_tangent);
 }
 
 double CableSeabed::AddElementDissipation(const ElementAt<3>& at, const ElementCoords<3>& e,
                                           const ElementCoords<3>& edot, ElementCoords<3>* force,
                                           ElementMatrix<3>* c) const {
-  return BedOf(at.index).AddDissipation<3>(e, edot, at.element.length(), force, c);
+  return BedOf(at.index).AddDissipation<3>(e, edot, at.element.length(), force, c,
+                                            at.position_tangent);
 }
 
 void CableSeabed::AddStaticFriction(const ElementCoords<2>& e, const ElementCoords<2>& e0,

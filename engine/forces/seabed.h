@@ -185,13 +185,18 @@ class Seabed {
 
   // Adds the generalized damping and friction force Q_d to `force` and its
   // velocity tangent -dQ_d/d(edot) (symmetric positive semi-definite, see
-  // above) to `c` when not null. Returns the power they dissipate,
-  // -Q_d . edot >= 0 [W].
+  // above) to `c` when not null. When `position` is not null, adds the
+  // damping's position tangent -dQ_d/de there: on a plane bed the exact
+  // one of the damping c (the ends of the pieces in the bed move with e,
+  // and the damping force does not vanish there; symmetric, indefinite),
+  // friction's left out as above; nothing on a grid bed (left out).
+  // Returns the power they dissipate, -Q_d . edot >= 0 [W].
   template <int D>
   double AddDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
                         const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
                         Eigen::Matrix<double, 4 * D, 1>* force,
-                        Eigen::Matrix<double, 4 * D, 4 * D>* c) const;
+                        Eigen::Matrix<double, 4 * D, 4 * D>* c,
+                        Eigen::Matrix<double, 4 * D, 4 * D>* position = nullptr) const;
 
   // STATIC analyses: adds the static friction force q_s integrated with
   // the shape functions (a generalized force, like AddDissipation's) to
@@ -272,7 +277,8 @@ class Seabed {
                           const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
                           Eigen::Matrix<double, 4 * D, 1>* force,
                           Eigen::Matrix<double, 4 * D, 4 * D>* c, double damping,
-                          double speed, double moordyn_damping) const;
+                          double speed, double moordyn_damping,
+                          Eigen::Matrix<double, 4 * D, 4 * D>* position = nullptr) const;
   // The gap g at a point of D coordinates, its gradient (and, on a grid,
   // Hessian when not null).
   template <int D>
