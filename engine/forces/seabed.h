@@ -36,6 +36,24 @@
 // of the derivative (no boundary terms): the tangent k int S^T n n^T S dx
 // is exact and Newton converges quadratically through lift-off.
 //
+// The damping's integrand -c pdot s_k n does not vanish at the roots (a
+// cable entering or leaving the bed at speed), so its integral moves with
+// them: at a root x* of h (inside the element), dx*/de_m = -s_m n^T /
+// (n . r'), and the damping force changes by s_k q dx* there (with the
+// sign of the end), which is the symmetric position tangent
+//
+//   -dQ_d/de = -c (n . rdot) / |n . r'| S(x*)^T n n^T S(x*)
+//
+// (negative where the cable lifts off). It is large where the cable meets
+// the bed at a small angle (a catenary's touchdown, n . r' -> 0): on the
+// OC4 mooring (bench/scenes/oc4-three-lines.json, 10 elements per line,
+// HHT at h = 0.5 s) leaving it out of Newton's matrix cost 9.3 iterations
+// per step and 13 halved steps at the deck's damping, 15 and 48 at ten
+// times it, against 5.5 and 6.5 with it (docs/mooring-speed.md).
+// AddDissipation gives it on a plane bed (the model adds it with the
+// position-dependent forces' scale, MultibodyModel::DampingForce); on a
+// grid bed it is left out.
+//
 // Friction (dynamic runs), with N = k p the elastic normal force per unit
 // length (the damping part is left out, so friction never pulls), the
 // sliding velocity v_b = rdot - (n . rdot) n in the bed's plane, the
