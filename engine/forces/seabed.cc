@@ -247,12 +247,45 @@ double Seabed::GridDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
                                const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
                                Eigen::Matrix<double, 4 * D, 1>* force,
                                Eigen::Matrix<double, 4 * D, 4 * D>* c, double damping,
-                               double speed, double moordyn_damping) const {
+                               double speed, double moordyn_damping,
+                               Eigen::Matrix<double, 4 * D, 4 * D>* position) const {
   using Point = Eigen::Matrix<double, D, 1>;
   using Block = Eigen::Matrix<double, D, D>;
   static const GaussRule rule = MakeGaussRule(7);
   double power = 0;
+  // The damping's moving ends (PlaneDissipation), where g changes sign: at
+  // a root x* (g(r(x*)) = 0), dx*/de_m = -s_m grad g^T / g' (g' = grad g .
+  // r'), so -dQ/de = -c (n . v) |grad g| / |g'| s_k s_m n n^T. A piece also
+  // ends at a grid line (line_crossed, called after the piece it closes)
+  // and at the element's ends: no term there. `pending` holds a piece's
+  // far end until it is known not to be a grid line.
+  const bool ends = position && damping != 0;
+  double pending = -1, last_line = -1;
+  auto end_term = [&](double xi) {
+    if (!(xi > 0 && xi < 1)) return;
+    double s[4], ds[4];
+    HermiteShape(xi, length, s);
+    HermiteShapeD1(xi, length, ds);
+    Point r = Point::Zero(), v = Point::Zero(), u = Point::Zero();
+    for (int k = 0; k < 4; ++k) {
+      r += s[k] * e.template segment<D>(k * D);
+      u += ds[k] * e.template segment<D>(k * D);
+      v += s[k] * edot.template segment<D>(k * D);
+    }
+    Point grad;
+    GridAt<D>(r, &grad, nullptr);
+    const double slope = grad.dot(u), gn = grad.norm();
+    if (slope == 0) return;
+    const Point n = grad / gn;
+    AddShapeBlocks<D>(-damping * n.dot(v) * gn / std::abs(slope), s, Block(n * n.transpose()),
+                      position);
+  };
   ForEachGridPiece<D>(e, length, [&](double a, double b) {
+    if (ends) {
+      if (pending >= 0) end_term(pending);
+      if (a != last_line) end_term(a);
+      pending = b;
+    }
     for (int gp = 0; gp < rule.n; ++gp) {
       double s[4], ds[4];
       const double xi = a + (b - a) * rule.xi[gp];
@@ -279,7 +312,11 @@ double Seabed::GridDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
         for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s[k]) * q;
       if (c) AddShapeBlocks<D>(wl, s, h, c);
     }
-  }, [](double, int) {});
+  }, [&](double xi, int) {
+    if (pending == xi) pending = -1;
+    last_line = xi;
+  });
+  if (ends && pending >= 0) end_term(pending);
   return power;
 }
 
@@ -393,7 +430,8 @@ double Seabed::AddDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
                               Eigen::Matrix<double, 4 * D, 1>* force,
                               Eigen::Matrix<double, 4 * D, 4 * D>* c,
                               Eigen::Matrix<double, 4 * D, 4 * D>* position) const {
-  if (grid_) return GridDissipation<D>(e, edot, length, force, c, c_, v_s_, moordyn_c_);
+  if (grid_)
+    return GridDissipation<D>(e, edot, length, force, c, c_, v_s_, moordyn_c_, position);
   return PlaneDissipation<D>(e, edot, length, force, c, c_, v_s_, moordyn_c_, position);
 }
 

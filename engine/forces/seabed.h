@@ -50,9 +50,11 @@
 // HHT at h = 0.5 s) leaving it out of Newton's matrix cost 9.3 iterations
 // per step and 13 halved steps at the deck's damping, 15 and 48 at ten
 // times it, against 5.5 and 6.5 with it (docs/mooring-speed.md).
-// AddDissipation gives it on a plane bed (the model adds it with the
-// position-dependent forces' scale, MultibodyModel::DampingForce); on a
-// grid bed it is left out.
+// AddDissipation gives it (the model adds it with the position-dependent
+// forces' scale, MultibodyModel::DampingForce); on a grid bed with
+// |grad g| / |grad g . r'| in place of 1 / |n . r'|, and there the
+// damping's other position dependences (n turning inside a cell, its jump
+// at a grid line the element crosses in the bed) are left out.
 //
 // Friction (dynamic runs), with N = k p the elastic normal force per unit
 // length (the damping part is left out, so friction never pulls), the
@@ -207,7 +209,8 @@ class Seabed {
   // damping's position tangent -dQ_d/de there: on a plane bed the exact
   // one of the damping c (the ends of the pieces in the bed move with e,
   // and the damping force does not vanish there; symmetric, indefinite),
-  // friction's left out as above; nothing on a grid bed (left out).
+  // friction's left out as above; on a grid bed only the ends' part
+  // (exact on a uniformly sloped grid).
   // Returns the power they dissipate, -Q_d . edot >= 0 [W].
   template <int D>
   double AddDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
@@ -289,7 +292,8 @@ class Seabed {
                          const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
                          Eigen::Matrix<double, 4 * D, 1>* force,
                          Eigen::Matrix<double, 4 * D, 4 * D>* c, double damping,
-                         double speed, double moordyn_damping) const;
+                         double speed, double moordyn_damping,
+                         Eigen::Matrix<double, 4 * D, 4 * D>* position = nullptr) const;
   template <int D>
   double PlaneDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
                           const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
