@@ -45,6 +45,24 @@ Cubic CoordinateCubic(const Eigen::Matrix<double, 4 * D, 1>& e, double l, int ax
                 2 * a0 + l * b0 - 2 * a1 + l * b1}};
 }
 
+// The point r, its x-derivative u and its rate v along an element
+// (AncfCableElement<D> layout) where the shape functions and their
+// x-derivatives are s, ds.
+template <int D>
+void PointOnElement(const Eigen::Matrix<double, 4 * D, 1>& e,
+                    const Eigen::Matrix<double, 4 * D, 1>& edot, const double* s, const double* ds,
+                    Eigen::Matrix<double, D, 1>* r, Eigen::Matrix<double, D, 1>* u,
+                    Eigen::Matrix<double, D, 1>* v) {
+  r->setZero();
+  u->setZero();
+  v->setZero();
+  for (int k = 0; k < 4; ++k) {
+    *r += s[k] * e.template segment<D>(k * D);
+    *u += ds[k] * e.template segment<D>(k * D);
+    *v += s[k] * edot.template segment<D>(k * D);
+  }
+}
+
 }  // namespace
 
 using contact::AddShapeBlocks;
@@ -266,12 +284,8 @@ double Seabed::GridDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
     double s[4], ds[4];
     HermiteShape(xi, length, s);
     HermiteShapeD1(xi, length, ds);
-    Point r = Point::Zero(), v = Point::Zero(), u = Point::Zero();
-    for (int k = 0; k < 4; ++k) {
-      r += s[k] * e.template segment<D>(k * D);
-      u += ds[k] * e.template segment<D>(k * D);
-      v += s[k] * edot.template segment<D>(k * D);
-    }
+    Point r, u, v;
+    PointOnElement<D>(e, edot, s, ds, &r, &u, &v);
     Point grad;
     GridAt<D>(r, &grad, nullptr);
     const double slope = grad.dot(u), gn = grad.norm();
@@ -292,12 +306,8 @@ double Seabed::GridDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
       HermiteShape(xi, length, s);
       HermiteShapeD1(xi, length, ds);
       const double wl = rule.weight[gp] * (b - a) * length;
-      Point r = Point::Zero(), v = Point::Zero(), u = Point::Zero();
-      for (int k = 0; k < 4; ++k) {
-        r += s[k] * e.template segment<D>(k * D);
-        u += ds[k] * e.template segment<D>(k * D);
-        v += s[k] * edot.template segment<D>(k * D);
-      }
+      Point r, u, v;
+      PointOnElement<D>(e, edot, s, ds, &r, &u, &v);
       Point grad;
       const double pen = std::max(0.0, -GridAt<D>(r, &grad, nullptr));
       const double gn = grad.norm();
@@ -533,12 +543,8 @@ double Seabed::PlaneDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
   const Block proj = Block::Identity() - n * n.transpose();
   double power = 0;
   ForEachContactPoint(pieces, count, length, [&](double wl, const double* s, const double* ds) {
-    Point r = Point::Zero(), v = Point::Zero(), u = Point::Zero();
-    for (int k = 0; k < 4; ++k) {
-      r += s[k] * e.template segment<D>(k * D);
-      u += ds[k] * e.template segment<D>(k * D);
-      v += s[k] * edot.template segment<D>(k * D);
-    }
+    Point r, u, v;
+    PointOnElement<D>(e, edot, s, ds, &r, &u, &v);
     const double pen = std::max(0.0, -(depth_ + n.dot(r)));
     Point q;
     Block h;
@@ -563,13 +569,11 @@ double Seabed::PlaneDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
         double s[4], ds[4];
         HermiteShape(xi, length, s);
         HermiteShapeD1(xi, length, ds);
-        double slope = 0, vn = 0;
-        for (int k = 0; k < 4; ++k) {
-          slope += ds[k] * n.dot(e.template segment<D>(k * D));
-          vn += s[k] * n.dot(edot.template segment<D>(k * D));
-        }
+        Point r, u, v;
+        PointOnElement<D>(e, edot, s, ds, &r, &u, &v);
+        const double slope = n.dot(u);
         if (slope == 0) continue;
-        AddShapeBlocks<D>(-damping * vn / std::abs(slope), s, Block(n * n.transpose()),
+        AddShapeBlocks<D>(-damping * n.dot(v) / std::abs(slope), s, Block(n * n.transpose()),
                           position);
       }
   }
