@@ -100,6 +100,49 @@ TEST(SeabedBathymetryTest, PlanarForceAndTangentAreDerivativesOfTheEnergy) {
   CheckDerivatives<2>(bed, e, 2.3);
 }
 
+// The damping's position tangent on a grid bed (Seabed::AddDissipation's
+// `position`: the moving ends where g changes sign) against central
+// differences of the damping force in e at a fixed rate, on a uniformly
+// sloped 3 x 3 grid (d = 0.2 + 0.15 u - 0.1 v: the normal is the same
+// everywhere, so the ends' term is the whole derivative), with an element
+// that dips into the bed across grid lines u = 0.8 and v = 0.1 and stays
+// inside the grid (beyond it the depth continues flat, and the normal would
+// jump at the last line) (the pieces split at the lines must add no term:
+// a wrong one errs by the tangent's scale). Bound 1e-6
+// of the largest entry, as in seabed_test's plane-bed check (smooth in e
+// at this state; truncation and rounding of the difference below 1e-9).
+TEST(SeabedBathymetryTest, DampingPositionTangentIsTheDerivativeOfTheDampingForce) {
+  SeabedSpec spec = GridBed(Eigen::Vector3d::UnitZ());
+  spec.damping_n_s_m2 = 2e4;
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) {
+      const double u = 0.8 * i, v = -0.5 + 0.6 * j;
+      spec.bathymetry.depths_m[j * 3 + i] = 0.2 + 0.15 * u - 0.1 * v;
+    }
+  const Seabed bed(spec);
+  using Coords = Eigen::Matrix<double, 12, 1>;
+  using Matrix = Eigen::Matrix<double, 12, 12>;
+  Coords e, edot;
+  e << 0.1, -0.4, -0.2, 0.8, 0.5, -0.8, 1.5, 0.65, -0.3, 0.8, 0.3, 0.6;
+  edot << 0.3, 0.5, -0.1, 0.05, -0.2, 0.1, -0.2, 0.8, 0.3, 0.1, 0.4, -0.3;
+  constexpr double kL = 2.0;
+  Coords f = Coords::Zero();
+  Matrix c = Matrix::Zero(), k = Matrix::Zero();
+  bed.AddDissipation<3>(e, edot, kL, &f, &c, &k);
+  const double scale = k.cwiseAbs().maxCoeff();
+  ASSERT_GT(scale, 0);
+  const double d = 1e-6;
+  for (int i = 0; i < 12; ++i) {
+    Coords ep = e, em = e, fp = Coords::Zero(), fm = Coords::Zero();
+    ep(i) += d;
+    em(i) -= d;
+    bed.AddDissipation<3>(ep, edot, kL, &fp, nullptr);
+    bed.AddDissipation<3>(em, edot, kL, &fm, nullptr);
+    for (int j = 0; j < 12; ++j)
+      EXPECT_NEAR(-(fp(j) - fm(j)) / (2 * d), k(j, i), 1e-6 * scale) << i << "," << j;
+  }
+}
+
 TEST(SeabedBathymetryTest, HeightIsBilinearAndContinuesAtTheEdges) {
   const Seabed bed(GridBed(Eigen::Vector3d::UnitZ()));
   // Node (1, 1): depth -0.1 at (0.8, 0.1).

@@ -216,6 +216,11 @@ struct ElementAt {
   const Eigen::VectorXd* qdot = nullptr;
   ForceOutput* coupled = nullptr;
   double* coupled_power = nullptr;
+  // When not null, AddElementDissipation may add here the position tangent
+  // -dQ_d/de of its velocity-dependent force (the model scales it as the
+  // position-dependent forces' tangent); a term that leaves it out adds
+  // nothing.
+  ElementMatrix<D>* position_tangent = nullptr;
 };
 
 class ElementTerm {

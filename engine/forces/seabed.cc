@@ -43,6 +43,24 @@ Cubic CoordinateCubic(const Eigen::Matrix<double, 4 * D, 1>& e, double l, int ax
                 2 * a0 + l * b0 - 2 * a1 + l * b1}};
 }
 
+// The point r, its x-derivative u and its rate v along an element
+// (AncfCableElement<D> layout) where the shape functions and their
+// x-derivatives are s, ds.
+template <int D>
+void PointOnElement(const Eigen::Matrix<double, 4 * D, 1>& e,
+                    const Eigen::Matrix<double, 4 * D, 1>& edot, const double* s, const double* ds,
+                    Eigen::Matrix<double, D, 1>* r, Eigen::Matrix<double, D, 1>* u,
+                    Eigen::Matrix<double, D, 1>* v) {
+  r->setZero();
+  u->setZero();
+  v->setZero();
+  for (int k = 0; k < 4; ++k) {
+    *r += s[k] * e.template segment<D>(k * D);
+    *u += ds[k] * e.template segment<D>(k * D);
+    *v += s[k] * edot.template segment<D>(k * D);
+  }
+}
+
 }  // namespace
 
 using contact::AddShapeBlocks;
@@ -245,24 +263,49 @@ double Seabed::GridDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
                                const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
                                Eigen::Matrix<double, 4 * D, 1>* force,
                                Eigen::Matrix<double, 4 * D, 4 * D>* c, double damping,
-                               double speed, double moordyn_damping) const {
+                               double speed, double moordyn_damping,
+                               Eigen::Matrix<double, 4 * D, 4 * D>* position) const {
   using Point = Eigen::Matrix<double, D, 1>;
   using Block = Eigen::Matrix<double, D, D>;
   static const GaussRule rule = MakeGaussRule(7);
   double power = 0;
+  // The damping's moving ends (PlaneDissipation), where g changes sign: at
+  // a root x* (g(r(x*)) = 0), dx*/de_m = -s_m grad g^T / g' (g' = grad g .
+  // r'), so -dQ/de = -c (n . v) |grad g| / |g'| s_k s_m n n^T. A piece also
+  // ends at a grid line (line_crossed, called after the piece it closes)
+  // and at the element's ends: no term there. `pending` holds a piece's
+  // far end until it is known not to be a grid line.
+  const bool ends = position && damping != 0;
+  double pending = -1, last_line = -1;
+  auto end_term = [&](double xi) {
+    if (!(xi > 0 && xi < 1)) return;
+    double s[4], ds[4];
+    HermiteShape(xi, length, s);
+    HermiteShapeD1(xi, length, ds);
+    Point r, u, v;
+    PointOnElement<D>(e, edot, s, ds, &r, &u, &v);
+    Point grad;
+    GridAt<D>(r, &grad, nullptr);
+    const double slope = grad.dot(u), gn = grad.norm();
+    if (slope == 0) return;
+    const Point n = grad / gn;
+    AddShapeBlocks<D>(-damping * n.dot(v) * gn / std::abs(slope), s, Block(n * n.transpose()),
+                      position);
+  };
   ForEachGridPiece<D>(e, length, [&](double a, double b) {
+    if (ends) {
+      if (pending >= 0) end_term(pending);
+      if (a != last_line) end_term(a);
+      pending = b;
+    }
     for (int gp = 0; gp < rule.n; ++gp) {
       double s[4], ds[4];
       const double xi = a + (b - a) * rule.xi[gp];
       HermiteShape(xi, length, s);
       HermiteShapeD1(xi, length, ds);
       const double wl = rule.weight[gp] * (b - a) * length;
-      Point r = Point::Zero(), v = Point::Zero(), u = Point::Zero();
-      for (int k = 0; k < 4; ++k) {
-        r += s[k] * e.template segment<D>(k * D);
-        u += ds[k] * e.template segment<D>(k * D);
-        v += s[k] * edot.template segment<D>(k * D);
-      }
+      Point r, u, v;
+      PointOnElement<D>(e, edot, s, ds, &r, &u, &v);
       Point grad;
       const double pen = std::max(0.0, -GridAt<D>(r, &grad, nullptr));
       const double gn = grad.norm();
@@ -277,7 +320,11 @@ double Seabed::GridDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
         for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s[k]) * q;
       if (c) AddShapeBlocks<D>(wl, s, h, c);
     }
-  }, [](double, int) {});
+  }, [&](double xi, int) {
+    if (pending == xi) pending = -1;
+    last_line = xi;
+  });
+  if (ends && pending >= 0) end_term(pending);
   return power;
 }
 
@@ -358,9 +405,11 @@ template <int D>
 double Seabed::AddDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
                               const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
                               Eigen::Matrix<double, 4 * D, 1>* force,
-                              Eigen::Matrix<double, 4 * D, 4 * D>* c) const {
-  if (grid_) return GridDissipation<D>(e, edot, length, force, c, c_, v_s_, moordyn_c_);
-  return PlaneDissipation<D>(e, edot, length, force, c, c_, v_s_, moordyn_c_);
+                              Eigen::Matrix<double, 4 * D, 4 * D>* c,
+                              Eigen::Matrix<double, 4 * D, 4 * D>* position) const {
+  if (grid_)
+    return GridDissipation<D>(e, edot, length, force, c, c_, v_s_, moordyn_c_, position);
+  return PlaneDissipation<D>(e, edot, length, force, c, c_, v_s_, moordyn_c_, position);
 }
 
 template <int D>
@@ -450,7 +499,8 @@ double Seabed::PlaneDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
                                 const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
                                 Eigen::Matrix<double, 4 * D, 1>* force,
                                 Eigen::Matrix<double, 4 * D, 4 * D>* c, double damping,
-                                double speed, double moordyn_damping) const {
+                                double speed, double moordyn_damping,
+                                Eigen::Matrix<double, 4 * D, 4 * D>* position) const {
   using Point = Eigen::Matrix<double, D, 1>;
   using Block = Eigen::Matrix<double, D, D>;
   double pieces[2][2];
@@ -460,12 +510,8 @@ double Seabed::PlaneDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
   const Block proj = Block::Identity() - n * n.transpose();
   double power = 0;
   ForEachContactPoint(pieces, count, length, [&](double wl, const double* s, const double* ds) {
-    Point r = Point::Zero(), v = Point::Zero(), u = Point::Zero();
-    for (int k = 0; k < 4; ++k) {
-      r += s[k] * e.template segment<D>(k * D);
-      u += ds[k] * e.template segment<D>(k * D);
-      v += s[k] * edot.template segment<D>(k * D);
-    }
+    Point r, u, v;
+    PointOnElement<D>(e, edot, s, ds, &r, &u, &v);
     const double pen = std::max(0.0, -(depth_ + n.dot(r)));
     Point q;
     Block h;
@@ -475,6 +521,29 @@ double Seabed::PlaneDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
       for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s[k]) * q;
     if (c) AddShapeBlocks<D>(wl, s, h, c);
   });
+  // The damping's integrand -c (n . v) s_k n does not vanish where the
+  // element enters or leaves the bed, so the force moves with those ends
+  // (see the header): at an end x* (h(x*) = 0, inside the element) moved by
+  // dx*/de_m = -s_m n^T / (n . r'), Q_k changes by +-s_k q dx*, which is
+  // -dQ/de = -c (n . v) / |n . r'| s_k s_m n n^T at either end (symmetric;
+  // negative where the cable lifts off, n . v > 0). Friction vanishes there
+  // (N = k p = 0) and adds no such term.
+  if (position && damping != 0) {
+    for (int p = 0; p < count; ++p)
+      for (int end = 0; end < 2; ++end) {
+        const double xi = pieces[p][end];
+        if (!(xi > 0 && xi < 1)) continue;  // an element end, not a root of h
+        double s[4], ds[4];
+        HermiteShape(xi, length, s);
+        HermiteShapeD1(xi, length, ds);
+        Point r, u, v;
+        PointOnElement<D>(e, edot, s, ds, &r, &u, &v);
+        const double slope = n.dot(u);
+        if (slope == 0) continue;
+        AddShapeBlocks<D>(-damping * n.dot(v) / std::abs(slope), s, Block(n * n.transpose()),
+                          position);
+      }
+  }
   return power;
 }
 
@@ -487,7 +556,8 @@ double Seabed::PlaneDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
   template double Seabed::Energy<D>(const Eigen::Matrix<double, 4 * D, 1>&, double) const; \
   template double Seabed::AddDissipation<D>(                                               \
       const Eigen::Matrix<double, 4 * D, 1>&, const Eigen::Matrix<double, 4 * D, 1>&,      \
-      double, Eigen::Matrix<double, 4 * D, 1>*, Eigen::Matrix<double, 4 * D, 4 * D>*) const; \
+      double, Eigen::Matrix<double, 4 * D, 1>*, Eigen::Matrix<double, 4 * D, 4 * D>*,      \
+      Eigen::Matrix<double, 4 * D, 4 * D>*) const;                                         \
   template void Seabed::AddStaticFriction<D>(                                            \
       const Eigen::Matrix<double, 4 * D, 1>&, const Eigen::Matrix<double, 4 * D, 1>&,      \
       double, Eigen::Matrix<double, 4 * D, 1>*, Eigen::Matrix<double, 4 * D, 4 * D>*) const; \
@@ -567,13 +637,15 @@ double CableSeabed::AddDissipation(const ElementCoords<3>& e, const ElementCoord
 double CableSeabed::AddElementDissipation(const ElementAt<2>& at, const ElementCoords<2>& e,
                                           const ElementCoords<2>& edot, ElementCoords<2>* force,
                                           ElementMatrix<2>* c) const {
-  return BedOf(at.index).AddDissipation<2>(e, edot, at.element.length(), force, c);
+  return BedOf(at.index).AddDissipation<2>(e, edot, at.element.length(), force, c,
+                                            at.position_tangent);
 }
 
 double CableSeabed::AddElementDissipation(const ElementAt<3>& at, const ElementCoords<3>& e,
                                           const ElementCoords<3>& edot, ElementCoords<3>* force,
                                           ElementMatrix<3>* c) const {
-  return BedOf(at.index).AddDissipation<3>(e, edot, at.element.length(), force, c);
+  return BedOf(at.index).AddDissipation<3>(e, edot, at.element.length(), force, c,
+                                            at.position_tangent);
 }
 
 void CableSeabed::AddStaticFriction(const ElementCoords<2>& e, const ElementCoords<2>& e0,

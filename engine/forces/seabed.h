@@ -36,6 +36,26 @@
 // of the derivative (no boundary terms): the tangent k int S^T n n^T S dx
 // is exact and Newton converges quadratically through lift-off.
 //
+// The damping's integrand -c pdot s_k n does not vanish at the roots (a
+// cable entering or leaving the bed at speed), so its integral moves with
+// them: at a root x* of h (inside the element), dx*/de_m = -s_m n^T /
+// (n . r'), and the damping force changes by s_k q dx* there (with the
+// sign of the end), which is the symmetric position tangent
+//
+//   -dQ_d/de = -c (n . rdot) / |n . r'| S(x*)^T n n^T S(x*)
+//
+// (negative where the cable lifts off). It is large where the cable meets
+// the bed at a small angle (a catenary's touchdown, n . r' -> 0): on the
+// OC4 mooring (bench/scenes/oc4-three-lines.json, 10 elements per line,
+// HHT at h = 0.5 s) leaving it out of Newton's matrix cost 9.3 iterations
+// per step and 13 halved steps at the deck's damping, 15 and 48 at ten
+// times it, against 5.5 and 6.5 with it (docs/mooring-speed.md).
+// AddDissipation gives it (the model adds it with the position-dependent
+// forces' scale, MultibodyModel::DampingForce); on a grid bed with
+// |grad g| / |grad g . r'| in place of 1 / |n . r'|, and there the
+// damping's other position dependences (n turning inside a cell, its jump
+// at a grid line the element crosses in the bed) are left out.
+//
 // Friction (dynamic runs), with N = k p the elastic normal force per unit
 // length (the damping part is left out, so friction never pulls), the
 // sliding velocity v_b = rdot - (n . rdot) n in the bed's plane, the
@@ -185,13 +205,19 @@ class Seabed {
 
   // Adds the generalized damping and friction force Q_d to `force` and its
   // velocity tangent -dQ_d/d(edot) (symmetric positive semi-definite, see
-  // above) to `c` when not null. Returns the power they dissipate,
-  // -Q_d . edot >= 0 [W].
+  // above) to `c` when not null. When `position` is not null, adds the
+  // damping's position tangent -dQ_d/de there: on a plane bed the exact
+  // one of the damping c (the ends of the pieces in the bed move with e,
+  // and the damping force does not vanish there; symmetric, indefinite),
+  // friction's left out as above; on a grid bed only the ends' part
+  // (exact on a uniformly sloped grid).
+  // Returns the power they dissipate, -Q_d . edot >= 0 [W].
   template <int D>
   double AddDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
                         const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
                         Eigen::Matrix<double, 4 * D, 1>* force,
-                        Eigen::Matrix<double, 4 * D, 4 * D>* c) const;
+                        Eigen::Matrix<double, 4 * D, 4 * D>* c,
+                        Eigen::Matrix<double, 4 * D, 4 * D>* position = nullptr) const;
 
   // STATIC analyses: adds the static friction force q_s integrated with
   // the shape functions (a generalized force, like AddDissipation's) to
@@ -266,13 +292,15 @@ class Seabed {
                          const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
                          Eigen::Matrix<double, 4 * D, 1>* force,
                          Eigen::Matrix<double, 4 * D, 4 * D>* c, double damping,
-                         double speed, double moordyn_damping) const;
+                         double speed, double moordyn_damping,
+                         Eigen::Matrix<double, 4 * D, 4 * D>* position = nullptr) const;
   template <int D>
   double PlaneDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
                           const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
                           Eigen::Matrix<double, 4 * D, 1>* force,
                           Eigen::Matrix<double, 4 * D, 4 * D>* c, double damping,
-                          double speed, double moordyn_damping) const;
+                          double speed, double moordyn_damping,
+                          Eigen::Matrix<double, 4 * D, 4 * D>* position = nullptr) const;
   // The gap g at a point of D coordinates, its gradient (and, on a grid,
   // Hessian when not null).
   template <int D>

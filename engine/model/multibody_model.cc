@@ -304,10 +304,12 @@ void MultibodyModel::SubtractDiscreteGradientCorrection(const VectorXd& q0, cons
 template <int D>
 double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, VectorXd* full,
                                       SkylineLdlt* tangent, double tangent_scale,
-                                      VectorXd* roundoff, double* power) const {
+                                      VectorXd* roundoff, double* power,
+                                      double position_scale) const {
   constexpr int kN = 4 * D, kN2 = kN * kN;
   const auto& elements = Elements<D>();
-  typename AncfCableElement<D>::Matrix ce;
+  typename AncfCableElement<D>::Matrix ce, ke;
+  const bool position = tangent && position_scale != 0;
   typename AncfCableElement<D>::Coords fe;
   double size = 0;
   double* values = tangent ? tangent->values() : nullptr;
@@ -332,8 +334,9 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
     // sheaves').
     fe.setZero();
     ce.setZero();
-    const ElementAt<D> at{e.element, static_cast<int>(k), time_, e.first_coord, &q, &qdot,
-                          &coupled, power};
+    if (position) ke.setZero();
+    const ElementAt<D> at{e.element,  static_cast<int>(k), time_, e.first_coord, &q, &qdot,
+                          &coupled,   power,           position ? &ke : nullptr};
     for (const ElementTerm* t : dissipative_terms_)
       t->AddElementDissipation(at, q.segment<kN>(e.first_coord), ve, &fe, &ce);
     if (power) *power -= ve.dot(fe);
@@ -344,13 +347,14 @@ double MultibodyModel::ElementDamping(const VectorXd& q, const VectorXd& qdot, V
           kSumRounding * (ce.cwiseAbs() * ve.cwiseAbs() + fe.cwiseAbs());
     if (!tangent) continue;
     ScatterElementMatrix<kN2>(k, ce.data(), tangent_scale, values);
+    if (position) ScatterElementMatrix<kN2>(k, ke.data(), position_scale, values);
   }
   return size;
 }
 
 double MultibodyModel::DampingForce(const VectorXd& q, const VectorXd& qdot, VectorXd* f,
                                     SkylineLdlt* tangent, double tangent_scale,
-                                    VectorXd* roundoff) {
+                                    VectorXd* roundoff, double position_scale) {
   if (!has_damping_) return 0;
   constexpr double kEps = std::numeric_limits<double>::epsilon();
   VectorXd& full = scratch_damping_;
@@ -361,9 +365,9 @@ double MultibodyModel::DampingForce(const VectorXd& q, const VectorXd& qdot, Vec
     full_roundoff->setZero();
   }
   double size = dim_ == 2 ? ElementDamping<2>(q, qdot, &full, tangent, tangent_scale,
-                                              full_roundoff, nullptr)
+                                              full_roundoff, nullptr, position_scale)
                           : ElementDamping<3>(q, qdot, &full, tangent, tangent_scale,
-                                              full_roundoff, nullptr);
+                                              full_roundoff, nullptr, position_scale);
   // Contributors' velocity-dependent forces.
   if (!contributors_.empty()) {
     const ForceState state = StateAt(q, &qdot, 1.0);

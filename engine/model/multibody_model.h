@@ -192,9 +192,14 @@ class MultibodyModel {
   // damping is strong and the motion fast). When `roundoff` is not null,
   // adds a bound of the rounding of these terms (eps times the sums of
   // absolute values). Returns the largest damping force entry [N].
+  // `position_scale` (the scale the stepper gives NetForce's tangent; 0:
+  // none) adds position_scale times the q-derivatives that element terms
+  // do give (ElementAt::position_tangent: the seabed damping's moving
+  // contact ends, which are large where a cable touches down at a small
+  // angle; engine/forces/seabed.h).
   double DampingForce(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, Eigen::VectorXd* f,
                       SkylineLdlt* tangent = nullptr, double tangent_scale = 0,
-                      Eigen::VectorXd* roundoff = nullptr);
+                      Eigen::VectorXd* roundoff = nullptr, double position_scale = 0);
 
   // The cables' added mass where it is not the constant mass matrix's
   // (engine/forces/cable_added_mass.h: an axial coefficient apart, or none
@@ -564,7 +569,8 @@ class MultibodyModel {
   template <int D>
   double ElementDamping(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
                         Eigen::VectorXd* full, SkylineLdlt* tangent, double tangent_scale,
-                        Eigen::VectorXd* roundoff, double* power) const;
+                        Eigen::VectorXd* roundoff, double* power,
+                        double position_scale = 0) const;
   template <int D>
   double ElementAddedMass(const Eigen::VectorXd& q, const Eigen::VectorXd& qdd,
                           Eigen::VectorXd* full, SkylineLdlt* matrix, double scale) const;

@@ -58,7 +58,8 @@ double EnergyMomentumStepper::Forces(double h, Eigen::VectorXd* f, SkylineLdlt* 
   if (model_->has_damping()) {
     mdv_ = 0.5 * (v_ + v1_);  // scratch: the mean velocity
     model_->RateToFull(mdv_, &qd_);
-    size = std::max(size, model_->DampingForce(qm_, qd_, f, a, 0.5 * h, roundoff));
+    size = std::max(size, model_->DampingForce(qm_, qd_, f, a, 0.5 * h, roundoff,
+                                                  0.25 * h * h));
   }
   return size;
 }

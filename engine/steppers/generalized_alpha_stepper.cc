@@ -43,7 +43,7 @@ double GeneralizedAlphaStepper::Forces(const Eigen::VectorXd& v, Eigen::VectorXd
   double size = model_->NetForce(q_, 1.0, f, a, c, roundoff);
   if (model_->has_damping()) {
     model_->RateToFull(v, &qd_);
-    size = std::max(size, model_->DampingForce(q_, qd_, f, a, cd, roundoff));
+    size = std::max(size, model_->DampingForce(q_, qd_, f, a, cd, roundoff, c));
   }
   return size;
 }

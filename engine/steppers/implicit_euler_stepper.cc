@@ -39,7 +39,7 @@ double ImplicitEulerStepper::Forces(const Eigen::VectorXd& v, Eigen::VectorXd* f
   double size = model_->NetForce(q_, 1.0, f, a, h * h, roundoff);
   if (model_->has_damping()) {
     model_->RateToFull(v, &qd_);
-    size = std::max(size, model_->DampingForce(q_, qd_, f, a, h, roundoff));
+    size = std::max(size, model_->DampingForce(q_, qd_, f, a, h, roundoff, h * h));
   }
   return size;
 }
