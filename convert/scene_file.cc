@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -186,7 +187,9 @@ std::string JsonPathAt(absl::string_view json, size_t offset) {
         break;
     }
     if (c == '{' || c == '[') {
-      stack.push_back(Frame{c == '['});
+      Frame frame;
+      frame.array = c == '[';
+      stack.push_back(std::move(frame));
     } else if ((c == '}' || c == ']') && !stack.empty()) {
       stack.pop_back();
     } else if (c == ':' && !stack.empty()) {
