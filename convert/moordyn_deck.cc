@@ -22,6 +22,7 @@
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
+#include "convert/scene/field_checks.h"
 #include "convert/scene_from_proto.h"
 
 namespace cablesim {
@@ -216,6 +217,20 @@ class DeckReader {
 
   absl::Status Error(int line, absl::string_view field, absl::string_view message) const {
     return absl::InvalidArgumentError(absl::StrCat(file_, ":", line, ": ", field, ": ", message));
+  }
+
+  // The text of a file the deck names (read relative to the deck's
+  // directory), or the deck's error at line `line`, field `field`:
+  // `no_directory` when the deck came as text alone (no reader),
+  // `cannot_read` followed by the reader's message when it fails.
+  absl::StatusOr<std::string> ReadNamedFile(int line, absl::string_view field,
+                                            absl::string_view name,
+                                            absl::string_view no_directory,
+                                            absl::string_view cannot_read) const {
+    if (!read_file_) return Error(line, field, no_directory);
+    absl::StatusOr<std::string> text = read_file_(std::string_view(name.data(), name.size()));
+    if (!text.ok()) return Error(line, field, absl::StrCat(cannot_read, text.status().message()));
+    return text;
   }
 
   static Section SectionOf(std::string upper) {
@@ -430,24 +445,19 @@ class DeckReader {
   // ratio, is scaled by, and EI is divided by).
   absl::Status ReadTensionTable(int n, absl::string_view field, absl::string_view name,
                                 LineType* t) const {
-    if (!read_file_) {
-      return Error(n, field,
-                   absl::StrCat("\"", name,
-                                "\": a tension-strain table file cannot be read here (a deck's "
-                                "text alone, as the service takes it, has no directory): give "
-                                "the scene with cables[].tension_table, or run the deck's file"));
-    }
-    absl::StatusOr<std::string> text = read_file_(std::string_view(name.data(), name.size()));
-    if (!text.ok()) {
-      return Error(n, field,
-                   absl::StrCat("\"", name, "\": cannot read the tension-strain table: ",
-                                text.status().message()));
-    }
+    CABLESIM_ASSIGN_OR_RETURN(
+        const std::string text,
+        ReadNamedFile(n, field, name,
+                      absl::StrCat("\"", name,
+                                   "\": a tension-strain table file cannot be read here (a deck's "
+                                   "text alone, as the service takes it, has no directory): give "
+                                   "the scene with cables[].tension_table, or run the deck's file"),
+                      absl::StrCat("\"", name, "\": cannot read the tension-strain table: ")));
     auto bad = [&](int row, absl::string_view message) {
       return Error(n, field, absl::StrCat(name, ":", row, ": ", message));
     };
     int row = 0;
-    for (absl::string_view raw : absl::StrSplit(*text, '\n')) {
+    for (absl::string_view raw : absl::StrSplit(text, '\n')) {
       ++row;
       if (row <= 3) continue;  // MoorDyn's three header lines
       const std::vector<absl::string_view> w =
@@ -738,18 +748,15 @@ class DeckReader {
                                                           absl::string_view name) const {
     const Option& o = options_.at(key);
     const std::string field = key == "wavekin" ? "OPTIONS WaveKin" : "OPTIONS Currents";
-    if (!read_file_) {
-      return Error(o.line, field,
-                   absl::StrCat(name, " cannot be read here (a deck's text alone, as the service "
-                                      "takes it, has no directory): give the scene's fluid "
-                                      "fields, or run the deck's file"));
-    }
-    absl::StatusOr<std::string> text = read_file_(std::string_view(name.data(), name.size()));
-    if (!text.ok()) {
-      return Error(o.line, field, absl::StrCat("cannot read ", name, ": ", text.status().message()));
-    }
+    CABLESIM_ASSIGN_OR_RETURN(
+        const std::string text,
+        ReadNamedFile(o.line, field, name,
+                      absl::StrCat(name, " cannot be read here (a deck's text alone, as the "
+                                         "service takes it, has no directory): give the scene's "
+                                         "fluid fields, or run the deck's file"),
+                      absl::StrCat("cannot read ", name, ": ")));
     std::vector<std::string> lines;
-    for (absl::string_view raw : absl::StrSplit(*text, '\n'))
+    for (absl::string_view raw : absl::StrSplit(text, '\n'))
       lines.emplace_back(absl::StripTrailingAsciiWhitespace(raw));
     while (!lines.empty() && lines.back().empty()) lines.pop_back();
     return lines;
@@ -1508,25 +1515,21 @@ class DeckReader {
     const int n = seafloor_line_;
     const std::string field = "OPTIONS SeafloorFile";
     const std::string& name = seafloor_file_;
-    if (!read_file_) {
-      return Error(n, field,
-                   absl::StrCat("\"", name,
-                                "\": a seafloor file cannot be read here (a deck's text alone, "
-                                "as the service takes it, has no directory): give the scene with "
-                                "seabed.bathymetry, or run the deck's file"));
-    }
-    absl::StatusOr<std::string> text = read_file_(std::string_view(name.data(), name.size()));
-    if (!text.ok()) {
-      return Error(n, field, absl::StrCat("\"", name, "\": cannot read the seafloor file: ",
-                                          text.status().message()));
-    }
+    CABLESIM_ASSIGN_OR_RETURN(
+        const std::string text,
+        ReadNamedFile(n, field, name,
+                      absl::StrCat("\"", name,
+                                   "\": a seafloor file cannot be read here (a deck's text alone, "
+                                   "as the service takes it, has no directory): give the scene "
+                                   "with seabed.bathymetry, or run the deck's file"),
+                      absl::StrCat("\"", name, "\": cannot read the seafloor file: ")));
     auto bad = [&](int row, absl::string_view message) {
       return Error(n, field, absl::StrCat(name, ":", row, ": ", message));
     };
     std::vector<std::vector<double>> rows;
     std::vector<int> row_line;
     int row = 0;
-    for (absl::string_view raw : absl::StrSplit(*text, '\n')) {
+    for (absl::string_view raw : absl::StrSplit(text, '\n')) {
       ++row;
       const std::vector<absl::string_view> w =
           absl::StrSplit(raw, absl::ByAnyChar(" \t\r,"), absl::SkipEmpty());

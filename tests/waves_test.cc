@@ -35,7 +35,9 @@ TEST(WavesTest, DispersionRelationSolvedTo1e10) {
         (kG * m * std::tanh(m * depth) < w * w ? lo : hi) = m;
       }
       EXPECT_NEAR(k, 0.5 * (lo + hi), 1e-12 * k) << depth << " " << period;
-      if (k * depth > 19) EXPECT_NEAR(k, w * w / kG, 1e-14 * k);
+      if (k * depth > 19) {
+        EXPECT_NEAR(k, w * w / kG, 1e-14 * k);
+      }
       if (k * depth < 0.05) {
         const double kh = k * depth;
         EXPECT_NEAR(k, w / std::sqrt(kG * depth) * (1 + kh * kh / 6), 0.1 * std::pow(kh, 4) * k);

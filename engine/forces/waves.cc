@@ -134,15 +134,22 @@ int WaveField::AddElevationSeries(const std::vector<double>& times_s,
   return added;
 }
 
+bool WaveField::Ramp(double t, double* ramp, double* rate) const {
+  *ramp = 1;
+  if (rate != nullptr) *rate = 0;
+  if (ramp_s_ > 0 && t < ramp_s_) {
+    if (t <= 0) return false;
+    const double x = std::numbers::pi * t / ramp_s_;
+    *ramp = 0.5 * (1 - std::cos(x));
+    if (rate != nullptr) *rate = 0.5 * std::numbers::pi / ramp_s_ * std::sin(x);
+  }
+  return true;
+}
+
 WaveField::Kinematics WaveField::At(const Eigen::Vector3d& r, double t) const {
   Kinematics out;
-  double ramp = 1, ramp_rate = 0;
-  if (ramp_s_ > 0 && t < ramp_s_) {
-    if (t <= 0) return out;
-    const double x = std::numbers::pi * t / ramp_s_;
-    ramp = 0.5 * (1 - std::cos(x));
-    ramp_rate = 0.5 * std::numbers::pi / ramp_s_ * std::sin(x);
-  }
+  double ramp, ramp_rate;
+  if (!Ramp(t, &ramp, &ramp_rate)) return out;
   const double z = std::clamp(up_.dot(r) - surface_, -depth_, 0.0);
   Eigen::Vector3d u = Eigen::Vector3d::Zero(), a = Eigen::Vector3d::Zero();
   double eta = mean_elevation_m_;
@@ -167,11 +174,8 @@ WaveField::Kinematics WaveField::At(const Eigen::Vector3d& r, double t) const {
 }
 
 double WaveField::ElevationAt(const Eigen::Vector3d& r, double t) const {
-  double ramp = 1;
-  if (ramp_s_ > 0 && t < ramp_s_) {
-    if (t <= 0) return 0;
-    ramp = 0.5 * (1 - std::cos(std::numbers::pi * t / ramp_s_));
-  }
+  double ramp;
+  if (!Ramp(t, &ramp, nullptr)) return 0;
   double eta = mean_elevation_m_;
   for (const Component& c : components_) {
     const double theta =

@@ -149,6 +149,11 @@ class WaveField {
 
  private:
   Eigen::Vector3d Horizontal(const Eigen::Vector3d& direction) const;
+  // The ramp-in factor r(t) = (1 - cos(pi t / ramp_s)) / 2 over the first
+  // ramp_s seconds (1 after, or without a ramp) into `ramp` and its rate
+  // [1/s] into `rate` (may be null); false at t <= 0 inside a ramp: no
+  // waves yet.
+  bool Ramp(double t, double* ramp, double* rate) const;
 
   Eigen::Vector3d up_;
   double surface_ = 0, depth_ = 0, g_ = 9.81, ramp_s_ = 0;
