@@ -142,5 +142,27 @@ TEST(WavesTest, JonswapSeaHasItsSignificantHeightAndSeed) {
               1e-15 + 1e-12 * std::abs(d.At(r, 10).velocity_m_s.x()));
 }
 
+// ElevationAt is At's elevation to the bit (the free surface's wet test and
+// the buoyancy call it instead of At), before, inside and after a ramp, in
+// a sea of many components and of one, with a mean level from a series.
+TEST(WavesTest, ElevationAtIsAtsElevationToTheBit) {
+  WaveField sea(Vector3d::UnitZ(), 0, 200, kG, 20);
+  sea.AddJonswap(6, 12, 3.3, Vector3d(1, 1, 0), 80, 7);
+  sea.AddRegular(2, 7, Vector3d::UnitY(), 0.3);
+  WaveField series(Vector3d::UnitZ(), 0, 30, kG, 0);
+  series.AddElevationSeries({0, 1, 2, 3, 4, 5, 6, 7, 8}, {0.1, 0.5, 0.2, -0.3, 0.4, 0.0, -0.2, 0.3, 0.1},
+                            1, 0, Vector3d::UnitX());
+  ASSERT_NE(series.mean_elevation(), 0);
+  int compared = 0;
+  for (const WaveField* f : {&sea, &series})
+    for (double t : {-1.0, 0.0, 0.5, 7.3, 19.99, 20.0, 41.7})
+      for (const Vector3d& r : {Vector3d(0, 0, -10), Vector3d(130.5, -42.25, -199), Vector3d(-7, 3, 2)}) {
+        EXPECT_EQ(f->ElevationAt(r, t), f->At(r, t).elevation_m) << t << " " << r.transpose();
+        ++compared;
+      }
+  EXPECT_EQ(compared, 42);
+  EXPECT_NE(sea.ElevationAt(Vector3d::Zero(), 7.3), 0);  // not all zero
+}
+
 }  // namespace
 }  // namespace cablesim
