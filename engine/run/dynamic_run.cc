@@ -406,6 +406,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       // frame is its end (within 1e-6 of the step, which also keeps t on
       // the frames' grid), otherwise interpolated (dense output).
       bool end_checked = false;
+      rec->EndStep(t, stepper->z(), stepper->v());
       while (next_frame <= frames) {
         const double tf = frame_time(next_frame);
         const bool at_end = std::abs(tf - t) <= 1e-6 * h_try;

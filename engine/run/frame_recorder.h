@@ -75,21 +75,52 @@ class FrameRecorder {
   }
 
   // energy.damped: the trapezoidal rule on the dissipated power from the
-  // last accepted step's end (AdvanceDamping) to the state in q_, qd_ at t.
+  // last accepted step's end (AdvanceDamping) to t. At a step's end the
+  // rule itself; inside a step whose end power is known (EndStep), the
+  // rule's own interpolant, the power linear between the step's two ends
+  // (so a frame between step ends costs no evaluation of the damping, and
+  // energy.damped is the same function of time whatever the frames);
+  // otherwise the power of the state in q_, qd_ at t.
   double Damped(double t) const {
     if (!model_->has_damping()) return 0;
+    if (t == damped_t_) return damped_;
+    if (has_end_) {
+      const double h = end_t_ - damped_t_, dt = t - damped_t_;
+      // (A frame within 1e-6 of the step from its end is that end, as the
+      // run's frame grid takes it: RunDynamic.)
+      if (!(t < end_t_ - 1e-6 * h) || !(h > 0))
+        return damped_ + 0.5 * dt * (damped_power_ + end_power_);
+      return damped_ + dt * (damped_power_ + 0.5 * (dt / h) * (end_power_ - damped_power_));
+    }
     const double power = model_->DampingPower(q_, qd_);
     return damped_ + 0.5 * (t - damped_t_) * (damped_power_ + power);
   }
-  // Moves the start of that rule to an accepted step's end (t, z, v).
-  void AdvanceDamping(double t, const Eigen::VectorXd& z, const Eigen::VectorXd& v) {
+  // The dissipated power at an accepted step's end (t, z, v), evaluated
+  // once, before the frames inside the step (Damped) and AdvanceDamping.
+  void EndStep(double t, const Eigen::VectorXd& z, const Eigen::VectorXd& v) {
     if (!model_->has_damping()) return;
     model_->SetTime(t);  // the damping power of waves depends on it
     model_->ToFull(z, &q_);
     model_->RateToFull(v, &qd_);
-    damped_ = Damped(t);
+    end_power_ = model_->DampingPower(q_, qd_);
+    end_t_ = t;
+    has_end_ = true;
+  }
+  // Moves the start of that rule to an accepted step's end (t, z, v), with
+  // the power EndStep evaluated there when it did.
+  void AdvanceDamping(double t, const Eigen::VectorXd& z, const Eigen::VectorXd& v) {
+    if (!model_->has_damping()) return;
+    double power = end_power_;
+    if (!has_end_) {
+      model_->SetTime(t);  // the damping power of waves depends on it
+      model_->ToFull(z, &q_);
+      model_->RateToFull(v, &qd_);
+      power = model_->DampingPower(q_, qd_);
+    }
+    has_end_ = false;
+    damped_ += 0.5 * (t - damped_t_) * (damped_power_ + power);
     damped_t_ = t;
-    damped_power_ = model_->DampingPower(q_, qd_);
+    damped_power_ = power;
   }
 
   // Records the evaluated frame in the summary and delivers it. `reached`:
@@ -134,6 +165,9 @@ class FrameRecorder {
   double energy_scale_ = 0;
   // energy.damped at damped_t_ and the dissipated power there.
   double damped_ = 0, damped_t_ = 0, damped_power_ = 0;
+  // The power at the end (end_t_) of the step being recorded (EndStep).
+  double end_power_ = 0, end_t_ = 0;
+  bool has_end_ = false;
 };
 
 }  // namespace cablesim
