@@ -185,6 +185,34 @@ TEST(AutoIntegratorTest, NamedSteppersAreKeptAndAutoIsTheDefault) {
   ExpectSameFrames(unset, RunJson(Rope(R"("step": 1e-4, "integrator": "AUTO_STEPPER")")));
 }
 
+// No solver.step: the step is AUTO's to choose too, so AUTO steps
+// adaptively, held to 1e-4 of the scene's size (the 2 m rope: 2e-4 m)
+// unless the scene gives a tolerance: the same run, to the bit, as the
+// scene asking for those adaptive steps itself (from the old default step,
+// 1 ms, as the first). A named stepper without a step keeps the fixed 1 ms.
+TEST(AutoIntegratorTest, AutoChoosesAdaptiveStepsWhenTheSceneGivesNoStep) {
+  const Result unset = RunJson(Rope(R"("initial_state": "AS_GIVEN")"));
+  EXPECT_EQ(unset.summary.status, "ok");
+  EXPECT_EQ(unset.summary.integrator_requested, "AUTO");
+  EXPECT_DOUBLE_EQ(unset.summary.error_tolerance_m, 2e-4);
+  EXPECT_TRUE(absl::StrContains(unset.summary.integrator_reason,
+                                "steps adaptive, held to a local error of 0.0002 m"))
+      << unset.summary.integrator_reason;
+  const Result asked = RunJson(Rope(R"("adaptive": true, "tolerance": 2e-4, "step": 1e-3)"));
+  EXPECT_EQ(unset.summary.steps, asked.summary.steps);
+  EXPECT_EQ(unset.summary.integrator, asked.summary.integrator);
+  ExpectSameFrames(unset, asked);
+  // The scene's own tolerance holds those steps.
+  const Result loose = RunJson(Rope(R"("tolerance": 1e-2)"));
+  EXPECT_DOUBLE_EQ(loose.summary.error_tolerance_m, 1e-2);
+  EXPECT_LT(loose.summary.steps, unset.summary.steps);
+  // A named stepper keeps the fixed default step: 0.05 s in 50 steps.
+  const Result named = RunJson(Rope(R"("integrator": "HHT")"));
+  EXPECT_EQ(named.summary.steps, 50);
+  EXPECT_EQ(named.summary.rejected_steps, 0);
+  EXPECT_DOUBLE_EQ(named.summary.max_step_s, 1e-3);
+}
+
 // A rubber cord (E = 1e7 Pa, 1 m, ten elements) pinned at its top, pulled
 // at its end by a load that ramps to 400 N in 0.2 s and back to 0 by 0.4 s.
 // Green-Lagrange's tangent stiffness grows with the strain (about 30 % at

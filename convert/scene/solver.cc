@@ -37,6 +37,10 @@ constexpr int kMaxModes = 100000;
 // sample scenes, whose results are checked against references
 // (docs/honest-runs.md has the figures).
 constexpr double kDefaultRelativeErrorTolerance = 1e-2;
+// AUTO without solver.step: the local error tolerance of its adaptive
+// steps, relative to the scene's size (SceneSize), when the scene gives no
+// solver.tolerance.
+constexpr double kDefaultAutoStepRelativeTolerance = 1e-4;
 
 // A tolerance in (0, kMaxTolerance].
 absl::Status CheckTolerance(absl::string_view path, double value) {
@@ -275,6 +279,17 @@ absl::Status ConvertSolver(ConversionState* state) {
                      absl::StrCat("must be < 1 (got ", Num(s.relative_tolerance()), ")"));
     }
     out.relative_tolerance = s.relative_tolerance();
+  }
+  // AUTO and no step: the step is AUTO's to choose too, so it steps
+  // adaptively, held to the scene's tolerance or 1e-4 of the scene's size
+  // (a fixed 1 ms step, the old default, ran the OC4 mooring 60 times
+  // slower than it needed: docs/steppers.md).
+  if (out.auto_integrator && out.analysis == Analysis::kDynamic && !s.has_step() &&
+      !out.adaptive) {
+    out.adaptive = true;
+    out.auto_step = true;
+    if (!s.has_tolerance())
+      out.tolerance_m = kDefaultAutoStepRelativeTolerance * SceneSize(state->proto);
   }
   // What the run's error estimate is held to: the scene's tolerance, the
   // adaptive controller's default, or for fixed steps a default relative

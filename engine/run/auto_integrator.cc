@@ -33,6 +33,10 @@ Integrator Choose(Integrator chosen, const std::string& why, std::string* reason
   return chosen;
 }
 
+// ChooseIntegrator without the note on adaptive steps.
+Integrator ChooseStepper(MultibodyModel* model, const Scene& scene, std::string* reason,
+                         bool* may_switch);
+
 }  // namespace
 
 std::unique_ptr<Stepper> TryExplicit(MultibodyModel* model, const SolverSettings& settings,
@@ -48,6 +52,18 @@ std::unique_ptr<Stepper> TryExplicit(MultibodyModel* model, const SolverSettings
 
 Integrator ChooseIntegrator(MultibodyModel* model, const Scene& scene, std::string* reason,
                             bool* may_switch) {
+  const Integrator chosen = ChooseStepper(model, scene, reason, may_switch);
+  if (scene.solver.auto_step)
+    absl::StrAppendFormat(reason,
+                          "; steps adaptive, held to a local error of %g m (solver.step not "
+                          "given)",
+                          scene.solver.tolerance_m);
+  return chosen;
+}
+
+namespace {
+Integrator ChooseStepper(MultibodyModel* model, const Scene& scene, std::string* reason,
+                         bool* may_switch) {
   const SolverSettings& s = scene.solver;
   if (may_switch != nullptr) *may_switch = false;
   if (const std::string need = ImplicitNeed(*model, scene); !need.empty())
@@ -90,5 +106,6 @@ Integrator ChooseIntegrator(MultibodyModel* model, const Scene& scene, std::stri
                                 s.step_s),
                 reason);
 }
+}  // namespace
 
 }  // namespace cablesim

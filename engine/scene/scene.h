@@ -424,6 +424,9 @@ struct SolverSettings {
   // error of every unknown stays below tolerance_m + relative_tolerance |z|.
   bool adaptive = false;
   double tolerance_m = 1e-4;
+  // AUTO made the steps adaptive because the scene gives no solver.step
+  // (convert/; tolerance_m then defaults to 1e-4 of the scene's size).
+  bool auto_step = false;
   double relative_tolerance = 0;
   // DYNAMIC: the tolerance every run's error estimate is held to (the
   // summary's error_tolerance_m; engine/run/run_warnings.h): tolerance_m
