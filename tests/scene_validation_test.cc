@@ -911,6 +911,58 @@ TEST(SceneConversionTest, SteppersAndTheirSettings) {
   EXPECT_FALSE(scene->solver.reuse_factorization);  // backward Euler does not reuse
 }
 
+// solver.reuse_factorization unset: true for the alpha family, but false on
+// a scene with a seabed or with fluid drag on a cable (ReuseCostsNewton),
+// with the reason AUTO's integrator_reason gives; a scene that sets it
+// keeps what it set; the other steppers keep their own default.
+TEST(SceneConversionTest, ReuseFactorizationDefaultFollowsTheScene) {
+  const std::string bed = R"("gravity": {"y": -9.81}, "seabed": {"depth": 1, "stiffness": 1e5}, )";
+  const auto with = [&](const std::string& cable, const std::string& more,
+                        const std::string& solver) {
+    return absl::StrCat(R"({"cables": [)", cable, "], ", more, R"("solver": {"duration": 1)",
+                        solver, "}}");
+  };
+  struct Case {
+    std::string name, json;
+    bool reuse;
+    std::string why;  // in reuse_factorization_off; empty: none
+  };
+  const std::string drag =
+      R"({"name": "c", "length": 1, "density": 1000, "youngs_modulus": 1e7, "diameter": 0.01,
+          "hydrodynamics": {"normal_drag": 1.2}})";
+  const std::string added_mass_only =
+      R"({"name": "c", "length": 1, "density": 1000, "youngs_modulus": 1e7, "diameter": 0.01,
+          "hydrodynamics": {"added_mass": 1}})";
+  const std::string water = R"("fluid": {"density": 1025}, )";
+  const Case cases[] = {
+      {"plain", with(kCable, "", ""), true, ""},
+      {"seabed", with(kCable, bed, ""), false, "seabed contact"},
+      {"seabed, AUTO named", with(kCable, bed, R"(, "integrator": "AUTO_STEPPER")"), false,
+       "seabed contact"},
+      {"seabed, GENERALIZED_ALPHA", with(kCable, bed, R"(, "integrator": "GENERALIZED_ALPHA")"),
+       false, "seabed contact"},
+      {"seabed, set true", with(kCable, bed, R"(, "reuse_factorization": true)"), true, ""},
+      {"seabed, ENERGY_MOMENTUM", with(kCable, bed, R"(, "integrator": "ENERGY_MOMENTUM")"), false,
+       ""},
+      {"seabed, IMPLICIT_EULER", with(kCable, bed, R"(, "integrator": "IMPLICIT_EULER")"), false,
+       ""},
+      {"cable drag", with(drag, water, ""), false, "fluid drag"},
+      {"cable drag, set true", with(drag, water, R"(, "reuse_factorization": true)"), true, ""},
+      {"fluid without drag", with(kCable, water, ""), true, ""},
+      {"added mass only", with(added_mass_only, water, ""), true, ""},
+  };
+  for (const Case& c : cases) {
+    absl::StatusOr<Scene> scene = ConvertJson(c.json);
+    ASSERT_TRUE(scene.ok()) << c.name << ": " << scene.status();
+    EXPECT_EQ(scene->solver.reuse_factorization, c.reuse) << c.name;
+    if (c.why.empty()) {
+      EXPECT_EQ(scene->solver.reuse_factorization_off, "") << c.name;
+    } else {
+      EXPECT_THAT(scene->solver.reuse_factorization_off, testing::HasSubstr(c.why)) << c.name;
+    }
+  }
+}
+
 TEST(EnumConversionTest, Names) {
   EXPECT_EQ(AnalysisName(Analysis::kStatic), "STATIC");
   EXPECT_EQ(IntegratorName(Integrator::kImplicitEuler), "IMPLICIT_EULER");

@@ -209,12 +209,19 @@ absl::Status ConvertSolver(ConversionState* state) {
   // Steppers whose Newton matrix can be kept across iterations and steps
   // (IntegratorTraits::keeps_newton_matrix).
   const bool keeps_matrix = traits.keeps_newton_matrix;
-  // Default on for the alpha family; off for ENERGY_MOMENTUM, whose point
-  // is conservation: with a kept matrix Newton converges linearly and
-  // stops just under its tolerance, and those residuals add up (the 100 s
-  // falling pendulum drifted by 2e-5 of its energy with it, 5e-7 without).
+  // Default on for the alpha family, except on a scene whose tangents
+  // move with the state (seabed contact, the cables' fluid drag:
+  // ReuseCostsNewton, measured in docs/steppers.md); off for
+  // ENERGY_MOMENTUM, whose point is conservation: with a kept matrix
+  // Newton converges linearly and stops just under its tolerance, and
+  // those residuals add up (the 100 s falling pendulum drifted by 2e-5 of
+  // its energy with it, 5e-7 without).
   out.reuse_factorization =
       s.has_reuse_factorization() ? s.reuse_factorization() : traits.reuses_matrix_by_default;
+  if (!s.has_reuse_factorization() && out.reuse_factorization) {
+    out.reuse_factorization_off = ReuseCostsNewton(state->scene);
+    if (!out.reuse_factorization_off.empty()) out.reuse_factorization = false;
+  }
   if (s.has_reuse_factorization() && s.reuse_factorization() && !keeps_matrix) {
     return Invalid(
         "solver.reuse_factorization",

@@ -66,8 +66,16 @@ Integrator ChooseStepper(MultibodyModel* model, const Scene& scene, std::string*
                          bool* may_switch) {
   const SolverSettings& s = scene.solver;
   if (may_switch != nullptr) *may_switch = false;
-  if (const std::string need = ImplicitNeed(*model, scene); !need.empty())
-    return Choose(Integrator::kHht, need, reason);
+  if (const std::string need = ImplicitNeed(*model, scene); !need.empty()) {
+    // The Newton economy chosen from the scene (convert/scene/solver.cc).
+    const std::string& fresh = s.reuse_factorization_off;
+    return Choose(Integrator::kHht,
+                  fresh.empty() || s.reuse_factorization ? need
+                                : absl::StrCat(need, "; a fresh Newton matrix every iteration "
+                                                     "(solver.reuse_factorization false): ",
+                                               fresh),
+                  reason);
+  }
   if (may_switch != nullptr) *may_switch = true;
   if (s.adaptive) {
     // Measured (docs/honest-runs.md): adaptive DORMAND_PRINCE is held to

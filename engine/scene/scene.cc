@@ -57,4 +57,16 @@ std::string_view LinearSolverName(LinearSolverKind solver) {
   return "UNKNOWN";
 }
 
+std::string ReuseCostsNewton(const Scene& scene) {
+  if (scene.seabed.enabled)
+    return "the seabed contact's tangent (touchdown, bed damping and friction) changes with "
+           "the state";
+  if (scene.fluid.density_kg_m3 > 0) {
+    for (const CableSpec& c : scene.cables)
+      if (c.normal_drag > 0 || c.tangential_drag > 0)
+        return "the cables' fluid drag tangent changes with the state";
+  }
+  return "";
+}
+
 }  // namespace cablesim

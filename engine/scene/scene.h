@@ -460,8 +460,13 @@ struct SolverSettings {
   // Newton economy: keep the factorized Newton matrix across iterations and
   // steps while Newton contracts fast enough (a fresh one otherwise).
   // GENERALIZED_ALPHA, HHT, ENERGY_MOMENTUM (convert/ defaults it off for
-  // ENERGY_MOMENTUM: see README).
+  // ENERGY_MOMENTUM: see README, and for the alpha family on a scene whose
+  // tangents move with the state: ReuseCostsNewton).
   bool reuse_factorization = true;
+  // Why convert/ turned reuse_factorization off for a scene that did not
+  // set it (ReuseCostsNewton's sentence); empty otherwise. AUTO's
+  // integrator_reason says it.
+  std::string reuse_factorization_off;
   InitialState initial_state = InitialState::kAsGiven;  // DYNAMIC only
 };
 
@@ -524,6 +529,18 @@ struct Scene {
 // host's), named "<body> (coupled)". Scene readers call it once all the
 // scene's own joints are in, so the drivers come last.
 void AddCoupledBodyDrivers(Scene* scene);
+
+// Why a kept Newton matrix (SolverSettings::reuse_factorization) costs
+// this scene Newton iterations rather than saving them, in a sentence;
+// empty when it does not. A kept matrix pays where the tangent changes
+// slowly with the state (pendulums: one factorisation serves several
+// steps) and loses where a force's tangent turns with it, since Newton
+// then converges linearly on the stale matrix: seabed contact (the
+// touchdown point and its damping's moving term, friction) and the
+// cables' Morison drag (its tangent follows the relative flow). Measured
+// in docs/steppers.md (OC4 three-line mooring: 3.1x the Newton iterations
+// and 1.9x the CPU time with a kept matrix).
+std::string ReuseCostsNewton(const Scene& scene);
 
 }  // namespace cablesim
 
