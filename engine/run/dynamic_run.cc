@@ -72,6 +72,10 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   // iterations or more does not lengthen the next.
   constexpr int kCapProbe = 10, kSlowNewton = 10;
   double newton_cap = std::numeric_limits<double>::infinity();
+  // Step attempts so far, and the end state's energy the guard evaluated
+  // before accepting attempt guarded_attempt (reused by its frames).
+  long attempt = 0, guarded_attempt = -1;
+  EnergySample guarded_end;
   int since_cap = 0;
   // Fixed steps: the time reached counted in ticks of h_min (every step is
   // h_nominal / 2^k, a whole number of ticks), so that whether t is on a
@@ -97,6 +101,18 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   // ExternalPower), so the guard holds on winch scenes too. Rises below the
   // model's energy rounding are a scene at rest.
   const EnergyGuard guard(true, summary->energy_initial, model->energy_roundoff());
+  // A start as given that stores most of the largest energy term as
+  // strain is likely not an equilibrium the scene meant (a MoorDyn deck's
+  // points, a polyline's kink): an energy failure says how to start from one.
+  auto AppendStartHint = [&](double scale, std::string* error) {
+    if (settings.initial_state == InitialState::kAsGiven && strain_initial_j > 0.5 * scale) {
+      absl::StrAppendFormat(
+          error,
+          "; the run started from the scene's points as given, which store %.3g J of strain "
+          "energy: if they are not an equilibrium, solver.initial_state: STATIC starts from one",
+          strain_initial_j);
+    }
+  };
   auto EnergyHolds = [&](const EnergySample& e, double t_state) {
     if (guard.Fails(e, rec->energy_scale())) {
       const double rise = guard.Rise(e), scale = EnergyGuard::Scale(e, rec->energy_scale());
@@ -106,16 +122,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
                           "step; use a smaller solver.step, adaptive steps or a smaller "
                           "rho_infinity",
                           rise, 100 * EnergyGuard::kRiseLimit, scale, t_state);
-      // A start as given that stores most of the largest energy term as
-      // strain is likely not an equilibrium the scene meant (a MoorDyn
-      // deck's points, a polyline's kink): say how to start from one.
-      if (settings.initial_state == InitialState::kAsGiven && strain_initial_j > 0.5 * scale) {
-        absl::StrAppendFormat(
-            &error,
-            "; the run started from the scene's points as given, which store %.3g J of strain "
-            "energy: if they are not an equilibrium, solver.initial_state: STATIC starts from one",
-            strain_initial_j);
-      }
+      AppendStartHint(scale, &error);
       Fail(summary, t_state, error);
       return false;
     }
@@ -256,6 +263,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     const auto st = stepper->Step(h_try);
     if (model->stop_requested()) {  // the step was cut short (StopPoll)
       stepper->Restore();
+      rec->DropEndStep();  // its end state is not the run's
       summary->status = "cancelled";
       summary->error = absl::StrFormat("stopped by the caller during the step from t = %.9g", t);
       return;
@@ -271,24 +279,37 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     summary->linear_solves += st.linear_solves;
     summary->inexact_linear_solves += st.inexact_solves;
     summary->max_linear_residual = std::max(summary->max_linear_residual, st.max_linear_residual);
+    ++attempt;
+    // The guard looks at a converged step before accepting it when Newton
+    // found it hard, and when a frame needs its end state's energy anyway
+    // (a frame's guard could only fail the run, not halve the step: with
+    // a faster Newton a step that was halved failed the run instead).
+    const bool reaches_frame =
+        next_frame <= frames && frame_time(next_frame) <= t + h_try * (1 + 1e-6);
     if (st.converged && check_steps && guard.enabled() &&
-        st.newton_iterations >= EnergyGuard::kCheckAfterNewtonIterations) {
+        (st.newton_iterations >= EnergyGuard::kCheckAfterNewtonIterations || reaches_frame)) {
       // A step Newton found hard may have landed on a spurious root (an
       // element folded through itself: Green-Lagrange strain does not see
       // it); its energy says so. Take it back and halve the step.
+      rec->EndStep(t + h_try, stepper->z(), stepper->v(), attempt);
       const EnergySample e = rec->StateEnergy(t + h_try, stepper->z(), stepper->v());
+      guarded_end = e;
+      guarded_attempt = attempt;
       if (guard.Fails(e, rec->energy_scale())) {
         stepper->Restore();
+        rec->DropEndStep();  // its end state is not the run's
         ++summary->rejected_steps;
         successes = 0;
         h = h_step / 2;
         summary->smallest_cut_step_s = std::min(summary->smallest_cut_step_s, h);
         if (h < h_min * (1 - 1e-12)) {
-          Fail(summary, t + h_try,
-               absl::StrFormat("step from t = %.9g s raises the total energy by %.3g J down to "
-                               "h = %.3g s: the stepper is unstable here; use a smaller "
-                               "rho_infinity",
-                               t, guard.Rise(e), h_try));
+          std::string error =
+              absl::StrFormat("step from t = %.9g s raises the total energy by %.3g J down to "
+                              "h = %.3g s: the stepper is unstable here; use a smaller "
+                              "rho_infinity",
+                              t, guard.Rise(e), h_try);
+          AppendStartHint(EnergyGuard::Scale(e, rec->energy_scale()), &error);
+          Fail(summary, t + h_try, error);
           return;
         }
         continue;
@@ -316,6 +337,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       const double ratio = error_ratio;
       if (!(ratio <= 1)) {
         stepper->Restore();
+        rec->DropEndStep();  // its end state is not the run's
         // Tries back to central difference start again at 64 HHT steps
         // after a long explicit stretch (the choice was right); after a
         // short one they stay spaced out (the scene is at the edge).
@@ -341,6 +363,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       const double factor = StepFactor(err, TraitsOf(stepping.integrator).local_error_order);
       if (!(err <= 1)) {
         stepper->Restore();
+        rec->DropEndStep();  // its end state is not the run's
         ++summary->rejected_steps;
         h = h_try * factor;
         if (h < h_min * (1 - 1e-12)) {
@@ -406,7 +429,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       // frame is its end (within 1e-6 of the step, which also keeps t on
       // the frames' grid), otherwise interpolated (dense output).
       bool end_checked = false;
-      rec->EndStep(t, stepper->z(), stepper->v());
+      rec->EndStep(t, stepper->z(), stepper->v(), attempt);
       while (next_frame <= frames) {
         const double tf = frame_time(next_frame);
         const bool at_end = std::abs(tf - t) <= 1e-6 * h_try;
@@ -421,7 +444,9 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
           // The step's end is guarded before any frame inside it goes out.
           if (!end_checked) {
             model->SetTime(t);
-            const EnergySample end = rec->StateEnergy(t, stepper->z(), stepper->v());
+            const EnergySample end = guarded_attempt == attempt
+                                         ? guarded_end
+                                         : rec->StateEnergy(t, stepper->z(), stepper->v());
             if (!EnergyHolds(end, t)) return;
             rec->NoteReachedState(end);
             end_checked = true;

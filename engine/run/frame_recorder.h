@@ -95,10 +95,14 @@ class FrameRecorder {
     const double power = model_->DampingPower(q_, qd_);
     return damped_ + 0.5 * (t - damped_t_) * (damped_power_ + power);
   }
-  // The dissipated power at an accepted step's end (t, z, v), evaluated
-  // once, before the frames inside the step (Damped) and AdvanceDamping.
-  void EndStep(double t, const Eigen::VectorXd& z, const Eigen::VectorXd& v) {
+  // The dissipated power at a step's end (t, z, v), evaluated once per
+  // step attempt (`attempt`, the caller's count: a second call for the same
+  // attempt keeps the first's power), before the step's guard, its frames
+  // (Damped) and AdvanceDamping.
+  void EndStep(double t, const Eigen::VectorXd& z, const Eigen::VectorXd& v, long attempt) {
     if (!model_->has_damping()) return;
+    if (has_end_ && end_attempt_ == attempt) return;
+    end_attempt_ = attempt;
     model_->SetTime(t);  // the damping power of waves depends on it
     model_->ToFull(z, &q_);
     model_->RateToFull(v, &qd_);
@@ -106,6 +110,8 @@ class FrameRecorder {
     end_t_ = t;
     has_end_ = true;
   }
+  // Forgets the power EndStep evaluated (the step was taken back).
+  void DropEndStep() { has_end_ = false; }
   // Moves the start of that rule to an accepted step's end (t, z, v), with
   // the power EndStep evaluated there when it did.
   void AdvanceDamping(double t, const Eigen::VectorXd& z, const Eigen::VectorXd& v) {
@@ -167,6 +173,7 @@ class FrameRecorder {
   double damped_ = 0, damped_t_ = 0, damped_power_ = 0;
   // The power at the end (end_t_) of the step being recorded (EndStep).
   double end_power_ = 0, end_t_ = 0;
+  long end_attempt_ = -1;
   bool has_end_ = false;
 };
 
