@@ -264,7 +264,7 @@ double Seabed::GridDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
                                Eigen::Matrix<double, 4 * D, 1>* force,
                                Eigen::Matrix<double, 4 * D, 4 * D>* c, double damping,
                                double speed, double moordyn_damping,
-                               Eigen::Matrix<double, 4 * D, 4 * D>* position) const {
+                               Eigen::Matrix<double, 4 * D, 4 * D>* position, bool rate_tangent) const {
   using Point = Eigen::Matrix<double, D, 1>;
   using Block = Eigen::Matrix<double, D, D>;
   static const GaussRule rule = MakeGaussRule(7);
@@ -315,7 +315,7 @@ double Seabed::GridDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
       Block h;
       power += wl * contact::PointDissipation<D>(n, proj, k_ * pen * gn, v, u, damping, mu_a_,
                                                  mu_t_, speed, &q, &h, moordyn_damping,
-                                                 moordyn_scale_);
+                                                 moordyn_scale_, rate_tangent);
       if (force)
         for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s[k]) * q;
       if (c) AddShapeBlocks<D>(wl, s, h, c);
@@ -421,9 +421,9 @@ void Seabed::AddStaticFriction(const Eigen::Matrix<double, 4 * D, 1>& e,
   // The displacement from the start takes the rate's place, u_s v_s's.
   const Eigen::Matrix<double, 4 * D, 1> displacement = e - e0;
   if (grid_) {
-    GridDissipation<D>(e, displacement, length, force, matrix, 0.0, u_s_, 0.0);
+    GridDissipation<D>(e, displacement, length, force, matrix, 0.0, u_s_, 0.0, nullptr, false);
   } else {
-    PlaneDissipation<D>(e, displacement, length, force, matrix, 0.0, u_s_, 0.0);
+    PlaneDissipation<D>(e, displacement, length, force, matrix, 0.0, u_s_, 0.0, nullptr, false);
   }
 }
 
@@ -489,7 +489,8 @@ void Seabed::PointStaticFriction(const Eigen::Matrix<double, D, 1>& r,
   Point q;
   Block h;
   contact::PointDissipation<D>(n, Block::Identity() - n * n.transpose(), -k * g * gn,
-                               (r - r0).eval(), Point::Zero(), 0.0, mu, mu, u_s_, &q, &h);
+                               (r - r0).eval(), Point::Zero(), 0.0, mu, mu, u_s_, &q, &h, 0.0, 1.0,
+                               false);
   if (force) *force += q;
   if (matrix) *matrix += h;
 }
@@ -500,7 +501,7 @@ double Seabed::PlaneDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
                                 Eigen::Matrix<double, 4 * D, 1>* force,
                                 Eigen::Matrix<double, 4 * D, 4 * D>* c, double damping,
                                 double speed, double moordyn_damping,
-                                Eigen::Matrix<double, 4 * D, 4 * D>* position) const {
+                                Eigen::Matrix<double, 4 * D, 4 * D>* position, bool rate_tangent) const {
   using Point = Eigen::Matrix<double, D, 1>;
   using Block = Eigen::Matrix<double, D, D>;
   double pieces[2][2];
@@ -516,7 +517,8 @@ double Seabed::PlaneDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
     Point q;
     Block h;
     power += wl * contact::PointDissipation<D>(n, proj, k_ * pen, v, u, damping, mu_a_, mu_t_,
-                                               speed, &q, &h, moordyn_damping, moordyn_scale_);
+                                               speed, &q, &h, moordyn_damping, moordyn_scale_,
+                                               rate_tangent);
     if (force)
       for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s[k]) * q;
     if (c) AddShapeBlocks<D>(wl, s, h, c);

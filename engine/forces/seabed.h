@@ -285,22 +285,24 @@ class Seabed {
                        Eigen::Matrix<double, 4 * D, 4 * D>* hessian,
                        Eigen::Matrix<double, 4 * D, 1>* roundoff) const;
   // Damping c and friction regularised at `speed` on the rate edot (the
-  // dynamic law), or friction alone on a displacement (statics). Returns
-  // the power.
+  // dynamic law), or friction alone on a displacement (statics, with
+  // rate_tangent false: contact::PointDissipation). Returns the power.
   template <int D>
   double GridDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
                          const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
                          Eigen::Matrix<double, 4 * D, 1>* force,
                          Eigen::Matrix<double, 4 * D, 4 * D>* c, double damping,
                          double speed, double moordyn_damping,
-                         Eigen::Matrix<double, 4 * D, 4 * D>* position = nullptr) const;
+                         Eigen::Matrix<double, 4 * D, 4 * D>* position = nullptr,
+                         bool rate_tangent = true) const;
   template <int D>
   double PlaneDissipation(const Eigen::Matrix<double, 4 * D, 1>& e,
                           const Eigen::Matrix<double, 4 * D, 1>& edot, double length,
                           Eigen::Matrix<double, 4 * D, 1>* force,
                           Eigen::Matrix<double, 4 * D, 4 * D>* c, double damping,
                           double speed, double moordyn_damping,
-                          Eigen::Matrix<double, 4 * D, 4 * D>* position = nullptr) const;
+                          Eigen::Matrix<double, 4 * D, 4 * D>* position = nullptr,
+                          bool rate_tangent = true) const;
   // The gap g at a point of D coordinates, its gradient (and, on a grid,
   // Hessian when not null).
   template <int D>
