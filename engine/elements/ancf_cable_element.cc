@@ -320,6 +320,12 @@ template <int D>
 void AncfCableElement<D>::AddDirectionalMass(const Coords& e, const Coords& edd,
                                              const double* a_n, const double* a_t, Coords* force,
                                              Matrix* m) const {
+  // Two passes: first every point's A_g and A_g r''(x_g) (a square root
+  // and a division each, independent from point to point, so that the
+  // processor overlaps them), then the sums into force and m in the order
+  // of the points, as one pass would add them (the same roundings).
+  Block a[GaussRule::kMaxPoints];
+  Point q[GaussRule::kMaxPoints];
   for (int g = 0; g < rule_.n; ++g) {
     if (a_n[g] == 0 && a_t[g] == 0) continue;
     const double* s0 = s0_[g];
@@ -329,19 +335,23 @@ void AncfCableElement<D>::AddDirectionalMass(const Coords& e, const Coords& edd,
       acc += s0[k] * edd.template segment<D>(k * D);
     }
     const double un = u.norm();
-    Block a = a_n[g] * Block::Identity();
+    a[g] = a_n[g] * Block::Identity();
     // A collapsed point has no axis: a_n in every direction.
     if (un > 0) {
       const Point t = u / un;
-      a += (a_t[g] - a_n[g]) * t * t.transpose();
+      a[g] += (a_t[g] - a_n[g]) * t * t.transpose();
     }
+    q[g] = a[g] * acc;
+  }
+  for (int g = 0; g < rule_.n; ++g) {
+    if (a_n[g] == 0 && a_t[g] == 0) continue;
+    const double* s0 = s0_[g];
     const double wl = rule_.weight[g] * length_;
-    const Point q = a * acc;
-    for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) -= (wl * s0[k]) * q;
+    for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) -= (wl * s0[k]) * q[g];
     if (!m) continue;
     for (int k = 0; k < 4; ++k)
       for (int j = 0; j < 4; ++j)
-        m->template block<D, D>(k * D, j * D) += (wl * s0[k] * s0[j]) * a;
+        m->template block<D, D>(k * D, j * D) += (wl * s0[k] * s0[j]) * a[g];
   }
 }
 
