@@ -5,6 +5,7 @@
 // could go wrong: random cubics over many scales, roots at an exact end
 // (a line anchored on the bed's plane, h(0) = 0) with a large or tiny
 // slope against its curvature, nearly double roots, flat and linear ones.
+// SignChanges' memo must return what ComputeSignChanges computes.
 
 #include "engine/forces/element_cubic.h"
 
@@ -12,6 +13,7 @@
 #include <cmath>
 #include <cstdint>
 #include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -138,6 +140,35 @@ TEST(BisectCubicSign, DoubleFlatAndLinearRootsMatchBisectSignToTheBit) {
     checked += CheckBrackets(steep);
   }
   EXPECT_GT(checked, 5000);
+}
+
+TEST(SignChanges, MemoReturnsWhatTheComputationReturns) {
+  // Many more cubics than the memo has slots, each asked for again at
+  // once and again later (after others may have taken its slot), with
+  // coefficients a bit apart: every answer must be ComputeSignChanges'.
+  std::mt19937_64 rng(34000);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  std::vector<ElementCubic> cubics;
+  for (int k = 0; k < 500; ++k) {
+    ElementCubic h{{unit(rng), unit(rng), unit(rng), unit(rng)}};
+    cubics.push_back(h);
+    h.c[0] = std::nextafter(h.c[0], 2.0);  // one ulp apart: another cubic
+    cubics.push_back(h);
+  }
+  int roots_seen = 0;
+  for (int pass = 0; pass < 3; ++pass) {
+    for (const ElementCubic& h : cubics) {
+      double want[3], got[3];
+      const int n = ComputeSignChanges(h, want);
+      for (int again = 0; again < 2; ++again) {
+        ASSERT_EQ(SignChanges(h, got), n);
+        for (int i = 0; i < n; ++i)
+          EXPECT_EQ(std::bit_cast<uint64_t>(got[i]), std::bit_cast<uint64_t>(want[i]));
+      }
+      roots_seen += n;
+    }
+  }
+  EXPECT_GT(roots_seen, 1000);
 }
 
 }  // namespace

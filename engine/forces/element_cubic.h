@@ -85,7 +85,9 @@ inline int ComputeSignChanges(const ElementCubic& h, double roots[3]) {
   } else if (qb != 0) {
     crit[ncrit++] = -qc / qb;
   }
-  std::sort(crit, crit + ncrit);
+  // Sorted (two at most: what std::sort does with them, without GCC's
+  // -Warray-bounds false alarm where it is inlined).
+  if (ncrit == 2 && crit[1] < crit[0]) std::swap(crit[0], crit[1]);
   for (int i = 0; i < ncrit; ++i)
     if (crit[i] > 0 && crit[i] < 1 && crit[i] > br[nbr - 1]) br[nbr++] = crit[i];
   int n = 0;
