@@ -243,8 +243,9 @@ void AncfCableElement<D>::AddDampingMatrix(const Coords& e, double axial_s, doub
 template <int D>
 void AncfCableElement<D>::AddDrag(const Coords& e, const Coords& edot, const Point& current,
                                   double kn, double kt, Coords* force, Matrix* c) const {
-  for (int g = 0; g < rule_.n; ++g)
-    AddFlowLoadAt(g, e, edot, current, nullptr, kn, kt, 0, 0, force, c);
+  Point flow[GaussRule::kMaxPoints];
+  for (int g = 0; g < rule_.n; ++g) flow[g] = current;
+  AddMorison(e, edot, flow, nullptr, kn, kt, 0, 0, nullptr, force, c);
 }
 
 template <int D>
@@ -260,59 +261,78 @@ void AncfCableElement<D>::AddMorison(const Coords& e, const Coords& edot,
                                      const Point* flow_velocity, const Point* flow_acceleration,
                                      double kn, double kt, double mi_n, double mi_t,
                                      const bool* wet, Coords* force, Matrix* c) const {
+  // Two passes: first every point's load (three square roots and a
+  // division, independent from point to point, so that the processor
+  // overlaps them), then the sums into force and c in the order of the
+  // points, as one pass would add them (the same roundings).
+  FlowPoint points[GaussRule::kMaxPoints];
   for (int g = 0; g < rule_.n; ++g) {
-    if (wet && !wet[g]) continue;
-    AddFlowLoadAt(g, e, edot, flow_velocity[g],
-                  flow_acceleration ? &flow_acceleration[g] : nullptr, kn, kt, mi_n, mi_t, force,
-                  c);
+    if (wet && !wet[g]) {
+      points[g].kind = FlowPoint::kDry;
+      continue;
+    }
+    FlowLoadAt(g, e, edot, flow_velocity[g],
+               flow_acceleration ? &flow_acceleration[g] : nullptr, kn, kt, mi_n, mi_t,
+               c != nullptr, &points[g]);
+  }
+  for (int g = 0; g < rule_.n; ++g) {
+    const FlowPoint& p = points[g];
+    if (p.kind == FlowPoint::kDry) continue;
+    const double* s0 = s0_[g];
+    const double wl = rule_.weight[g] * length_;
+    if (p.kind == FlowPoint::kInertiaOnly) {
+      for (int k = 0; k < 4; ++k)
+        force->template segment<D>(k * D) += (wl * s0[k] * mi_n) * p.q;
+      continue;
+    }
+    for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s0[k]) * p.q;
+    if (!c) continue;
+    for (int k = 0; k < 4; ++k)
+      for (int m = 0; m < 4; ++m)
+        c->template block<D, D>(k * D, m * D) += (wl * s0[k] * s0[m]) * p.h;
   }
 }
 
 template <int D>
-void AncfCableElement<D>::AddFlowLoadAt(int g, const Coords& e, const Coords& edot,
-                                        const Point& flow, const Point* accel, double kn,
-                                        double kt, double mi_n, double mi_t, Coords* force,
-                                        Matrix* c) const {
-  {
-    const double* s0 = s0_[g];
-    Point u = Point::Zero(), v = flow;
-    for (int k = 0; k < 4; ++k) {
-      u += d1_[g][k] * e.template segment<D>(k * D);
-      v -= s0[k] * edot.template segment<D>(k * D);
+void AncfCableElement<D>::FlowLoadAt(int g, const Coords& e, const Coords& edot,
+                                     const Point& flow, const Point* accel, double kn, double kt,
+                                     double mi_n, double mi_t, bool tangent,
+                                     FlowPoint* point) const {
+  const double* s0 = s0_[g];
+  Point u = Point::Zero(), v = flow;
+  for (int k = 0; k < 4; ++k) {
+    u += d1_[g][k] * e.template segment<D>(k * D);
+    v -= s0[k] * edot.template segment<D>(k * D);
+  }
+  const double un = u.norm();
+  if (!(un > 0)) {
+    // No tangent (a collapsed point): no drag, but the flow's inertia
+    // acts (with the coefficient across the line: no axis to split on).
+    point->kind = accel ? FlowPoint::kInertiaOnly : FlowPoint::kDry;
+    if (accel) point->q = *accel;
+    return;
+  }
+  point->kind = FlowPoint::kLoad;
+  const Point t = u / un;
+  const Point vt = t.dot(v) * t, vn = v - vt;
+  const double an = vn.norm(), at = vt.norm();
+  Point& q = point->q;
+  q = kn * an * vn + kt * at * vt;
+  if (accel) {
+    // mi_n P du/dt + mi_t t t^T du/dt, P = I - t t^T (one product when
+    // the two are equal, as they were before the split).
+    if (mi_t == mi_n) {
+      q += mi_n * *accel;
+    } else {
+      const Point a_t = t.dot(*accel) * t;
+      q += mi_n * (*accel - a_t) + mi_t * a_t;
     }
-    const double un = u.norm();
-    const double wl = rule_.weight[g] * length_;
-    if (!(un > 0)) {
-      // No tangent (a collapsed point): no drag, but the flow's inertia
-      // acts (with the coefficient across the line: no axis to split on).
-      if (accel)
-        for (int k = 0; k < 4; ++k)
-          force->template segment<D>(k * D) += (wl * s0[k] * mi_n) * *accel;
-      return;
-    }
-    const Point t = u / un;
-    const Point vt = t.dot(v) * t, vn = v - vt;
-    const double an = vn.norm(), at = vt.norm();
-    Point q = kn * an * vn + kt * at * vt;
-    if (accel) {
-      // mi_n P du/dt + mi_t t t^T du/dt, P = I - t t^T (one product when
-      // the two are equal, as they were before the split).
-      if (mi_t == mi_n) {
-        q += mi_n * *accel;
-      } else {
-        const Point a_t = t.dot(*accel) * t;
-        q += mi_n * (*accel - a_t) + mi_t * a_t;
-      }
-    }
-    for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s0[k]) * q;
-    if (!c) return;
-    Block h = (2 * kt * at) * t * t.transpose();
-    if (an > 0) {
-      h += (kn * an) * (Block::Identity() - t * t.transpose()) + (kn / an) * vn * vn.transpose();
-    }
-    for (int k = 0; k < 4; ++k)
-      for (int m = 0; m < 4; ++m)
-        c->template block<D, D>(k * D, m * D) += (wl * s0[k] * s0[m]) * h;
+  }
+  if (!tangent) return;
+  Block& h = point->h;
+  h = (2 * kt * at) * t * t.transpose();
+  if (an > 0) {
+    h += (kn * an) * (Block::Identity() - t * t.transpose()) + (kn / an) * vn * vn.transpose();
   }
 }
 
