@@ -252,6 +252,8 @@ class AncfCableElement {
   using Block = Eigen::Matrix<double, D, D>;
   void AddUpperBlocks(int g, double wl, const Block& huu, const Block& huw, const Block& hww,
                       Matrix* tangent) const;
+  // AddUpperBlocks with huw = hww = 0 (its path for them).
+  void AddUpperAxialBlocks(int g, double wl, const Block& huu, Matrix* tangent) const;
   static void MirrorUpperBlocks(Matrix* tangent);
   // The drag (and, with `accel` not null, the inertia mi accel) at Gauss
   // point g for the flow velocity `flow`: AddMorison's first pass. kLoad:
