@@ -167,12 +167,7 @@ void AncfCableElement<D>::AddUpperBlocks(int g, double wl, const Block& huu, con
   const double* s1 = d1_[g];
   const double* s2 = d2_[g];
   if (huw.isZero(0) && hww.isZero(0)) {
-    // No curvature terms (bending NONE, a mooring line's usual model): the
-    // same sums without their exact-zero products, a quarter of the work.
-    for (int k = 0; k < 4; ++k) {
-      const double p1 = wl * s1[k];
-      for (int m = k; m < 4; ++m) tangent->template block<D, D>(k * D, m * D) += (p1 * s1[m]) * huu;
-    }
+    AddUpperAxialBlocks(g, wl, huu, tangent);
     return;
   }
   for (int k = 0; k < 4; ++k) {
@@ -182,6 +177,19 @@ void AncfCableElement<D>::AddUpperBlocks(int g, double wl, const Block& huu, con
       tangent->template block<D, D>(k * D, m * D) +=
           (p1 * q1) * huu + (p1 * q2) * huw + (p2 * q1) * huw.transpose() + (p2 * q2) * hww;
     }
+  }
+}
+
+template <int D>
+void AncfCableElement<D>::AddUpperAxialBlocks(int g, double wl, const Block& huu,
+                                              Matrix* tangent) const {
+  // No curvature terms (bending NONE, a mooring line's usual model): the
+  // sums of AddUpperBlocks without their exact-zero products, a quarter of
+  // the work.
+  const double* s1 = d1_[g];
+  for (int k = 0; k < 4; ++k) {
+    const double p1 = wl * s1[k];
+    for (int m = k; m < 4; ++m) tangent->template block<D, D>(k * D, m * D) += (p1 * s1[m]) * huu;
   }
 }
 
@@ -200,41 +208,59 @@ void AncfCableElement<D>::AddDampingMatrix(const Coords& e, double axial_s, doub
   constexpr int kRows = D == 2 ? 1 : 3;
   using GBlock = Eigen::Matrix<double, kRows, D>;
   const double ca = ea_ * axial_s, cb = bending_ == BendingModel::kNone ? 0.0 : ei_ * bending_s;
-  Matrix upper = Matrix::Zero();
+  // Two passes, as AddMorison: the points' blocks (a division each,
+  // independent), then the sums in the points' order (the same roundings).
+  Block huu[GaussRule::kMaxPoints], huw[GaussRule::kMaxPoints], hww[GaussRule::kMaxPoints];
   for (int g = 0; g < rule_.n; ++g) {
     Point u = Point::Zero(), w = Point::Zero();
     for (int k = 0; k < 4; ++k) {
       u += d1_[g][k] * e.template segment<D>(k * D);
       w += d2_[g][k] * e.template segment<D>(k * D);
     }
-    const double wl = rule_.weight[g] * length_;
     // Engineering strain: d eps/dt = u.udot / |u|.
     const double axial_scale =
         axial_law_ != AxialLaw::kGreenLagrange && u.squaredNorm() > 0 ? 1 / u.squaredNorm() : 1.0;
-    Block huu = (ca * axial_scale) * u * u.transpose(), huw = Block::Zero(), hww = Block::Zero();
-    if (cb != 0) {
-      // k = u x w / a^(3/2), a = u.u: dk/dw = [u]x / a^(3/2),
-      // dk/du = -[w]x / a^(3/2) - 3 k u^T / a.
-      const double a = u.squaredNorm(), ia15 = 1 / (a * std::sqrt(a));
-      GBlock gu, gw;
-      if constexpr (D == 2) {
-        const double k = (u.x() * w.y() - u.y() * w.x()) * ia15;
-        gu << w.y() * ia15, -w.x() * ia15;
-        gu -= (3 * k / a) * u.transpose();
-        gw << -u.y() * ia15, u.x() * ia15;
-      } else {
-        const Point k = u.cross(w) * ia15;
-        Block wx, ux;
-        wx << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
-        ux << 0, -u.z(), u.y(), u.z(), 0, -u.x(), -u.y(), u.x(), 0;
-        gu = -ia15 * wx - (3 / a) * k * u.transpose();
-        gw = ia15 * ux;
-      }
-      huu += cb * gu.transpose() * gu;
-      huw = cb * gu.transpose() * gw;
-      hww = cb * gw.transpose() * gw;
+    // (ca s u) u^T entry by entry: Eigen's outer product, rounding for
+    // rounding, without its 3-vector temporary (a 16-byte load of two
+    // 8-byte stores, which stalled store forwarding: a third of this
+    // function's time on the OC4 mooring).
+    const double cs = ca * axial_scale;
+    for (int i = 0; i < D; ++i) {
+      const double cu = cs * u(i);
+      for (int j = 0; j < D; ++j) huu[g](i, j) = cu * u(j);
     }
-    AddUpperBlocks(g, wl, huu, huw, hww, &upper);
+    if (cb == 0) continue;
+    // k = u x w / a^(3/2), a = u.u: dk/dw = [u]x / a^(3/2),
+    // dk/du = -[w]x / a^(3/2) - 3 k u^T / a.
+    const double a = u.squaredNorm(), ia15 = 1 / (a * std::sqrt(a));
+    GBlock gu, gw;
+    if constexpr (D == 2) {
+      const double k = (u.x() * w.y() - u.y() * w.x()) * ia15;
+      gu << w.y() * ia15, -w.x() * ia15;
+      gu -= (3 * k / a) * u.transpose();
+      gw << -u.y() * ia15, u.x() * ia15;
+    } else {
+      const Point k = u.cross(w) * ia15;
+      Block wx, ux;
+      wx << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
+      ux << 0, -u.z(), u.y(), u.z(), 0, -u.x(), -u.y(), u.x(), 0;
+      gu = -ia15 * wx - (3 / a) * k * u.transpose();
+      gw = ia15 * ux;
+    }
+    huu[g] += cb * gu.transpose() * gu;
+    huw[g] = cb * gu.transpose() * gw;
+    hww[g] = cb * gw.transpose() * gw;
+  }
+  Matrix upper = Matrix::Zero();
+  for (int g = 0; g < rule_.n; ++g) {
+    const double wl = rule_.weight[g] * length_;
+    // Without bending the curvature blocks are zero by construction:
+    // AddUpperBlocks' own test for that (18 compares), skipped.
+    if (cb == 0) {
+      AddUpperAxialBlocks(g, wl, huu[g], &upper);
+    } else {
+      AddUpperBlocks(g, wl, huu[g], huw[g], hww[g], &upper);
+    }
   }
   MirrorUpperBlocks(&upper);
   *c += upper;
@@ -243,8 +269,9 @@ void AncfCableElement<D>::AddDampingMatrix(const Coords& e, double axial_s, doub
 template <int D>
 void AncfCableElement<D>::AddDrag(const Coords& e, const Coords& edot, const Point& current,
                                   double kn, double kt, Coords* force, Matrix* c) const {
-  for (int g = 0; g < rule_.n; ++g)
-    AddFlowLoadAt(g, e, edot, current, nullptr, kn, kt, 0, 0, force, c);
+  Point flow[GaussRule::kMaxPoints];
+  for (int g = 0; g < rule_.n; ++g) flow[g] = current;
+  AddMorison(e, edot, flow, nullptr, kn, kt, 0, 0, nullptr, force, c);
 }
 
 template <int D>
@@ -260,59 +287,78 @@ void AncfCableElement<D>::AddMorison(const Coords& e, const Coords& edot,
                                      const Point* flow_velocity, const Point* flow_acceleration,
                                      double kn, double kt, double mi_n, double mi_t,
                                      const bool* wet, Coords* force, Matrix* c) const {
+  // Two passes: first every point's load (three square roots and a
+  // division, independent from point to point, so that the processor
+  // overlaps them), then the sums into force and c in the order of the
+  // points, as one pass would add them (the same roundings).
+  FlowPoint points[GaussRule::kMaxPoints];
   for (int g = 0; g < rule_.n; ++g) {
-    if (wet && !wet[g]) continue;
-    AddFlowLoadAt(g, e, edot, flow_velocity[g],
-                  flow_acceleration ? &flow_acceleration[g] : nullptr, kn, kt, mi_n, mi_t, force,
-                  c);
+    if (wet && !wet[g]) {
+      points[g].kind = FlowPoint::kDry;
+      continue;
+    }
+    FlowLoadAt(g, e, edot, flow_velocity[g],
+               flow_acceleration ? &flow_acceleration[g] : nullptr, kn, kt, mi_n, mi_t,
+               c != nullptr, &points[g]);
+  }
+  for (int g = 0; g < rule_.n; ++g) {
+    const FlowPoint& p = points[g];
+    if (p.kind == FlowPoint::kDry) continue;
+    const double* s0 = s0_[g];
+    const double wl = rule_.weight[g] * length_;
+    if (p.kind == FlowPoint::kInertiaOnly) {
+      for (int k = 0; k < 4; ++k)
+        force->template segment<D>(k * D) += (wl * s0[k] * mi_n) * p.q;
+      continue;
+    }
+    for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s0[k]) * p.q;
+    if (!c) continue;
+    for (int k = 0; k < 4; ++k)
+      for (int m = 0; m < 4; ++m)
+        c->template block<D, D>(k * D, m * D) += (wl * s0[k] * s0[m]) * p.h;
   }
 }
 
 template <int D>
-void AncfCableElement<D>::AddFlowLoadAt(int g, const Coords& e, const Coords& edot,
-                                        const Point& flow, const Point* accel, double kn,
-                                        double kt, double mi_n, double mi_t, Coords* force,
-                                        Matrix* c) const {
-  {
-    const double* s0 = s0_[g];
-    Point u = Point::Zero(), v = flow;
-    for (int k = 0; k < 4; ++k) {
-      u += d1_[g][k] * e.template segment<D>(k * D);
-      v -= s0[k] * edot.template segment<D>(k * D);
+void AncfCableElement<D>::FlowLoadAt(int g, const Coords& e, const Coords& edot,
+                                     const Point& flow, const Point* accel, double kn, double kt,
+                                     double mi_n, double mi_t, bool tangent,
+                                     FlowPoint* point) const {
+  const double* s0 = s0_[g];
+  Point u = Point::Zero(), v = flow;
+  for (int k = 0; k < 4; ++k) {
+    u += d1_[g][k] * e.template segment<D>(k * D);
+    v -= s0[k] * edot.template segment<D>(k * D);
+  }
+  const double un = u.norm();
+  if (!(un > 0)) {
+    // No tangent (a collapsed point): no drag, but the flow's inertia
+    // acts (with the coefficient across the line: no axis to split on).
+    point->kind = accel ? FlowPoint::kInertiaOnly : FlowPoint::kDry;
+    if (accel) point->q = *accel;
+    return;
+  }
+  point->kind = FlowPoint::kLoad;
+  const Point t = u / un;
+  const Point vt = t.dot(v) * t, vn = v - vt;
+  const double an = vn.norm(), at = vt.norm();
+  Point& q = point->q;
+  q = kn * an * vn + kt * at * vt;
+  if (accel) {
+    // mi_n P du/dt + mi_t t t^T du/dt, P = I - t t^T (one product when
+    // the two are equal, as they were before the split).
+    if (mi_t == mi_n) {
+      q += mi_n * *accel;
+    } else {
+      const Point a_t = t.dot(*accel) * t;
+      q += mi_n * (*accel - a_t) + mi_t * a_t;
     }
-    const double un = u.norm();
-    const double wl = rule_.weight[g] * length_;
-    if (!(un > 0)) {
-      // No tangent (a collapsed point): no drag, but the flow's inertia
-      // acts (with the coefficient across the line: no axis to split on).
-      if (accel)
-        for (int k = 0; k < 4; ++k)
-          force->template segment<D>(k * D) += (wl * s0[k] * mi_n) * *accel;
-      return;
-    }
-    const Point t = u / un;
-    const Point vt = t.dot(v) * t, vn = v - vt;
-    const double an = vn.norm(), at = vt.norm();
-    Point q = kn * an * vn + kt * at * vt;
-    if (accel) {
-      // mi_n P du/dt + mi_t t t^T du/dt, P = I - t t^T (one product when
-      // the two are equal, as they were before the split).
-      if (mi_t == mi_n) {
-        q += mi_n * *accel;
-      } else {
-        const Point a_t = t.dot(*accel) * t;
-        q += mi_n * (*accel - a_t) + mi_t * a_t;
-      }
-    }
-    for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s0[k]) * q;
-    if (!c) return;
-    Block h = (2 * kt * at) * t * t.transpose();
-    if (an > 0) {
-      h += (kn * an) * (Block::Identity() - t * t.transpose()) + (kn / an) * vn * vn.transpose();
-    }
-    for (int k = 0; k < 4; ++k)
-      for (int m = 0; m < 4; ++m)
-        c->template block<D, D>(k * D, m * D) += (wl * s0[k] * s0[m]) * h;
+  }
+  if (!tangent) return;
+  Block& h = point->h;
+  h = (2 * kt * at) * t * t.transpose();
+  if (an > 0) {
+    h += (kn * an) * (Block::Identity() - t * t.transpose()) + (kn / an) * vn * vn.transpose();
   }
 }
 
@@ -320,6 +366,12 @@ template <int D>
 void AncfCableElement<D>::AddDirectionalMass(const Coords& e, const Coords& edd,
                                              const double* a_n, const double* a_t, Coords* force,
                                              Matrix* m) const {
+  // Two passes: first every point's A_g and A_g r''(x_g) (a square root
+  // and a division each, independent from point to point, so that the
+  // processor overlaps them), then the sums into force and m in the order
+  // of the points, as one pass would add them (the same roundings).
+  Block a[GaussRule::kMaxPoints];
+  Point q[GaussRule::kMaxPoints];
   for (int g = 0; g < rule_.n; ++g) {
     if (a_n[g] == 0 && a_t[g] == 0) continue;
     const double* s0 = s0_[g];
@@ -329,19 +381,23 @@ void AncfCableElement<D>::AddDirectionalMass(const Coords& e, const Coords& edd,
       acc += s0[k] * edd.template segment<D>(k * D);
     }
     const double un = u.norm();
-    Block a = a_n[g] * Block::Identity();
+    a[g] = a_n[g] * Block::Identity();
     // A collapsed point has no axis: a_n in every direction.
     if (un > 0) {
       const Point t = u / un;
-      a += (a_t[g] - a_n[g]) * t * t.transpose();
+      a[g] += (a_t[g] - a_n[g]) * t * t.transpose();
     }
+    q[g] = a[g] * acc;
+  }
+  for (int g = 0; g < rule_.n; ++g) {
+    if (a_n[g] == 0 && a_t[g] == 0) continue;
+    const double* s0 = s0_[g];
     const double wl = rule_.weight[g] * length_;
-    const Point q = a * acc;
-    for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) -= (wl * s0[k]) * q;
+    for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) -= (wl * s0[k]) * q[g];
     if (!m) continue;
     for (int k = 0; k < 4; ++k)
       for (int j = 0; j < 4; ++j)
-        m->template block<D, D>(k * D, j * D) += (wl * s0[k] * s0[j]) * a;
+        m->template block<D, D>(k * D, j * D) += (wl * s0[k] * s0[j]) * a[g];
   }
 }
 

@@ -252,12 +252,22 @@ class AncfCableElement {
   using Block = Eigen::Matrix<double, D, D>;
   void AddUpperBlocks(int g, double wl, const Block& huu, const Block& huw, const Block& hww,
                       Matrix* tangent) const;
+  // AddUpperBlocks with huw = hww = 0 (its path for them).
+  void AddUpperAxialBlocks(int g, double wl, const Block& huu, Matrix* tangent) const;
   static void MirrorUpperBlocks(Matrix* tangent);
   // The drag (and, with `accel` not null, the inertia mi accel) at Gauss
-  // point g for the flow velocity `flow`: AddDrag's and AddMorison's body.
-  void AddFlowLoadAt(int g, const Coords& e, const Coords& edot, const Point& flow,
-                     const Point* accel, double kn, double kt, double mi_n, double mi_t,
-                     Coords* force, Matrix* c) const;
+  // point g for the flow velocity `flow`: AddMorison's first pass. kLoad:
+  // the load q per unit length [N/m] and, when `tangent`, its velocity
+  // derivative h; kInertiaOnly (a collapsed point): q holds accel, whose
+  // share is mi_n accel; kDry: nothing.
+  struct FlowPoint {
+    enum Kind { kDry, kInertiaOnly, kLoad } kind = kDry;
+    Point q;
+    Block h;
+  };
+  void FlowLoadAt(int g, const Coords& e, const Coords& edot, const Point& flow,
+                  const Point* accel, double kn, double kt, double mi_n, double mi_t,
+                  bool tangent, FlowPoint* point) const;
 
   double length_ = 0;
   double ea_ = 0;

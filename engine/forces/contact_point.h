@@ -87,11 +87,12 @@ double PointDissipation(const Eigen::Matrix<double, D, 1>& n,
 }
 
 // The root of f on [a, b] (f(a) < 0 <= f(b) or the reverse, f continuous
-// and crossing once), by bisection to the last bit.
+// and crossing once), by bisection to the last bit (at most `rounds`
+// halvings).
 template <typename F>
-double BisectSign(const F& f, double a, double b) {
+double BisectSign(const F& f, double a, double b, int rounds = 200) {
   const bool rising = f(a) < 0;
-  for (int i = 0; i < 200; ++i) {
+  for (int i = 0; i < rounds; ++i) {
     const double m = 0.5 * (a + b);
     if (m <= a || m >= b) break;
     if ((f(m) < 0) == rising) {

@@ -282,7 +282,9 @@ class ElementTerm {
   // Whether AddDissipation adds anything.
   virtual bool dissipates() const { return false; }
   // Adds the velocity-dependent force to `force` and its velocity tangent
-  // -df/d(edot) to `c`; returns the power dissipated [W].
+  // -df/d(edot) to `c` (null: not wanted, and then not computed; the
+  // model passes null when it needs the force or the power alone);
+  // returns the power dissipated [W].
   virtual double AddDissipation(const ElementCoords<2>& e, const ElementCoords<2>& edot,
                                 double length, ElementCoords<2>* force,
                                 ElementMatrix<2>* c) const {
