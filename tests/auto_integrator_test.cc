@@ -214,6 +214,41 @@ TEST(AutoIntegratorTest, AutoChoosesAdaptiveStepsWhenTheSceneGivesNoStep) {
   EXPECT_DOUBLE_EQ(named.summary.max_step_s, 1e-3);
 }
 
+// The spatial pendulum with a 10 g bob on a pin (bench/work_precision_auto.json),
+// 2 s at an adaptive tolerance of 1e-6 m: central difference is held by its
+// stable step, HHT wins its 4-step trial on an optimistic guess of its step
+// and then loses over its window. Each such loss must space the next trial
+// as a lost trial does (8 times further off), or the two alternate every
+// window: 180 changes in 2 s before, HHT two thirds of the steps, 1.7 times
+// the CPU time of staying explicit. Bound: a logarithmic number of changes,
+// at most 12 (measured 7 with the spacing).
+TEST(AutoIntegratorTest, HhtThatLosesItsWindowSpacesTheNextTrialOut) {
+  const Result r = RunJson(R"({"name": "bob",
+    "gravity": {"y": -9.81},
+    "cables": [{"name": "pendulum", "length": 1.0, "elements": 16, "start": {"x": 0, "y": 0, "z": 0},
+                "direction": {"x": 1}, "density": 320, "youngs_modulus": 1.6e6, "area": 2.5e-05,
+                "second_moment": 4.973591971621729e-11, "bending": "EXACT"}],
+    "bodies": [{"name": "bob", "mass": 0.01, "inertia": {"x": 2e-06, "y": 3e-06, "z": 4e-06},
+                "position": {"x": 1.05}}],
+    "joints": [{"type": "PIN", "a": {"cable": "pendulum", "s": 0}},
+               {"type": "PIN", "a": {"cable": "pendulum", "s": 1.0},
+                "b": {"body": "bob", "point": {"x": -0.05}}}],
+    "initial_velocity": {"angular": {"y": 4.0}},
+    "probes": [{"name": "tip", "cable": "pendulum", "s": 1.0}],
+    "solver": {"analysis": "DYNAMIC", "duration": 2.0, "output_interval": 0.01, "step": 0.002,
+               "adaptive": true, "tolerance": 1e-6}})");
+  ASSERT_EQ(r.summary.status, "ok") << r.summary.error;
+  const auto& segments = r.summary.integrator_segments;
+  int64_t hht_steps = 0;
+  for (const auto& s : segments)
+    if (s.integrator == "HHT") hht_steps += s.steps;
+  std::printf("%zu stretches, HHT %ld of %ld steps\n", segments.size(),
+              static_cast<long>(hht_steps), static_cast<long>(r.summary.steps));
+  EXPECT_GE(segments.size(), 2u);  // the trial happened
+  EXPECT_LE(segments.size(), 12u);
+  EXPECT_LT(hht_steps, r.summary.steps / 10);
+}
+
 // A rubber cord (E = 1e7 Pa, 1 m, ten elements) pinned at its top, pulled
 // at its end by a load that ramps to 400 N in 0.2 s and back to 0 by 0.4 s.
 // Green-Lagrange's tangent stiffness grows with the strain (about 30 % at
