@@ -35,34 +35,6 @@ Integrator Choose(Integrator chosen, const std::string& why, std::string* reason
 
 // ChooseIntegrator without the note on adaptive steps.
 Integrator ChooseStepper(MultibodyModel* model, const Scene& scene, std::string* reason,
-                         bool* may_switch);
-
-}  // namespace
-
-std::unique_ptr<Stepper> TryExplicit(MultibodyModel* model, const SolverSettings& settings,
-                                     std::string* why) {
-  SolverSettings trial = settings;
-  trial.integrator = Integrator::kCentralDifference;
-  std::unique_ptr<Stepper> stepper = MakeStepper(model, trial);
-  const bool fits = stepper->Initialize(why);
-  model->SetTime(model->initial_time());
-  if (!fits) stepper.reset();
-  return stepper;
-}
-
-Integrator ChooseIntegrator(MultibodyModel* model, const Scene& scene, std::string* reason,
-                            bool* may_switch) {
-  const Integrator chosen = ChooseStepper(model, scene, reason, may_switch);
-  if (scene.solver.auto_step)
-    absl::StrAppendFormat(reason,
-                          "; steps adaptive, held to a local error of %g m (solver.step not "
-                          "given)",
-                          scene.solver.tolerance_m);
-  return chosen;
-}
-
-namespace {
-Integrator ChooseStepper(MultibodyModel* model, const Scene& scene, std::string* reason,
                          bool* may_switch) {
   const SolverSettings& s = scene.solver;
   if (may_switch != nullptr) *may_switch = false;
@@ -114,6 +86,29 @@ Integrator ChooseStepper(MultibodyModel* model, const Scene& scene, std::string*
                                 s.step_s),
                 reason);
 }
+
 }  // namespace
+
+std::unique_ptr<Stepper> TryExplicit(MultibodyModel* model, const SolverSettings& settings,
+                                     std::string* why) {
+  SolverSettings trial = settings;
+  trial.integrator = Integrator::kCentralDifference;
+  std::unique_ptr<Stepper> stepper = MakeStepper(model, trial);
+  const bool fits = stepper->Initialize(why);
+  model->SetTime(model->initial_time());
+  if (!fits) stepper.reset();
+  return stepper;
+}
+
+Integrator ChooseIntegrator(MultibodyModel* model, const Scene& scene, std::string* reason,
+                            bool* may_switch) {
+  const Integrator chosen = ChooseStepper(model, scene, reason, may_switch);
+  if (scene.solver.auto_step)
+    absl::StrAppendFormat(reason,
+                          "; steps adaptive, held to a local error of %g m (solver.step not "
+                          "given)",
+                          scene.solver.tolerance_m);
+  return chosen;
+}
 
 }  // namespace cablesim

@@ -72,6 +72,12 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   // iterations or more does not lengthen the next.
   constexpr int kCapProbe = 10, kSlowNewton = 10;
   double newton_cap = std::numeric_limits<double>::infinity();
+  // Takes the last step back: the stepper's state, and the damping power
+  // the recorder evaluated at its end (not a state of the run).
+  auto TakeBack = [&] {
+    stepper->Restore();
+    rec->DropEndStep();
+  };
   // Step attempts so far, and the end state's energy the guard evaluated
   // before accepting attempt guarded_attempt (reused by its frames).
   long attempt = 0, guarded_attempt = -1;
@@ -262,8 +268,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
     external_work.Before(stepper->z(), t, stepper->lambda(), &stepper->v());
     const auto st = stepper->Step(h_try);
     if (model->stop_requested()) {  // the step was cut short (StopPoll)
-      stepper->Restore();
-      rec->DropEndStep();  // its end state is not the run's
+      TakeBack();
       summary->status = "cancelled";
       summary->error = absl::StrFormat("stopped by the caller during the step from t = %.9g", t);
       return;
@@ -296,8 +301,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       guarded_end = e;
       guarded_attempt = attempt;
       if (guard.Fails(e, rec->energy_scale())) {
-        stepper->Restore();
-        rec->DropEndStep();  // its end state is not the run's
+        TakeBack();
         ++summary->rejected_steps;
         successes = 0;
         h = h_step / 2;
@@ -336,8 +340,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       EstimateStepError();
       const double ratio = error_ratio;
       if (!(ratio <= 1)) {
-        stepper->Restore();
-        rec->DropEndStep();  // its end state is not the run's
+        TakeBack();
         // Tries back to central difference start again at 64 HHT steps
         // after a long explicit stretch (the choice was right); after a
         // short one they stay spaced out (the scene is at the edge).
@@ -362,8 +365,7 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
                                                 settings.relative_tolerance);
       const double factor = StepFactor(err, TraitsOf(stepping.integrator).local_error_order);
       if (!(err <= 1)) {
-        stepper->Restore();
-        rec->DropEndStep();  // its end state is not the run's
+        TakeBack();
         ++summary->rejected_steps;
         h = h_try * factor;
         if (h < h_min * (1 - 1e-12)) {
