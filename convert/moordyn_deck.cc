@@ -1913,31 +1913,35 @@ class DeckReader {
     int line = 0;
   };
 
-  // Sets `h` from the one wet part of a free scene body whose centre of
-  // mass is `com`, or refuses what BodyHydrodynamics (a cylinder centred at
-  // the centre of mass, buoyed as a vertical one, forces only) cannot
-  // express.
-  // `along_axis`: the body's x axis is the (one) rod's, so its loads split
-  // along it (BodyHydrodynamics.along_axis).
+  // Sets the fluid loads of a free scene body whose centre of mass is
+  // `com` from its wet parts, one BodyHydrodynamics each (the first in
+  // `hydrodynamics`, the others in `hydrodynamics_parts`), or refuses what
+  // they cannot express (a cylinder centred at the centre of mass, buoyed
+  // as a vertical one, forces only). `own_rod`: the body is the one rod's,
+  // its x axis the rod's (BodyHydrodynamics.along_axis); a tilted rod on a
+  // body splits its loads along its own axis (BodyHydrodynamics.axis, in
+  // the body's frame: the world's at the start).
   absl::Status SetHydrodynamics(const std::vector<Wet>& wet, const Eigen::Vector3d& com,
-                                v1::Body* body, bool along_axis = false) const {
-    if (wet.empty()) return absl::OkStatus();
-    if (wet.size() > 1) {
-      return Error(wet[1].line, wet[1].rod ? "RODS RodType" : "BODIES Volume",
-                   absl::StrCat("a second part with volume on one rigid body (the first on line ",
-                                wet[0].line,
-                                "): cablesim's body fluid loads are those of one vertical "
-                                "cylinder per body"));
+                                v1::Body* body, bool own_rod = false) const {
+    for (size_t k = 0; k < wet.size(); ++k) {
+      const Wet& p = wet[k];
+      const double size = std::max(p.length, p.diameter);
+      if ((p.centre - com).norm() > 1e-6 * size) {
+        return Error(p.line, p.rod ? "RODS Attachment" : "BODIES CG",
+                     absl::StrCat("the displaced volume's centre lies ", (p.centre - com).norm(),
+                                  " m from the body's centre of mass: cablesim's body fluid "
+                                  "loads act on cylinders centred at the centre of mass (forces "
+                                  "only)"));
+      }
+      v1::BodyHydrodynamics* h =
+          k == 0 ? body->mutable_hydrodynamics() : body->add_hydrodynamics_parts();
+      if (absl::Status s = SetPart(p, own_rod, h); !s.ok()) return s;
     }
-    const Wet& p = wet[0];
-    const double size = std::max(p.length, p.diameter);
-    if ((p.centre - com).norm() > 1e-6 * size) {
-      return Error(p.line, p.rod ? "RODS Attachment" : "BODIES CG",
-                   absl::StrCat("the displaced volume's centre lies ", (p.centre - com).norm(),
-                                " m from the body's centre of mass: cablesim's body fluid loads "
-                                "act on a cylinder centred at the centre of mass (forces only)"));
-    }
-    v1::BodyHydrodynamics* h = body->mutable_hydrodynamics();
+    return absl::OkStatus();
+  }
+
+  // One wet part's cylinder and coefficients into `h` (SetHydrodynamics).
+  absl::Status SetPart(const Wet& p, bool own_rod, v1::BodyHydrodynamics* h) const {
     if (p.body != nullptr) {
       // A body's volume: a vertical cylinder as tall as wide, as a free
       // point's (MoorDyn buoys it by rho g V at its CG and adds Ca rho V;
@@ -1952,12 +1956,6 @@ class DeckReader {
     const RodType& t = *p.rod;
     const bool vertical = std::abs(std::abs(p.axis.z()) - 1) < 1e-9;
     const bool loads = t.cd > 0 || t.ca > 0 || t.cd_end > 0 || t.ca_end > 0;
-    if (!vertical && loads && !along_axis) {
-      return Error(p.line, "RODS Xb",
-                   "a rod on a body that is not vertical with drag or added mass (its type's "
-                   "Cd, Ca, CdEnd or CaEnd > 0) cannot be expressed: a body's fluid loads split "
-                   "across and along its vertical, or along its x axis for a rod of its own");
-    }
     // A tilted rod's buoyancy is the vertical cylinder's of its length:
     // the same while both are wholly under water (or above it).
     if (!vertical && p.centre.z() + p.length / 2 >= 0 && p.centre.z() - p.length / 2 <= 0) {
@@ -1966,7 +1964,14 @@ class DeckReader {
                    "cannot be expressed: cablesim's body buoyancy is that of a vertical cylinder "
                    "(exact for a tilted rod only while it is wholly under water or above it)");
     }
-    if (along_axis) h->set_along_axis(true);
+    if (own_rod) {
+      h->set_along_axis(true);
+    } else if (!vertical && loads) {
+      // A rod on a body: its loads split along its own axis, turning with
+      // the body (a vertical one keeps the vertical split, as before).
+      h->set_along_axis(true);
+      SetVec(h->mutable_axis(), p.axis.x(), p.axis.y(), p.axis.z());
+    }
     h->set_diameter(t.diameter);
     h->set_height(p.length);
     const double area = kPi * t.diameter * t.diameter / 4;
@@ -2219,7 +2224,7 @@ class DeckReader {
       } else if (*rod_wet) {
         absl::Status s = SetHydrodynamics(
             {Wet{*com, axis, r.type->diameter, length, r.type, nullptr, r.line}}, *com, body,
-            /*along_axis=*/true);
+            /*own_rod=*/true);
         if (!s.ok()) return s;
       }
       if (r.mount == Mount::kPinned || r.mount == Mount::kCoupledPinned) {

@@ -95,7 +95,9 @@ std::string ContactBlock(const char* model, double friction = 0.5) {
 
 // A buoy (d = 2 m, H = 4 m) whose centre is 0.5 m above the still level,
 // with drag and added mass, in still water or in waves.
-std::string Buoy(const char* model, bool waves) {
+// With `rod_part`, a second part (Body.hydrodynamics_parts): a rod clamped
+// across the buoy along its body-frame (y + z) direction.
+std::string Buoy(const char* model, bool waves, bool rod_part = false) {
   const char* up = std::string(model) == "PLANAR" ? "y" : "z";
   return absl::StrFormat(R"({
     "model": "%s", "gravity": {"%s": -9.81},
@@ -104,13 +106,18 @@ std::string Buoy(const char* model, bool waves) {
                 "position": {"%s": 0.5},
                 "hydrodynamics": {"diameter": 2, "height": 4, "drag_coefficient": 1.2,
                                   "heave_drag_coefficient": 0.8, "added_mass": 1,
-                                  "heave_added_mass": 0.5}}],
+                                  "heave_added_mass": 0.5} %s}],
     "solver": {"duration": 1}})",
                          model, up,
                          waves ? R"(, "waves": {"regular": [{"height": 2, "period": 8}],
                                                 "ramp_time": 5})"
                                : "",
-                         up);
+                         up,
+                         rod_part ? R"(, "hydrodynamics_parts": [{"diameter": 0.4, "height": 6,
+                                         "drag_coefficient": 1.1, "heave_drag_coefficient": 0.5,
+                                         "added_mass": 1, "heave_added_mass": 0.2,
+                                         "along_axis": true, "axis": {"y": 1, "z": 1}}])"
+                                  : "");
 }
 
 // How a contributor's matrix relates to its force: the exact derivative,
@@ -227,6 +234,8 @@ const Case kCases[] = {
      [] { return SceneFromJson(ContactBlock("SPATIAL")); }, kSymmetricBound, kSymmetricBound},
     {"BodyFluidPlanar", "body_fluid", [] { return SceneFromJson(Buoy("PLANAR", false)); }},
     {"BodyFluidSpatialInWaves", "body_fluid", [] { return SceneFromJson(Buoy("SPATIAL", true)); }},
+    {"BodyFluidPartsSpatialInWaves", "body_fluid",
+     [] { return SceneFromJson(Buoy("SPATIAL", true, /*rod_part=*/true)); }},
     {"SlidingJointsZipLine", "sliding_joints", [] { return SampleScene("zip-line.json"); },
      kExact, kExact, 1e-3},
     {"FreeSurfacePlanar", "free_surface", [] { return SceneFromJson(PiercingLine("PLANAR")); }},

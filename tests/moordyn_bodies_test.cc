@@ -496,6 +496,55 @@ TEST(MoorDynBodiesTest, BodyWithRodAndPointsIsOneRigidBody) {
   EXPECT_EQ(s.probes(0).body(), "body1");
 }
 
+// A body with its own volume (3 m^3) and a horizontal rod on it (along
+// the body's x, the world's y after the yaw of 90 degrees), both centred at
+// its centre of mass (MoorDyn's riser decks clamp such a rod to a buoy):
+// two parts, the volume's vertical cylinder in `hydrodynamics` and the rod
+// in hydrodynamics_parts, its loads split along its own axis (the world's
+// y in the scene body's frame, the world's at the start), the ends' CdEnd
+// and CaEnd on its axis. Before, a second part with volume was refused.
+TEST(MoorDynBodiesTest, BodyVolumeAndHorizontalRodAreTwoParts) {
+  const std::string deck = absl::StrReplaceAll(
+      Deck(kBodyWithRod), {{"5e4     0        0", "5e4     3        0"},
+                           {"1    can       Body1      0     0     -5    0     0     5    4",
+                            "1    can       Body1      -5    0     0     5     0     0    4"}});
+  const v1::Scene s = Read(deck);
+  ASSERT_EQ(s.bodies_size(), 1);
+  const v1::Body& b = BodyNamed(s, "body1");
+  EXPECT_NEAR(b.position().z(), -40, 1e-12);
+  // The body's volume: a vertical cylinder as tall as wide.
+  const double d = std::cbrt(4 * 3 / kPi);
+  EXPECT_NEAR(b.hydrodynamics().diameter(), d, 1e-14);
+  EXPECT_NEAR(b.hydrodynamics().height(), d, 1e-14);
+  EXPECT_FALSE(b.hydrodynamics().along_axis());
+  // The rod: d 2 m, 10 m, Cd 0.6 and Ca 1 across, both ends' CdEnd 1.2
+  // along, and CaEnd 1 on the ends' (2/3) pi r^3 each over the rod's
+  // volume pi r^2 L: 2 (2/3) / 10.
+  ASSERT_EQ(b.hydrodynamics_parts_size(), 1);
+  const v1::BodyHydrodynamics& rod = b.hydrodynamics_parts(0);
+  EXPECT_TRUE(rod.along_axis());
+  EXPECT_NEAR(rod.axis().x(), 0, 1e-12);
+  EXPECT_NEAR(rod.axis().y(), 1, 1e-12);
+  EXPECT_NEAR(rod.axis().z(), 0, 1e-12);
+  EXPECT_DOUBLE_EQ(rod.diameter(), 2);
+  EXPECT_DOUBLE_EQ(rod.height(), 10);
+  EXPECT_DOUBLE_EQ(rod.drag_coefficient(), 0.6);
+  EXPECT_DOUBLE_EQ(rod.added_mass(), 1.0);
+  EXPECT_DOUBLE_EQ(rod.heave_drag_coefficient(), 2 * 1.2);
+  EXPECT_NEAR(rod.heave_added_mass(), 2 * (2.0 / 3) / 10, 1e-15);
+  // The scene builds a model with one fluid load per part.
+  const absl::StatusOr<Scene> scene = SceneFromProto(s);
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  absl::StatusOr<MultibodyModel> model = MultibodyModel::Build(*scene);
+  ASSERT_TRUE(model.ok()) << model.status();
+  EXPECT_EQ(model->body_fluid_loads().size(), 2u);
+  // Its statics: the body hangs between its two lines, buoyed by both
+  // parts.
+  CollectingSink sink;
+  const Frame last = Statics(s, "body1", &sink);
+  EXPECT_TRUE(std::isfinite(last.probes[0].position_m.z()));
+}
+
 // Fixed, coupled and coupled-pinned bodies; pinned, fixed and coupled
 // rods.
 TEST(MoorDynBodiesTest, MountsBecomeSupportsCoupledBodiesAndPins) {
@@ -601,9 +650,13 @@ TEST(MoorDynBodiesTest, RefusalsNameTheLineAndField) {
   const std::string body = Deck(kBodyWithRod);
   EXPECT_EQ(Refusal(absl::StrReplaceAll(body, {{"1     Body1     2", "1     Body4     2"}})),
             "bad.dat:22: POINTS Type: body 4 does not exist (define it in BODIES)");
-  // A second part with volume on one body.
-  EXPECT_NE(Refusal(absl::StrReplaceAll(body, {{"5e4     0        0", "5e4     3        0"}}))
-                .find("bad.dat:18: RODS RodType: a second part with volume"),
+  // A second part with volume on one body is read (BodyVolumeAndHorizontalRodAreTwoParts);
+  // a tilted rod on a body within half its length of the surface is refused.
+  EXPECT_NE(Refusal(absl::StrReplaceAll(
+                        body, {{"-40   0       0      90", "-2    0       0      90"},
+                               {"1    can       Body1      0     0     -5    0     0     5    4",
+                                "1    can       Body1      -5    0     0     5     0     0    4"}}))
+                .find("bad.dat:18: RODS Zb: a rod that is not vertical within half its length"),
             std::string::npos);
   // The rod's cylinder off the centre of mass (the points' masses moved).
   EXPECT_NE(Refusal(absl::StrReplaceAll(body, {{"2     Body1     -2      0       0       50",

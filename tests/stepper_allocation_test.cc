@@ -693,7 +693,8 @@ TEST_F(StepperAllocationTest, SheaveContactDoesNotAllocate) {
 
 
 // Nor the fluid's loads on a body (engine/forces/body_fluid_load.h): a
-// floating buoy with drag and added mass on a riser, in a regular wave.
+// floating buoy with drag and added mass on a riser, in a regular wave,
+// with a second part (a rod clamped along the body's y axis).
 TEST_F(StepperAllocationTest, BodyHydrodynamicsDoNotAllocate) {
   Scene scene = testing::SceneFromJson(R"({
     "gravity": {"y": -9.81},
@@ -704,7 +705,10 @@ TEST_F(StepperAllocationTest, BodyHydrodynamicsDoNotAllocate) {
     "bodies": [{"name": "buoy", "mass": 2000, "inertia": {"x": 100, "y": 100, "z": 100},
                 "hydrodynamics": {"diameter": 2, "height": 2, "drag_coefficient": 1,
                                   "heave_drag_coefficient": 2, "added_mass": 1,
-                                  "heave_added_mass": 0.5}}],
+                                  "heave_added_mass": 0.5},
+                "hydrodynamics_parts": [{"diameter": 0.3, "height": 3, "drag_coefficient": 1.2,
+                                         "heave_drag_coefficient": 0.6, "added_mass": 1,
+                                         "along_axis": true, "axis": {"y": 1}}]}],
     "joints": [{"type": "PIN", "a": {"cable": "riser", "s": 0}},
                {"type": "PIN", "a": {"cable": "riser", "s": 20}, "b": {"body": "buoy"}}],
     "solver": {"duration": 1}})");

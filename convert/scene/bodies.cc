@@ -38,27 +38,28 @@ absl::Status ConvertBodyContact(const std::string& path, const v1::Body& b, Body
   return absl::OkStatus();
 }
 
-// Body.hydrodynamics (BodyFluidLoad): the cylinder's size from the
-// body's cylinder unless given (none for drag areas alone); coefficients
-// and areas >= 0.
-absl::Status ConvertBodyHydrodynamics(const ConversionState& state, int i, const v1::Body& b,
-                                      BodySpec* body) {
-  if (!b.has_hydrodynamics()) return absl::OkStatus();
-  const v1::BodyHydrodynamics& h = b.hydrodynamics();
-  const std::string path = Sub(Indexed("", "bodies", i), "hydrodynamics");
-  if (!(state.proto.fluid().density() > 0))
-    return Invalid(path, "needs a fluid around the body (fluid.density > 0)");
+// One of Body.hydrodynamics and Body.hydrodynamics_parts (BodyFluidLoad) at
+// `path`: the cylinder's size from the body's cylinder unless given (none
+// for drag areas alone); coefficients and areas >= 0; the axis only with
+// along_axis.
+absl::Status ConvertBodyFluidPart(const ConversionState& state, const std::string& path,
+                                  const v1::Body& b, const v1::BodyHydrodynamics& h,
+                                  BodyFluidPart* part) {
   for (const auto& [name, v, range, out] :
-       {std::tuple{"drag_area", &h.drag_area(), &plausible::kDragArea, &body->hydro_drag_area_m2},
+       {std::tuple{"drag_area", &h.drag_area(), &plausible::kDragArea, &part->drag_area_m2},
         std::tuple{"rotational_drag_area", &h.rotational_drag_area(),
-                   &plausible::kRotationalDragArea, &body->hydro_rotational_drag_area_m5}}) {
+                   &plausible::kRotationalDragArea, &part->rotational_drag_area_m5}}) {
     CABLESIM_ASSIGN_OR_RETURN(*out, VectorInRange(Sub(path, name), *v, *range));
+  }
+  if (h.has_axis()) {
+    if (!h.along_axis())
+      return Invalid(Sub(path, "axis"), "only with along_axis (the split's direction)");
+    CABLESIM_ASSIGN_OR_RETURN(part->axis_body, Direction(Sub(path, "axis"), h.axis()));
   }
   // Drag areas alone on a body given by mass: no cylinder (no buoyancy).
   const bool cylinder = h.has_diameter() || h.has_height() || b.has_cylinder() ||
                         h.drag_coefficient() != 0 || h.heave_drag_coefficient() != 0 ||
                         h.added_mass() != 0 || h.heave_added_mass() != 0 || h.along_axis();
-  body->has_hydrodynamics = true;
   if (!cylinder) return absl::OkStatus();
   if (!(state.scene.gravity_m_s2.norm() > 0)) {
     return Invalid(path, "needs gravity for its cylinder (it sets the vertical and the "
@@ -66,9 +67,9 @@ absl::Status ConvertBodyHydrodynamics(const ConversionState& state, int i, const
   }
   for (const auto& [name, given, value, from_cylinder, out] :
        {std::tuple{"diameter", h.has_diameter(), h.diameter(), b.cylinder().diameter(),
-                   &body->hydro_diameter_m},
+                   &part->diameter_m},
         std::tuple{"height", h.has_height(), h.height(), b.cylinder().height(),
-                   &body->hydro_height_m}}) {
+                   &part->height_m}}) {
     if (!given && !b.has_cylinder())
       return Invalid(Sub(path, name), "required for a body given by mass (no cylinder)");
     const double v = given ? value : from_cylinder;
@@ -76,15 +77,42 @@ absl::Status ConvertBodyHydrodynamics(const ConversionState& state, int i, const
     *out = v;
   }
   for (const auto& [name, value, out] :
-       {std::tuple{"drag_coefficient", h.drag_coefficient(), &body->hydro_drag},
-        std::tuple{"heave_drag_coefficient", h.heave_drag_coefficient(), &body->hydro_heave_drag},
-        std::tuple{"added_mass", h.added_mass(), &body->hydro_added_mass},
-        std::tuple{"heave_added_mass", h.heave_added_mass(), &body->hydro_heave_added_mass}}) {
+       {std::tuple{"drag_coefficient", h.drag_coefficient(), &part->drag},
+        std::tuple{"heave_drag_coefficient", h.heave_drag_coefficient(), &part->heave_drag},
+        std::tuple{"added_mass", h.added_mass(), &part->added_mass},
+        std::tuple{"heave_added_mass", h.heave_added_mass(), &part->heave_added_mass}}) {
     CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(path, name), value));
     CABLESIM_RETURN_IF_ERROR(CheckRange(Sub(path, name), value, plausible::kHydroCoefficient));
     *out = value;
   }
-  body->hydro_along_axis = h.along_axis();
+  part->along_axis = h.along_axis();
+  return absl::OkStatus();
+}
+
+// Body.hydrodynamics and Body.hydrodynamics_parts: one BodyFluidPart each,
+// `hydrodynamics` first.
+absl::Status ConvertBodyHydrodynamics(const ConversionState& state, int i, const v1::Body& b,
+                                      BodySpec* body) {
+  if (!b.has_hydrodynamics() && b.hydrodynamics_parts_size() == 0) return absl::OkStatus();
+  const std::string body_path = Indexed("", "bodies", i);
+  if (!(state.proto.fluid().density() > 0)) {
+    return Invalid(Sub(body_path, b.has_hydrodynamics() ? "hydrodynamics" : "hydrodynamics_parts"),
+                   "needs a fluid around the body (fluid.density > 0)");
+  }
+  body->has_hydrodynamics = true;
+  if (b.has_hydrodynamics()) {
+    BodyFluidPart part;
+    CABLESIM_RETURN_IF_ERROR(ConvertBodyFluidPart(state, Sub(body_path, "hydrodynamics"), b,
+                                                  b.hydrodynamics(), &part));
+    body->hydro_parts.push_back(part);
+  }
+  for (int k = 0; k < b.hydrodynamics_parts_size(); ++k) {
+    BodyFluidPart part;
+    part.scene_index = k;
+    CABLESIM_RETURN_IF_ERROR(ConvertBodyFluidPart(
+        state, Indexed(body_path, "hydrodynamics_parts", k), b, b.hydrodynamics_parts(k), &part));
+    body->hydro_parts.push_back(part);
+  }
   return absl::OkStatus();
 }
 

@@ -25,9 +25,17 @@ BodyFluidLoad::BodyFluidLoad(const Params& p, int coord, int dim)
 
 Vector3d BodyFluidLoad::Axis(const VectorXd& q) const {
   if (!p_.along_axis) return up_;
-  // The body's natural coordinates: [r_c, u, ...], u its x axis (D each).
+  // The body's natural coordinates: [r_c, u] (planar, u its x axis) or
+  // [r_c, e1, e2, e3] (spatial); a = R a_b (planar: a_bx u + a_by e_z x u,
+  // both of length |u|). a_b = e_x gives u (e1) exactly.
+  const Vector3d& ab = p_.axis_body;
   Vector3d a = Vector3d::Zero();
-  a.head(dim_) = q.segment(coord_ + dim_, dim_);
+  if (dim_ == 2) {
+    const Eigen::Vector2d u = q.segment<2>(coord_ + 2);
+    a.head<2>() = ab.x() * u + ab.y() * Eigen::Vector2d(-u.y(), u.x());
+  } else {
+    for (int k = 0; k < 3; ++k) a += ab(k) * q.segment<3>(coord_ + 3 + 3 * k);
+  }
   const double n = a.norm();
   return n > 0 ? Vector3d(a / n) : up_;
 }
@@ -290,23 +298,26 @@ std::unique_ptr<BodyFluidForces> MakeBodyFluidForces(const Scene& scene,
   for (size_t b = 0; b < scene.bodies.size(); ++b) {
     const BodySpec& body = scene.bodies[b];
     if (!body.has_hydrodynamics || !(fluid.density_kg_m3 > 0)) continue;
-    if (!(g > 0) && body.hydro_height_m > 0) continue;
-    BodyFluidLoad::Params p;
-    p.density_kg_m3 = fluid.density_kg_m3;
-    p.g_m_s2 = g;
-    p.up = g > 0 ? Vector3d(-scene.gravity_m_s2 / g) : Vector3d::UnitZ();
-    p.still_level_m = fluid.still_water_level_m;
-    p.diameter_m = body.hydro_diameter_m;
-    p.height_m = body.hydro_height_m;
-    p.drag = body.hydro_drag;
-    p.heave_drag = body.hydro_heave_drag;
-    p.added_mass = body.hydro_added_mass;
-    p.heave_added_mass = body.hydro_heave_added_mass;
-    p.along_axis = body.hydro_along_axis;
-    p.current_m_s = fluid.current_m_s;
-    p.drag_area = body.hydro_drag_area_m2;
-    p.rotational_drag_area = body.hydro_rotational_drag_area_m5;
-    loads.emplace_back(p, body_coord[b], dim);
+    for (const BodyFluidPart& part : body.hydro_parts) {
+      if (!(g > 0) && part.height_m > 0) continue;
+      BodyFluidLoad::Params p;
+      p.density_kg_m3 = fluid.density_kg_m3;
+      p.g_m_s2 = g;
+      p.up = g > 0 ? Vector3d(-scene.gravity_m_s2 / g) : Vector3d::UnitZ();
+      p.still_level_m = fluid.still_water_level_m;
+      p.diameter_m = part.diameter_m;
+      p.height_m = part.height_m;
+      p.drag = part.drag;
+      p.heave_drag = part.heave_drag;
+      p.added_mass = part.added_mass;
+      p.heave_added_mass = part.heave_added_mass;
+      p.along_axis = part.along_axis;
+      p.axis_body = part.axis_body;
+      p.current_m_s = fluid.current_m_s;
+      p.drag_area = part.drag_area_m2;
+      p.rotational_drag_area = part.rotational_drag_area_m5;
+      loads.emplace_back(p, body_coord[b], dim);
+    }
   }
   if (loads.empty()) return nullptr;
   auto forces = std::make_unique<BodyFluidForces>(std::move(loads));

@@ -66,8 +66,11 @@
 // dependence on position) are left out, as for the cables' WaveLoad.
 //
 // Along the body's axis (Params::along_axis, a rod): the same drag and
-// inertia with the body's x axis a = u / |u| (from the body's natural
-// coordinates at q) in place of `up` in the split: v_h the relative
+// inertia with the part's axis a = R a_b / |R a_b| in place of `up` in the
+// split, a_b (Params::axis_body) a direction in the body's frame and R =
+// [e1 e2 e3] the body's axes from its natural coordinates at q (planar:
+// R a_b = a_bx u + a_by e_z x u; a_b = e_x gives the body's x axis
+// a = u / |u|): v_h the relative
 // velocity across the axis, v_v along it, C_d on d s across, C_dv on A
 // along, C_a = C_ah (I - a a^T) + C_av a a^T; the added mass on the body's
 // own acceleration takes a at the body's `position` (the constant mass
@@ -98,6 +101,13 @@
 // symmetric part for omega (planar: 2 k A_wz |omega| (e_z x u)(e_z x u)^T),
 // positive semi-definite. Derivatives in q (through R and f) are left out.
 //
+// Parts. A body may carry several such loads (BodySpec::hydro_parts: its
+// own volume and rods on it), each a BodyFluidLoad on the same centre of
+// mass with its own cylinder, coefficients and axis; their forces,
+// tangents, added masses (MultibodyModel sums AddedMass over them), energies
+// and damping powers add. Every part is centred at the centre of mass, so
+// none has a moment arm.
+//
 // Energy: F_d + F_i + F_w (and F_a, M_a) is not a potential's force; its power -F . rdot_c
 // joins the damping power (MultibodyModel::DampingPower), so energy.damped
 // counts the drag's dissipation and the waves' work, and energy.total +
@@ -127,8 +137,10 @@ class BodyFluidLoad {
     double diameter_m = 0, height_m = 0;
     double drag = 0, heave_drag = 0;              // C_d, C_dv [-]
     double added_mass = 0, heave_added_mass = 0;  // C_ah, C_av [-]
-    // The split across/along the body's x axis instead of the vertical.
+    // The split across/along the body-frame direction axis_body (unit;
+    // default the body's x axis) instead of the vertical.
     bool along_axis = false;
+    Eigen::Vector3d axis_body = Eigen::Vector3d::UnitX();
     Eigen::Vector3d current_m_s = Eigen::Vector3d::Zero();
     // Drag areas along the body's axes [m^2] and about them [m^5].
     Eigen::Vector3d drag_area = Eigen::Vector3d::Zero();
@@ -148,7 +160,7 @@ class BodyFluidLoad {
   double waterplane_area() const { return area_; }
 
   // The unit direction the loads split along at q: the vertical, or the
-  // body's x axis (along_axis).
+  // part's axis R a_b (along_axis).
   Eigen::Vector3d Axis(const Eigen::VectorXd& q) const;
 
   // The submerged length s(z) [m] at the centre's height z above a level.
@@ -220,7 +232,7 @@ class BodyFluidForces : public ForceContributor {
 
 // The contributor for the scene's bodies with hydrodynamics (in a fluid;
 // a cylinder's buoyancy and vertical need gravity, SceneFromProto checks),
-// or null when none has any. `body_coord[b]`: body b's
+// one BodyFluidLoad per part in body order, or null when none has any. `body_coord[b]`: body b's
 // first full coordinate; `has_waves`: the model built a wave field.
 std::unique_ptr<BodyFluidForces> MakeBodyFluidForces(const Scene& scene,
                                                      const std::vector<int>& body_coord, int dim,

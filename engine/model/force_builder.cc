@@ -369,12 +369,13 @@ absl::Status ModelBuilder::Contributors() {
     add(std::move(contact));
   }
   if (auto fluid = MakeBodyFluidForces(scene_, body_coord, m.dim_, m.wave_load_ != nullptr)) {
-    // The added mass joins the body's mass matrix and kinetic energy.
+    // The added mass joins the body's mass matrix and kinetic energy: the
+    // sum over the body's parts.
     for (const BodyFluidLoad& load : fluid->loads()) {
       for (size_t b = 0; b < body_coord.size(); ++b) {
         if (body_coord[b] != load.coord()) continue;
         MultibodyModel::BodyData& data = m.bodies_[b];
-        data.added_mass = load.AddedMass(q0_);
+        data.added_mass += load.AddedMass(q0_);
         data.has_added_mass = !data.added_mass.isZero(0);
       }
     }

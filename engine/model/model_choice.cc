@@ -32,6 +32,12 @@ std::string OutOfPlaneField(const Scene& scene) {
     const std::string path = absl::StrCat("bodies[", i, "]");
     if (auto f = Z(path + ".position", scene.bodies[i].position_m); !f.empty()) return f;
     if (auto f = Z(path + ".axis", scene.bodies[i].axis); !f.empty()) return f;
+    for (const BodyFluidPart& part : scene.bodies[i].hydro_parts) {
+      const std::string part_path =
+          part.scene_index < 0 ? path + ".hydrodynamics"
+                               : absl::StrCat(path, ".hydrodynamics_parts[", part.scene_index, "]");
+      if (auto f = Z(part_path + ".axis", part.axis_body); !f.empty()) return f;
+    }
   }
   auto attachment = [](const std::string& path, const Attachment& at) -> std::string {
     if (at.body < 0) return "";

@@ -112,6 +112,29 @@ struct CableSpec {
   double seabed_damping_n_s_m2 = -1;
 };
 
+// One hydrodynamic part of a body (BodySpec::hydro_parts): a circular
+// cylinder of diameter and height [m] centred at the body's centre of mass
+// displaces the fluid (buoyed as a vertical one); Morison drag
+// coefficients across its split axis (on d times the submerged length) and
+// along it (on the end area) [-], added-mass coefficients across and along
+// [-]. The split axis is the vertical, or with along_axis the body-frame
+// direction axis_body (a rod, turning with the body).
+struct BodyFluidPart {
+  double diameter_m = 0, height_m = 0;
+  double drag = 0, heave_drag = 0;
+  double added_mass = 0, heave_added_mass = 0;
+  bool along_axis = false;
+  Eigen::Vector3d axis_body = Eigen::Vector3d::UnitX();  // unit, body frame
+  // Drag areas along the body's axes [m^2] and about them [m^5]
+  // (BodyFluidLoad::AreaDrag); a part with them alone has no cylinder
+  // (diameter_m = height_m = 0: no buoyancy, wet wherever it is).
+  Eigen::Vector3d drag_area_m2 = Eigen::Vector3d::Zero();
+  Eigen::Vector3d rotational_drag_area_m5 = Eigen::Vector3d::Zero();
+  // Where the scene gave it: -1 Body.hydrodynamics, k >= 0
+  // Body.hydrodynamics_parts[k] (for naming the field).
+  int scene_index = -1;
+};
+
 struct BodySpec {
   std::string name;
   double mass_kg = 0;
@@ -136,24 +159,10 @@ struct BodySpec {
   double contact_damping_n_s_m = 0;
   double contact_friction = 0;
   // Fluid loads in the scene's fluid (engine/forces/body_fluid_load.h),
-  // only when has_hydrodynamics: a vertical cylinder of diameter and
-  // height [m] centred at the centre of mass displaces the fluid; Morison
-  // drag coefficients across the vertical (on d times the submerged length)
-  // and along it (on the end area) [-], added-mass coefficients across
-  // and along the vertical [-].
+  // only when has_hydrodynamics: one or more parts (BodyFluidPart), each a
+  // cylinder centred at the centre of mass whose loads add up.
   bool has_hydrodynamics = false;
-  double hydro_diameter_m = 0, hydro_height_m = 0;
-  double hydro_drag = 0, hydro_heave_drag = 0;
-  double hydro_added_mass = 0, hydro_heave_added_mass = 0;
-  // The drag and added mass split across and along the body's x axis (a
-  // rod) instead of the vertical (the buoyancy stays the vertical
-  // cylinder's).
-  bool hydro_along_axis = false;
-  // Drag areas along the body's axes [m^2] and about them [m^5]
-  // (BodyFluidLoad::AreaDrag); a body with them alone has no cylinder
-  // (hydro_diameter_m = hydro_height_m = 0: no buoyancy, wet wherever it is).
-  Eigen::Vector3d hydro_drag_area_m2 = Eigen::Vector3d::Zero();
-  Eigen::Vector3d hydro_rotational_drag_area_m5 = Eigen::Vector3d::Zero();
+  std::vector<BodyFluidPart> hydro_parts;
   // Driven by a coupling host (engine/run/coupling.h): its pose (centre of
   // mass and axes) is the host's, step by step; the scene holds it by a
   // driver joint (CoupledBodyDriver, appended to the joints). In an
