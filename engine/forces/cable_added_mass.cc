@@ -24,7 +24,8 @@ void CableAddedMass::Add(const AncfCableElement<D>& element, int index,
     if (!(stretch > 0)) continue;
     t /= stretch;
     if (!surface_.Wet(r, surface_.enabled && waves_ ? waves_->ElevationAt(r, t_s) : 0.0)) continue;
-    const Eigen::Matrix<double, D, D> tt = (p.tip_mass[end] * t * t.transpose()).topLeftCorner<D, D>();
+    const Eigen::Matrix3d tt3 = p.tip_mass[end] * t * t.transpose();
+    const Eigen::Matrix<double, D, D> tt = tt3.topLeftCorner<D, D>();
     force->template segment<D>(i) -= tt * edd.template segment<D>(i);
     if (m != nullptr) m->template block<D, D>(i, i) += tt;
   }

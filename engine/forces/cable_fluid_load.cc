@@ -73,11 +73,13 @@ void CableFluidLoad::AddTips(const ElementAt<D>& at, const ElementCoords<D>& e,
     }
     if (!wet) continue;
     const double w = (u - v).dot(t);
-    const Eigen::Vector3d f = p.tip_drag[end] * std::abs(w) * w * t + p.tip_inertia[end] * du.dot(t) * t;
+    const Eigen::Vector3d f =
+        (p.tip_drag[end] * std::abs(w) * w + p.tip_inertia[end] * du.dot(t)) * t;
     force->template segment<D>(i) += f.head<D>();
     if (c != nullptr && p.tip_drag[end] != 0) {
       const Eigen::Matrix3d tt = t * t.transpose();
-      c->template block<D, D>(i, i) += (2 * p.tip_drag[end] * std::abs(w)) * tt.topLeftCorner<D, D>();
+      c->template block<D, D>(i, i) +=
+          (2 * p.tip_drag[end] * std::abs(w)) * tt.topLeftCorner<D, D>();
     }
   }
 }
