@@ -1019,7 +1019,7 @@ TEST(MoorDynBodiesTest, BodyDragWithoutVolume) {
 constexpr char kPointRodTypes[] = R"(----------------------- LINE TYPES ------------------------------------------
 TypeName   Diam    Mass/m     EA         BA/-zeta    EI         Cd     Ca     CdAx    CaAx
 (name)     (m)     (kg/m)     (N)        (N-s/-)     (N-m^2)    (-)    (-)    (-)     (-)
-cable      0.1     20         1.0e8      -0.5        1.0e3      1.2    1.0    0.0     0.0
+cable      0.1     20         1.0e8      -0.5        1.0e5      1.2    1.0    0.0     0.0
 rope       0.1     20         1.0e8      -0.5        0          1.2    1.0    0.0     0.0
 soft       0.1     20         5.0e7      -0.5        1.0e3      1.2    1.0    0.0     0.0
 ---------------------- ROD TYPES ------------------------------------
@@ -1160,6 +1160,25 @@ TEST(MoorDynPointRodsTest, TautLineSplitAtARodOfZeroLengthCarriesTheUnsplitTensi
   EXPECT_NEAR(top, t0 + w * length, 1e-6 * t0);
   EXPECT_NEAR(bottom_split, t0, 1e-6 * t0);
   EXPECT_NEAR(top_split, t0 + w * length, 1e-6 * t0);
+}
+
+// A sagging line with bending stiffness (EI 1e5 N m^2: a bending length
+// sqrt(EI / T) of some 8 m at its 1.7 kN) between points 60 m apart at
+// the same depth, split at its middle: the FIXED weld keeps it one smooth
+// line (a PIN there would let it kink), so the statics are the unsplit
+// line's, node for node (the split's nodes are the unsplit's); 1e-6 of
+// the tension (Newton's tolerance).
+TEST(MoorDynPointRodsTest, SaggingLineSplitAtARodOfZeroLengthStaysOneSmoothLine) {
+  const std::pair<std::string, std::string> beside = {
+      "2     Fixed     0       0       -10 ", "2     Fixed     60      0       -100"};
+  const auto [bottom_split, top_split] = Tensions(absl::StrReplaceAll(
+      SplitDeck(kFreeRod, "1 cable 1 R1A 44.5 10 -\n2 cable R1B 2 44.5 10 -\n"), {beside}));
+  const auto [bottom, top] = Tensions(absl::StrReplaceAll(
+      SplitDeck("", "1 cable 1 2 89 20 -\n"), {beside, {"FairTen2", "FairTen1"}}));
+  std::printf("sagging, split: %.9g %.9g N, whole: %.9g %.9g N\n", bottom_split, top_split,
+              bottom, top);
+  EXPECT_NEAR(bottom_split, bottom, 1e-6 * bottom);
+  EXPECT_NEAR(top_split, top, 1e-6 * top);
 }
 
 TEST(MoorDynPointRodsTest, RefusalsNameTheLineAndField) {
