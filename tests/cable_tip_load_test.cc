@@ -8,6 +8,7 @@
 // integrator, naming the field.
 
 #include <cmath>
+#include <memory>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -16,6 +17,8 @@
 #include "engine/elements/ancf_cable_element.h"
 #include "engine/forces/cable_added_mass.h"
 #include "engine/forces/cable_fluid_load.h"
+#include "engine/forces/wave_load.h"
+#include "engine/forces/waves.h"
 #include "tests/test_util.h"
 
 namespace cablesim {
@@ -72,6 +75,37 @@ TEST(CableTipLoadTest, DragAlongTheTangentAtTheTipNode) {
     EXPECT_NEAR((c.col(i) - column).norm(), 0, 1e-8 * c.norm()) << "column " << i;
   }
   EXPECT_GT(c.norm(), 0);
+}
+
+// In waves the flow at the tip is the current plus the waves' velocity,
+// and the tip's added mass takes the flow's acceleration along t:
+// f = k |w| w t + m (du/dt . t) t with u, du/dt from WaveField::At at the
+// node (the same field the load holds); 1e-14 relative.
+TEST(CableTipLoadTest, InWavesTheTipTakesTheFlowsVelocityAndAcceleration) {
+  const AncfCableElement<3> element(2, 1e6, 0, BendingModel::kNone);
+  const Coords e = Straight(kTangent);
+  WaveField field(Eigen::Vector3d::UnitZ(), 0, 100, 9.81, 0);
+  field.AddRegular(4, 8, Eigen::Vector3d(1, 0.5, 0), 0.3);
+  const Eigen::Vector3d current(0.3, 0, 0);
+  const auto waves = std::make_shared<const WaveLoad>(field, current);
+  CableFluidLoad::Element tip;
+  tip.tip_drag[1] = 6.5;
+  tip.tip_inertia[1] = 0.84;
+  CableFluidLoad load({tip}, waves, current);
+  const double time = 1.7;
+  const ElementAt<3> at{element, 0, time};
+  Coords edot = Coords::Zero();
+  const Eigen::Vector3d v(0.1, -0.2, 0.05);
+  edot.segment<3>(6) = v;
+  Coords f = Coords::Zero();
+  load.AddElementDissipation(at, e, edot, &f, nullptr);
+  const Eigen::Vector3d r = e.segment<3>(6);
+  const WaveField::Kinematics k = field.At(r, time);
+  const double w = (current + k.velocity_m_s - v).dot(kTangent);
+  const Eigen::Vector3d expected =
+      (6.5 * std::abs(w) * w + 0.84 * k.acceleration_m_s2.dot(kTangent)) * kTangent;
+  ASSERT_GT(k.acceleration_m_s2.dot(kTangent) * k.acceleration_m_s2.dot(kTangent), 1e-6);
+  EXPECT_NEAR((f.segment<3>(6) - expected).norm(), 0, 1e-14 * expected.norm());
 }
 
 TEST(CableTipLoadTest, NoTipLoadAboveTheFreeSurface) {
