@@ -121,7 +121,7 @@ struct Rod {
   int body = 0;  // kOnBody, or kPinned to a body: the body's ID (0: the ground)
   Eigen::Vector3d a = Eigen::Vector3d::Zero(), b = Eigen::Vector3d::Zero();  // world [m]
   Eigen::Vector3d a_rel = Eigen::Vector3d::Zero(), b_rel = Eigen::Vector3d::Zero();
-  int segments = 0;
+  int segments = 0;  // 0: MoorDyn's rod of zero length (a point)
   double length() const { return (b - a).norm(); }
 };
 
@@ -1313,17 +1313,30 @@ class DeckReader {
     }
 
     if (absl::Status s = BuildBodiesAndRods(&scene); !s.ok()) return s;
+    if (absl::Status s = JoinAtPointRods(depth); !s.ok()) return s;
 
     std::map<int, std::pair<std::string, double>> first_end_at;  // free point -> (cable, s)
     for (const Line& l : lines_) {
+      const int index = static_cast<int>(&l - lines_.data());
       const LineType& t = *l.type;
       v1::Cable* c = scene.add_cables();
       const std::string name = absl::StrCat("line", l.id);
       c->set_name(name);
-      const Point& a = points_.at(l.a);
-      const Point& b = points_.at(l.b);
-      for (const Eigen3& p : Layout(a, b, l.length, depth))
-        SetVec(c->add_points(), p[0], p[1], p[2]);
+      std::vector<Eigen3> laid = laid_[index];
+      if (laid.empty()) {
+        // An end at a rod of zero length that a chain moved: there.
+        Point a = points_.at(l.a), b = points_.at(l.b);
+        for (Point* p : {&a, &b}) {
+          const auto moved = point_rod_at_.find(p->rod);
+          if (p->rod > 0 && moved != point_rod_at_.end()) {
+            p->x = moved->second[0];
+            p->y = moved->second[1];
+            p->z = moved->second[2];
+          }
+        }
+        laid = Layout(a, b, l.length, depth);
+      }
+      for (const Eigen3& p : laid) SetVec(c->add_points(), p[0], p[1], p[2]);
       c->set_length(l.length);
       c->set_elements(l.segments);
       const double area = kPi * t.diameter * t.diameter / 4;
@@ -1358,6 +1371,7 @@ class DeckReader {
         h->set_added_mass(t.ca);
         h->set_axial_added_mass(t.ca_axial);
         h->set_diameter(t.diameter);
+        SetTipLoads(index, rho, h);
       }
       if (std::abs(t.diameter - d0) > 1e-12 * d0) {
         c->set_seabed_stiffness(OptionOr("kbot", kDefaultKBot) * t.diameter);
@@ -1365,6 +1379,22 @@ class DeckReader {
       }
       for (const auto& [end, pid] : {std::pair{0.0, l.a}, std::pair{l.length, l.b}}) {
         const Point& p = points_.at(pid);
+        if (p.rod > 0 && rods_[p.rod - 1].segments == 0) {
+          // At a rod of zero length: joined to its reference end (PIN, or
+          // FIXED between two lines with bending stiffness).
+          const PointRodJoin& join = point_rods_.at(p.rod);
+          const PointRodEnd& ref = join.ends[join.reference];
+          const bool end_b = end != 0.0;
+          if (ref.line == index && ref.line_end_b == end_b) continue;
+          const Line& other = lines_[ref.line];
+          v1::Joint* j = scene.add_joints();
+          j->set_type(t.ei > 0 && ref.bending ? v1::FIXED : v1::PIN);
+          j->mutable_a()->set_cable(name);
+          j->mutable_a()->set_s(end);
+          j->mutable_b()->set_cable(absl::StrCat("line", other.id));
+          j->mutable_b()->set_s(ref.line_end_b ? other.length : 0.0);
+          continue;
+        }
         if (const auto h = holders_.find(pid); h != holders_.end() && !h->second.ground) {
           // On a body or rod: pinned to its point.
           v1::Joint* j = scene.add_joints();
@@ -1458,6 +1488,214 @@ class DeckReader {
     return scene;
   }
 
+  // ---- MoorDyn's rods of zero length (NumSegs 0) ----
+  //
+  // MoorDyn (Rod.cpp, N = 0): a free rod of zero length has no mass, no
+  // volume and no buoyancy (its two ends' buoyancy and pressure cancel);
+  // it moves as a point with the lines' end masses. Its direction q is the
+  // unit sum over its lines of (end segment's unit vector, signed to run
+  // along q) EI / stretched segment length (Line::getEndSegmentMoment), and
+  // each line's end is clamped in bending to q (Line::setEndOrientation):
+  // two lines with EI > 0 are tangent to each other there, a line of EI 0
+  // adds nothing and is pinned, and with no line of EI > 0 q is the zero
+  // vector (Eigen's normalized()). Both ends' axial drag and added mass act
+  // at the point along q: 2 x 1/2 rho CdEnd (pi d^2 / 4) |v_q| v_q and
+  // 2 x rho CaEnd (pi d^3 / 12) along q, with the flow's acceleration.
+
+  // A line's end at a rod of zero length.
+  struct PointRodEnd {
+    int line = 0;  // index into lines_
+    bool line_end_b = false;
+    bool rod_end_b = false;
+    bool bending = false;  // the line's EI > 0
+    // MoorDyn's sense of the line's tangent against the rod's q: +1 when
+    // the line's end B is at the rod's end A or its end A at end B.
+    int sign() const { return line_end_b != rod_end_b ? 1 : -1; }
+  };
+  struct PointRodJoin {
+    std::vector<PointRodEnd> ends;  // in LINES order
+    // The end the others are joined to: the first with EI > 0, else the
+    // first; it carries the rod's end loads when it has EI > 0.
+    int reference = 0;
+  };
+
+  // Fills point_rods_, laid_ (the lines welded end to end at rods of zero
+  // length, laid as one chain) and point_rod_at_, or refuses what a chain
+  // of FIXED joints cannot express.
+  absl::Status JoinAtPointRods(double depth) const {
+    point_rods_.clear();
+    point_rod_at_.clear();
+    laid_.assign(lines_.size(), {});
+    for (size_t i = 0; i < lines_.size(); ++i) {
+      for (const bool end_b : {false, true}) {
+        const Point& p = points_.at(end_b ? lines_[i].b : lines_[i].a);
+        if (p.rod == 0 || rods_[p.rod - 1].segments != 0) continue;
+        PointRodJoin& join = point_rods_[p.rod];
+        for (const PointRodEnd& o : join.ends) {
+          if (o.line == static_cast<int>(i)) {
+            return Error(lines_[i].line, "LINES AttachB",
+                         absl::StrCat("a line with both ends at rod ", p.rod,
+                                      " (of zero length) cannot be expressed"));
+          }
+        }
+        join.ends.push_back({static_cast<int>(i), end_b, p.rod_end_b, lines_[i].type->ei > 0});
+      }
+    }
+    std::vector<int> next(lines_.size(), -1), prev(lines_.size(), -1);
+    for (const Rod& r : rods_) {
+      if (r.segments != 0) continue;
+      const auto it = point_rods_.find(r.id);
+      if (it == point_rods_.end()) {
+        return Error(r.line, "RODS ID",
+                     "a rod of zero length with no line cannot be expressed (it has no mass: "
+                     "MoorDyn's moves with its lines' ends)");
+      }
+      PointRodJoin& join = it->second;
+      std::vector<int> bent;
+      for (size_t k = 0; k < join.ends.size(); ++k)
+        if (join.ends[k].bending) bent.push_back(static_cast<int>(k));
+      join.reference = bent.empty() ? 0 : bent[0];
+      if (bent.size() < 2) continue;
+      if (bent.size() > 2) {
+        return Error(r.line, "RODS NumSegs",
+                     absl::StrCat("rod ", r.id, " of zero length joins ", bent.size(),
+                                  " lines with bending stiffness (EI > 0): only two, welded end "
+                                  "to end as one chain, can be laid out"));
+      }
+      const PointRodEnd& a = join.ends[bent[0]];
+      const PointRodEnd& b = join.ends[bent[1]];
+      const Line& la = lines_[a.line];
+      const Line& lb = lines_[b.line];
+      const char* field = b.line_end_b ? "LINES AttachB" : "LINES AttachA";
+      if (a.sign() != b.sign() || a.line_end_b == b.line_end_b) {
+        return Error(lb.line, field,
+                     absl::StrCat(
+                         "lines ", la.id, " and ", lb.id, " meet at rod ", r.id,
+                         " (of zero length) ",
+                         a.sign() != b.sign()
+                             ? "with tangents MoorDyn holds opposite (a line ending at the "
+                               "rod's end A runs along its direction, one ending at end B "
+                               "against it, one starting there the other way)"
+                             : "both arriving (or both leaving)",
+                         ": only one line ending at the rod and the other starting there, "
+                         "tangent in the same sense (a FIXED joint between cables), can be "
+                         "expressed; give one line the other way round or use the rod's "
+                         "other end"));
+      }
+      const LineType& ta = *la.type;
+      const LineType& tb = *lb.type;
+      if (ta.ea != tb.ea || !ta.table_strains.empty() || !tb.table_strains.empty()) {
+        return Error(lb.line, "LINES LineType",
+                     absl::StrCat("lines ", la.id, " and ", lb.id, " meet at rod ", r.id,
+                                  " (of zero length) with ",
+                                  ta.table_strains.empty() && tb.table_strains.empty()
+                                      ? "different EA"
+                                      : "a tension-strain table",
+                                  ": the FIXED joint between them holds their stretches equal "
+                                  "there, right only for one constant EA"));
+      }
+      const int first = a.line_end_b ? a.line : b.line;
+      const int second = a.line_end_b ? b.line : a.line;
+      next[first] = second;
+      prev[second] = first;
+    }
+    std::vector<bool> seen(lines_.size(), false);
+    for (size_t i = 0; i < lines_.size(); ++i) {
+      if (prev[i] >= 0 || next[i] < 0) continue;
+      std::vector<int> chain;
+      for (int k = static_cast<int>(i); k >= 0; k = next[k]) {
+        chain.push_back(k);
+        seen[k] = true;
+      }
+      LayChain(chain, depth);
+    }
+    for (size_t i = 0; i < lines_.size(); ++i) {
+      if (next[i] >= 0 && !seen[i]) {
+        return Error(lines_[i].line, "LINES AttachB",
+                     "lines welded end to end at rods of zero length close a loop, which cannot "
+                     "be laid out");
+      }
+    }
+    return absl::OkStatus();
+  }
+
+  // Lays the lines of `chain` (each line's end B welded to the next one's
+  // end A at a rod of zero length) as one line from the first one's end A
+  // to the last one's end B, cut at their lengths: every line gets the same
+  // stretch and, at each weld, both lines' end legs lie on one leg of the
+  // chain (a weld that falls on a corner of it gets a chamfer of 1e-6 of
+  // the shorter leg there), as the FIXED joint needs at the start. The
+  // rods of zero length inside the chain move to the welds (their deck
+  // place is MoorDyn's starting guess too).
+  void LayChain(const std::vector<int>& chain, double depth) const {
+    double total = 0;
+    for (int k : chain) total += lines_[k].length;
+    const std::vector<Eigen3> poly =
+        Layout(points_.at(lines_[chain.front()].a), points_.at(lines_[chain.back()].b), total,
+               depth);
+    auto vec = [](const Eigen3& p) { return Eigen::Vector3d(p[0], p[1], p[2]); };
+    auto arr = [](const Eigen::Vector3d& v) { return Eigen3{v.x(), v.y(), v.z()}; };
+    std::vector<double> cum(1, 0.0);
+    for (size_t v = 1; v < poly.size(); ++v) cum.push_back(cum.back() + Dist(poly[v - 1], poly[v]));
+    const double scale = cum.back() / total;
+    const double tol = 1e-9 * cum.back();
+    auto at = [&](double s) {
+      size_t v = 1;
+      while (v + 1 < poly.size() && cum[v] < s) ++v;
+      const double f = std::clamp((s - cum[v - 1]) / (cum[v] - cum[v - 1]), 0.0, 1.0);
+      return arr(vec(poly[v - 1]) + f * (vec(poly[v]) - vec(poly[v - 1])));
+    };
+    double start = 0;
+    for (size_t k = 0; k < chain.size(); ++k) {
+      const double s0 = start * scale;
+      start += lines_[chain[k]].length;
+      const double s1 = k + 1 == chain.size() ? cum.back() : start * scale;
+      std::vector<Eigen3>& out = laid_[chain[k]];
+      out.push_back(k == 0 ? poly.front() : at(s0));
+      for (size_t v = 1; v + 1 < poly.size(); ++v)
+        if (cum[v] > s0 + tol && cum[v] < s1 - tol) out.push_back(poly[v]);
+      out.push_back(k + 1 == chain.size() ? poly.back() : at(s1));
+    }
+    // The welds: on a corner, a chamfer; the rods move there.
+    for (size_t k = 0; k + 1 < chain.size(); ++k) {
+      std::vector<Eigen3>& in = laid_[chain[k]];
+      std::vector<Eigen3>& out = laid_[chain[k + 1]];
+      for (size_t v = 1; v + 1 < poly.size(); ++v) {
+        const Eigen::Vector3d weld = vec(in.back());
+        if ((weld - vec(poly[v])).norm() > tol) continue;
+        const Eigen::Vector3d u_in = (vec(poly[v]) - vec(poly[v - 1])).normalized();
+        const Eigen::Vector3d u_out = (vec(poly[v + 1]) - vec(poly[v])).normalized();
+        const double delta =
+            1e-6 * std::min({cum[v] - cum[v - 1], cum[v + 1] - cum[v],
+                             lines_[chain[k]].length, lines_[chain[k + 1]].length});
+        const Eigen::Vector3d corner = vec(poly[v]);
+        const Eigen::Vector3d mid = corner + delta / 2 * (u_out - u_in);
+        in.back() = arr(corner - delta * u_in);
+        in.push_back(arr(mid));
+        out.front() = arr(mid);
+        out.insert(out.begin() + 1, arr(corner + delta * u_out));
+        break;
+      }
+      const Point& weld_point = points_.at(lines_[chain[k]].b);
+      point_rod_at_[weld_point.rod] = in.back();
+    }
+  }
+
+  // The end loads of the rods of zero length whose reference end (with
+  // EI > 0: MoorDyn's direction is its tangent, shared by a FIXED joint)
+  // is one of line `index`'s ends, as its tip loads.
+  void SetTipLoads(int index, double rho, v1::Hydrodynamics* h) const {
+    for (const auto& [id, join] : point_rods_) {
+      const PointRodEnd& ref = join.ends[join.reference];
+      if (ref.line != index || !ref.bending) continue;
+      const RodType& type = *rods_[id - 1].type;
+      const double d = type.diameter;
+      v1::TipLoad* tip = ref.line_end_b ? h->mutable_end_tip() : h->mutable_start_tip();
+      tip->set_drag_area(tip->drag_area() + 2 * type.cd_end * kPi * d * d / 4);
+      tip->set_added_mass(tip->added_mass() + 2 * rho * type.ca_end * kPi * d * d * d / 12);
+    }
+  }
+
   // The body channels (OUTPUTS Body<n>...): a probe "Body<n>" on the
   // scene body at the reference point (the columns Body<n>.x ... .az), and
   // output.orientation for a rotation's (the scene body's axes are the
@@ -1501,6 +1739,7 @@ class DeckReader {
   // do not touch it, as MoorDyn's.
   absl::StatusOr<v1::Scene> BuildRigidOnly(v1::Scene scene) const {
     if (absl::Status s = BuildBodiesAndRods(&scene); !s.ok()) return s;
+    if (absl::Status s = JoinAtPointRods(0); !s.ok()) return s;  // refuses a rod of zero length
     if (absl::Status s = AddBodyChannels(&scene); !s.ok()) return s;
     scene.mutable_solver()->set_analysis(v1::STATIC);
     return scene;
@@ -1828,16 +2067,32 @@ class DeckReader {
     }
     r.a_rel = Eigen::Vector3d(e[0], e[1], e[2]);
     r.b_rel = Eigen::Vector3d(e[3], e[4], e[5]);
-    if (!((r.b_rel - r.a_rel).norm() > 0)) {
-      return Error(n, "RODS Xb",
-                   "a rod of zero length (MoorDyn's point-like rod) cannot be expressed");
-    }
     // NumSegs only divides a MoorDyn rod's loads along it (the rod is
-    // rigid either way); 0 makes a point-like rod of end loads only.
-    if (!absl::SimpleAtoi(w[9], &r.segments) || r.segments < 1) {
+    // rigid either way); 0 makes a rod of zero length at end A: a joint of
+    // the lines at it with its ends' loads (JoinAtPointRods).
+    if (!absl::SimpleAtoi(w[9], &r.segments) || r.segments < 0) {
       return Error(n, "RODS NumSegs",
-                   absl::StrCat("must be a whole number >= 1 (got ", w[9],
-                                "; 0, MoorDyn's rod of end loads alone, cannot be expressed)"));
+                   absl::StrCat("must be a whole number >= 0 (got ", w[9], ")"));
+    }
+    const bool zero_length = !((r.b_rel - r.a_rel).norm() > 0);
+    if (r.segments == 0 && !zero_length) {
+      return Error(n, "RODS NumSegs",
+                   "0 makes a rod of zero length at end A (MoorDyn ignores end B's "
+                   "coordinates): give end B at end A");
+    }
+    if (r.segments > 0 && zero_length) {
+      return Error(n, "RODS NumSegs",
+                   "a rod of zero length has no direction: MoorDyn's point-like rod has "
+                   "NumSegs 0");
+    }
+    if (r.segments == 0 && r.mount != Mount::kFree) {
+      const bool pinned = r.mount == Mount::kPinned || r.mount == Mount::kCoupledPinned;
+      return Error(n, "RODS Attachment",
+                   pinned ? "a pinned rod of zero length cannot be expressed (MoorDyn turns a "
+                            "pinned rod by its rotational inertia, which a rod of zero length "
+                            "does not have)"
+                          : "a rod of zero length that is not Free (Fixed, Coupled, on a body) "
+                            "cannot be expressed yet");
     }
     rods_.push_back(r);
     return absl::OkStatus();
@@ -2203,6 +2458,7 @@ class DeckReader {
     // Rods of their own.
     for (const Rod& r : rods_) {
       if (r.mount == Mount::kOnBody) continue;
+      if (r.segments == 0) continue;  // a joint of its lines (JoinAtPointRods)
       const bool on_fixed_body = r.body > 0 && md_bodies_[r.body - 1].mount == Mount::kFixed;
       if (r.mount == Mount::kFixed) {
         rod_ends(r.id, [&](const Point&) { return held(); });
@@ -2280,6 +2536,12 @@ class DeckReader {
   std::vector<Rod> rods_;          // in ID order, from 1
   // What each body point and rod end (by point ID) is joined to (Build).
   mutable std::map<int, Holder> holders_;
+  // The rods of zero length (by rod ID), the lines laid as chains through
+  // them (by line index; empty: laid alone) and where the chains put the
+  // rods (JoinAtPointRods).
+  mutable std::map<int, PointRodJoin> point_rods_;
+  mutable std::vector<std::vector<Eigen3>> laid_;
+  mutable std::map<int, Eigen3> point_rod_at_;
 };
 
 }  // namespace

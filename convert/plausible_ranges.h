@@ -32,6 +32,8 @@ inline constexpr PlausibleRange kDensity{1e-6, 1e6, "kg/m^3"};
 // A soft gel to well above carbon nanotubes.
 inline constexpr PlausibleRange kYoungsModulus{1, 1e13, "Pa"};
 inline constexpr PlausibleRange kMass{1e-9, 1e9, "kg"};
+// A mass that may be 0 (a cable tip's added mass).
+inline constexpr PlausibleRange kMassOrZero{0, 1e9, "kg"};
 inline constexpr PlausibleRange kInertia{0, 1e15, "kg m^2"};
 // Each component of gravity (a centrifuge's 10,000 g is inside).
 inline constexpr PlausibleRange kGravity{-1e6, 1e6, "m/s^2"};

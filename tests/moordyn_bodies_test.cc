@@ -1063,5 +1063,211 @@ TEST(MoorDynBodiesTest, BodyDragWithoutVolume) {
   EXPECT_EQ(model->body_fluid_loads()[0].waterplane_area(), 0);
 }
 
+// ---- Rods of zero length (RODS NumSegs 0; convert/moordyn_deck.cc
+// JoinAtPointRods, docs/moordyn-files.md "Bodies and rods"): the joints and
+// tip loads a deck's rod becomes, a taut line split in two at such a rod
+// against the unsplit line and the closed form of a hanging bar, and the
+// refusals naming the deck's line.
+
+constexpr char kPointRodTypes[] = R"(----------------------- LINE TYPES ------------------------------------------
+TypeName   Diam    Mass/m     EA         BA/-zeta    EI         Cd     Ca     CdAx    CaAx
+(name)     (m)     (kg/m)     (N)        (N-s/-)     (N-m^2)    (-)    (-)    (-)     (-)
+cable      0.1     20         1.0e8      -0.5        1.0e5      1.2    1.0    0.0     0.0
+rope       0.1     20         1.0e8      -0.5        0          1.2    1.0    0.0     0.0
+soft       0.1     20         5.0e7      -0.5        1.0e3      1.2    1.0    0.0     0.0
+---------------------- ROD TYPES ------------------------------------
+TypeName      Diam     Mass/m    Cd     Ca      CdEnd    CaEnd
+(name)        (m)      (kg/m)    (-)    (-)     (-)      (-)
+conn          0.116    25        1.1    1.0     1.1      0.9
+)";
+
+// A taut vertical line from an anchor at -100 m to a fixed point at -10 m,
+// 89 m long, split at a rod of zero length (placed off the line: a free
+// rod's place is only where it starts) into 44.5 m and 44.5 m.
+std::string SplitDeck(const std::string& rods, const std::string& lines) {
+  return Deck(absl::StrCat(kPointRodTypes, R"(---------------------- RODS ----------------------------------------
+ID   RodType  Attachment  Xa    Ya    Za    Xb    Yb    Zb   NumSegs  RodOutputs
+(#)  (name)    (#/key)    (m)   (m)   (m)   (m)   (m)   (m)  (-)       (-)
+)",
+                           rods, R"(---------------------- POINTS --------------------------------
+ID    Type      X       Y       Z       Mass   Volume  CdA    Ca
+(#)   (-)       (m)     (m)     (m)     (kg)   (m^3)   (m^2)  (-)
+1     Fixed     0       0       -100    0      0       0      0
+2     Fixed     0       0       -10     0      0       0      0
+---------------------- LINES ----------------------------------------
+ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
+(#)   (name)     (#)      (#)       (m)       (-)     (-)
+)",
+                           lines, R"(----------------------- OUTPUTS -----------------------------------------
+AnchTen1
+FairTen2
+)"));
+}
+
+constexpr char kFreeRod[] = "1    conn       Free   1  0  -50   1  0  -50    0   -\n";
+
+TEST(MoorDynPointRodsTest, RodOfZeroLengthJoinsItsLinesAndCarriesItsEndLoads) {
+  // Lines 1 (ending at R1A) and 2 (starting at R1B) have EI > 0: a FIXED
+  // joint; line 3 (EI 0) is pinned to line 1's end.
+  const std::string deck = absl::StrReplaceAll(
+      SplitDeck(kFreeRod, "1 cable 1 R1A 44.5 10 -\n2 cable R1B 2 44.5 10 -\n"
+                          "3 rope R1A 3 20 10 -\n"),
+      {{"2     Fixed     0       0       -10     0      0       0      0\n",
+        "2     Fixed     0       0       -10     0      0       0      0\n"
+        "3     Fixed     15      0       -55     0      0       0      0\n"}});
+  const absl::StatusOr<v1::Scene> s = SceneFromMoorDyn(deck, "test.dat");
+  ASSERT_TRUE(s.ok()) << s.status();
+  ASSERT_EQ(s->cables_size(), 3);
+  EXPECT_EQ(s->bodies_size(), 0) << "a rod of zero length has no mass: no body";
+  int fixed = 0, pinned = 0;
+  for (const v1::Joint& j : s->joints()) {
+    if (!j.b().cable().empty()) {
+      EXPECT_EQ(j.b().cable(), "line1");
+      EXPECT_DOUBLE_EQ(j.b().s(), 44.5);
+      if (j.type() == v1::FIXED) {
+        ++fixed;
+        EXPECT_EQ(j.a().cable(), "line2");
+        EXPECT_DOUBLE_EQ(j.a().s(), 0);
+      } else {
+        ++pinned;
+        EXPECT_EQ(j.type(), v1::PIN);
+        EXPECT_EQ(j.a().cable(), "line3");
+        EXPECT_DOUBLE_EQ(j.a().s(), 0);
+      }
+    }
+  }
+  EXPECT_EQ(fixed, 1);
+  EXPECT_EQ(pinned, 1);
+  // Both ends' loads on line 1's end B (the first line with EI > 0):
+  // 2 CdEnd pi d^2 / 4 and 2 rho CaEnd pi d^3 / 12.
+  const double d = 0.116;
+  const v1::Hydrodynamics& h = s->cables(0).hydrodynamics();
+  EXPECT_DOUBLE_EQ(h.end_tip().drag_area(), 2 * 1.1 * kPi * d * d / 4);
+  EXPECT_DOUBLE_EQ(h.end_tip().added_mass(), 2 * kRho * 0.9 * kPi * d * d * d / 12);
+  EXPECT_FALSE(h.has_start_tip());
+  for (int c = 1; c < 3; ++c) {
+    EXPECT_FALSE(s->cables(c).hydrodynamics().has_start_tip()) << c;
+    EXPECT_FALSE(s->cables(c).hydrodynamics().has_end_tip()) << c;
+  }
+  // Laid as one chain: line 1 ends where line 2 starts, on the straight
+  // line between the points (the rod moved there from x = 1), and line 3
+  // starts there too.
+  const v1::Vec3& end1 = s->cables(0).points(s->cables(0).points_size() - 1);
+  const v1::Vec3& start2 = s->cables(1).points(0);
+  const v1::Vec3& start3 = s->cables(2).points(0);
+  EXPECT_DOUBLE_EQ(end1.x(), 0);
+  EXPECT_NEAR(end1.z(), -55, 1e-12);
+  EXPECT_DOUBLE_EQ(start2.z(), end1.z());
+  EXPECT_DOUBLE_EQ(start3.z(), end1.z());
+  EXPECT_TRUE(SceneFromProto(*s).ok());
+}
+
+TEST(MoorDynPointRodsTest, RodWithoutALineOfBendingStiffnessCarriesNoEndLoads) {
+  // MoorDyn's direction is then the zero vector: no end loads; the lines
+  // are pinned.
+  const absl::StatusOr<v1::Scene> s = SceneFromMoorDyn(
+      SplitDeck(kFreeRod, "1 rope 1 R1A 44.5 10 -\n2 rope R1B 2 44.5 10 -\n"), "test.dat");
+  ASSERT_TRUE(s.ok()) << s.status();
+  for (const v1::Cable& c : s->cables()) {
+    EXPECT_FALSE(c.hydrodynamics().has_start_tip());
+    EXPECT_FALSE(c.hydrodynamics().has_end_tip());
+  }
+  ASSERT_EQ(s->joints_size(), 3);
+  EXPECT_EQ(s->joints(1).type(), v1::PIN);
+  EXPECT_EQ(s->joints(1).b().cable(), "line1");
+}
+
+// The top and bottom tensions of the taut line (deck's probes AnchTen1
+// and FairTen2 or FairTen1).
+std::pair<double, double> Tensions(const std::string& deck) {
+  const absl::StatusOr<v1::Scene> proto = SceneFromMoorDyn(deck, "test.dat");
+  EXPECT_TRUE(proto.ok()) << proto.status();
+  if (!proto.ok()) return {0, 0};
+  const absl::StatusOr<Scene> scene = SceneFromProto(*proto);
+  EXPECT_TRUE(scene.ok()) << scene.status();
+  if (!scene.ok()) return {0, 0};
+  CollectingSink sink;
+  RunOk(*scene, &sink);
+  const Frame& last = sink.frames().back();
+  EXPECT_EQ(last.probe_tensions.size(), 2u);
+  return {last.probe_tensions[0], last.probe_tensions[1]};
+}
+
+TEST(MoorDynPointRodsTest, TautLineSplitAtARodOfZeroLengthCarriesTheUnsplitTension) {
+  const auto [bottom_split, top_split] =
+      Tensions(SplitDeck(kFreeRod, "1 cable 1 R1A 44.5 10 -\n2 cable R1B 2 44.5 10 -\n"));
+  std::string whole = SplitDeck("", "1 cable 1 2 89 20 -\n");
+  whole = absl::StrReplaceAll(whole, {{"FairTen2", "FairTen1"}});
+  const auto [bottom, top] = Tensions(whole);
+  // The closed form: a bar of wet weight w per unit length between points
+  // 90 m apart, unstretched 89 m, stretches by (T0 L + w L^2 / 2) / EA
+  // (T0 at the bottom, engineering strain).
+  const double length = 89, ea = 1e8;
+  const double w = kG * (20 - kRho * kPi * 0.1 * 0.1 / 4);
+  const double t0 = ((90 - length) * ea - w * length * length / 2) / length;
+  std::printf("split: %.9g %.9g N, whole: %.9g %.9g N, closed form: %.9g %.9g N\n",
+              bottom_split, top_split, bottom, top, t0, t0 + w * length);
+  // Newton's tolerance and the elements' end forces (as the hanging rod's
+  // test in moordyn_bodies_test.cc): 1e-6 relative.
+  EXPECT_NEAR(bottom, t0, 1e-6 * t0);
+  EXPECT_NEAR(top, t0 + w * length, 1e-6 * t0);
+  EXPECT_NEAR(bottom_split, t0, 1e-6 * t0);
+  EXPECT_NEAR(top_split, t0 + w * length, 1e-6 * t0);
+}
+
+// A sagging line with bending stiffness (EI 1e5 N m^2: a bending length
+// sqrt(EI / T) of some 8 m at its 1.7 kN) between points 60 m apart at
+// the same depth, split at its middle: the FIXED weld keeps it one smooth
+// line (a PIN there would let it kink), so the statics are the unsplit
+// line's, node for node (the split's nodes are the unsplit's); 1e-6 of
+// the tension (Newton's tolerance).
+TEST(MoorDynPointRodsTest, SaggingLineSplitAtARodOfZeroLengthStaysOneSmoothLine) {
+  const std::pair<std::string, std::string> beside = {
+      "2     Fixed     0       0       -10 ", "2     Fixed     60      0       -100"};
+  const auto [bottom_split, top_split] = Tensions(absl::StrReplaceAll(
+      SplitDeck(kFreeRod, "1 cable 1 R1A 44.5 10 -\n2 cable R1B 2 44.5 10 -\n"), {beside}));
+  const auto [bottom, top] = Tensions(absl::StrReplaceAll(
+      SplitDeck("", "1 cable 1 2 89 20 -\n"), {beside, {"FairTen2", "FairTen1"}}));
+  std::printf("sagging, split: %.9g %.9g N, whole: %.9g %.9g N\n", bottom_split, top_split,
+              bottom, top);
+  EXPECT_NEAR(bottom_split, bottom, 1e-6 * bottom);
+  EXPECT_NEAR(top_split, top, 1e-6 * top);
+}
+
+TEST(MoorDynPointRodsTest, RefusalsNameTheLineAndField) {
+  const std::string two = "1 cable 1 R1A 44.5 10 -\n2 cable R1B 2 44.5 10 -\n";
+  // On a body, pinned, fixed: not a free rod.
+  std::string m = Refusal(SplitDeck("1 conn Pinned 1 0 -50 1 0 -50 0 -\n", two));
+  EXPECT_NE(m.find("bad.dat:16: RODS Attachment: a pinned rod of zero length"), std::string::npos)
+      << m;
+  m = Refusal(SplitDeck("1 conn Fixed 1 0 -50 1 0 -50 0 -\n", two));
+  EXPECT_NE(m.find("bad.dat:16: RODS Attachment: a rod of zero length that is not Free"),
+            std::string::npos)
+      << m;
+  // NumSegs 0 with end B elsewhere; zero length with NumSegs 1.
+  m = Refusal(SplitDeck("1 conn Free 1 0 -50 1 0 -49 0 -\n", two));
+  EXPECT_NE(m.find("bad.dat:16: RODS NumSegs: 0 makes a rod of zero length at end A"),
+            std::string::npos)
+      << m;
+  m = Refusal(SplitDeck("1 conn Free 1 0 -50 1 0 -50 1 -\n", two));
+  EXPECT_NE(m.find("bad.dat:16: RODS NumSegs: a rod of zero length has no direction"),
+            std::string::npos)
+      << m;
+  // Head to head (both lines end at the rod, at its two ends).
+  m = Refusal(SplitDeck(kFreeRod, "1 cable 1 R1A 44.5 10 -\n2 cable 2 R1B 44.5 10 -\n"));
+  EXPECT_NE(m.find("bad.dat:26: LINES AttachB: lines 1 and 2 meet at rod 1"), std::string::npos)
+      << m;
+  // Different EA.
+  m = Refusal(SplitDeck(kFreeRod, "1 cable 1 R1A 44.5 10 -\n2 soft R1B 2 44.5 10 -\n"));
+  EXPECT_NE(m.find("bad.dat:26: LINES LineType: lines 1 and 2 meet at rod 1 (of zero length) "
+                   "with different EA"),
+            std::string::npos)
+      << m;
+  // A rod of zero length with no line.
+  m = Refusal(SplitDeck(kFreeRod, "1 cable 1 2 89 20 -\n"));
+  EXPECT_NE(m.find("bad.dat:16: RODS ID: a rod of zero length with no line"), std::string::npos)
+      << m;
+}
+
 }  // namespace
 }  // namespace cablesim

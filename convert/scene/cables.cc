@@ -230,6 +230,22 @@ absl::Status ConvertCable(ConversionState* state, int i, CableSpec* cable) {
           CheckPositiveInRange(Sub(hydro_path, "diameter"), h.diameter(), plausible::kSize));
       cable->hydro_diameter_m = h.diameter();
     }
+    for (int end = 0; end < 2; ++end) {
+      const v1::TipLoad& tip = end == 0 ? h.start_tip() : h.end_tip();
+      const std::string tip_path = Sub(hydro_path, end == 0 ? "start_tip" : "end_tip");
+      const std::string area_path = Sub(tip_path, "drag_area");
+      const std::string mass_path = Sub(tip_path, "added_mass");
+      CABLESIM_RETURN_IF_ERROR(CheckNonNegative(area_path, tip.drag_area()));
+      CABLESIM_RETURN_IF_ERROR(CheckRange(area_path, tip.drag_area(), plausible::kDragArea));
+      CABLESIM_RETURN_IF_ERROR(CheckNonNegative(mass_path, tip.added_mass()));
+      CABLESIM_RETURN_IF_ERROR(CheckRange(mass_path, tip.added_mass(), plausible::kMassOrZero));
+      if ((tip.drag_area() != 0 || tip.added_mass() != 0) && c.has_winch()) {
+        return Invalid(tip_path, "a tip load on a winch cable is not modelled (its end nodes "
+                                 "move with the mesh, not the material)");
+      }
+      cable->tip_drag_area_m2[end] = tip.drag_area();
+      cable->tip_added_mass_kg[end] = tip.added_mass();
+    }
   }
   switch (c.axial_law()) {
     case v1::AXIAL_LAW_UNSPECIFIED:

@@ -9,13 +9,29 @@ namespace cablesim {
 template <int D>
 void CableAddedMass::Add(const AncfCableElement<D>& element, int index,
                          const typename AncfCableElement<D>::Coords& e,
-                         const typename AncfCableElement<D>::Coords& edd, double t,
+                         const typename AncfCableElement<D>::Coords& edd, double t_s,
                          typename AncfCableElement<D>::Coords* force,
                          typename AncfCableElement<D>::Matrix* m) const {
   const Element& p = elements_[index];
   if (!p.any(surface_.enabled)) return;
+  for (int end = 0; end < 2; ++end) {
+    if (p.tip_mass[end] == 0) continue;
+    const int i = 2 * D * end;  // the node's position coordinates
+    Eigen::Vector3d r = Eigen::Vector3d::Zero(), t = Eigen::Vector3d::Zero();
+    r.head<D>() = e.template segment<D>(i);
+    t.head<D>() = e.template segment<D>(i + D);
+    const double stretch = t.norm();
+    if (!(stretch > 0)) continue;
+    t /= stretch;
+    if (!surface_.Wet(r, surface_.enabled && waves_ ? waves_->ElevationAt(r, t_s) : 0.0)) continue;
+    const Eigen::Matrix3d tt3 = p.tip_mass[end] * t * t.transpose();
+    const Eigen::Matrix<double, D, D> tt = tt3.topLeftCorner<D, D>();
+    force->template segment<D>(i) -= tt * edd.template segment<D>(i);
+    if (m != nullptr) m->template block<D, D>(i, i) += tt;
+  }
+  if (!p.distributed(surface_.enabled)) return;
   bool wet[GaussRule::kMaxPoints];
-  surface_.WetPoints<D>(element, e, waves_, t, wet);
+  surface_.WetPoints<D>(element, e, waves_, t_s, wet);
   double a_n[GaussRule::kMaxPoints], a_t[GaussRule::kMaxPoints];
   for (int g = 0; g < element.gauss_points(); ++g) {
     // D = m_a - rho_f A C_a I, split across (a_n) and along (a_t) [kg/m].

@@ -38,6 +38,12 @@
 // (t turning, a point crossing the surface): the energy balance carries
 // 1/2 qdot^T Ddot qdot, as a line's energy does in MoorDyn's lumped model.
 //
+// Tip loads (Hydrodynamics.start_tip, end_tip): an added mass m [kg]
+// along the unit tangent t at a cable's first or last node (MoorDyn's rod
+// of zero length), D_tip = m t t^T on the node's position coordinates
+// while the node is under the surface: force -m t t^T a, and m t t^T
+// joins the Newton matrix (the derivative through t left out, as above).
+//
 // Units SI. Allocates nothing.
 
 #include <memory>
@@ -55,9 +61,14 @@ class CableAddedMass {
     double displaced_kg_m = 0;  // rho_f A [kg/m]
     double added_mass = 0;      // C_a, across (and in the mass matrix) [-]
     double axial_added_mass = 0;  // C_a,ax [-]
-    bool any(bool surface) const {
+    // The tip added mass at the element's first [0] and last [1] node [kg].
+    double tip_mass[2] = {0, 0};
+    bool distributed(bool surface) const {
       return displaced_kg_m != 0 &&
              (axial_added_mass != added_mass || (surface && added_mass != 0));
+    }
+    bool any(bool surface) const {
+      return distributed(surface) || tip_mass[0] != 0 || tip_mass[1] != 0;
     }
   };
   // Per element of the model, in its order; `waves` the wave field whose

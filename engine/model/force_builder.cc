@@ -173,6 +173,7 @@ void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* 
       table = std::make_shared<const TensionTable>(cable.tension_table_strains,
                                                    cable.tension_table_tensions);
     }
+    const size_t first_element = fluid_elements_.size();
     for (int k = first_node[c]; k + 1 < first_node[c + 1]; ++k) {
       if (mesh_.twin_of[k + 1] == k) continue;  // the two halves of a split node
       const int local = k - first_node[c];
@@ -217,6 +218,16 @@ void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* 
       for (int a = 0; a < 4; ++a)
         for (int b = 0; b < 4; ++b) e.mbar(a, b) = me(D * a, D * b);
       elements->push_back(e);
+    }
+    // Tip loads (Hydrodynamics.start_tip, end_tip) on the first element's
+    // first node and the last element's last node.
+    if (rho_f > 0 && fluid_elements_.size() > first_element) {
+      for (int end = 0; end < 2; ++end) {
+        const size_t k = end == 0 ? first_element : fluid_elements_.size() - 1;
+        fluid_elements_[k].tip_drag[end] = 0.5 * rho_f * cable.tip_drag_area_m2[end];
+        if (model_.wave_load_) fluid_elements_[k].tip_inertia[end] = cable.tip_added_mass_kg[end];
+        added_mass_elements_[k].tip_mass[end] = cable.tip_added_mass_kg[end];
+      }
     }
     model_.cable_element_begin_.push_back(static_cast<int>(elements->size()));
   }

@@ -336,6 +336,9 @@ absl::Status ModelBuilder::CheckIntegratorFits() const {
         why = absl::StrFormat("cables[%d].hydrodynamics.axial_added_mass differs from its "
                               "added_mass",
                               c);
+      } else if (cable.tip_added_mass_kg[0] != 0 || cable.tip_added_mass_kg[1] != 0) {
+        why = absl::StrFormat("cables[%d].hydrodynamics.%s.added_mass acts along the tangent", c,
+                              cable.tip_added_mass_kg[0] != 0 ? "start_tip" : "end_tip");
       } else if (scene_.fluid.free_surface && cable.added_mass != 0) {
         why = absl::StrFormat("fluid.free_surface takes cables[%d]'s added mass off above the "
                               "surface",

@@ -104,6 +104,16 @@ struct CableSpec {
   bool has_axial_added_mass = false;
   double axial_added_mass = 0;
   double hydro_diameter_m = 0;
+  // Concentrated fluid loads along the tangent at the cable's start [0]
+  // and end [1] (Hydrodynamics.start_tip, end_tip): drag area C_d A [m^2]
+  // and added mass [kg] (engine/forces/cable_fluid_load.h,
+  // cable_added_mass.h).
+  double tip_drag_area_m2[2] = {0, 0};
+  double tip_added_mass_kg[2] = {0, 0};
+  bool has_tip_loads() const {
+    return tip_drag_area_m2[0] != 0 || tip_drag_area_m2[1] != 0 || tip_added_mass_kg[0] != 0 ||
+           tip_added_mass_kg[1] != 0;
+  }
   WinchSpec winch;  // disabled: the length is fixed
   // The seabed's normal stiffness [N/m^2] and damping [N s/m^2] per unit
   // length of this cable when it has its own (a mooring deck's kBot and
