@@ -4,6 +4,8 @@
 // differences of the force; rigid motions and rotations.
 
 #include "engine/elements/ancf_cable_element.h"
+#include "engine/elements/gauss_quadrature.h"
+#include "engine/elements/hermite_shape.h"
 
 #include <cmath>
 #include <random>
@@ -309,6 +311,62 @@ TEST(AncfCableElementTest, FiveGaussPointsConvergeTheExactCurvatureEnergy) {
   std::printf("5 vs 8 Gauss points, exact bending energy: worst relative difference %.3g\n",
               worst);
   EXPECT_LT(worst, 1e-5);
+}
+
+// AddDirectionalMass sums only the node blocks k <= j of its symmetric
+// matrix and mirrors them: against the plain 16-block quadrature
+// sum_g w_g l S_g^T A_g S_g, A_g = a_n I + (a_t - a_n) t t^T, with a
+// different mass per point and a point without one (skipped). Tolerance
+// 1e-13 relative: five-term sums of terms of one sign per entry, a few
+// eps each; a lower block left unset or taken from the wrong upper block
+// is off by O(1).
+TEST(AncfCableElementTest, DirectionalMassMatrixIsTheQuadratureOfItsTensor) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const E3 element(kLength, kEA, 0, BendingModel::kNone);
+  for (int trial = 0; trial < 5; ++trial) {
+    const E3::Coords e = RandomLargeDeformation<3>(&rng);
+    E3::Coords edd;
+    for (int i = 0; i < 12; ++i) edd(i) = u(rng);
+    double a_n[GaussRule::kMaxPoints], a_t[GaussRule::kMaxPoints];
+    for (int g = 0; g < GaussRule::kMaxPoints; ++g) {
+      a_n[g] = 1.5 + 0.3 * u(rng);  // kg/m
+      a_t[g] = 0.2 + 0.1 * u(rng);
+    }
+    a_n[2] = a_t[2] = 0;  // no mass at the middle point
+    E3::Matrix m = E3::Matrix::Zero();
+    E3::Coords force = E3::Coords::Zero();
+    element.AddDirectionalMass(e, edd, a_n, a_t, &force, &m);
+
+    const GaussRule rule = MakeGaussRule(element.gauss_points());
+    E3::Matrix ref = E3::Matrix::Zero();
+    for (int g = 0; g < rule.n; ++g) {
+      double s[4], s1[4];
+      HermiteShape(rule.xi[g], kLength, s);
+      HermiteShapeD1(rule.xi[g], kLength, s1);
+      Eigen::Vector3d slope = Eigen::Vector3d::Zero();
+      for (int k = 0; k < 4; ++k) slope += s1[k] * e.segment<3>(3 * k);
+      const Eigen::Vector3d t = slope.normalized();
+      const Eigen::Matrix3d a =
+          a_n[g] * Eigen::Matrix3d::Identity() + (a_t[g] - a_n[g]) * t * t.transpose();
+      for (int k = 0; k < 4; ++k)
+        for (int j = 0; j < 4; ++j)
+          ref.block<3, 3>(3 * k, 3 * j) += rule.weight[g] * kLength * s[k] * s[j] * a;
+    }
+    EXPECT_LE((m - ref).cwiseAbs().maxCoeff(), 1e-13 * ref.cwiseAbs().maxCoeff()) << trial;
+    // The inertia force is -M edd (the same quadrature).
+    const E3::Coords f_ref = -ref * edd;
+    EXPECT_LE((force - f_ref).cwiseAbs().maxCoeff(), 1e-13 * f_ref.cwiseAbs().maxCoeff())
+        << trial;
+    // Mirrored: each lower block exactly the transpose of its upper one
+    // (the diagonal blocks carry A_g's own last-bit asymmetry).
+    for (int k = 0; k < 4; ++k)
+      for (int j = k + 1; j < 4; ++j) {
+        const Eigen::Matrix3d up = m.block<3, 3>(3 * k, 3 * j);
+        const Eigen::Matrix3d lo = m.block<3, 3>(3 * j, 3 * k);
+        EXPECT_EQ((lo - up.transpose()).cwiseAbs().maxCoeff(), 0.0) << trial << k << j;
+      }
+  }
 }
 
 }  // namespace

@@ -11,6 +11,36 @@
 #include "engine/elements/hermite_shape.h"
 
 namespace cablesim {
+namespace {
+
+// upper += wl S^T h S on the node blocks k <= j of a 4D x 4D matrix whose
+// node block (k, j) is sum over points of (wl s_k s_j) h: the symmetric
+// element matrices' (added mass, drag tangent) upper blocks, each
+// coefficient and product as a sum over all 16 blocks forms it.
+template <int D>
+void AddUpperShapeBlocks(double wl, const double* s, const Eigen::Matrix<double, D, D>& h,
+                         Eigen::Matrix<double, 4 * D, 4 * D>* upper) {
+  for (int k = 0; k < 4; ++k)
+    for (int j = k; j < 4; ++j) upper->template block<D, D>(k * D, j * D) += (wl * s[k] * s[j]) * h;
+}
+
+// m += U with U's blocks k <= j and their transposes below: 10 of the 16
+// block sums, the lower 6 mirrored (each the upper block's transpose, equal
+// to its own sum up to the rounding of s_j s_k against s_k s_j and of h's
+// asymmetry by an ulp; the Newton matrix reads only the upper blocks).
+template <int D>
+void AddMirroredUpperBlocks(const Eigen::Matrix<double, 4 * D, 4 * D>& upper,
+                            Eigen::Matrix<double, 4 * D, 4 * D>* m) {
+  for (int k = 0; k < 4; ++k) {
+    m->template block<D, D>(k * D, k * D) += upper.template block<D, D>(k * D, k * D);
+    for (int j = k + 1; j < 4; ++j) {
+      m->template block<D, D>(k * D, j * D) += upper.template block<D, D>(k * D, j * D);
+      m->template block<D, D>(j * D, k * D) += upper.template block<D, D>(k * D, j * D).transpose();
+    }
+  }
+}
+
+}  // namespace
 
 template <int D>
 AncfCableElement<D>::AncfCableElement(double length_m, double ea_n, double ei_n_m2,
@@ -313,6 +343,11 @@ void AncfCableElement<D>::AddMorison(const Coords& e, const Coords& edot,
     }
     for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) += (wl * s0[k]) * p.q;
     if (!c) continue;
+    // All 16 blocks, summed into c as they come: c holds other terms'
+    // tangents on entry, and the upper blocks' sums in this order are
+    // what the Newton matrix reads (summing the 10 upper blocks apart and
+    // mirroring them, as AddDirectionalMass does, moved the OC4 mooring's
+    // output by 1e-12 relative).
     for (int k = 0; k < 4; ++k)
       for (int m = 0; m < 4; ++m)
         c->template block<D, D>(k * D, m * D) += (wl * s0[k] * s0[m]) * p.h;
@@ -372,6 +407,8 @@ void AncfCableElement<D>::AddDirectionalMass(const Coords& e, const Coords& edd,
   // of the points, as one pass would add them (the same roundings).
   Block a[GaussRule::kMaxPoints];
   Point q[GaussRule::kMaxPoints];
+  Matrix upper;  // the matrix's blocks k <= j (`m` only)
+  if (m) upper.setZero();
   for (int g = 0; g < rule_.n; ++g) {
     if (a_n[g] == 0 && a_t[g] == 0) continue;
     const double* s0 = s0_[g];
@@ -395,10 +432,10 @@ void AncfCableElement<D>::AddDirectionalMass(const Coords& e, const Coords& edd,
     const double wl = rule_.weight[g] * length_;
     for (int k = 0; k < 4; ++k) force->template segment<D>(k * D) -= (wl * s0[k]) * q[g];
     if (!m) continue;
-    for (int k = 0; k < 4; ++k)
-      for (int j = 0; j < 4; ++j)
-        m->template block<D, D>(k * D, j * D) += (wl * s0[k] * s0[j]) * a[g];
+    // Symmetric: the blocks k <= j only, mirrored below.
+    AddUpperShapeBlocks<D>(wl, s0, a[g], &upper);
   }
+  if (m) AddMirroredUpperBlocks<D>(upper, m);
 }
 
 namespace {

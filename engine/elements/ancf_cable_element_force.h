@@ -123,7 +123,15 @@ void AncfCableElement<D>::ElasticForceWith(const Coords& e, Coords* force, Matri
       const double dgw = wl * (nuw * du + nww * dw + kEps * gw.template lpNorm<1>());
       for (int k = 0; k < 4; ++k) node_bound[k] += std::abs(s1[k]) * dgu + std::abs(s2[k]) * dgw;
     }
-    if (tangent) AddUpperBlocks(g, wl, huu, huw, hww, tangent);
+    if (tangent) {
+      // Without bending huw = hww = 0 by construction: AddUpperBlocks'
+      // test for that (18 compares per point) skipped.
+      if (bending_ == BendingModel::kNone) {
+        AddUpperAxialBlocks(g, wl, huu, tangent);
+      } else {
+        AddUpperBlocks(g, wl, huu, huw, hww, tangent);
+      }
+    }
   }
   if (roundoff)
     for (int k = 0; k < 4; ++k) roundoff->template segment<D>(k * D).array() += node_bound[k];

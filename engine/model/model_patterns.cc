@@ -19,6 +19,8 @@ void ModelBuilder::SetupElementSlots(const std::vector<MultibodyModel::ElementDa
   constexpr int kN = 4 * D, kN2 = kN * kN;
   m.element_slots_.resize(kN2 * elements.size());
   m.element_factors_.resize(kN2 * elements.size());
+  m.element_scatter_.clear();
+  m.element_scatter_begin_.assign(elements.size() + 1, 0);
   for (size_t k = 0; k < elements.size(); ++k) {
     if (k % 65536 == 0 && Stopped()) return;
     const MultibodyModel::ElementData<D>& e = elements[k];
@@ -33,6 +35,11 @@ void ModelBuilder::SetupElementSlots(const std::vector<MultibodyModel::ElementDa
         m.element_factors_[kN2 * k + kN * a + b] = slot < 0 ? 0 : m.s_(ia) * m.s_(ib);
       }
     }
+    for (int t = 0; t < kN2; ++t)
+      if (m.element_slots_[kN2 * k + t] >= 0)
+        m.element_scatter_.push_back(
+            {m.element_slots_[kN2 * k + t], t, m.element_factors_[kN2 * k + t]});
+    m.element_scatter_begin_[k + 1] = static_cast<int>(m.element_scatter_.size());
     const auto me = e.element.MassMatrix(e.mass_per_length);
     for (int t = 0; t < kN2; ++t) {
       const int slot = m.element_slots_[kN2 * k + t];

@@ -748,14 +748,26 @@ class MultibodyModel {
   // Per element, the (4D)^2 skyline slots (or -1) and factors s_a s_b.
   std::vector<int> element_slots_;
   std::vector<double> element_factors_;
+  // The same, only the entries with a slot (about half: the skyline holds
+  // one triangle), in the order of t: element k's are
+  // element_scatter_[element_scatter_begin_[k] .. element_scatter_begin_[k + 1]).
+  struct ScatterEntry {
+    int slot;
+    int t;  // index into the element's (4D)^2 matrix data
+    double factor;
+  };
+  std::vector<ScatterEntry> element_scatter_;
+  std::vector<int> element_scatter_begin_;
   // Adds scale times element k's symmetric (4D)^2 matrix m (either storage
   // order) to the skyline `values` through those slots; kN2 = (4D)^2.
+  // The entries without a slot are not visited (a test per entry cost the
+  // OC4 mooring's damping, force and added-mass loops 6 % of its run);
+  // the sums are the same, in the same order.
   template <int kN2>
   void ScatterElementMatrix(int k, const double* m, double scale, double* values) const {
-    const int* slots = &element_slots_[kN2 * k];
-    const double* factors = &element_factors_[kN2 * k];
-    for (int t = 0; t < kN2; ++t)
-      if (slots[t] >= 0) values[slots[t]] += scale * factors[t] * m[t];
+    const ScatterEntry* entry = element_scatter_.data() + element_scatter_begin_[k];
+    const ScatterEntry* end = element_scatter_.data() + element_scatter_begin_[k + 1];
+    for (; entry < end; ++entry) values[entry->slot] += scale * entry->factor * m[entry->t];
   }
   SparseRows jac_pattern_;
   // Scratch (full size) for NetForce.
