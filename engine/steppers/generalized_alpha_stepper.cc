@@ -10,6 +10,7 @@ namespace cablesim {
 GeneralizedAlphaStepper::GeneralizedAlphaStepper(MultibodyModel* model,
                                                  const SolverSettings& settings, Variant variant)
     : ImplicitStepper(model, settings), variant_(variant) {
+  finish_on_last_matrix_ = true;  // ImplicitStepper::kFinishRatio
   const double rho = std::clamp(settings.rho_infinity, 0.0, 1.0);
   if (variant == Variant::kGeneralizedAlpha) {
     alpha_m_ = (2 * rho - 1) / (rho + 1);

@@ -65,6 +65,9 @@ Stepper::StepStats ImplicitStepper::Newton(bool fresh, bool reuse) {
   const double tol = settings_.newton_tolerance;
   double last_increment = 0, previous_increment = 0;
   bool previous_at_floor = false;
+  // Whether this solve may still finish on the last factored matrix
+  // (kFinishOnLastMatrix): false once doing so failed to contract.
+  bool may_finish_on_last = finish_on_last_matrix_ && fresh && !reuse;
   for (int it = 0; it <= settings_.max_newton_iterations; ++it) {
     PlaceIterate();
     // A checking iteration follows a correction already below tol: it is
@@ -73,9 +76,24 @@ Stepper::StepStats ImplicitStepper::Newton(bool fresh, bool reuse) {
     // The rounding floor is needed where convergence is judged (and for the
     // message of the last iteration), unless the residual is below tol.
     const bool judge = checking || it == settings_.max_newton_iterations;
+    // A fresh matrix every iteration (reuse false) stops refreshing once
+    // Newton is in its quadratic phase near the solution: the last
+    // correction shrank at least kFinishRatio times against the one before
+    // and is within kFinishNear of the convergence test's tol (1 + |z|).
+    // The matrix of the iterate before then differs from a fresh one by
+    // O(correction) (relative), so the corrections still contract about as
+    // fast, and the iteration skips the matrix's assembly and its
+    // factoring (measured: OC4's three lines, 10 elements, h = 0.75 s:
+    // factorizations 2,638 -> 2,046, Newton iterations 2,743 -> 2,853,
+    // instructions -9.5 %, fairlead tensions within 5e-10). A correction
+    // that did not halve asks for fresh matrices again for the rest of
+    // the solve. Convergence is judged as before, on the true residual.
+    const bool finish_on_last =
+        may_finish_on_last && it >= 2 && last_increment <= kFinishRatio * previous_increment &&
+        last_increment <= kFinishNear * tol * (1 + z1_.lpNorm<Eigen::Infinity>());
     // Assemble the Newton matrix with the forces when this iteration will
     // need a fresh one and is not expected to be the converged one.
-    const bool assemble = fresh && !checking;
+    const bool assemble = fresh && !checking && !finish_on_last;
     // The forces' rounding bound in the same pass when the last step was
     // accepted at its floor: this one most likely will be too.
     const bool with_floor =
@@ -105,7 +123,7 @@ Stepper::StepStats ImplicitStepper::Newton(bool fresh, bool reuse) {
       if (reuse) kept_.refresh = true;
       return st;
     }
-    if (fresh) {
+    if (fresh && !finish_on_last) {
       if (!FactorMatrix(assemble, &st)) return st;
       // Keep this matrix for the next iterations only when asked to.
       fresh = !reuse;
@@ -120,6 +138,7 @@ Stepper::StepStats ImplicitStepper::Newton(bool fresh, bool reuse) {
       if (reuse) kept_.refresh = true;
       return st;
     }
+    if (finish_on_last && increment > 0.5 * last_increment) may_finish_on_last = false;
     // Safeguard of the kept matrix: slow contraction asks for a fresh one.
     if (reuse && it > 0 && increment > 0.5 * last_increment) fresh = true;
     previous_increment = last_increment;
