@@ -85,8 +85,8 @@ TEST(RunWarningsTest, TheWireAtStepTwoWarnsAndFailsUnderStrict) {
   EXPECT_EQ(s.status, "ok");  // what it was before: finished, status ok
   EXPECT_DOUBLE_EQ(s.error_tolerance_m, 0.2);  // 1 % of the 20 m wire
   EXPECT_GT(s.local_error_estimate_m, s.error_tolerance_m);
-  EXPECT_TRUE(HasWarning(s, "exceeds the tolerance")) << testing::PrintToString(s.warnings);
-  EXPECT_TRUE(HasWarning(s, "steps were cut to")) << testing::PrintToString(s.warnings);
+  EXPECT_TRUE(HasWarning(s, "exceeds the tolerance")) << ::testing::PrintToString(s.warnings);
+  EXPECT_TRUE(HasWarning(s, "steps were cut to")) << ::testing::PrintToString(s.warnings);
 
   const RunSummary strict =
       RunJson(Wire(R"("duration": 10, "step": 2, "output_interval": 2, "strict": true)"));
@@ -102,7 +102,7 @@ TEST(RunWarningsTest, InexactSolvesAccepted) {
   EXPECT_EQ(s.status, "ok");
   ASSERT_GT(s.inexact_linear_solves, 0);
   EXPECT_TRUE(HasWarning(s, "linear solves were accepted inexact"))
-      << testing::PrintToString(s.warnings);
+      << ::testing::PrintToString(s.warnings);
 }
 
 // The sample falling pendulum (its trajectory checked against the
@@ -124,7 +124,7 @@ TEST(RunWarningsTest, TheFallingPendulumIsQuiet) {
   // No run warning: only the scene's one plausibility warning (the paper's
   // soft beam would stretch 9 % hanging, tests/plausibility_warnings_test.cc).
   ASSERT_EQ(s->warnings, scene->warnings);
-  ASSERT_EQ(s->warnings.size(), 1u) << testing::PrintToString(s->warnings);
+  ASSERT_EQ(s->warnings.size(), 1u) << ::testing::PrintToString(s->warnings);
   EXPECT_TRUE(absl::StrContains(s->warnings[0], "static strain"));
 }
 

@@ -958,7 +958,7 @@ TEST(SceneConversionTest, ReuseFactorizationDefaultFollowsTheScene) {
     if (c.why.empty()) {
       EXPECT_EQ(scene->solver.reuse_factorization_off, "") << c.name;
     } else {
-      EXPECT_THAT(scene->solver.reuse_factorization_off, testing::HasSubstr(c.why)) << c.name;
+      EXPECT_THAT(scene->solver.reuse_factorization_off, ::testing::HasSubstr(c.why)) << c.name;
     }
   }
 }
