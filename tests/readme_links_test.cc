@@ -80,7 +80,7 @@ TEST(ReadmeLinksTest, TheReadmeIsShortAndStartsWithTheTwoCommands) {
       "# cablesim\n\n```sh\n"
       "deploy/install-deps.sh && cmake -S . -B build && cmake --build build -j2 --target cablesim "
       "&& build/bin/cablesim run scenes/falling-pendulum.json --out falling-pendulum.csv\n"
-      "cmake -S . -B build && cmake --build build -j2 && ctest --test-dir build "
+      "cmake -S . -B build && cmake --build build -j2 && ctest --test-dir build -j2 "
       "--output-on-failure\n```\n";
   EXPECT_EQ(readme.substr(0, head.size()), head);
 }
