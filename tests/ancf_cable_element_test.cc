@@ -369,5 +369,80 @@ TEST(AncfCableElementTest, DirectionalMassMatrixIsTheQuadratureOfItsTensor) {
   }
 }
 
+// The matrix-free damping force is AddDampingMatrix's C times edot, and its
+// power edot^T C edot, for the three axial laws' scalings (Green-Lagrange:
+// EA axial_s u u^T; engineering: over |u|^2), in space and in the plane;
+// with a bending term it declines (false, nothing added). Tolerance 1e-12
+// relative: the same five-point sums in another order (a few eps per
+// term); a missing 1/|u|^2, a wrong sign or a lost point is off by O(1).
+template <int D>
+void CheckAxialDampingForce(AxialLaw law, std::mt19937* rng) {
+  using E = AncfCableElement<D>;
+  std::uniform_real_distribution<double> u(-1, 1);
+  const E element(kLength, kEA, 0, BendingModel::kNone, E::kDefaultGaussPoints, law);
+  for (int trial = 0; trial < 5; ++trial) {
+    const typename E::Coords e = RandomLargeDeformation<D>(rng);
+    typename E::Coords edot;
+    for (int i = 0; i < 4 * D; ++i) edot(i) = u(*rng);
+    const double axial_s = 0.01 * (1.5 + u(*rng));
+    typename E::Matrix c = E::Matrix::Zero();
+    element.AddDampingMatrix(e, axial_s, 0.0, &c);
+    const typename E::Coords f_ref = -c * edot;
+    typename E::Coords f = E::Coords::Zero();
+    double power = -1;
+    ASSERT_TRUE(element.AddAxialDampingForce(e, edot, axial_s, 0.0, &f, &power));
+    EXPECT_LE((f - f_ref).cwiseAbs().maxCoeff(), 1e-12 * f_ref.cwiseAbs().maxCoeff())
+        << static_cast<int>(law) << " " << trial;
+    const double power_ref = edot.dot(c * edot);
+    EXPECT_GT(power_ref, 0);
+    EXPECT_NEAR(power, power_ref, 1e-12 * power_ref) << static_cast<int>(law) << " " << trial;
+  }
+  // A bending term: C must be formed.
+  const E bent(kLength, kEA, kEI, BendingModel::kExact, E::kDefaultGaussPoints, law);
+  typename E::Coords f = E::Coords::Zero();
+  double power = 0;
+  EXPECT_FALSE(bent.AddAxialDampingForce(RandomLargeDeformation<D>(rng),
+                                         E::Coords::Ones(), 0.01, 0.01, &f, &power));
+  EXPECT_EQ(f.cwiseAbs().maxCoeff(), 0.0);
+  // ... but with bending_s 0 only the axial term acts.
+  EXPECT_TRUE(bent.AddAxialDampingForce(RandomLargeDeformation<D>(rng), E::Coords::Ones(), 0.01,
+                                        0.0, &f, &power));
+}
+
+TEST(AncfCableElementTest, AxialDampingForceIsTheDampingMatrixTimesTheRates) {
+  std::mt19937 rng(5);
+  for (AxialLaw law : {AxialLaw::kGreenLagrange, AxialLaw::kEngineering}) {
+    CheckAxialDampingForce<3>(law, &rng);
+    CheckAxialDampingForce<2>(law, &rng);
+  }
+}
+
+// The directional added mass's kinetic energy is 1/2 edot^T M edot with M
+// AddDirectionalMass's matrix (a point without mass included). Tolerance
+// 1e-13 relative, as above.
+TEST(AncfCableElementTest, DirectionalKineticEnergyIsHalfTheRatesThroughItsMatrix) {
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const E3 element(kLength, kEA, 0, BendingModel::kNone);
+  for (int trial = 0; trial < 5; ++trial) {
+    const E3::Coords e = RandomLargeDeformation<3>(&rng);
+    E3::Coords edot;
+    for (int i = 0; i < 12; ++i) edot(i) = u(rng);
+    double a_n[GaussRule::kMaxPoints], a_t[GaussRule::kMaxPoints];
+    for (int g = 0; g < GaussRule::kMaxPoints; ++g) {
+      a_n[g] = 1.5 + 0.3 * u(rng);  // kg/m
+      a_t[g] = -0.2 + 0.1 * u(rng);  // below the mass matrix's part, as CaAx < Ca
+    }
+    a_n[3] = a_t[3] = 0;
+    E3::Matrix m = E3::Matrix::Zero();
+    E3::Coords force = E3::Coords::Zero();
+    element.AddDirectionalMass(e, edot, a_n, a_t, &force, &m);
+    const double ref = 0.5 * edot.dot(m * edot);
+    EXPECT_NEAR(element.DirectionalKineticEnergy(e, edot, a_n, a_t), ref,
+                1e-13 * 0.5 * edot.cwiseAbs().dot(m.cwiseAbs() * edot.cwiseAbs()))
+        << trial;
+  }
+}
+
 }  // namespace
 }  // namespace cablesim

@@ -88,8 +88,23 @@ class CableAddedMass {
            const typename AncfCableElement<D>::Coords& edd, double t,
            typename AncfCableElement<D>::Coords* force,
            typename AncfCableElement<D>::Matrix* m) const;
+  // The kinetic energy of that added mass, 1/2 edot^T (int S^T D S dx)
+  // edot (tip masses included) at coordinates e and velocities edot [J]:
+  // Add's quadrature, without its force.
+  template <int D>
+  double KineticEnergy(const AncfCableElement<D>& element, int index,
+                       const typename AncfCableElement<D>::Coords& e,
+                       const typename AncfCableElement<D>::Coords& edot, double t) const;
 
  private:
+  // a_n, a_t of AncfCableElement::AddDirectionalMass at the element's
+  // Gauss points (D split across and along; the dry points lose their
+  // whole added mass).
+  template <int D>
+  void PointMasses(const AncfCableElement<D>& element, const Element& p,
+                   const typename AncfCableElement<D>::Coords& e, double t, double* a_n,
+                   double* a_t) const;
+
   std::vector<Element> elements_;
   FreeSurface surface_;
   const WaveField* waves_;

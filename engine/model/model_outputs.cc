@@ -59,14 +59,10 @@ void MultibodyModel::ElementEnergy(const VectorXd& q, const VectorXd& qdot, Ener
     // The added mass that is not the constant mass matrix's isotropic part
     // (along the line, CaAx != Ca; none where the line is out of the water:
     // engine/forces/cable_added_mass.h): 1/2 ve^T (int S^T Dm S dx) ve, from
-    // the same quadrature as its inertia force f = -int S^T Dm S a dx taken
-    // at a = ve, so T = -1/2 ve . f.
+    // the same quadrature as its inertia force f = -int S^T Dm S a dx).
     if (cable_added_mass_ && cable_added_mass_->ActsOn(static_cast<int>(k))) {
-      typename AncfCableElement<D>::Coords inertia = AncfCableElement<D>::Coords::Zero();
-      const typename AncfCableElement<D>::Coords ve_coords = ve;
-      cable_added_mass_->Add<D>(e.element, static_cast<int>(k), ElementCoords<D>(qe), ve_coords,
-                                time_, &inertia, nullptr);
-      kinetic -= 0.5 * ve_coords.dot(inertia);
+      kinetic += cable_added_mass_->KineticEnergy<D>(e.element, static_cast<int>(k),
+                                                     ElementCoords<D>(qe), ve, time_);
     }
     const auto se = e.element.StrainEnergy(qe);
     en->kinetic += kinetic;
