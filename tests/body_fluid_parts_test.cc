@@ -313,6 +313,20 @@ TEST(BodyFluidPartsTest, ValidationNamesThePartsField) {
   std::string dry = parts(R"({"diameter": 1, "height": 1})");
   dry.replace(dry.find(R"("density": 1025)"), 15, R"("density": 0)");
   EXPECT_THAT(error(dry), HasSubstr("bodies[0].hydrodynamics_parts: needs a fluid"));
+  // A current that varies in space is refused for a body's drag, naming
+  // the field the body was given (parts only here, not `hydrodynamics`).
+  const std::string profile =
+      R"({}, "current_profile": [{"depth": 0, "velocity": {"x": 1}},
+                                 {"depth": 50, "velocity": {"x": 0.5}}])";
+  const std::string gravity = R"({"z": -9.81})";
+  EXPECT_THAT(error(BodyJson(R"({"z": -5})", R"({"x": 1})",
+                             absl::StrFormat(R"(, "hydrodynamics_parts": [%s])", kPartB),
+                             /*waves=*/false, gravity, profile)),
+              HasSubstr("fluid.current_profile: not taken by bodies[0].hydrodynamics_parts"));
+  EXPECT_THAT(error(BodyJson(R"({"z": -5})", R"({"x": 1})",
+                             absl::StrFormat(R"(, "hydrodynamics": %s)", kPartA),
+                             /*waves=*/false, gravity, profile)),
+              HasSubstr("fluid.current_profile: not taken by bodies[0].hydrodynamics "));
 }
 
 // A part's axis out of the plane makes the scene spatial: a scene forced

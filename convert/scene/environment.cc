@@ -9,6 +9,14 @@
 namespace cablesim::scene_convert {
 namespace {
 
+// The field that gave body b its drag: `hydrodynamics`, or
+// `hydrodynamics_parts` when only parts did (errors name what was written).
+std::string BodyDragField(const ConversionState& state, size_t b) {
+  const bool whole = static_cast<int>(b) < state.proto.bodies_size() &&
+                     state.proto.bodies(static_cast<int>(b)).has_hydrodynamics();
+  return absl::StrCat("bodies[", b, "].", whole ? "hydrodynamics" : "hydrodynamics_parts");
+}
+
 // JONSWAP components per sea (each costs a few exponentials per Gauss
 // point per force evaluation).
 constexpr int kMaxWaveComponents = 1000;
@@ -177,9 +185,8 @@ absl::Status ConvertCurrentGrid(ConversionState* state) {
     return Invalid(path, "give fluid.current_profile or fluid.current_grid, not both");
   for (size_t b = 0; b < state->scene.bodies.size(); ++b) {
     if (state->scene.bodies[b].has_hydrodynamics) {
-      return Invalid(path, absl::StrCat("not taken by bodies[", b,
-                                        "].hydrodynamics (a body's drag takes the uniform "
-                                        "fluid.current)"));
+      return Invalid(path, absl::StrCat("not taken by ", BodyDragField(*state, b),
+                                        " (a body's drag takes the uniform fluid.current)"));
     }
   }
   struct Axis {
@@ -307,9 +314,8 @@ absl::Status ConvertFluid(ConversionState* state) {
     for (size_t b = 0; b < state->scene.bodies.size(); ++b) {
       if (state->scene.bodies[b].has_hydrodynamics) {
         return Invalid("fluid.current_profile",
-                       absl::StrCat("not taken by bodies[", b,
-                                    "].hydrodynamics (a body's drag takes the uniform "
-                                    "fluid.current)"));
+                       absl::StrCat("not taken by ", BodyDragField(*state, b),
+                                    " (a body's drag takes the uniform fluid.current)"));
       }
     }
     for (int i = 0; i < f.current_profile_size(); ++i) {
