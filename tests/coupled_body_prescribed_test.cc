@@ -79,7 +79,9 @@ TEST(CoupledBodyPrescribedTest, TheHostsMotionGivesThePrescribedMotionsForces) {
   double worst = 0;
   for (int n = 0; n <= 20; ++n) {
     const double t = n * kDt;
-    if (n > 0) ASSERT_TRUE(session.Step(t, {}, {}, {pose(t)}).ok());
+    if (n > 0) {
+      ASSERT_TRUE(session.Step(t, {}, {}, {pose(t)}).ok());
+    }
     const Frame* frame = nullptr;
     for (const Frame& f : sink.frames())
       if (std::abs(f.t - t) < 1e-9) frame = &f;

@@ -110,7 +110,9 @@ TEST(SkylineLdltTest, SparseRightHandSidesInUncoupledBlocksMatchDenseLu) {
     for (int blk = 0; blk < kBlocks; ++blk) {
       bool touched = false;
       for (int i : nz) touched |= i / kBlock == blk;
-      if (!touched) EXPECT_EQ(x.segment(blk * kBlock, kBlock).norm(), 0) << "block " << blk;
+      if (!touched) {
+        EXPECT_EQ(x.segment(blk * kBlock, kBlock).norm(), 0) << "block " << blk;
+      }
     }
   }
 }
