@@ -10,12 +10,15 @@ double CableDamping::Dissipation(const ElementAt<D>& at, const ElementCoords<D>&
                          ElementMatrix<D>* c) const {
   const Element& p = elements_[at.index];
   if (!p.any()) return 0;
-  // The force alone (Newton's residual-only iterations, the damping power):
-  // point by point, without the 12 x 12 C, when only the axial term acts.
+  // Only the axial term acting: the force point by point, not as C edot
+  // (Newton's residual-only iterations and the damping power need no C;
+  // the others get C added straight into c, without a local copy).
   double power = 0;
-  if (!c && p.alpha_1_s == 0 &&
-      at.element.AddAxialDampingForce(e, edot, p.axial_s, p.bending_s, force, &power))
+  if (p.alpha_1_s == 0 &&
+      at.element.AddAxialDampingForce(e, edot, p.axial_s, p.bending_s, force, &power)) {
+    if (c) at.element.AddDampingMatrix(e, p.axial_s, p.bending_s, c);
     return power;
+  }
   ElementMatrix<D> local = ElementMatrix<D>::Zero();
   if (p.axial_s != 0 || p.bending_s != 0)
     at.element.AddDampingMatrix(e, p.axial_s, p.bending_s, &local);
