@@ -10,10 +10,10 @@ namespace cablesim::scene_convert {
 namespace {
 
 // The field that gave body b its drag: `hydrodynamics`, or
-// `hydrodynamics_parts` when only parts did (errors name what was written).
+// `hydrodynamics_parts` when only parts did (errors name what was written;
+// the scene's bodies are the proto's, index for index).
 std::string BodyDragField(const ConversionState& state, size_t b) {
-  const bool whole = static_cast<int>(b) < state.proto.bodies_size() &&
-                     state.proto.bodies(static_cast<int>(b)).has_hydrodynamics();
+  const bool whole = state.proto.bodies(static_cast<int>(b)).has_hydrodynamics();
   return absl::StrCat("bodies[", b, "].", whole ? "hydrodynamics" : "hydrodynamics_parts");
 }
 
