@@ -1,5 +1,6 @@
 #include "engine/linear/saddle_point_solver.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace cablesim {
@@ -17,6 +18,8 @@ void SaddlePointSolver::Resize(const std::vector<int>& envelope,
   schur_dense_ = static_cast<long>(n) * m <= kMaxDenseSchurEntries;
   if (schur_dense_) {
     y_.setZero(n, m);
+    y_lo_.assign(m, 0);
+    y_hi_.assign(m, 0);
     schur_.setZero(m, m);
     schur_l_.setZero(m, m);
   }
@@ -90,17 +93,30 @@ bool SaddlePointSolver::Prepare() {
     return true;
   }
   if (schur_dense_) {
-    y_.setZero();
+    const int n = a_.size();
+    // Y = L^{-1} B^T column by column; S = Y^T |D|^{-1} Y (= B A^{-1} B^T
+    // when every pivot is positive, the preconditioner's block otherwise).
     for (int r = 0; r < m; ++r) {
-      for (int k = b_.row_start[r]; k < b_.row_start[r + 1]; ++k) y_(b_.col[k], r) += b_.value[k];
-      a_.SolveAbs(y_.col(r).data());
+      double* y = y_.col(r).data();
+      std::fill(y + y_lo_[r], y + y_hi_[r], 0.0);
+      int lo = n;
+      for (int k = b_.row_start[r]; k < b_.row_start[r + 1]; ++k) {
+        y[b_.col[k]] += b_.value[k];
+        lo = std::min(lo, b_.col[k]);
+      }
+      y_lo_[r] = lo < n ? lo : 0;
+      y_hi_[r] = lo < n ? a_.ForwardSolve(y, lo) : 0;
     }
     for (int r = 0; r < m; ++r) {
-      for (int c = 0; c < m; ++c) {
+      const double* yr = y_.col(r).data();
+      for (int c = 0; c <= r; ++c) {
+        const double* yc = y_.col(c).data();
         double acc = 0;
-        for (int k = b_.row_start[r]; k < b_.row_start[r + 1]; ++k)
-          acc += b_.value[k] * y_(b_.col[k], c);
+        const int hi = std::min(y_hi_[r], y_hi_[c]);
+        for (int k = std::max(y_lo_[r], y_lo_[c]); k < hi; ++k)
+          acc += yr[k] * yc[k] / std::abs(a_.pivot(k));
         schur_(r, c) = acc;
+        schur_(c, r) = acc;
       }
     }
     // Redundant constraints make S singular: a relative shift keeps the
@@ -163,31 +179,41 @@ void SaddlePointSolver::Precondition(const Eigen::VectorXd& r, Eigen::VectorXd& 
 
 void SaddlePointSolver::SolveDirect(const Eigen::VectorXd& rhs, Eigen::VectorXd* x, bool abs) {
   const int n = a_.size(), m = b_.rows();
-  // x1 <- A^{-1} r1 (y_ and the Schur complement are formed with
-  // (L|D|L^T)^{-1}, the same as A^{-1} when every pivot is positive).
+  // w = L^{-1} r1 (y_ and the Schur complement are formed with |D|, the
+  // same as D when every pivot is positive).
   x->head(n) = rhs.head(n);
-  if (abs) {
-    a_.SolveAbs(x->data());
-  } else {
-    a_.Solve(x->data());
+  double* w = x->data();
+  a_.ForwardSolve(w, 0);
+  auto divide = [&](int i) { return abs ? std::abs(a_.pivot(i)) : a_.pivot(i); };
+  if (m > 0) {
+    // x2 <- S^{-1} (B A^{-1} r1 - r2), B A^{-1} r1 = Y^T D^{-1} w.
+    auto x2 = x->segment(n, m);
+    for (int r = 0; r < m; ++r) {
+      const double* y = y_.col(r).data();
+      double acc = 0;
+      for (int k = y_lo_[r]; k < y_hi_[r]; ++k) acc += y[k] * w[k] / divide(k);
+      x2(r) = acc - rhs(n + r);
+    }
+    for (int i = 0; i < m; ++i) {  // L y = r
+      double v = x2(i);
+      for (int k = 0; k < i; ++k) v -= schur_l_(i, k) * x2(k);
+      x2(i) = v / schur_l_(i, i);
+    }
+    for (int i = m - 1; i >= 0; --i) {  // L^T x2 = y
+      double v = x2(i);
+      for (int k = i + 1; k < m; ++k) v -= schur_l_(k, i) * x2(k);
+      x2(i) = v / schur_l_(i, i);
+    }
+    // w <- w - Y x2 = L^{-1} (r1 - B^T x2).
+    for (int r = 0; r < m; ++r) {
+      const double* y = y_.col(r).data();
+      const double xr = x2(r);
+      for (int k = y_lo_[r]; k < y_hi_[r]; ++k) w[k] -= y[k] * xr;
+    }
   }
-  if (m == 0) return;
-  // x2 <- S^{-1} (B A^{-1} r1 - r2).
-  auto x2 = x->segment(n, m);
-  b_.Multiply(x->data(), x2.data());
-  x2 -= rhs.segment(n, m);
-  for (int i = 0; i < m; ++i) {  // L y = r
-    double v = x2(i);
-    for (int k = 0; k < i; ++k) v -= schur_l_(i, k) * x2(k);
-    x2(i) = v / schur_l_(i, i);
-  }
-  for (int i = m - 1; i >= 0; --i) {  // L^T x2 = y
-    double v = x2(i);
-    for (int k = i + 1; k < m; ++k) v -= schur_l_(k, i) * x2(k);
-    x2(i) = v / schur_l_(i, i);
-  }
-  // x1 <- A^{-1} r1 - (A^{-1} B^T) x2.
-  x->head(n).noalias() -= y_ * x2;
+  // x1 <- L^{-T} D^{-1} w.
+  for (int i = 0; i < n; ++i) w[i] /= divide(i);
+  a_.BackwardSolve(w);
 }
 
 bool SaddlePointSolver::SolveAbs(const Eigen::VectorXd& rhs, Eigen::VectorXd* x) {

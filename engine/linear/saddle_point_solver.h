@@ -33,7 +33,10 @@
 //
 //   S x2 = B A^{-1} r1 - r2,   x1 = A^{-1} r1 - (A^{-1} B^T) x2,
 //
-// one skyline solve and two dense triangular solves of size m, followed by
+// with Y = L^{-1} B^T (forward solves only, each starting at the first
+// coordinate its row touches), S = Y^T D^{-1} Y, B A^{-1} r1 = Y^T D^{-1} w
+// and x1 = L^{-T} D^{-1} (w - Y x2) for w = L^{-1} r1: one skyline solve
+// split around the Schur step and two dense triangular solves of size m, followed by
 // one refinement pass if the true residual is above the tolerance (the
 // Schur complement carries a 1e-12 relative shift against redundant
 // constraints). Otherwise (a negative pivot, or too many constraints for a
@@ -116,7 +119,12 @@ class SaddlePointSolver {
 
   SkylineLdlt a_;
   SparseRows b_;
-  Eigen::MatrixXd y_;      // (L|D|L^T)^{-1} B^T, n x m
+  // L^{-1} B^T, n x m (A = L D L^T). Column r is non-zero only in rows
+  // [y_lo_[r], y_hi_[r]): from the first coordinate constraint r touches to
+  // where the forward solve stops filling in, a few rows for a joint on a
+  // cable's last node.
+  Eigen::MatrixXd y_;
+  std::vector<int> y_lo_, y_hi_;
   Eigen::MatrixXd schur_;  // m x m
   // Cholesky factor of the Schur complement, in place (lower triangle):
   // Eigen's LLT allocates a workspace for large matrices.

@@ -134,13 +134,31 @@ void SkylineLdlt::SolveImpl(double* x, bool abs) const {
   }
 }
 
-void SkylineLdlt::ForwardSolve(double* x, int from) const {
+int SkylineLdlt::ForwardSolve(double* x, int from) const {
+  int last = from - 1;
   for (int i = from; i < n_; ++i) {
-    const double* row = &factor_[start_[i]];
     const int fi = std::max(first_[i], from);
+    if (fi > last) {
+      if (x[i] != 0) last = i;
+      continue;
+    }
+    const double* row = &factor_[start_[i]];
+    const int f = first_[i];
     double acc = x[i];
-    for (int k = fi; k < i; ++k) acc -= row[k - first_[i]] * x[k];
+    for (int k = fi; k < i; ++k) acc -= row[k - f] * x[k];
     x[i] = acc;
+    if (acc != 0) last = i;
+  }
+  return last + 1;
+}
+
+void SkylineLdlt::BackwardSolve(double* x) const {
+  for (int i = n_ - 1; i >= 0; --i) {
+    const double xi = x[i];
+    if (xi == 0) continue;
+    const double* row = &factor_[start_[i]];
+    const int fi = first_[i];
+    for (int k = fi; k < i; ++k) x[k] -= row[k - fi] * xi;
   }
 }
 

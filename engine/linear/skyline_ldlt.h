@@ -63,7 +63,15 @@ class SkylineLdlt {
   // before index `from` (entries there are neither read nor written): a
   // right-hand side that starts late in the ordering costs only the rows
   // after it. With pivot(i) = D_ii, b^T A^{-1} c = sum_i x_b[i] x_c[i] / D_ii.
-  void ForwardSolve(double* x, int from) const;
+  // Rows whose envelope starts after the last non-zero entry so far keep
+  // b's entry (they would only subtract products with exact zeros). Returns
+  // one past the last non-zero entry of x (`from` if there is none): a
+  // constraint row's column of B^T on a cable's last node stays within the
+  // few rows after that node.
+  int ForwardSolve(double* x, int from) const;
+  // The second half of Solve: x = L^{-T} y in place (zero entries of y are
+  // skipped).
+  void BackwardSolve(double* x) const;
   double pivot(int i) const { return d_[i]; }
 
  private:
