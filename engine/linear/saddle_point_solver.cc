@@ -162,18 +162,23 @@ void SaddlePointSolver::Precondition(const Eigen::VectorXd& r, Eigen::VectorXd& 
   if (m == 0) return;
   auto z2 = z.segment(n, m);
   if (schur_dense_) {
-    for (int i = 0; i < m; ++i) {  // L y = r2
-      double v = z2(i);
-      for (int k = 0; k < i; ++k) v -= schur_l_(i, k) * z2(k);
-      z2(i) = v / schur_l_(i, i);
-    }
-    for (int i = m - 1; i >= 0; --i) {  // L^T z2 = y
-      double v = z2(i);
-      for (int k = i + 1; k < m; ++k) v -= schur_l_(k, i) * z2(k);
-      z2(i) = v / schur_l_(i, i);
-    }
+    SchurSolve(z2.data());
   } else {
     z2.array() /= schur_diag_.array();
+  }
+}
+
+void SaddlePointSolver::SchurSolve(double* x) const {
+  const int m = b_.rows();
+  for (int i = 0; i < m; ++i) {  // L y = x
+    double v = x[i];
+    for (int k = 0; k < i; ++k) v -= schur_l_(i, k) * x[k];
+    x[i] = v / schur_l_(i, i);
+  }
+  for (int i = m - 1; i >= 0; --i) {  // L^T x = y
+    double v = x[i];
+    for (int k = i + 1; k < m; ++k) v -= schur_l_(k, i) * x[k];
+    x[i] = v / schur_l_(i, i);
   }
 }
 
@@ -194,16 +199,7 @@ void SaddlePointSolver::SolveDirect(const Eigen::VectorXd& rhs, Eigen::VectorXd*
       for (int k = y_lo_[r]; k < y_hi_[r]; ++k) acc += y[k] * w[k] / divide(k);
       x2(r) = acc - rhs(n + r);
     }
-    for (int i = 0; i < m; ++i) {  // L y = r
-      double v = x2(i);
-      for (int k = 0; k < i; ++k) v -= schur_l_(i, k) * x2(k);
-      x2(i) = v / schur_l_(i, i);
-    }
-    for (int i = m - 1; i >= 0; --i) {  // L^T x2 = y
-      double v = x2(i);
-      for (int k = i + 1; k < m; ++k) v -= schur_l_(k, i) * x2(k);
-      x2(i) = v / schur_l_(i, i);
-    }
+    SchurSolve(x2.data());
     // w <- w - Y x2 = L^{-1} (r1 - B^T x2).
     for (int r = 0; r < m; ++r) {
       const double* y = y_.col(r).data();

@@ -116,6 +116,8 @@ class SaddlePointSolver {
   void SolveDirect(const Eigen::VectorXd& rhs, Eigen::VectorXd* x, bool abs = false);
 
   void Precondition(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
+  // x <- S^{-1} x (size m) with the Cholesky factor schur_l_.
+  void SchurSolve(double* x) const;
 
   SkylineLdlt a_;
   SparseRows b_;

@@ -16,10 +16,46 @@ void SkylineLdlt::SetPattern(const std::vector<int>& first_col) {
   values_.assign(start_[n_], 0.0);
   factor_.assign(start_[n_], 0.0);
   d_.assign(n_, 0.0);
+  compressed_ = false;
+}
+
+void SkylineLdlt::CompressForMultiply() {
+  nz_start_.resize(n_ + 1);
+  nz_diag_.resize(n_);
+  nz_col_.clear();
+  nz_value_.clear();
+  for (int i = 0; i < n_; ++i) {
+    nz_start_[i] = static_cast<int>(nz_col_.size());
+    const double* row = &values_[start_[i]];
+    const int f = first_[i];
+    for (int j = f; j < i; ++j) {
+      if (row[j - f] == 0) continue;
+      nz_col_.push_back(j);
+      nz_value_.push_back(row[j - f]);
+    }
+    nz_diag_[i] = row[i - f];
+  }
+  nz_start_[n_] = static_cast<int>(nz_col_.size());
+  compressed_ = true;
 }
 
 void SkylineLdlt::Multiply(const double* x, double* y) const {
   for (int i = 0; i < n_; ++i) y[i] = 0;
+  if (compressed_) {
+    // The loop below without its products with exact zeros.
+    for (int i = 0; i < n_; ++i) {
+      const double xi = x[i];
+      double acc = 0;
+      for (int k = nz_start_[i]; k < nz_start_[i + 1]; ++k) {
+        const double a = nz_value_[k];
+        const int j = nz_col_[k];
+        acc += a * x[j];
+        y[j] += a * xi;
+      }
+      y[i] += acc + nz_diag_[i] * xi;
+    }
+    return;
+  }
   for (int i = 0; i < n_; ++i) {
     const double* row = &values_[start_[i]];
     const int f = first_[i];
@@ -103,35 +139,15 @@ bool SkylineLdlt::Factor(double tiny) {
 }
 
 void SkylineLdlt::SolveImpl(double* x, bool abs) const {
-  // Zeros are skipped, not multiplied: a right-hand side with few non-zero
-  // entries (a constraint row's column of B^T, touching one node) costs only
-  // the rows its solution reaches, the block of the cable that holds that
-  // node, instead of the whole matrix twice. Every non-zero value is the one
-  // the full loops give (they would only add products with exact zeros).
-  // L y = b. `last`: the last non-zero entry of y so far; a row whose
-  // envelope starts after it sees only zeros and keeps b's entry.
-  int last = -1;
-  for (int i = 0; i < n_; ++i) {
-    const int fi = first_[i];
-    if (fi > last) {
-      if (x[i] != 0) last = i;
-      continue;
-    }
-    const double* row = &factor_[start_[i]];
-    double acc = x[i];
-    for (int k = fi; k < i; ++k) acc -= row[k - fi] * x[k];
-    x[i] = acc;
-    if (acc != 0) last = i;
-  }
+  // L y = b, then D (or |D|), then L^T x = y. Zeros are skipped, not
+  // multiplied: a right-hand side with few non-zero entries (a constraint
+  // row's column of B^T, touching one node) costs only the rows its
+  // solution reaches, the block of the cable that holds that node, instead
+  // of the whole matrix twice. Every non-zero value is the one the full
+  // loops give (they would only add products with exact zeros).
+  ForwardSolve(x, 0);
   for (int i = 0; i < n_; ++i) x[i] /= abs ? std::abs(d_[i]) : d_[i];
-  // L^T x = y: a zero x_i changes nothing above it.
-  for (int i = n_ - 1; i >= 0; --i) {
-    const double xi = x[i];
-    if (xi == 0) continue;
-    const double* row = &factor_[start_[i]];
-    const int fi = first_[i];
-    for (int k = fi; k < i; ++k) x[k] -= row[k - fi] * xi;
-  }
+  BackwardSolve(x);
 }
 
 int SkylineLdlt::ForwardSolve(double* x, int from) const {

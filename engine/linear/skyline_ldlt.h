@@ -36,12 +36,27 @@ class SkylineLdlt {
     if (j > i) std::swap(i, j);
     return j < first_[i] ? -1 : start_[i] + (j - first_[i]);
   }
-  void SetZero() { std::fill(values_.begin(), values_.end(), 0.0); }
-  double* values() { return values_.data(); }
+  void SetZero() {
+    std::fill(values_.begin(), values_.end(), 0.0);
+    compressed_ = false;
+  }
+  // Writable values: forgets CompressForMultiply's record.
+  double* values() {
+    compressed_ = false;
+    return values_.data();
+  }
   const double* values() const { return values_.data(); }
 
   // y = A x (the matrix as assembled, not the factor).
   void Multiply(const double* x, double* y) const;
+  // Records where the assembled values are non-zero, for a matrix
+  // multiplied many times between changes (the mass matrix: a cable's is
+  // mbar (x) I, so two thirds of its envelope are zeros between directions).
+  // Multiply then visits only those entries, in the same order, so its sums
+  // are the same. Allocates (call outside the stepping loop, or with the
+  // pattern's capacity already reserved); writing through values() drops the
+  // record.
+  void CompressForMultiply();
   // y += |A| |x| (entrywise absolute values): a bound on the terms summed
   // into A x, for rounding estimates.
   void AddAbsMultiply(const double* x, double* y) const;
@@ -82,6 +97,11 @@ class SkylineLdlt {
   std::vector<double> values_;  // the assembled matrix
   std::vector<double> factor_;  // L (strict lower) in the same layout
   std::vector<double> d_;
+  // CompressForMultiply: row i's non-zero strictly lower entries are
+  // nz_col_/nz_value_[nz_start_[i] .. nz_start_[i + 1]), its diagonal nz_diag_[i].
+  bool compressed_ = false;
+  std::vector<int> nz_start_, nz_col_;
+  std::vector<double> nz_value_, nz_diag_;
   int small_pivots_ = 0;
   int negative_pivots_ = 0;
 };

@@ -522,6 +522,8 @@ MultibodyModel ModelBuilder::Finish() {
     model_.scratch_damping_ = VectorXd::Zero(q0_.size());
     model_.scratch_damping_roundoff_ = VectorXd::Zero(q0_.size());
   }
+  // The mass matrix is multiplied at every residual: only its non-zeros.
+  model_.mass_.CompressForMultiply();
   model_.ProjectInitialVelocity();
   return std::move(model_);
 }

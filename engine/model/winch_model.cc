@@ -42,6 +42,8 @@ void MultibodyModel::UpdateWinches() {
       ScatterElementMatrix<kN2>(index, me.data(), 1.0, mass_.values());
     }
   }
+  // The same non-zeros as before: the record keeps its capacity.
+  mass_.CompressForMultiply();
 }
 
 double MultibodyModel::CableMass(int cable) const {
