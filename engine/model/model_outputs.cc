@@ -152,15 +152,16 @@ template <int D>
 Eigen::Vector3d MultibodyModel::ElementAngularMomentum(const VectorXd& q,
                                                       const VectorXd& qdot) const {
   Vector3d l = Vector3d::Zero();
+  // L_e = sum_a r_a x (sum_b mbar_ab v_b): the rates weighted by the
+  // element's scalar mass matrix first, then four cross products (not
+  // sixteen; computed at every output frame).
   for (const ElementData<D>& e : Elements<D>()) {
     for (int a = 0; a < 4; ++a) {
-      Vector3d ra = Vector3d::Zero();
+      Vector3d ra = Vector3d::Zero(), wa = Vector3d::Zero();
       ra.head<D>() = q.segment<D>(e.first_coord + D * a);
-      for (int b = 0; b < 4; ++b) {
-        Vector3d vb = Vector3d::Zero();
-        vb.head<D>() = qdot.segment<D>(e.first_coord + D * b);
-        l += e.mbar(a, b) * ra.cross(vb);
-      }
+      for (int b = 0; b < 4; ++b)
+        wa.head<D>() += e.mbar(a, b) * qdot.segment<D>(e.first_coord + D * b);
+      l += ra.cross(wa);
     }
   }
   return l;
