@@ -117,6 +117,81 @@ TEST(SkylineLdltTest, SparseRightHandSidesInUncoupledBlocksMatchDenseLu) {
   }
 }
 
+// The forward solve alone, from the first non-zero of a right-hand side on
+// a block's last rows (a fairlead's column of B^T): it must report where its
+// fill-in ends (inside that block), and with the pivots and the backward
+// solve give A^{-1} b of dense LU.
+TEST(SkylineLdltTest, ForwardSolveStopsWhereItsFillEndsAndBackwardSolveCompletesIt) {
+  std::mt19937 rng(11);
+  constexpr int kBlock = 20, kBlocks = 3, n = kBlock * kBlocks;
+  std::vector<int> first(n);
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
+  for (int b = 0; b < kBlocks; ++b) {
+    std::vector<int> f;
+    a.block(b * kBlock, b * kBlock, kBlock, kBlock) = RandomBanded(kBlock, &f, false, &rng);
+    for (int i = 0; i < kBlock; ++i) first[b * kBlock + i] = b * kBlock + f[i];
+  }
+  SkylineLdlt s;
+  s.SetPattern(first);
+  Load(a, &s);
+  ASSERT_TRUE(s.Factor());
+  const auto lu = a.partialPivLu();
+  for (int from : {kBlock - 3, kBlock + 5, n - 1}) {
+    Eigen::VectorXd b = Eigen::VectorXd::Zero(n);
+    b(from) = 2.0;
+    if (from + 1 < n) b(from + 1) = -1.0;
+    Eigen::VectorXd x = b;
+    const int end = s.ForwardSolve(x.data(), from);
+    const int block_end = (from / kBlock + 1) * kBlock;
+    EXPECT_GT(end, from);
+    EXPECT_LE(end, block_end) << "fill-in left the block of row " << from;
+    EXPECT_EQ(x.tail(n - end).norm(), 0);
+    EXPECT_EQ(x.head(from).norm(), 0);
+    for (int i = 0; i < n; ++i) x(i) /= s.pivot(i);
+    s.BackwardSolve(x.data());
+    const Eigen::VectorXd ref = lu.solve(b);
+    EXPECT_LT((x - ref).norm(), 1e-8 * ref.norm()) << "from " << from;
+  }
+}
+
+// A mass-like matrix, mbar (x) I_3 node by node: two thirds of its
+// envelope are exact zeros. The compressed multiply must give the full
+// loop's sums bit for bit, and writing through values() must drop the
+// record (a changed matrix multiplies as changed).
+TEST(SkylineLdltTest, CompressedMultiplyIsTheFullMultiplyBitForBit) {
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> u(0.5, 2);
+  constexpr int kNodes = 8, n = 6 * kNodes;  // position and slope, 3 components
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
+  std::vector<int> first(n);
+  for (int e = 0; e + 1 < kNodes; ++e) {  // elements between nodes e and e + 1
+    Eigen::Matrix4d mbar;
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j <= i; ++j) mbar(i, j) = mbar(j, i) = u(rng) + (i == j ? 4 : 0);
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j)
+        for (int d = 0; d < 3; ++d) a(6 * e + 3 * i + d, 6 * e + 3 * j + d) += mbar(i, j);
+  }
+  for (int i = 0; i < n; ++i) first[i] = std::max(0, 6 * (i / 6 - 1));
+  SkylineLdlt full, compressed;
+  full.SetPattern(first);
+  compressed.SetPattern(first);
+  Load(a, &full);
+  Load(a, &compressed);
+  compressed.CompressForMultiply();
+  const Eigen::VectorXd x = Eigen::VectorXd::Random(n);
+  Eigen::VectorXd y_full(n), y_compressed(n);
+  full.Multiply(x.data(), y_full.data());
+  compressed.Multiply(x.data(), y_compressed.data());
+  for (int i = 0; i < n; ++i) EXPECT_EQ(y_compressed(i), y_full(i)) << i;
+  EXPECT_LT((y_full - a * x).norm(), 1e-12 * (a * x).norm());
+  // An entry that was zero (x of node 0 against y of node 1) is written.
+  a(7, 0) = a(0, 7) = 0.25;
+  compressed.values()[compressed.Slot(7, 0)] = 0.25;
+  compressed.Multiply(x.data(), y_compressed.data());
+  EXPECT_LT((y_compressed - a * x).norm(), 1e-12 * (a * x).norm());
+}
+
 TEST(KrylovTest, MinresMatchesEigenMinresOnSymmetricIndefiniteSystems) {
   std::mt19937 rng(5);
   for (int trial = 0; trial < 5; ++trial) {
@@ -190,6 +265,71 @@ TEST(SaddlePointSolverTest, BlockPreconditionedMinresNeedsFewIterations) {
     EXPECT_LT((x - ref).norm(), 1e-8 * ref.norm());
     EXPECT_LE(stats.iterations, 6);
     EXPECT_LT(stats.relative_residual, 1e-10);
+  }
+}
+
+// DIRECT's block elimination (forward solves for L^{-1} B^T, the Schur
+// complement from them, one forward and one backward solve per right-hand
+// side) against dense LU of the whole saddle-point matrix, with rows on a
+// block's last coordinates (fairleads) and rows across blocks; and the
+// modified step of an indefinite A (SolveAbs) against dense LU with A
+// replaced by L |D| L^T.
+TEST(SaddlePointSolverTest, DirectEliminationMatchesDenseLu) {
+  std::mt19937 rng(13);
+  constexpr int kBlock = 18, kBlocks = 3, n = kBlock * kBlocks, m = 6;
+  for (bool definite : {true, false}) {
+    std::vector<int> first(n);
+    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
+    for (int b = 0; b < kBlocks; ++b) {
+      std::vector<int> f;
+      a.block(b * kBlock, b * kBlock, kBlock, kBlock) = RandomBanded(kBlock, &f, definite, &rng);
+      for (int i = 0; i < kBlock; ++i) first[b * kBlock + i] = b * kBlock + f[i];
+    }
+    SparseRows pattern;
+    pattern.cols = n;
+    Eigen::MatrixXd bd = Eigen::MatrixXd::Zero(m, n);
+    auto add = [&](int r, int c, double v) {
+      pattern.col.push_back(c);
+      pattern.value.push_back(v);
+      bd(r, c) += v;
+    };
+    for (int r = 0; r < 3; ++r) {  // a support on each block's last node
+      add(r, (r + 1) * kBlock - 3 + r, 1.0);
+      pattern.row_start.push_back(static_cast<int>(pattern.col.size()));
+    }
+    for (int r = 3; r < m; ++r) {  // rows coupling two blocks, and one inside
+      add(r, 4 * r - 9, 1.5);
+      add(r, r == 5 ? 5 : kBlock + 2 * r, -0.5 * r);
+      pattern.row_start.push_back(static_cast<int>(pattern.col.size()));
+    }
+    SaddlePointSolver solver;
+    solver.Resize(first, pattern);
+    Load(a, &solver.a());
+    ASSERT_TRUE(solver.Prepare());
+    EXPECT_EQ(solver.direct_ready(), definite);
+    const Eigen::VectorXd rhs = Eigen::VectorXd::Random(n + m);
+    Eigen::MatrixXd k = Eigen::MatrixXd::Zero(n + m, n + m);
+    k.topRightCorner(n, m) = bd.transpose();
+    k.bottomLeftCorner(m, n) = bd;
+    Eigen::VectorXd x(n + m);
+    if (definite) {
+      k.topLeftCorner(n, n) = a;
+      const auto stats = solver.Solve(LinearSolverKind::kDirect, rhs, 1e-12, 200, &x);
+      EXPECT_TRUE(stats.direct);
+      EXPECT_FALSE(stats.fallback);
+    } else {
+      // L |D| L^T, from its inverse column by column.
+      Eigen::MatrixXd p_inv(n, n);
+      for (int c = 0; c < n; ++c) {
+        Eigen::VectorXd e = Eigen::VectorXd::Unit(n, c);
+        solver.a().SolveAbs(e.data());
+        p_inv.col(c) = e;
+      }
+      k.topLeftCorner(n, n) = p_inv.inverse();
+      ASSERT_TRUE(solver.SolveAbs(rhs, &x));
+    }
+    const Eigen::VectorXd ref = k.partialPivLu().solve(rhs);
+    EXPECT_LT((x - ref).norm(), 1e-9 * ref.norm()) << (definite ? "definite" : "indefinite");
   }
 }
 
