@@ -30,6 +30,21 @@ Eigen::MatrixXd RandomBanded(int n, std::vector<int>* first, bool definite, std:
   return a;
 }
 
+// `blocks` uncoupled RandomBanded blocks of size `block` (cables that no
+// joint connects), with the skyline's first columns in `first`.
+Eigen::MatrixXd BlockBanded(int block, int blocks, bool definite, std::vector<int>* first,
+                            std::mt19937* rng) {
+  const int n = block * blocks;
+  first->resize(n);
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
+  for (int b = 0; b < blocks; ++b) {
+    std::vector<int> f;
+    a.block(b * block, b * block, block, block) = RandomBanded(block, &f, definite, rng);
+    for (int i = 0; i < block; ++i) (*first)[b * block + i] = b * block + f[i];
+  }
+  return a;
+}
+
 void Load(const Eigen::MatrixXd& a, SkylineLdlt* s) {
   s->SetZero();
   for (int i = 0; i < a.rows(); ++i)
@@ -83,14 +98,8 @@ TEST(SkylineLdltTest, AbsoluteSolveIsPositiveDefinite) {
 TEST(SkylineLdltTest, SparseRightHandSidesInUncoupledBlocksMatchDenseLu) {
   std::mt19937 rng(5);
   constexpr int kBlock = 20, kBlocks = 3, n = kBlock * kBlocks;
-  std::vector<int> first(n);
-  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
-  for (int b = 0; b < kBlocks; ++b) {
-    std::vector<int> f;
-    const Eigen::MatrixXd block = RandomBanded(kBlock, &f, false, &rng);
-    a.block(b * kBlock, b * kBlock, kBlock, kBlock) = block;
-    for (int i = 0; i < kBlock; ++i) first[b * kBlock + i] = b * kBlock + f[i];
-  }
+  std::vector<int> first;
+  const Eigen::MatrixXd a = BlockBanded(kBlock, kBlocks, false, &first, &rng);
   SkylineLdlt s;
   s.SetPattern(first);
   Load(a, &s);
@@ -124,13 +133,8 @@ TEST(SkylineLdltTest, SparseRightHandSidesInUncoupledBlocksMatchDenseLu) {
 TEST(SkylineLdltTest, ForwardSolveStopsWhereItsFillEndsAndBackwardSolveCompletesIt) {
   std::mt19937 rng(11);
   constexpr int kBlock = 20, kBlocks = 3, n = kBlock * kBlocks;
-  std::vector<int> first(n);
-  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
-  for (int b = 0; b < kBlocks; ++b) {
-    std::vector<int> f;
-    a.block(b * kBlock, b * kBlock, kBlock, kBlock) = RandomBanded(kBlock, &f, false, &rng);
-    for (int i = 0; i < kBlock; ++i) first[b * kBlock + i] = b * kBlock + f[i];
-  }
+  std::vector<int> first;
+  const Eigen::MatrixXd a = BlockBanded(kBlock, kBlocks, false, &first, &rng);
   SkylineLdlt s;
   s.SetPattern(first);
   Load(a, &s);
@@ -278,13 +282,8 @@ TEST(SaddlePointSolverTest, DirectEliminationMatchesDenseLu) {
   std::mt19937 rng(13);
   constexpr int kBlock = 18, kBlocks = 3, n = kBlock * kBlocks, m = 6;
   for (bool definite : {true, false}) {
-    std::vector<int> first(n);
-    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
-    for (int b = 0; b < kBlocks; ++b) {
-      std::vector<int> f;
-      a.block(b * kBlock, b * kBlock, kBlock, kBlock) = RandomBanded(kBlock, &f, definite, &rng);
-      for (int i = 0; i < kBlock; ++i) first[b * kBlock + i] = b * kBlock + f[i];
-    }
+    std::vector<int> first;
+    const Eigen::MatrixXd a = BlockBanded(kBlock, kBlocks, definite, &first, &rng);
     SparseRows pattern;
     pattern.cols = n;
     Eigen::MatrixXd bd = Eigen::MatrixXd::Zero(m, n);
