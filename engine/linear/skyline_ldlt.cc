@@ -22,6 +22,10 @@ void SkylineLdlt::SetPattern(const std::vector<int>& first_col) {
 void SkylineLdlt::CompressForMultiply() {
   nz_start_.resize(n_ + 1);
   nz_diag_.resize(n_);
+  // Capacity for the whole envelope: a later call (winches, every step)
+  // never allocates, even where an entry that was zero becomes non-zero.
+  nz_col_.reserve(values_.size());
+  nz_value_.reserve(values_.size());
   nz_col_.clear();
   nz_value_.clear();
   for (int i = 0; i < n_; ++i) {

@@ -42,7 +42,7 @@ void MultibodyModel::UpdateWinches() {
       ScatterElementMatrix<kN2>(index, me.data(), 1.0, mass_.values());
     }
   }
-  // The same non-zeros as before: the record keeps its capacity.
+  // The record was reserved for the whole envelope: no allocation here.
   mass_.CompressForMultiply();
 }
 
