@@ -52,6 +52,13 @@ void Load(const Eigen::MatrixXd& a, SkylineLdlt* s) {
       if (s->Slot(i, j) >= 0) s->values()[s->Slot(i, j)] = a(i, j);
 }
 
+// `s` with `a`'s pattern and values, factored; false if a pivot is not finite.
+bool LoadAndFactor(const Eigen::MatrixXd& a, const std::vector<int>& first, SkylineLdlt* s) {
+  s->SetPattern(first);
+  Load(a, s);
+  return s->Factor();
+}
+
 TEST(SkylineLdltTest, SolvesIndefiniteBandedSystemsLikeDenseLu) {
   std::mt19937 rng(3);
   for (int trial = 0; trial < 10; ++trial) {
@@ -101,9 +108,7 @@ TEST(SkylineLdltTest, SparseRightHandSidesInUncoupledBlocksMatchDenseLu) {
   std::vector<int> first;
   const Eigen::MatrixXd a = BlockBanded(kBlock, kBlocks, false, &first, &rng);
   SkylineLdlt s;
-  s.SetPattern(first);
-  Load(a, &s);
-  ASSERT_TRUE(s.Factor());
+  ASSERT_TRUE(LoadAndFactor(a, first, &s));
   const auto lu = a.partialPivLu();
   // Non-zeros: inside the middle block (its last rows, as a fairlead's), at
   // the first and last index of the whole system, and one in two blocks.
@@ -136,9 +141,7 @@ TEST(SkylineLdltTest, ForwardSolveStopsWhereItsFillEndsAndBackwardSolveCompletes
   std::vector<int> first;
   const Eigen::MatrixXd a = BlockBanded(kBlock, kBlocks, false, &first, &rng);
   SkylineLdlt s;
-  s.SetPattern(first);
-  Load(a, &s);
-  ASSERT_TRUE(s.Factor());
+  ASSERT_TRUE(LoadAndFactor(a, first, &s));
   const auto lu = a.partialPivLu();
   for (int from : {kBlock - 3, kBlock + 5, n - 1}) {
     Eigen::VectorXd b = Eigen::VectorXd::Zero(n);

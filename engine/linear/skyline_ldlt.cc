@@ -21,7 +21,6 @@ void SkylineLdlt::SetPattern(const std::vector<int>& first_col) {
 
 void SkylineLdlt::CompressForMultiply() {
   nz_start_.resize(n_ + 1);
-  nz_diag_.resize(n_);
   // Capacity for the whole envelope: a later call (winches, every step)
   // never allocates, even where an entry that was zero becomes non-zero.
   nz_col_.reserve(values_.size());
@@ -37,7 +36,6 @@ void SkylineLdlt::CompressForMultiply() {
       nz_col_.push_back(j);
       nz_value_.push_back(row[j - f]);
     }
-    nz_diag_[i] = row[i - f];
   }
   nz_start_[n_] = static_cast<int>(nz_col_.size());
   compressed_ = true;
@@ -56,7 +54,7 @@ void SkylineLdlt::Multiply(const double* x, double* y) const {
         acc += a * x[j];
         y[j] += a * xi;
       }
-      y[i] += acc + nz_diag_[i] * xi;
+      y[i] += acc + values_[start_[i] + i - first_[i]] * xi;
     }
     return;
   }

@@ -53,9 +53,8 @@ class SkylineLdlt {
   // multiplied many times between changes (the mass matrix: a cable's is
   // mbar (x) I, so two thirds of its envelope are zeros between directions).
   // Multiply then visits only those entries, in the same order, so its sums
-  // are the same. Allocates (call outside the stepping loop, or with the
-  // pattern's capacity already reserved); writing through values() drops the
-  // record.
+  // are the same. Only the first call allocates (room for the whole
+  // envelope); writing through values() drops the record.
   void CompressForMultiply();
   // y += |A| |x| (entrywise absolute values): a bound on the terms summed
   // into A x, for rounding estimates.
@@ -98,10 +97,11 @@ class SkylineLdlt {
   std::vector<double> factor_;  // L (strict lower) in the same layout
   std::vector<double> d_;
   // CompressForMultiply: row i's non-zero strictly lower entries are
-  // nz_col_/nz_value_[nz_start_[i] .. nz_start_[i + 1]), its diagonal nz_diag_[i].
+  // nz_col_/nz_value_[nz_start_[i] .. nz_start_[i + 1]) (its diagonal stays
+  // in values_).
   bool compressed_ = false;
   std::vector<int> nz_start_, nz_col_;
-  std::vector<double> nz_value_, nz_diag_;
+  std::vector<double> nz_value_;
   int small_pivots_ = 0;
   int negative_pivots_ = 0;
 };
