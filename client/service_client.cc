@@ -111,6 +111,21 @@ absl::Status FromGrpc(const grpc::Status& status) {
   return absl::Status(static_cast<absl::StatusCode>(status.error_code()), status.error_message());
 }
 
+// Every method of the service: UNAVAILABLE is retried (3 attempts in all,
+// 0.1 s then up to 0.2 s apart, randomized by gRPC).
+constexpr char kRetryServiceConfig[] = R"json({
+  "methodConfig": [{
+    "name": [{"service": "cablesim.v1.CablesimService"}],
+    "retryPolicy": {
+      "maxAttempts": 3,
+      "initialBackoff": "0.1s",
+      "maxBackoff": "1s",
+      "backoffMultiplier": 2,
+      "retryableStatusCodes": ["UNAVAILABLE"]
+    }
+  }]
+})json";
+
 absl::StatusOr<std::unique_ptr<Connection>> Connect(const std::optional<std::string>& server,
                                                     bool jobs, int workers) {
   auto c = std::make_unique<Connection>();
@@ -120,6 +135,14 @@ absl::StatusOr<std::unique_ptr<Connection>> Connect(const std::optional<std::str
     // A target may name several servers (ipv4:A:P,B:Q, or a DNS name with
     // several addresses): spread the calls over all that answer.
     args.SetLoadBalancingPolicyName("round_robin");
+    // A call that fails UNAVAILABLE before any answer came back (a server
+    // that stopped while this client still had its connection, a write to
+    // a closed socket: "Broken pipe") is tried again, on the next server,
+    // up to twice (gRPC's retry policy). Without it, the first call after a
+    // server stops can fail although the others answer. A SubmitJob whose
+    // server died between storing the job and answering can so leave one
+    // job more (ListJobs shows it).
+    args.SetServiceConfigJSON(kRetryServiceConfig);
     const RemoteSecurity& security = Security();
     std::shared_ptr<grpc::ChannelCredentials> credentials = grpc::InsecureChannelCredentials();
     if (!security.tls_ca_pem.empty()) {

@@ -2,7 +2,9 @@
 // (`ipv4:127.0.0.1:A,127.0.0.1:B,127.0.0.1:C`), used by the CLI's channel
 // (client/service_client.h, gRPC's round_robin policy) and by the Python
 // client (client/python/cablesim_client.py), spreads the calls over all
-// three, and the calls go on succeeding when one server stops.
+// three, and the calls go on succeeding when one server stops or crashes
+// (the channels' retry policy: a call that failed UNAVAILABLE before any
+// answer is sent again).
 //
 // Each server has a store of its own here, so that the jobs a server holds
 // count the SubmitJob calls it answered (with a shared store, which
@@ -104,7 +106,19 @@ TEST_F(RoundRobinTest, TheCliChannelSpreadsCallsAndSurvivesAServerStopping) {
   EXPECT_GE(after[0] - before[0], 5);
   EXPECT_GE(after[2] - before[2], 5);
 
-  // The command line, one process per call, with server 1 still down.
+  // Server 2 crashes (SIGKILL: no goodbye to the clients). The channel
+  // still holds its connection, so the next call can be written to a
+  // closed socket and fail UNAVAILABLE ("Socket closed"); the channel's
+  // retry policy sends it again, to server 0. Without that policy, 10 of
+  // 20 runs of this test failed here (2026-11-28).
+  servers_[2]->Kill(SIGKILL);
+  for (int i = 0; i < 10; ++i) {
+    const grpc::Status s = submit();
+    EXPECT_TRUE(s.ok()) << "call " << i << " after the crash: " << s.error_message();
+  }
+  EXPECT_EQ(JobsHeld(*servers_[0]), after[0] + 10);
+
+  // The command line, one process per call, with servers 1 and 2 down.
   for (int i = 0; i < 3; ++i) {
     const int status = std::system(
         absl::StrCat("'", CABLESIM_BIN_DIR, "/cablesim' validate '", CABLESIM_SOURCE_DIR,
@@ -122,10 +136,12 @@ TEST_F(RoundRobinTest, ThePythonClientSpreadsCallsAndSurvivesAServerStopping) {
   const std::string dir = testing::FreshDir("rr_python");
   const std::string script = dir + "/rr.py";
   // 30 calls, then server 1 is stopped (SIGTERM; the script waits until
-  // its port refuses connections), then 30 more calls on the same channel.
+  // its port refuses connections), then 30 more calls on the same channel,
+  // then server 2 crashes (SIGKILL) and 10 more calls follow.
   std::ofstream(script) << R"(import os, signal, socket, sys, time
 import cablesim_client as c
-target, scene_path, pid, port = sys.argv[1], sys.argv[2], int(sys.argv[3]), int(sys.argv[4])
+target, scene_path, pid, port, pid2 = (sys.argv[1], sys.argv[2], int(sys.argv[3]),
+                                       int(sys.argv[4]), int(sys.argv[5]))
 stub = c.connect(target)
 scene = c.load_scene(scene_path)
 scene.solver.duration = 0.001
@@ -141,6 +157,9 @@ for _ in range(1000):
         break
 for i in range(30):
     c.submit(stub, scene)
+os.kill(pid2, signal.SIGKILL)  # a crash: no goodbye to the channel
+for i in range(10):
+    c.submit(stub, scene)
 print("ok")
 )";
   const std::vector<int> none = Held();
@@ -148,19 +167,24 @@ print("ok")
       absl::StrCat("PYTHONPATH='", CABLESIM_BIN_DIR, "/../python:", CABLESIM_SOURCE_DIR,
                    "/client/python' ", python, " '", script, "' '", target_, "' '",
                    CABLESIM_SOURCE_DIR, "/scenes/falling-pendulum.json' ", servers_[1]->pid(),
-                   " ", servers_[1]->port())
+                   " ", servers_[1]->port(), " ", servers_[2]->pid())
           .c_str());
   ASSERT_EQ(status, 0);
   EXPECT_EQ(none, (std::vector<int>{0, 0, 0}));
-  servers_[1]->Kill(SIGTERM);  // reaps it
-  servers_[1]->Restart();      // to count the calls it answered
+  for (int i : {1, 2}) {
+    servers_[i]->Kill(SIGTERM);  // reaps it
+    servers_[i]->Restart();      // to count the calls it answered
+  }
   const std::vector<int> held = Held();
-  std::cout << "60 Python calls through " << target_ << ", server 1 stopped after 30: "
+  std::cout << "70 Python calls through " << target_
+            << ", server 1 stopped after 30, server 2 crashed after 60: "
             << absl::StrJoin(held, " / ") << std::endl;
   for (int i = 0; i < kServers; ++i) EXPECT_GE(held[i], 1) << "server " << i;
-  EXPECT_EQ(held[0] + held[1] + held[2], 60);
-  // Server 1 answered some of the first 30 only.
+  EXPECT_EQ(held[0] + held[1] + held[2], 70);
+  // Server 1 answered some of the first 30 only, server 2 none of the last 10.
   EXPECT_LE(held[1], 30);
+  EXPECT_LE(held[2], 60 - held[1]);
+  EXPECT_GE(held[0], 10);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 
 import collections
 import functools
+import json
 import os
 from typing import Iterable, Mapping, Optional, Sequence, Tuple, Union
 
@@ -67,6 +68,17 @@ def read_token(path: str) -> str:
     raise ValueError("%s: no token" % path)
 
 
+# A call that fails UNAVAILABLE before any answer came back (a server that
+# stopped while the channel still had its connection) is tried again, on the
+# next server, up to twice: gRPC's retry policy, as the command line's
+# channel does (client/service_client.cc). A SubmitJob whose server died
+# between storing the job and answering can so leave one job more.
+_RETRY_SERVICE_CONFIG = json.dumps({"methodConfig": [{
+    "name": [{"service": "cablesim.v1.CablesimService"}],
+    "retryPolicy": {"maxAttempts": 3, "initialBackoff": "0.1s", "maxBackoff": "1s",
+                    "backoffMultiplier": 2, "retryableStatusCodes": ["UNAVAILABLE"]}}]})
+
+
 def open_channel(target: str, tls_ca: Optional[str] = None, token: Optional[str] = None,
                  options: Sequence[Tuple[str, object]] = ()) -> grpc.Channel:
     """A channel to `target`: "host:port", or any gRPC target naming several
@@ -74,7 +86,8 @@ def open_channel(target: str, tls_ca: Optional[str] = None, token: Optional[str]
     whose addresses are used in turn (gRPC's round_robin policy). `tls_ca`: a
     CA certificate file (PEM) the server's certificate is checked against.
     `token`: a bearer token sent with every call."""
-    options = [("grpc.lb_policy_name", "round_robin")] + list(options)
+    options = [("grpc.lb_policy_name", "round_robin"),
+               ("grpc.service_config", _RETRY_SERVICE_CONFIG)] + list(options)
     if tls_ca:
         with open(tls_ca, "rb") as f:
             channel = grpc.secure_channel(target, grpc.ssl_channel_credentials(f.read()), options)
