@@ -179,9 +179,9 @@ void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* 
       const int local = k - first_node[c];
       const double l = mesh_.node_s[c][local + 1] - mesh_.node_s[c][local];
       MultibodyModel::ElementData<D> e;
-      e.element = AncfCableElement<D>(l, ea, ei, cable.bending,
-                                      AncfCableElement<D>::kDefaultGaussPoints, cable.axial_law,
-                                      table);
+      static_assert(CableSpec::kMaxGaussPoints <= GaussRule::kMaxPoints);
+      e.element =
+          AncfCableElement<D>(l, ea, ei, cable.bending, cable.gauss_points, cable.axial_law, table);
       // Energy the element can hold from coordinates known to 16 eps
       // (1 + |q0|_inf): a strain of that over l, a curvature of it over l^2.
       const double strain = 16 * std::numeric_limits<double>::epsilon() * (1 + extent) / l;

@@ -69,6 +69,14 @@ struct CableSpec {
   std::vector<Eigen::Vector3d> points;
   double length_m = 0;  // undeformed length
   int elements = 10;    // before extra nodes are inserted
+  // Gauss points per element of the element's integrals without a closed
+  // form (strain energy, Kelvin-Voigt damping, fluid loads), in
+  // [kMinGaussPoints, kMaxGaussPoints]; the default is the element's
+  // (AncfCableElement::kDefaultGaussPoints). Two points sample too little
+  // strain for a string (bending NONE): OC4's lines found no static
+  // equilibrium with them. (Scene validation also refuses 4.)
+  static constexpr int kMinGaussPoints = 3, kMaxGaussPoints = 8;
+  int gauss_points = 5;
   double density_kg_m3 = 0;
   double youngs_modulus_pa = 0;
   double area_m2 = 0;
