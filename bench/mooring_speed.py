@@ -61,6 +61,9 @@ def variant_scene(base, variant):
     if "elements" in variant:
         for c in scene["cables"]:
             c["elements"] = int(variant["elements"])
+    if "gauss_points" in variant:
+        for c in scene["cables"]:
+            c["gauss_points"] = int(variant["gauss_points"])
     scene.setdefault("solver", {}).update(variant.get("solver", {}))
     return scene
 
@@ -71,6 +74,8 @@ def label(variant):
     parts = []
     if "elements" in variant:
         parts.append(f"{variant['elements']} el/line")
+    if "gauss_points" in variant:
+        parts.append(f"{variant['gauss_points']} Gauss points")
     for k, v in variant.get("solver", {}).items():
         parts.append(f"{k}={v}")
     return ", ".join(parts)
