@@ -56,6 +56,14 @@ std::string Scene1(const std::string& extra) {
   return absl::StrCat("{\"cables\": [", kCable, "], ", extra, kSolver, "}");
 }
 
+// The cable "c" of length 1 with `fields` among its own, and `solver`.
+std::string OneCable(const std::string& fields,
+                     const std::string& solver = R"("solver": {"duration": 1})") {
+  return absl::StrCat(R"({"cables": [{"name": "c", "length": 1, )", fields,
+                      R"(, "density": 1000, "youngs_modulus": 1e7, "diameter": 0.01}], )", solver,
+                      "}");
+}
+
 struct InvalidCase {
   const char* name;
   std::string json;
@@ -91,23 +99,14 @@ std::vector<InvalidCase> InvalidCases() {
        R"({"cables": [{"name": "c", "length": 1, "elements": 0, "density": 1000,
                        "youngs_modulus": 1e7, "diameter": 0.01}], "solver": {"duration": 1}})",
        "cables[0].elements: ", "must be in [1, 100000]"},
-      {"GaussPointsTwo",
-       R"({"cables": [{"name": "c", "length": 1, "gauss_points": 2, "density": 1000,
-                       "youngs_modulus": 1e7, "diameter": 0.01}], "solver": {"duration": 1}})",
-       "cables[0].gauss_points: ", "must be in [3, 8]"},
-      {"GaussPointsFour",
-       R"({"cables": [{"name": "c", "length": 1, "gauss_points": 4, "density": 1000,
-                       "youngs_modulus": 1e7, "diameter": 0.01}], "solver": {"duration": 1}})",
-       "cables[0].gauss_points: ", "4 is refused: with 4 points a slack line"},
-      {"GaussPointsNine",
-       R"({"cables": [{"name": "c", "length": 1, "gauss_points": 9, "density": 1000,
-                       "youngs_modulus": 1e7, "diameter": 0.01}], "solver": {"duration": 1}})",
-       "cables[0].gauss_points: ", "must be in [3, 8]"},
+      {"GaussPointsTwo", OneCable(R"("gauss_points": 2)"), "cables[0].gauss_points: ",
+       "must be in [3, 8]"},
+      {"GaussPointsFour", OneCable(R"("gauss_points": 4)"), "cables[0].gauss_points: ",
+       "4 is refused: with 4 points a slack line"},
+      {"GaussPointsNine", OneCable(R"("gauss_points": 9)"), "cables[0].gauss_points: ",
+       "must be in [3, 8]"},
       {"GaussPointsWithWinch",
-       R"({"cables": [{"name": "c", "length": 1, "gauss_points": 3, "density": 1000,
-                       "youngs_modulus": 1e7, "diameter": 0.01,
-                       "winch": {"speed": {"constant": 0.1}}}],
-           "solver": {"duration": 1, "step": 0.01}})",
+       OneCable(R"("gauss_points": 3, "winch": {"speed": {"constant": 0.1}})", kSolver),
        "cables[0].gauss_points: ", "a cable with a winch keeps the default 5"},
       {"ZeroStep",
        absl::StrCat(R"({"cables": [)", kCable, R"(], "solver": {"duration": 1, "step": 0}})"),
