@@ -1033,6 +1033,19 @@ class DeckReader {
   }
 
   absl::Status ParseOutput(int n, const std::vector<absl::string_view>& w) {
+    // OpenFAST's decks (MoorDyn's v1 format) close the list with a line
+    // END. MoorDyn-F stops reading there and MoorDyn-C warns and goes on, so
+    // a channel after it is refused rather than guessed at.
+    if (w.size() == 1 && absl::EqualsIgnoreCase(w[0], "END")) {
+      outputs_ended_ = n;
+      return absl::OkStatus();
+    }
+    if (outputs_ended_ > 0) {
+      return Error(n, absl::StrCat("OUTPUTS ", w[0]),
+                   absl::StrCat("a channel after END (line ", outputs_ended_,
+                                "): MoorDyn's readers disagree on it; remove END or move "
+                                "the channel before it"));
+    }
     for (absl::string_view channel : w) {
       for (absl::string_view c : absl::StrSplit(channel, ',', absl::SkipEmpty())) {
         const std::string lower = absl::AsciiStrToLower(c);
@@ -2526,6 +2539,8 @@ class DeckReader {
   std::vector<int> probe_points_;
   std::vector<BodyChannel> body_channels_;
   std::vector<TensionChannel> tension_channels_;
+  // The file line of OUTPUTS' closing END (0: none yet).
+  int outputs_ended_ = 0;
   // The POINTS (BODIES, RODS) row of each body Build made, in scene order
   // (for Located).
   mutable std::vector<int> body_points_;

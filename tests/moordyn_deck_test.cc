@@ -27,6 +27,7 @@
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
 #include "server/request_checks.h"
+#include "tests/scratch_dir.h"
 
 namespace cablesim {
 namespace {
@@ -227,6 +228,16 @@ TEST(MoorDynDeckTest, LineEndTensionChannelsBecomeTensionProbes) {
   EXPECT_TRUE(scene.ok()) << scene.status();
 }
 
+// OpenFAST's decks close OUTPUTS with a line END: the list ends there, the
+// channels before it are read (end was refused as a channel name before).
+TEST(MoorDynDeckTest, OutputsMayEndWithEnd) {
+  const v1::Scene s = Read(Edited("Point2Px Point2Pz", "FairTen1\nEND"));
+  ASSERT_EQ(s.probes_size(), 2);
+  EXPECT_EQ(s.probes(1).name(), "FairTen1");
+  EXPECT_EQ(Read(Edited("Point2Px Point2Pz", "Point2Px Point2Pz\nend")).probes_size(),
+            Read(kDeck).probes_size());
+}
+
 TEST(MoorDynDeckTest, SlackLinesAreLaidAlongTheirLengthAboveTheBed) {
   const v1::Scene s = Read(kDeck);
   for (const v1::Cable& c : s.cables()) {
@@ -268,6 +279,7 @@ TEST(MoorDynDeckTest, RefusalsNameTheLineAndField) {
       {"Point4Pz", "Line1N3T", "bad.dat:33: OUTPUTS Line1N3T: only point positions (Point<n>Px, Py, Pz), line-end tensions"},
       {"Point4Pz", "Body1Px", "bad.dat:33: OUTPUTS Body1Px: body 1 does not exist (define it in BODIES)"},
       {"Point4Pz", "FairTen7", "bad.dat:33: OUTPUTS FairTen7: line 7 does not exist"},
+      {"Point2Px Point2Pz", "END\nPoint2Px", "bad.dat:35: OUTPUTS Point2Px: a channel after END (line 34)"},
       {"100           WtrDpth       water depth (m)\n", "", "OPTIONS WtrDpth: required"},
       {"4     Free      -200", "4     Body1     -200", "bad.dat:14: POINTS Volume: a point on a body with volume"},
       {"5     Free      -100    0       -30     0      0       0      0",
@@ -429,7 +441,8 @@ TEST(MoorDynDeckTest, RecognisesDecksByNameOrContents) {
 }
 
 std::string WriteTemp(const std::string& name, const std::string& text) {
-  const std::string path = absl::StrCat(::testing::TempDir(), "/moordyn_", ::getpid(), "_", name);
+  const std::string path =
+      testing::Scratch(absl::StrCat(::testing::TempDir(), "/moordyn_", ::getpid(), "_", name));
   std::ofstream(path) << text;
   return path;
 }
@@ -438,7 +451,8 @@ using testing::Cli;
 
 TEST(MoorDynDeckTest, CliImportWritesTheSceneAndRefusesABadDeckWithExit2) {
   const std::string deck = WriteTemp("deck.dat", kDeck);
-  const std::string json = absl::StrCat(::testing::TempDir(), "/moordyn_", ::getpid(), ".json");
+  const std::string json =
+      testing::Scratch(absl::StrCat(::testing::TempDir(), "/moordyn_", ::getpid(), ".json"));
   std::string out, err;
   ASSERT_EQ(Cli({"import", deck, "--out", json}, &out, &err), 0) << err;
   const absl::StatusOr<v1::Scene> back = ReadSceneFile(json);
@@ -485,7 +499,8 @@ TEST(MoorDynDeckTest, CliRunsATxtDeck) {
 
 // The CLI reads a table file beside the deck (MoorDyn's base path).
 TEST(MoorDynDeckTest, CliReadsATableFileBesideTheDeck) {
-  const std::string dir = absl::StrCat(::testing::TempDir(), "/moordyn_table_", ::getpid());
+  const std::string dir =
+      testing::Scratch(absl::StrCat(::testing::TempDir(), "/moordyn_table_", ::getpid()));
   std::filesystem::create_directories(dir);
   std::ofstream(dir + "/wire_ea.txt") << "Strain Tension\n(-) (N)\n---\n0 0\n0.002 1e6\n"
                                          "0.01 6e6\n";
