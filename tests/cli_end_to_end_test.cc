@@ -17,6 +17,7 @@
 #include "absl/strings/str_split.h"
 #include "cablesim/version.h"
 #include "tests/process_util.h"
+#include "tests/scratch_dir.h"
 
 namespace cablesim {
 namespace {
@@ -69,7 +70,8 @@ Csv ReadCsv(const std::string& path) {
 Csv RunSample(const std::string& scene) {
   const std::string binary = absl::StrCat(CABLESIM_BIN_DIR, "/cablesim");
   EXPECT_TRUE(std::ifstream(binary).good()) << "build the cablesim target first: " << binary;
-  const std::string csv = absl::StrCat(::testing::TempDir(), "/cli_end_to_end_", ::getpid(), "_", scene, ".csv");
+  const std::string csv = testing::Scratch(
+      absl::StrCat(::testing::TempDir(), "/cli_end_to_end_", ::getpid(), "_", scene, ".csv"));
   std::remove(csv.c_str());
   const Process p = RunCommand(absl::StrCat("'", binary, "' run '", CABLESIM_SOURCE_DIR, "/scenes/",
                                             scene, "' --out '", csv, "'"));

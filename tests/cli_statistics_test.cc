@@ -12,6 +12,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "tests/process_util.h"
+#include "tests/scratch_dir.h"
 
 namespace cablesim {
 namespace {
@@ -29,8 +30,8 @@ std::string Cablesim(const std::string& args) {
 }
 
 std::string TempFile(const std::string& name, const std::string& contents) {
-  const std::string path =
-      absl::StrCat(::testing::TempDir(), "/cli_statistics_", ::getpid(), "_", name);
+  const std::string path = testing::Scratch(
+      absl::StrCat(::testing::TempDir(), "/cli_statistics_", ::getpid(), "_", name));
   std::ofstream(path) << contents;
   return path;
 }
@@ -103,8 +104,8 @@ Process ReadJUnit(const std::string& path) {
 }
 
 TEST(CliStatisticsTest, SweepThresholdFailsTheItemNamingItsAxisValues) {
-  const std::string junit = absl::StrCat(::testing::TempDir(), "/cli_statistics_", ::getpid(),
-                                         "_junit.xml");
+  const std::string junit = testing::Scratch(
+      absl::StrCat(::testing::TempDir(), "/cli_statistics_", ::getpid(), "_junit.xml"));
   const Process r = Sh(Cablesim(absl::StrCat("sweep ", SweepFile(), " --workers 1",
                                              " --min end.y=-1e-6 --max end.y=1 --junit ", junit)));
   EXPECT_EQ(r.exit_code, 3) << r.out;

@@ -19,6 +19,7 @@
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "client/csv_writer.h"
+#include "tests/scratch_dir.h"
 
 namespace cablesim {
 namespace {
@@ -47,7 +48,8 @@ std::string SampleScene(const char* name) {
 }
 
 std::string WriteTempFile(const std::string& name, const std::string& contents) {
-  const std::string path = absl::StrCat(::testing::TempDir(), "/cli_test_", ::getpid(), "_", name);
+  const std::string path =
+      testing::Scratch(absl::StrCat(::testing::TempDir(), "/cli_test_", ::getpid(), "_", name));
   std::ofstream(path) << contents;
   return path;
 }
@@ -155,7 +157,8 @@ TEST(CliTest, SweepRefusesABaseFileOutsideItsDirectoryUnlessAllowed) {
 // `energy --out` names its columns as the run CSV does.
 TEST(CliTest, EnergyCsvUsesTheRunCsvColumnNames) {
   const std::string scene = WriteTempFile("energy_scene.json", kTinyScene);
-  const std::string csv = absl::StrCat(::testing::TempDir(), "/cli_test_", ::getpid(), "_energy.csv");
+  const std::string csv =
+      testing::Scratch(absl::StrCat(::testing::TempDir(), "/cli_test_", ::getpid(), "_energy.csv"));
   const CliResult r = Cli({"energy", scene, "--out", csv});
   ASSERT_EQ(r.code, 0) << r.err;
   const std::vector<std::string> lines = ReadLines(csv);
@@ -251,7 +254,8 @@ TEST(CliTest, ValidateTakesNoOut) {
 
 TEST(CliTest, RunWritesSummaryAndCsv) {
   const std::string scene = WriteTempFile("tiny.json", kTinyScene);
-  const std::string csv = absl::StrCat(::testing::TempDir(), "/cli_test_", ::getpid(), "_tiny.csv");
+  const std::string csv =
+      testing::Scratch(absl::StrCat(::testing::TempDir(), "/cli_test_", ::getpid(), "_tiny.csv"));
   // Twice, with both spellings of --out: RunCli keeps no state.
   for (const std::string& out_flag : {std::string("--out=") + csv, std::string("--out")}) {
     std::vector<std::string> args = {"run", scene, out_flag};
@@ -284,8 +288,8 @@ TEST(CliTest, RunCsvMarksAReleasedJoint) {
   const std::string pin = R"("a": {"cable": "c", "s": 0})";
   json.insert(json.find(pin) + pin.size(), R"(, "release": {"time": 0.01})");
   const std::string scene = WriteTempFile("tiny_release.json", json);
-  const std::string csv =
-      absl::StrCat(::testing::TempDir(), "/cli_test_", ::getpid(), "_tiny_release.csv");
+  const std::string csv = testing::Scratch(
+      absl::StrCat(::testing::TempDir(), "/cli_test_", ::getpid(), "_tiny_release.csv"));
   const CliResult r = Cli({"run", scene, "--out", csv});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr(R"("releases":[{"joint":0,)"));
@@ -337,7 +341,8 @@ TEST(CliTest, NumericalFailureExitsWith3AndKeepsTheCsv) {
     "joints": [{"type": "PIN", "a": {"cable": "c", "s": 0}}],
     "solver": {"duration": 1, "step": 0.5, "max_newton_iterations": 1,
                "max_step_halvings": 0}})");
-  const std::string csv = absl::StrCat(::testing::TempDir(), "/cli_test_", ::getpid(), "_failing.csv");
+  const std::string csv =
+      testing::Scratch(absl::StrCat(::testing::TempDir(), "/cli_test_", ::getpid(), "_failing.csv"));
   const CliResult r = Cli({"run", scene, "--out", csv});
   EXPECT_EQ(r.code, 3) << r.err;
   EXPECT_THAT(r.out, StartsWith(R"({"status":"failed","error":")"));

@@ -31,13 +31,14 @@
 #include "server/store/sqlite_job_store.h"
 #include "server/result_codec.h"
 #include "tests/postgres_test_util.h"
+#include "tests/scratch_dir.h"
 
 namespace cablesim {
 namespace {
 
 std::string FreshDir(const std::string& name) {
-  const std::string dir =
-      absl::StrCat(::testing::TempDir(), "/job_store_test_", name, "_", ::getpid());
+  const std::string dir = testing::Scratch(
+      absl::StrCat(::testing::TempDir(), "/job_store_test_", name, "_", ::getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;

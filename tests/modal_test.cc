@@ -22,6 +22,7 @@
 #include "engine/run/simulation.h"
 #include "engine/analysis/static_solver.h"
 #include "test_util.h"
+#include "tests/scratch_dir.h"
 
 namespace cablesim {
 namespace {
@@ -324,7 +325,8 @@ TEST(ModalTest, ModesFieldIsValidated) {
 // The sample scene through the command line: exit code 0, the frequencies
 // in the summary line, the equilibrium and one row per mode in the CSV.
 TEST(ModalTest, SampleSceneThroughTheCommandLine) {
-  const std::string csv = absl::StrCat(::testing::TempDir(), "/hanging_chain_modes_", ::getpid(), ".csv");
+  const std::string csv = testing::Scratch(
+      absl::StrCat(::testing::TempDir(), "/hanging_chain_modes_", ::getpid(), ".csv"));
   const std::string command =
       absl::StrCat(CABLESIM_BIN_DIR, "/cablesim run ", CABLESIM_SOURCE_DIR,
                    "/scenes/hanging-chain-modes.json --out ", csv);

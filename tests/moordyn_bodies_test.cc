@@ -29,6 +29,7 @@
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
 #include "tests/test_util.h"
+#include "tests/scratch_dir.h"
 
 namespace cablesim {
 namespace {
@@ -895,7 +896,8 @@ using testing::Cli;
 // Each deck of this file through the CLI: import writes a scene, run
 // solves it; a bad deck exits 2 naming the line.
 TEST(MoorDynBodiesTest, CliImportsAndRunsTheDecks) {
-  const std::string dir = absl::StrCat(::testing::TempDir(), "/moordyn_bodies_", ::getpid());
+  const std::string dir =
+      testing::Scratch(absl::StrCat(::testing::TempDir(), "/moordyn_bodies_", ::getpid()));
   WriteTemp(dir, "bed.txt", SeafloorFile(kFlatNodes));
   const std::vector<std::pair<std::string, std::string>> decks = {
       {"floating_rod.txt", Deck(kFloatingRod)},

@@ -31,12 +31,15 @@
 #include "absl/strings/str_replace.h"
 #include "cablesim/v1/service.grpc.pb.h"
 #include "convert/scene_file.h"
+#include "tests/scratch_dir.h"
 
 namespace cablesim::testing {
 
-// A fresh empty directory under the test's temporary directory.
+// A fresh empty directory under the test's temporary directory, removed
+// when the test program exits having passed.
 inline std::string FreshDir(const std::string& name) {
-  const std::string dir = absl::StrCat(::testing::TempDir(), "/cablesim_", name, "_", ::getpid());
+  const std::string dir =
+      Scratch(absl::StrCat(::testing::TempDir(), "/cablesim_", name, "_", ::getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
