@@ -303,6 +303,24 @@ class DeckReader {
         continue;
       }
       if (raw.empty() || section == Section::kPreamble) continue;
+      // MoorDyn's version 1 format (OpenFAST's decks before MoorDyn v2) opens
+      // each table with a count line, "1  NTypes  - number of LineTypes", and
+      // orders its columns differently: refused as such, not misread.
+      if (skip == 2) {
+        const std::vector<absl::string_view> w =
+            absl::StrSplit(raw, absl::ByAnyChar(" \t"), absl::SkipEmpty());
+        static const char* const kCounts[] = {"ntypes", "nconnects", "nlines", "nrodtypes",
+                                              "nrods", "nbodies", "npoints"};
+        for (const char* count : kCounts) {
+          if (w.size() >= 2 && absl::EqualsIgnoreCase(w[1], count)) {
+            return Error(n, w[1],
+                         "a count line of MoorDyn's version 1 format (OpenFAST's decks before "
+                         "MoorDyn v2); cablesim reads the v2 format, as MoorDyn-C v2 does: drop "
+                         "the count lines and write the v2 columns (docs: MoorDyn files, "
+                         "\"Version 1 decks\")");
+          }
+        }
+      }
       if (skip > 0) {
         --skip;
         continue;

@@ -280,6 +280,8 @@ TEST(MoorDynDeckTest, RefusalsNameTheLineAndField) {
       {"Point4Pz", "Body1Px", "bad.dat:33: OUTPUTS Body1Px: body 1 does not exist (define it in BODIES)"},
       {"Point4Pz", "FairTen7", "bad.dat:33: OUTPUTS FairTen7: line 7 does not exist"},
       {"Point2Px Point2Pz", "END\nPoint2Px", "bad.dat:35: OUTPUTS Point2Px: a channel after END (line 34)"},
+      {"TypeName   Diam", "1   NTypes  - number of LineTypes\nTypeName   Diam",
+       "bad.dat:4: NTypes: a count line of MoorDyn's version 1 format"},
       {"100           WtrDpth       water depth (m)\n", "", "OPTIONS WtrDpth: required"},
       {"4     Free      -200", "4     Body1     -200", "bad.dat:14: POINTS Volume: a point on a body with volume"},
       {"5     Free      -100    0       -30     0      0       0      0",
