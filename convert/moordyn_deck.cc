@@ -277,8 +277,126 @@ class DeckReader {
     return v;
   }
 
+  // MoorDyn's version 1 format (OpenFAST's MoorDyn decks before MoorDyn v2)
+  // opens each table with a count line ("1  NTypes  - number of
+  // LineTypes") and orders its columns differently. Such a deck is read by
+  // rewriting its rows in the version 2 columns, line for line, so that
+  // every later message names the file's own line (and the version 2
+  // column): LINE TYPES `Name Diam MassDen EA BA/-zeta Can Cat Cdn Cdt` ->
+  // `Name Diam MassDen EA BA/-zeta 0 Cdn Can Cdt Cat` (no bending
+  // stiffness), CONNECTION PROPERTIES `Node Type X Y Z M V FX FY FZ CdA CA`
+  // -> `Node Type X Y Z M V CdA CA` (the initial force guesses dropped,
+  // `Connect` -> `Free`), LINE PROPERTIES `Line LineType UnstrLen NumSegs
+  // NodeAnch NodeFair Flags` -> `Line LineType NodeAnch NodeFair UnstrLen
+  // NumSegs Flags`. A deck without count lines is left as it is.
+  absl::Status FromVersion1(std::vector<absl::string_view>& lines,
+                            std::vector<std::string>& rewritten) const {
+    static const char* const kCounts[] = {"ntypes", "nconnects", "nlines", "nrodtypes",
+                                          "nrods", "nbodies", "npoints"};
+    const auto words = [](absl::string_view line) -> std::vector<absl::string_view> {
+      return absl::StrSplit(line, absl::ByAnyChar(" \t"), absl::SkipEmpty());
+    };
+    const auto is_count = [&](absl::string_view line) {
+      const std::vector<absl::string_view> w = words(line);
+      for (const char* count : kCounts)
+        if (w.size() >= 2 && absl::EqualsIgnoreCase(w[1], count)) return true;
+      return false;
+    };
+    // Pass 1: is the first row of any table a count line?
+    bool version1 = false;
+    {
+      Section section = Section::kPreamble;
+      bool first = false;
+      for (absl::string_view line : lines) {
+        const absl::string_view raw = absl::StripAsciiWhitespace(line);
+        if (absl::StartsWith(raw, "---")) {
+          section = SectionOf(absl::AsciiStrToUpper(raw));
+          if (section == Section::kEnd) break;
+          first = section == Section::kLineTypes || section == Section::kPoints ||
+                  section == Section::kLines || section == Section::kRodTypes ||
+                  section == Section::kRods || section == Section::kBodies;
+          continue;
+        }
+        if (raw.empty() || !first) continue;
+        first = false;
+        version1 = version1 || is_count(raw);
+      }
+    }
+    if (!version1) return absl::OkStatus();
+    // Pass 2: the rows, rewritten.
+    Section section = Section::kPreamble;
+    int row = -1;  // within a table: 0 the count line, 1 and 2 names and units
+    for (size_t i = 0; i < lines.size(); ++i) {
+      const int n = static_cast<int>(i) + 1;
+      const absl::string_view raw = absl::StripAsciiWhitespace(lines[i]);
+      if (absl::StartsWith(raw, "---")) {
+        section = SectionOf(absl::AsciiStrToUpper(raw));
+        if (section == Section::kEnd) break;
+        row = -1;
+        if (section == Section::kRodTypes || section == Section::kRods ||
+            section == Section::kBodies) {
+          return Error(n, "section",
+                       "a version 1 deck (its tables open with count lines, NTypes ...) "
+                       "with rods or bodies, which version 1 does not have");
+        }
+        if (section == Section::kLineTypes || section == Section::kPoints ||
+            section == Section::kLines)
+          row = 0;
+        continue;
+      }
+      if (raw.empty() || row < 0) continue;
+      const int at = row++;
+      if (at == 0) {
+        if (!is_count(raw)) {
+          return Error(n, "section",
+                       "a version 1 deck (count lines, NTypes ...) with a table that opens "
+                       "without one");
+        }
+        rewritten[i].clear();  // the count line: read as a blank line
+        lines[i] = rewritten[i];
+        continue;
+      }
+      if (at < 3) continue;  // column names and units, skipped as in version 2
+      std::vector<absl::string_view> w = words(raw);
+      for (size_t k = 0; k < w.size(); ++k)
+        if (absl::StartsWith(w[k], "#")) {
+          w.resize(k);
+          break;
+        }
+      const auto expect = [&](size_t count, absl::string_view columns) -> absl::Status {
+        if (w.size() == count) return absl::OkStatus();
+        return Error(n, "version 1 row",
+                     absl::StrCat("expected the ", count, " columns ", columns, ", got ",
+                                  w.size()));
+      };
+      std::vector<absl::string_view> v2;
+      if (section == Section::kLineTypes) {
+        if (absl::Status s = expect(9, "Name Diam MassDen EA BA/-zeta Can Cat Cdn Cdt"); !s.ok())
+          return s;
+        v2 = {w[0], w[1], w[2], w[3], w[4], "0", w[7], w[5], w[8], w[6]};
+      } else if (section == Section::kPoints) {
+        if (absl::Status s = expect(12, "Node Type X Y Z M V FX FY FZ CdA CA"); !s.ok()) return s;
+        const absl::string_view type =
+            absl::EqualsIgnoreCase(w[1], "Connect") ? absl::string_view("Free") : w[1];
+        v2 = {w[0], type, w[2], w[3], w[4], w[5], w[6], w[10], w[11]};
+      } else {
+        if (absl::Status s = expect(7, "Line LineType UnstrLen NumSegs NodeAnch NodeFair Flags");
+            !s.ok())
+          return s;
+        v2 = {w[0], w[1], w[4], w[5], w[2], w[3], w[6]};
+      }
+      rewritten[i] = absl::StrJoin(v2, " ");
+      lines[i] = rewritten[i];
+    }
+    return absl::OkStatus();
+  }
+
   absl::Status Parse() {
     std::vector<absl::string_view> lines = absl::StrSplit(text_, '\n');
+    // A version 1 deck's rows rewritten in the version 2 columns (the
+    // lines' numbers kept); `lines` points into it.
+    std::vector<std::string> rewritten(lines.size());
+    if (absl::Status s = FromVersion1(lines, rewritten); !s.ok()) return s;
     Section section = Section::kPreamble;
     int skip = 0;  // column-name and unit lines still to skip
     absl::string_view header;
@@ -303,24 +421,6 @@ class DeckReader {
         continue;
       }
       if (raw.empty() || section == Section::kPreamble) continue;
-      // MoorDyn's version 1 format (OpenFAST's decks before MoorDyn v2) opens
-      // each table with a count line, "1  NTypes  - number of LineTypes", and
-      // orders its columns differently: refused as such, not misread.
-      if (skip == 2) {
-        const std::vector<absl::string_view> w =
-            absl::StrSplit(raw, absl::ByAnyChar(" \t"), absl::SkipEmpty());
-        static const char* const kCounts[] = {"ntypes", "nconnects", "nlines", "nrodtypes",
-                                              "nrods", "nbodies", "npoints"};
-        for (const char* count : kCounts) {
-          if (w.size() >= 2 && absl::EqualsIgnoreCase(w[1], count)) {
-            return Error(n, w[1],
-                         "a count line of MoorDyn's version 1 format (OpenFAST's decks before "
-                         "MoorDyn v2); cablesim reads the v2 format, as MoorDyn-C v2 does: drop "
-                         "the count lines and write the v2 columns (docs: MoorDyn files, "
-                         "\"Version 1 decks\")");
-          }
-        }
-      }
       if (skip > 0) {
         --skip;
         continue;

@@ -228,6 +228,95 @@ TEST(MoorDynDeckTest, LineEndTensionChannelsBecomeTensionProbes) {
   EXPECT_TRUE(scene.ok()) << scene.status();
 }
 
+// MoorDyn's version 1 format (OpenFAST's decks before MoorDyn v2): count
+// lines and other column orders. A chain from an anchor to a connection
+// (free, with a clump's mass) and a rope on to a vessel point.
+constexpr char kVersion1Deck[] = R"(--------------------- MoorDyn Input File ------------------------------------
+Two lines and a clump
+FALSE    Echo      - echo the input file data (flag)
+----------------------- LINE TYPES ------------------------------------------
+2        NTypes    - number of LineTypes
+Name     Diam      MassDen   EA        BA/-zeta  Can   Cat   Cdn   Cdt
+(-)      (m)       (kg/m)    (N)       (N-s/-)   (-)   (-)   (-)   (-)
+chain    0.1       100       1.0e9     -0.5      1.0   0.5   1.2   0.05
+rope     0.1       10        2.0e8     -0.8      0.9   0.2   1.6   0.01
+---------------------- CONNECTION PROPERTIES --------------------------------
+3        NConnects - number of connections including anchors and fairleads
+Node     Type      X        Y         Z        M        V        FX       FY      FZ     CdA   CA
+(-)      (-)       (m)      (m)       (m)      (kg)     (m^3)    (kN)     (kN)    (kN)   (m^2) (-)
+1        Fixed     -300     0         -100     0        0        0        0       0      0     0
+2        Connect   -100     0         -60      2000     0.5      0        0       0      0.8   1.0
+3        Vessel     -10     0         -5       0        0        0        0       0      0     0
+---------------------- LINE PROPERTIES --------------------------------------
+2        NLines    - number of line objects
+Line     LineType  UnstrLen  NumSegs   NodeAnch  NodeFair  Flags/Outputs
+(-)      (-)       (m)       (-)       (-)       (-)       (-)
+1        chain     250       12        1         2         -
+2        rope      110       6         2         3         p
+---------------------- SOLVER OPTIONS ---------------------------------------
+0.001    dtM       - time step to use in mooring integration (s)
+3.0e6    kbot      - bottom stiffness (Pa/m)
+3.0e5    cbot      - bottom damping (Pa-s/m)
+100      WtrDpth   - water depth (m)
+60.0     TmaxIC    - max time for ic gen (s)
+------------------------ OUTPUTS --------------------------------------------
+FairTen2
+AnchTen1
+END
+------------------------- need this line --------------------------------------
+)";
+
+// The same deck in version 2's columns, written by hand.
+constexpr char kVersion2OfIt[] = R"(--------------------- MoorDyn Input File ------------------------------------
+Two lines and a clump
+----------------------- LINE TYPES ------------------------------------------
+TypeName Diam      Mass/m    EA        BA/-zeta  EI  Cd    Ca    CdAx  CaAx
+(-)      (m)       (kg/m)    (N)       (N-s/-)   (-) (-)   (-)   (-)   (-)
+chain    0.1       100       1.0e9     -0.5      0   1.2   1.0   0.05  0.5
+rope     0.1       10        2.0e8     -0.8      0   1.6   0.9   0.01  0.2
+---------------------- POINTS --------------------------------
+ID       Attachment X        Y         Z        M        V        CdA   CA
+(-)      (-)       (m)      (m)       (m)      (kg)     (m^3)    (m^2) (-)
+1        Fixed     -300     0         -100     0        0        0     0
+2        Free      -100     0         -60      2000     0.5      0.8   1.0
+3        Vessel     -10     0         -5       0        0        0     0
+---------------------- LINES --------------------------------------
+ID       LineType  AttachA  AttachB  UnstrLen  NumSegs  Outputs
+(-)      (-)       (-)      (-)      (m)       (-)      (-)
+1        chain     1        2        250       12       -
+2        rope      2        3        110       6        p
+---------------------- OPTIONS ---------------------------------------
+0.001    dtM       - time step to use in mooring integration (s)
+3.0e6    kbot      - bottom stiffness (Pa/m)
+3.0e5    cbot      - bottom damping (Pa-s/m)
+100      WtrDpth   - water depth (m)
+60.0     TmaxIC    - max time for ic gen (s)
+------------------------ OUTPUTS --------------------------------------------
+FairTen2
+AnchTen1
+------------------------- need this line --------------------------------------
+)";
+
+TEST(MoorDynDeckTest, Version1DeckReadsAsItsVersion2Equivalent) {
+  const v1::Scene old_format = Read(kVersion1Deck, "v1.dat");
+  const v1::Scene new_format = Read(kVersion2OfIt, "v1.dat");
+  ASSERT_EQ(old_format.cables_size(), 2);
+  EXPECT_EQ(old_format.SerializeAsString(), new_format.SerializeAsString())
+      << old_format.DebugString() << "\n---\n" << new_format.DebugString();
+  // A wrong row names the file's line; a version 1 deck with a table that
+  // has no count line is refused.
+  std::string text = kVersion1Deck;
+  text = absl::StrReplaceAll(text, {{"2        rope      110       6         2         3         p",
+                                     "2        rope      110       6         2         3"}});
+  const absl::StatusOr<v1::Scene> bad = SceneFromMoorDyn(text, "v1.dat");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("v1.dat:22: version 1 row: expected the 7 columns"),
+            std::string::npos)
+      << bad.status();
+  text = absl::StrReplaceAll(kVersion1Deck, {{"2        NLines    - number of line objects\n", ""}});
+  EXPECT_FALSE(SceneFromMoorDyn(text, "v1.dat").ok());
+}
+
 // OpenFAST's decks close OUTPUTS with a line END: the list ends there, the
 // channels before it are read (end was refused as a channel name before).
 TEST(MoorDynDeckTest, OutputsMayEndWithEnd) {
@@ -281,7 +370,8 @@ TEST(MoorDynDeckTest, RefusalsNameTheLineAndField) {
       {"Point4Pz", "FairTen7", "bad.dat:33: OUTPUTS FairTen7: line 7 does not exist"},
       {"Point2Px Point2Pz", "END\nPoint2Px", "bad.dat:35: OUTPUTS Point2Px: a channel after END (line 34)"},
       {"TypeName   Diam", "1   NTypes  - number of LineTypes\nTypeName   Diam",
-       "bad.dat:4: NTypes: a count line of MoorDyn's version 1 format"},
+       "bad.dat:7: version 1 row: expected the 9 columns Name Diam MassDen EA BA/-zeta Can Cat "
+       "Cdn Cdt, got 10"},
       {"100           WtrDpth       water depth (m)\n", "", "OPTIONS WtrDpth: required"},
       {"4     Free      -200", "4     Body1     -200", "bad.dat:14: POINTS Volume: a point on a body with volume"},
       {"5     Free      -100    0       -30     0      0       0      0",
