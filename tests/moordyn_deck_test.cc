@@ -231,7 +231,7 @@ TEST(MoorDynDeckTest, LineEndTensionChannelsBecomeTensionProbes) {
 // MoorDyn's version 1 format (OpenFAST's decks before MoorDyn v2): count
 // lines and other column orders. A chain from an anchor to a connection
 // (free, with a clump's mass) and a rope on to a vessel point.
-constexpr char kVersion1Deck[] = R"(--------------------- MoorDyn Input File ------------------------------------
+constexpr char kVersion1Head[] = R"(--------------------- MoorDyn Input File ------------------------------------
 Two lines and a clump
 FALSE    Echo      - echo the input file data (flag)
 ----------------------- LINE TYPES ------------------------------------------
@@ -253,21 +253,10 @@ Line     LineType  UnstrLen  NumSegs   NodeAnch  NodeFair  Flags/Outputs
 (-)      (-)       (m)       (-)       (-)       (-)       (-)
 1        chain     250       12        1         2         -
 2        rope      110       6         2         3         p
----------------------- SOLVER OPTIONS ---------------------------------------
-0.001    dtM       - time step to use in mooring integration (s)
-3.0e6    kbot      - bottom stiffness (Pa/m)
-3.0e5    cbot      - bottom damping (Pa-s/m)
-100      WtrDpth   - water depth (m)
-60.0     TmaxIC    - max time for ic gen (s)
------------------------- OUTPUTS --------------------------------------------
-FairTen2
-AnchTen1
-END
-------------------------- need this line --------------------------------------
 )";
 
-// The same deck in version 2's columns, written by hand.
-constexpr char kVersion2OfIt[] = R"(--------------------- MoorDyn Input File ------------------------------------
+// The same tables in version 2's columns, written by hand.
+constexpr char kVersion2Head[] = R"(--------------------- MoorDyn Input File ------------------------------------
 Two lines and a clump
 ----------------------- LINE TYPES ------------------------------------------
 TypeName Diam      Mass/m    EA        BA/-zeta  EI  Cd    Ca    CdAx  CaAx
@@ -285,7 +274,11 @@ ID       LineType  AttachA  AttachB  UnstrLen  NumSegs  Outputs
 (-)      (-)       (-)      (-)      (m)       (-)      (-)
 1        chain     1        2        250       12       -
 2        rope      2        3        110       6        p
----------------------- OPTIONS ---------------------------------------
+)";
+
+// Both decks' options and outputs (version 1 closes its outputs with END,
+// which version 2 also reads).
+constexpr char kVersionsTail[] = R"(---------------------- SOLVER OPTIONS ---------------------------------------
 0.001    dtM       - time step to use in mooring integration (s)
 3.0e6    kbot      - bottom stiffness (Pa/m)
 3.0e5    cbot      - bottom damping (Pa-s/m)
@@ -294,26 +287,27 @@ ID       LineType  AttachA  AttachB  UnstrLen  NumSegs  Outputs
 ------------------------ OUTPUTS --------------------------------------------
 FairTen2
 AnchTen1
+END
 ------------------------- need this line --------------------------------------
 )";
 
 TEST(MoorDynDeckTest, Version1DeckReadsAsItsVersion2Equivalent) {
-  const v1::Scene old_format = Read(kVersion1Deck, "v1.dat");
-  const v1::Scene new_format = Read(kVersion2OfIt, "v1.dat");
+  const std::string version1 = absl::StrCat(kVersion1Head, kVersionsTail);
+  const v1::Scene old_format = Read(version1, "v1.dat");
+  const v1::Scene new_format = Read(absl::StrCat(kVersion2Head, kVersionsTail), "v1.dat");
   ASSERT_EQ(old_format.cables_size(), 2);
   EXPECT_EQ(old_format.SerializeAsString(), new_format.SerializeAsString())
       << old_format.DebugString() << "\n---\n" << new_format.DebugString();
   // A wrong row names the file's line; a version 1 deck with a table that
   // has no count line is refused.
-  std::string text = kVersion1Deck;
-  text = absl::StrReplaceAll(text, {{"2        rope      110       6         2         3         p",
+  std::string text = absl::StrReplaceAll(version1, {{"2        rope      110       6         2         3         p",
                                      "2        rope      110       6         2         3"}});
   const absl::StatusOr<v1::Scene> bad = SceneFromMoorDyn(text, "v1.dat");
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.status().message().find("v1.dat:22: version 1 row: expected the 7 columns"),
             std::string::npos)
       << bad.status();
-  text = absl::StrReplaceAll(kVersion1Deck, {{"2        NLines    - number of line objects\n", ""}});
+  text = absl::StrReplaceAll(version1, {{"2        NLines    - number of line objects\n", ""}});
   EXPECT_FALSE(SceneFromMoorDyn(text, "v1.dat").ok());
 }
 
