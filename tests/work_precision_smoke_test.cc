@@ -17,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include "absl/strings/str_cat.h"
+#include "tests/scratch_dir.h"
 
 namespace cablesim {
 namespace {
@@ -83,8 +84,9 @@ constexpr char kConfig[] = R"({"repeats": 1,
 TEST(WorkPrecisionSmokeTest, TinyReport) {
   // A directory of this process's own: another checkout's tests may run
   // the same test at the same time.
-  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) /
-                                    ("work_precision_" + std::to_string(::getpid()));
+  const std::filesystem::path dir = testing::Scratch(
+      (std::filesystem::path(::testing::TempDir()) /
+       ("work_precision_" + std::to_string(::getpid()))).string());
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   const std::filesystem::path config = dir / "config.json";

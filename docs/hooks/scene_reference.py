@@ -12,12 +12,14 @@ enums, fields (`repeated`, scalar or message types) with `//` comments just
 above them. Standard library only."""
 import os
 import re
+import shutil
 import sys
 import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DEFAULT_PROTO = os.path.join(HERE, "..", "..", "proto", "cablesim", "v1", "scene.proto")
 PAGE = "reference/scene.md"
+_DIRECTORY = None  # the generated page's directory, removed after the build
 
 
 class Block:
@@ -134,7 +136,8 @@ def on_files(files, config):
     """MkDocs hook: adds the generated page to the build."""
     from mkdocs.structure.files import File
 
-    directory = tempfile.mkdtemp(prefix="cablesim-docs-")
+    global _DIRECTORY
+    directory = _DIRECTORY = tempfile.mkdtemp(prefix="cablesim-docs-")
     os.makedirs(os.path.join(directory, "reference"))
     with open(os.path.join(directory, PAGE), "w", encoding="utf-8") as f:
         f.write(render(DEFAULT_PROTO))
@@ -143,6 +146,14 @@ def on_files(files, config):
         files.remove(stub)
     files.append(File(PAGE, directory, config["site_dir"], config["use_directory_urls"]))
     return files
+
+
+def on_post_build(config):
+    """MkDocs hook: removes the generated page's directory once the site is written."""
+    global _DIRECTORY
+    if _DIRECTORY:
+        shutil.rmtree(_DIRECTORY, ignore_errors=True)
+        _DIRECTORY = None
 
 
 if __name__ == "__main__":
