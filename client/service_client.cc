@@ -84,8 +84,9 @@ bool& InProcessLimitsOn() {
 
 void SetInProcessLimits(bool on) { InProcessLimitsOn() = on; }
 
-ServerLimits InProcessLimits() {
-  if (InProcessLimitsOn()) return DefaultServerLimits();
+namespace {
+
+ServerLimits NoLimits() {
   ServerLimits none;  // no limits beyond the engine's
   none.max_elements = std::numeric_limits<int>::max();
   none.max_steps = std::numeric_limits<int64_t>::max() / 4;
@@ -94,6 +95,17 @@ ServerLimits InProcessLimits() {
   none.max_sweep_items = std::numeric_limits<int>::max();
   return none;
 }
+
+}  // namespace
+
+ServerLimits InProcessLimits() {
+  ServerLimits limits = InProcessLimitsOn() ? DefaultServerLimits() : NoLimits();
+  // A run in the command line's own process computes at the caller's
+  // priority: no calls or health checks to keep answering beside it.
+  limits.compute_nice = 0;
+  return limits;
+}
+
 
 Connection::~Connection() {
   stub.reset();

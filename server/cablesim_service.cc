@@ -352,7 +352,8 @@ grpc::Status CablesimServiceImpl::RunTo(grpc::ServerContext* context,
   StreamingSink sink(writer, slot.watch(), BatchSize(request->frames_per_batch()),
                      checked->scene.name, checked->end_time_s);
   absl::StatusOr<RunSummary> summary =
-      RunSceneWithinMemory(&*checked, &sink, ControlFor(context, limits_));
+      RunSceneWithinMemory(&*checked, &sink, ControlFor(context, limits_),
+                             limits_.compute_nice);
   if (!summary.ok()) return ToGrpc(summary.status());
   if (sink.gone() || context->IsCancelled()) {
     return grpc::Status(grpc::StatusCode::CANCELLED, "the client cancelled or went away");
@@ -574,7 +575,8 @@ grpc::Status CablesimServiceImpl::GetEnergy(grpc::ServerContext* context,
     StoredResult result;
     RowSink sink(&result);
     absl::StatusOr<RunSummary> summary =
-        RunSceneWithinMemory(&*checked, &sink, ControlFor(context, limits_));
+        RunSceneWithinMemory(&*checked, &sink, ControlFor(context, limits_),
+                             limits_.compute_nice);
     if (!summary.ok()) return ToGrpc(summary.status());
     if (context->IsCancelled()) return grpc::Status(grpc::StatusCode::CANCELLED, "cancelled");
     *response = EnergyFromTrajectory(result.header, result.values, SummaryToProto(*summary));

@@ -390,7 +390,7 @@ void JobManager::RunOne(const Claim& claim, std::shared_ptr<Running> running) {
     control.should_stop = [&] { return running->stop.load() != 0; };
     // Rejected steps count too: allow the nominal limit twice over.
     control.max_steps = 2 * limits_.max_steps;
-    absl::StatusOr<RunSummary> ran = RunSceneWithinMemory(*scene, &sink, control);
+    absl::StatusOr<RunSummary> ran = RunSceneWithinMemory(*scene, &sink, control, limits_.compute_nice);
     if (ran.ok()) {
       summary = std::move(*ran);
     } else {

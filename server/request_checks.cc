@@ -82,14 +82,16 @@ absl::StatusOr<RunSummary> RunCatchingBadAlloc(const Scene& scene, PreparedRun* 
 namespace {
 
 absl::StatusOr<RunSummary> RunOnComputeThread(const Scene& scene, PreparedRun* prepared,
-                                              FrameSink* sink, const RunControl& control) {
+                                              FrameSink* sink, const RunControl& control,
+                                              int compute_nice) {
   absl::StatusOr<RunSummary> result = absl::UnknownError("not run");
   std::thread compute([&] {
     // Linux: a thread's own nice value (setpriority on its thread id).
     const int tid = static_cast<int>(::syscall(SYS_gettid));
     errno = 0;
     const int nice = ::getpriority(PRIO_PROCESS, tid);
-    if (errno == 0) ::setpriority(PRIO_PROCESS, tid, std::min(19, nice + kComputeNice));
+    if (errno == 0 && compute_nice > 0)
+      ::setpriority(PRIO_PROCESS, tid, std::min(19, nice + compute_nice));
     result = RunCatchingBadAlloc(scene, prepared, sink, control);
   });
   compute.join();
@@ -99,13 +101,14 @@ absl::StatusOr<RunSummary> RunOnComputeThread(const Scene& scene, PreparedRun* p
 }  // namespace
 
 absl::StatusOr<RunSummary> RunSceneWithinMemory(const Scene& scene, FrameSink* sink,
-                                                const RunControl& control) {
-  return RunOnComputeThread(scene, nullptr, sink, control);
+                                                const RunControl& control, int compute_nice) {
+  return RunOnComputeThread(scene, nullptr, sink, control, compute_nice);
 }
 
 absl::StatusOr<RunSummary> RunSceneWithinMemory(CheckedScene* checked, FrameSink* sink,
-                                                const RunControl& control) {
-  return RunOnComputeThread(checked->scene, checked->prepared.get(), sink, control);
+                                                const RunControl& control, int compute_nice) {
+  return RunOnComputeThread(checked->scene, checked->prepared.get(), sink, control,
+                            compute_nice);
 }
 
 absl::StatusOr<v1::Scene> SceneOfRequest(bool has_scene, const v1::Scene& scene,

@@ -33,6 +33,11 @@ struct ServerLimits {
   int max_message_bytes = 16 << 20;  // gRPC receive limit
   // A Run stream whose client reads nothing for this long is cancelled.
   absl::Duration stall_timeout = absl::Seconds(30);
+  // Nice levels a computation's thread goes below the caller's (see
+  // kComputeNice, the same 10): 10 in cablesim-server, 0 in-process (`cablesim run`
+  // and `sweep` have no calls to keep answering, and a foreground run
+  // should not yield to everything else on the machine).
+  int compute_nice = 10;
   // Limits added later default to "none" here, so that in-process users
   // (`cablesim run`) keep the engine's own bounds; cablesim-server sets
   // them from its flags (README, service section).
@@ -129,11 +134,13 @@ absl::StatusOr<CheckedScene> CheckScene(const v1::Scene& proto, const ServerLimi
 // (bench/server_load_bench.cc).
 inline constexpr int kComputeNice = 10;
 absl::StatusOr<RunSummary> RunSceneWithinMemory(const Scene& scene, FrameSink* sink,
-                                                const RunControl& control);
+                                                const RunControl& control,
+                                                int compute_nice = kComputeNice);
 // The same for a checked scene: runs the model CheckScene built (built
 // once per request), or builds it again when that one has run.
 absl::StatusOr<RunSummary> RunSceneWithinMemory(CheckedScene* checked, FrameSink* sink,
-                                                const RunControl& control);
+                                                const RunControl& control,
+                                                int compute_nice = kComputeNice);
 
 // ResourceExhausted naming the first string field of `message` (its path,
 // after `prefix`) longer than limits.max_name_bytes.

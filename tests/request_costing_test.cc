@@ -9,6 +9,9 @@
 #include <string>
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 #include "convert/scene_file.h"
 #include "engine/output/frame_columns.h"
@@ -76,6 +79,41 @@ TEST(RequestCostingTest, ARunBuildsItsModelOnce) {
   ASSERT_TRUE(rerun.ok()) << rerun.status();
   EXPECT_EQ(MultibodyModel::BuildsStarted() - before, 3);
   EXPECT_EQ(rerun->energy_final, ran->energy_final);
+}
+
+// The thread a run computes on: kComputeNice levels below the caller in
+// the daemon (so that calls and health checks answer under load), at the
+// caller's own level when asked for 0 (`cablesim run` in-process, which a
+// busy machine slowed tenfold when it yielded to everything else).
+TEST(RequestCostingTest, ComputeThreadNiceIsTheCallersPlusComputeNice) {
+  class NiceOfFirstFrame : public FrameSink {
+   public:
+    absl::Status OnFrame(const Frame&) override {
+      if (!seen) {
+        seen = true;
+        errno = 0;
+        nice = ::getpriority(PRIO_PROCESS, static_cast<int>(::syscall(SYS_gettid)));
+      }
+      return absl::OkStatus();
+    }
+    bool seen = false;
+    int nice = 100;
+  };
+  errno = 0;
+  const int caller = ::getpriority(PRIO_PROCESS, static_cast<int>(::syscall(SYS_gettid)));
+  ASSERT_EQ(errno, 0);
+  if (caller + kComputeNice > 19) GTEST_SKIP() << "the test runs at nice " << caller;
+  const Scene scene = [] {
+    absl::StatusOr<CheckedScene> checked = CheckScene(SampleScene("falling-pendulum.json"), {});
+    EXPECT_TRUE(checked.ok()) << checked.status();
+    return checked.ok() ? checked->scene : Scene{};
+  }();
+  NiceOfFirstFrame daemon, in_process;
+  ASSERT_TRUE(RunSceneWithinMemory(scene, &daemon, {}).ok());
+  ASSERT_TRUE(RunSceneWithinMemory(scene, &in_process, {}, 0).ok());
+  EXPECT_EQ(daemon.nice, caller + kComputeNice);
+  EXPECT_EQ(in_process.nice, caller);
+  EXPECT_EQ(ServerLimits{}.compute_nice, kComputeNice);
 }
 
 }  // namespace
