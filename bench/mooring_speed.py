@@ -5,7 +5,7 @@ on a mooring scene against its own converged reference, on the fairlead tension 
     bench/mooring_speed.py CONFIG.json [--quick] [--build DIR] [--out DIR] [--docs DIR]
 
 CONFIG (bench/mooring_speed_oc4.json, bench/mooring_speed_buoy.json) names the scene (and a
-`scene_patch` deep-merged into it), the probes whose support force (`"tension": "support"`, a
+`scene_patch` deep-merged into it, and a `cable_patch` deep-merged into each of its cables), the probes whose support force (`"tension": "support"`, a
 moving support's NAME.fx/.fy/.fz) or tension column (`"tension": "column"`, NAME.tension with
 output.tension) is the fairlead tension, the reference ladder (mesh and step refined together;
 the last rung is the reference, the change between the last two rungs its own error), the
@@ -147,6 +147,8 @@ def main():
         config = {**config, **config.get("quick", {})}
     name = config["name"] + ("_quick" if args.quick else "")
     base = merge(json.load(open(os.path.join(ROOT, config["scene"]))), config.get("scene_patch", {}))
+    for cable in base["cables"]:  # lists are replaced by scene_patch, so cables get their own
+        merge(cable, config.get("cable_patch", {}))
     duration = float(base["solver"]["duration"])
     binary = os.path.join(args.build, "bin", "cablesim")
     repeats = int(config.get("repeats", 3))
