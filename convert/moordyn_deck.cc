@@ -277,53 +277,48 @@ class DeckReader {
     return v;
   }
 
+  // Tables start with a line of column names and one of units.
+  static bool IsTable(Section section) {
+    return section == Section::kLineTypes || section == Section::kRodTypes ||
+           section == Section::kBodies || section == Section::kRods ||
+           section == Section::kPoints || section == Section::kLines;
+  }
+
+  // A row's words; a word starting with '#' starts a comment.
+  static std::vector<absl::string_view> RowWords(absl::string_view raw) {
+    std::vector<absl::string_view> w = absl::StrSplit(raw, absl::ByAnyChar(" \t"),
+                                                    absl::SkipEmpty());
+    for (size_t k = 0; k < w.size(); ++k)
+      if (absl::StartsWith(w[k], "#")) {
+        w.resize(k);
+        break;
+      }
+    return w;
+  }
+
   // MoorDyn's version 1 format (OpenFAST's MoorDyn decks before MoorDyn v2)
   // opens each table with a count line ("1  NTypes  - number of
-  // LineTypes") and orders its columns differently. Such a deck is read by
-  // rewriting its rows in the version 2 columns, line for line, so that
-  // every later message names the file's own line (and the version 2
-  // column): LINE TYPES `Name Diam MassDen EA BA/-zeta Can Cat Cdn Cdt` ->
-  // `Name Diam MassDen EA BA/-zeta 0 Cdn Can Cdt Cat` (no bending
-  // stiffness), CONNECTION PROPERTIES `Node Type X Y Z M V FX FY FZ CdA CA`
-  // -> `Node Type X Y Z M V CdA CA` (the initial force guesses dropped,
-  // `Connect` -> `Free`), LINE PROPERTIES `Line LineType UnstrLen NumSegs
-  // NodeAnch NodeFair Flags` -> `Line LineType NodeAnch NodeFair UnstrLen
-  // NumSegs Flags`. A deck without count lines is left as it is.
+  // LineTypes") and orders its columns differently. A deck whose first
+  // table opens with one is read by rewriting its rows in the version 2
+  // columns, line for line, so that every later message names the file's
+  // own line (and the version 2 column): LINE TYPES `Name Diam MassDen EA
+  // BA/-zeta Can Cat Cdn Cdt` -> `Name Diam MassDen EA BA/-zeta 0 Cdn Can
+  // Cdt Cat` (no bending stiffness), CONNECTION PROPERTIES `Node Type X Y Z
+  // M V FX FY FZ CdA CA` -> `Node Type X Y Z M V CdA CA` (the initial force
+  // guesses dropped, `Connect` -> `Free`), LINE PROPERTIES `Line LineType
+  // UnstrLen NumSegs NodeAnch NodeFair Flags` -> `Line LineType NodeAnch
+  // NodeFair UnstrLen NumSegs Flags`. Any other deck is left as it is.
   absl::Status FromVersion1(std::vector<absl::string_view>& lines,
                             std::vector<std::string>& rewritten) const {
     static const char* const kCounts[] = {"ntypes", "nconnects", "nlines", "nrodtypes",
                                           "nrods", "nbodies", "npoints"};
-    const auto words = [](absl::string_view line) -> std::vector<absl::string_view> {
-      return absl::StrSplit(line, absl::ByAnyChar(" \t"), absl::SkipEmpty());
-    };
-    const auto is_count = [&](absl::string_view line) {
-      const std::vector<absl::string_view> w = words(line);
+    const auto is_count = [](absl::string_view raw) {
+      const std::vector<absl::string_view> w = RowWords(raw);
       for (const char* count : kCounts)
         if (w.size() >= 2 && absl::EqualsIgnoreCase(w[1], count)) return true;
       return false;
     };
-    // Pass 1: is the first row of any table a count line?
     bool version1 = false;
-    {
-      Section section = Section::kPreamble;
-      bool first = false;
-      for (absl::string_view line : lines) {
-        const absl::string_view raw = absl::StripAsciiWhitespace(line);
-        if (absl::StartsWith(raw, "---")) {
-          section = SectionOf(absl::AsciiStrToUpper(raw));
-          if (section == Section::kEnd) break;
-          first = section == Section::kLineTypes || section == Section::kPoints ||
-                  section == Section::kLines || section == Section::kRodTypes ||
-                  section == Section::kRods || section == Section::kBodies;
-          continue;
-        }
-        if (raw.empty() || !first) continue;
-        first = false;
-        version1 = version1 || is_count(raw);
-      }
-    }
-    if (!version1) return absl::OkStatus();
-    // Pass 2: the rows, rewritten.
     Section section = Section::kPreamble;
     int row = -1;  // within a table: 0 the count line, 1 and 2 names and units
     for (size_t i = 0; i < lines.size(); ++i) {
@@ -332,37 +327,32 @@ class DeckReader {
       if (absl::StartsWith(raw, "---")) {
         section = SectionOf(absl::AsciiStrToUpper(raw));
         if (section == Section::kEnd) break;
-        row = -1;
-        if (section == Section::kRodTypes || section == Section::kRods ||
-            section == Section::kBodies) {
+        row = IsTable(section) ? 0 : -1;
+        if (version1 && row == 0 && section != Section::kLineTypes &&
+            section != Section::kPoints && section != Section::kLines) {
           return Error(n, "section",
                        "a version 1 deck (its tables open with count lines, NTypes ...) "
                        "with rods or bodies, which version 1 does not have");
         }
-        if (section == Section::kLineTypes || section == Section::kPoints ||
-            section == Section::kLines)
-          row = 0;
         continue;
       }
       if (raw.empty() || row < 0) continue;
       const int at = row++;
       if (at == 0) {
+        // The first table decides the format; the others must follow it.
+        if (!version1 && !is_count(raw)) return absl::OkStatus();
         if (!is_count(raw)) {
           return Error(n, "section",
                        "a version 1 deck (count lines, NTypes ...) with a table that opens "
                        "without one");
         }
+        version1 = true;
         rewritten[i].clear();  // the count line: read as a blank line
         lines[i] = rewritten[i];
         continue;
       }
       if (at < 3) continue;  // column names and units, skipped as in version 2
-      std::vector<absl::string_view> w = words(raw);
-      for (size_t k = 0; k < w.size(); ++k)
-        if (absl::StartsWith(w[k], "#")) {
-          w.resize(k);
-          break;
-        }
+      const std::vector<absl::string_view> w = RowWords(raw);
       const auto expect = [&](size_t count, absl::string_view columns) -> absl::Status {
         if (w.size() == count) return absl::OkStatus();
         return Error(n, "version 1 row",
@@ -413,11 +403,7 @@ class DeckReader {
                                                   "LINE TYPES, ROD TYPES, BODIES, RODS, POINTS, "
                                                   "LINES, OPTIONS, OUTPUTS)"));
         }
-        // Tables start with a line of column names and one of units.
-        const bool table = section == Section::kLineTypes || section == Section::kRodTypes ||
-                           section == Section::kBodies || section == Section::kRods ||
-                           section == Section::kPoints || section == Section::kLines;
-        skip = table ? 2 : 0;
+        skip = IsTable(section) ? 2 : 0;
         continue;
       }
       if (raw.empty() || section == Section::kPreamble) continue;
@@ -425,14 +411,7 @@ class DeckReader {
         --skip;
         continue;
       }
-      std::vector<absl::string_view> w = absl::StrSplit(raw, absl::ByAnyChar(" \t"),
-                                                      absl::SkipEmpty());
-      // A word starting with '#' starts a comment.
-      for (size_t k = 0; k < w.size(); ++k)
-        if (absl::StartsWith(w[k], "#")) {
-          w.resize(k);
-          break;
-        }
+      const std::vector<absl::string_view> w = RowWords(raw);
       if (w.empty()) continue;
       absl::Status s;
       switch (section) {

@@ -37,11 +37,7 @@ namespace cablesim {
 namespace {
 
 std::string FreshDir(const std::string& name) {
-  const std::string dir = testing::Scratch(
-      absl::StrCat(::testing::TempDir(), "/job_store_test_", name, "_", ::getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
+  return testing::ScratchDir("job_store_test_" + name);
 }
 
 v1::Scene Named(const std::string& name) {

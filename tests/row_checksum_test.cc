@@ -31,11 +31,7 @@ namespace cablesim {
 namespace {
 
 std::string FreshDir(const std::string& name) {
-  const std::string dir = testing::Scratch(
-      absl::StrCat(::testing::TempDir(), "/row_checksum_test_", name, "_", ::getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
+  return testing::ScratchDir("row_checksum_test_" + name);
 }
 
 // Everything the store serves, as bytes per call (an error: absent).

@@ -55,6 +55,16 @@ inline std::string Scratch(std::string path) {
   return path;
 }
 
+// A fresh empty directory TempDir()/STEM_PID (STEM_PID: this process's),
+// removed at exit like Scratch.
+inline std::string ScratchDir(const std::string& stem) {
+  const std::string dir =
+      Scratch(::testing::TempDir() + "/" + stem + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
 }  // namespace cablesim::testing
 
 #endif  // CABLESIM_TESTS_SCRATCH_DIR_H_

@@ -37,13 +37,7 @@ namespace cablesim::testing {
 
 // A fresh empty directory under the test's temporary directory, removed
 // when the test program exits having passed.
-inline std::string FreshDir(const std::string& name) {
-  const std::string dir =
-      Scratch(absl::StrCat(::testing::TempDir(), "/cablesim_", name, "_", ::getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
+inline std::string FreshDir(const std::string& name) { return ScratchDir("cablesim_" + name); }
 
 // Writes `text` to `path`, readable by its owner only (the server refuses
 // a token file that others can read).
