@@ -105,7 +105,7 @@ StaticSolver::IncrementStats StaticSolver::Solve(double alpha, double tolerance)
     const double force_size = model_->NetForce(q_, alpha, &f_, &a, 1.0, &floor_);
     if (q_start_.size() > 0) {
       friction_.setZero(n_);
-      model_->StaticFriction(q_, q_start_, &friction_, &a, 1.0);
+      model_->StaticFriction(q_, q_start_, &friction_, &a, 1.0, &floor_);
       f_ += friction_;
     }
     model_->Constraints(q_, &phi_, &solver_.b());
@@ -136,13 +136,13 @@ StaticSolver::IncrementStats StaticSolver::Solve(double alpha, double tolerance)
     }
     if (it == max_iterations || travel > kMaxTravel * zscale0) {
       st.reason = absl::StrFormat(
-          "no static equilibrium found: %s (relative residual %.3g with a rounding floor of "
-          "%.3g, constraint violation %.3g); the loads may have none: is a body or cable not "
-          "held by the joints (a mechanism)?",
+          "no static equilibrium found: %s (position increment %.3g m, relative residual %.3g "
+          "with a rounding floor of %.3g, constraint violation %.3g); the loads may have none: "
+          "is a body or cable not held by the joints (a mechanism)?",
           it == max_iterations
               ? absl::StrFormat("Newton did not converge in %d iterations", it)
               : absl::StrFormat("the scene moved %.3g times its size", travel / zscale0),
-          iterate.residual, iterate.floor, iterate.violation);
+          last_increment, iterate.residual, iterate.floor, iterate.violation);
       return st;
     }
     double gamma = 0;

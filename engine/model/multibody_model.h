@@ -364,10 +364,12 @@ class MultibodyModel {
   // Adds its generalized force to the reduced `f` and scale times its
   // matrix (symmetric, positive semi-definite; on z) to `matrix` when not
   // null. has_static_friction(): whether there is any (else this does
-  // nothing and costs nothing).
+  // nothing and costs nothing). `roundoff` (reduced, when not null): adds
+  // the cables' friction's rounding floor, as NetForce's (see the .cc).
   bool has_static_friction() const;
   void StaticFriction(const Eigen::VectorXd& q, const Eigen::VectorXd& q_start,
-                        Eigen::VectorXd* f, SkylineLdlt* matrix, double scale);
+                        Eigen::VectorXd* f, SkylineLdlt* matrix, double scale,
+                        Eigen::VectorXd* roundoff = nullptr);
   // Whether frames carry energy.contact (a seabed or sheaves).
   bool has_contact() const { return has_element_contact_; }
 
@@ -695,6 +697,7 @@ class MultibodyModel {
   const CableSeabed* cable_seabed_ = nullptr;
   // Scratch (full size) for StaticFriction (sized on first use).
   Eigen::VectorXd scratch_static_;
+  Eigen::VectorXd scratch_static_roundoff_;
   // The sheaves' typed view (null without sheaves).
   const Sheaves* sheaves_ = nullptr;
   // Only in a scene whose fluid has waves (then it carries the current
