@@ -5,6 +5,8 @@
 #include <limits>
 #include <utility>
 
+#include "engine/linear/rounding.h"
+
 namespace cablesim {
 
 BodySeabedContact::BodySeabedContact(const Seabed& bed, std::vector<Body> bodies, int dim)
@@ -53,8 +55,16 @@ double BodySeabedContact::Terms(Term term, const Eigen::VectorXd& q,
         const Point v = b * other->segment<S>(c.coord);
         result += bed_.PointDissipation<D>(r, v, c.k, c.c, c.mu, &f, a ? &h : nullptr);
       } else {
-        const Point r0 = b * other->segment<S>(c.coord);
-        bed_.PointStaticFriction<D>(r, r0, c.k, c.mu, &f, a ? &h : nullptr);
+        const Local qb0 = other->segment<S>(c.coord);
+        const Point r0 = b * qb0;
+        bed_.PointStaticFriction<D>(r, r0, c.k, c.mu, &f, (a || roundoff) ? &h : nullptr);
+        // The displacement r - r0 = B (q_b - q_b0) is known to a few eps
+        // (kSumRounding) times |B| (|q_b| + |q_b0|), and the regularised law
+        // turns that into up to |h| times as much force, per point (tested
+        // against random roundings of q: seabed_body_test.cc).
+        if (roundoff)
+          bound += kSumRounding * (b.cwiseAbs().transpose() * h.cwiseAbs() * b.cwiseAbs()) *
+                   (qb.cwiseAbs() + qb0.cwiseAbs());
       }
       force.noalias() += b.transpose() * f;
       if (a) matrix.noalias() += b.transpose() * h * b;
@@ -107,9 +117,7 @@ bool BodySeabedContact::has_static_friction() const {
 void BodySeabedContact::AddStaticFriction(const Eigen::VectorXd& q,
                                           const Eigen::VectorXd& q_start,
                                           ForceOutput* out) const {
-  ForceOutput local = *out;
-  local.roundoff = nullptr;
-  Dispatch(Term::kStaticFriction, q, &q_start, &local);
+  Dispatch(Term::kStaticFriction, q, &q_start, out);
 }
 
 std::unique_ptr<BodySeabedContact> MakeBodySeabedContact(const Scene& scene,

@@ -174,7 +174,8 @@ class ForceContributor {
 
   virtual bool has_static_friction() const { return false; }
   // The static friction force at q opposing the displacement from q_start
-  // into out->full, scale times its matrix into out->matrix.
+  // into out->full, scale times its matrix into out->matrix, and (when
+  // out->roundoff is set) its rounding floor into out->roundoff.
   virtual void AddStaticFriction(const Eigen::VectorXd& q, const Eigen::VectorXd& q_start,
                                  ForceOutput* out) const {
     (void)q;

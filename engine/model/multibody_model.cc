@@ -459,7 +459,6 @@ bool MultibodyModel::has_static_friction() const {
 void MultibodyModel::StaticFriction(const VectorXd& q, const VectorXd& q_start, VectorXd* f,
                                     SkylineLdlt* matrix, double scale, VectorXd* roundoff) {
   if (!has_static_friction()) return;
-  constexpr double kEps = std::numeric_limits<double>::epsilon();
   VectorXd& full = scratch_static_;
   full.setZero(c_.size());
   VectorXd& full_roundoff = scratch_static_roundoff_;
@@ -485,14 +484,18 @@ void MultibodyModel::StaticFriction(const VectorXd& q, const VectorXd& q_start, 
       full.segment<kN>(e.first_coord) += fe;
       if (roundoff) {
         // The regularised law's force turns by mu N over friction_length of
-        // displacement, and the displacement e - e0 is known only to
+        // displacement, and the displacement e - e0 is known only to a few
         // eps (|e| + |e0|): that times the law's tangent (me) is what
         // rounding leaves in the force, however well Newton converges
         // (up to 1e5 N/m of bed per metre of line at friction_length
         // 1e-5 m: a 10 element buoy mooring's statics stalled 3e-12 of
-        // its force scale above a floor that left it out).
+        // its force scale above a floor that left it out). kSumRounding,
+        // not eps: random roundings of a chain's e and e0 moved the force
+        // by up to 3.7 eps |me| (|e| + |e0|), as the element's matrix sums
+        // its points' tangents with signs (a per-point bound, as the
+        // bodies', would be exact; Seabed does not return one yet).
         full_roundoff.segment<kN>(e.first_coord) +=
-            kEps * (me.cwiseAbs() * (ek.cwiseAbs() + e0k.cwiseAbs()) + fe.cwiseAbs());
+            kSumRounding * (me.cwiseAbs() * (ek.cwiseAbs() + e0k.cwiseAbs()) + fe.cwiseAbs());
       }
       if (!matrix) continue;
       ScatterElementMatrix<kN2>(k, me.data(), scale, values);
@@ -503,8 +506,8 @@ void MultibodyModel::StaticFriction(const VectorXd& q, const VectorXd& q_start, 
   } else {
     cables(elements3_, std::integral_constant<int, 3>());
   }
-  // Body contact points' friction (BodySeabedContact) adds no floor.
-  ForceOutput out{&full, nullptr, matrix, scale, Map()};
+  // Body contact points' friction (BodySeabedContact) adds its own floor.
+  ForceOutput out{&full, roundoff ? &full_roundoff : nullptr, matrix, scale, Map()};
   for (const auto& c : contributors_) c->AddStaticFriction(q, q_start, &out);
   const int n = coordinates();
   if (f) {
