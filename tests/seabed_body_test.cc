@@ -16,8 +16,8 @@
 #include <cmath>
 #include <limits>
 #include <random>
-#include <vector>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 

@@ -292,7 +292,7 @@ TEST(SeabedTest, MooringStaticsWithFrictionMatchesTheCatenaryWithCB) {
 // line: Newton reached the rounding floor in 90 iterations, then stayed
 // 3e-12 of the force scale above it for 500 more in every load increment,
 // because the floor left out the regularised friction's rounding (its
-// tangent, mu N / friction_length, times eps |q|: MultibodyModel::
+// tangent, mu N / friction_length, times a few eps |q|: MultibodyModel::
 // StaticFriction's roundoff). Now each mesh reaches its equilibrium.
 TEST(SeabedFrictionTest, CoarseBuoyMooringReachesItsStaticEquilibrium) {
   for (int elements : {10, 15, 50}) {

@@ -365,7 +365,8 @@ class MultibodyModel {
   // matrix (symmetric, positive semi-definite; on z) to `matrix` when not
   // null. has_static_friction(): whether there is any (else this does
   // nothing and costs nothing). `roundoff` (reduced, when not null): adds
-  // the cables' friction's rounding floor, as NetForce's (see the .cc).
+  // the friction's rounding floor (cables' and body contact points'), as
+  // NetForce's (see the .cc).
   bool has_static_friction() const;
   void StaticFriction(const Eigen::VectorXd& q, const Eigen::VectorXd& q_start,
                         Eigen::VectorXd* f, SkylineLdlt* matrix, double scale,
