@@ -2281,26 +2281,30 @@ class DeckReader {
   // Sets the fluid loads of a free scene body whose centre of mass is
   // `com` from its wet parts, one BodyHydrodynamics each (the first in
   // `hydrodynamics`, the others in `hydrodynamics_parts`), or refuses what
-  // they cannot express (a cylinder centred at the centre of mass, buoyed
-  // as a vertical one, forces only). `own_rod`: the body is the one rod's,
-  // its x axis the rod's (BodyHydrodynamics.along_axis); a tilted rod on a
-  // body splits its loads along its own axis (BodyHydrodynamics.axis, in
-  // the body's frame: the world's at the start).
+  // they cannot express (a cylinder buoyed as a vertical one). A part whose
+  // centre is off the centre of mass (a rod on a body, a body's volume at
+  // its CG when points or rods move the centre of mass) gets that offset as
+  // its `center`, in the body's frame: the world's at the start, as a
+  // body's axes are here (a rod's own body has one part, at its centre).
+  // `own_rod`: the body is the one rod's, its x axis the rod's
+  // (BodyHydrodynamics.along_axis); a tilted rod on a body splits its loads
+  // along its own axis (BodyHydrodynamics.axis, in the body's frame).
   absl::Status SetHydrodynamics(const std::vector<Wet>& wet, const Eigen::Vector3d& com,
                                 v1::Body* body, bool own_rod = false) const {
     for (size_t k = 0; k < wet.size(); ++k) {
       const Wet& p = wet[k];
-      const double size = std::max(p.length, p.diameter);
-      if ((p.centre - com).norm() > 1e-6 * size) {
-        return Error(p.line, p.rod ? "RODS Attachment" : "BODIES CG",
-                     absl::StrCat("the displaced volume's centre lies ", (p.centre - com).norm(),
-                                  " m from the body's centre of mass: cablesim's body fluid "
-                                  "loads act on cylinders centred at the centre of mass (forces "
-                                  "only)"));
-      }
       v1::BodyHydrodynamics* h =
           k == 0 ? body->mutable_hydrodynamics() : body->add_hydrodynamics_parts();
       if (absl::Status s = SetPart(p, own_rod, h); !s.ok()) return s;
+      const Eigen::Vector3d offset = p.centre - com;
+      const double size = std::max(p.length, p.diameter);
+      if (offset.norm() > 1e-6 * size) {
+        if (own_rod) {
+          return Error(p.line, "RODS Attachment",
+                       "internal: a rod's own body off its centre");  // not reached
+        }
+        SetVec(h->mutable_center(), offset.x(), offset.y(), offset.z());
+      }
     }
     return absl::OkStatus();
   }
@@ -2403,7 +2407,11 @@ class DeckReader {
                      "world's axes cannot be expressed (the scene body keeps the world's axes)");
       }
     }
-    v1::BodyHydrodynamics* h = body->mutable_hydrodynamics();
+    // On the body's own cylinder, or in a part of their own when that
+    // cylinder is off the centre of mass (drag areas act at the centre).
+    v1::BodyHydrodynamics* h = body->has_hydrodynamics() && body->hydrodynamics().has_center()
+                                   ? body->add_hydrodynamics_parts()
+                                   : body->mutable_hydrodynamics();
     SetVec(h->mutable_drag_area(), areas[0].x(), areas[0].y(), areas[0].z());
     SetVec(h->mutable_rotational_drag_area(), areas[1].x(), areas[1].y(), areas[1].z());
     return absl::OkStatus();

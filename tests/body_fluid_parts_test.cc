@@ -1,10 +1,13 @@
 // A body with several hydrodynamic parts (Body.hydrodynamics_parts, each a
-// BodyFluidLoad at the centre of mass; engine/forces/body_fluid_load.h):
+// BodyFluidLoad at the centre of mass or off it; engine/forces/body_fluid_load.h):
 // the loads, tangents, added mass and energies of two parts are the sums of
 // each part's alone; a rod part along an axis given in the body's frame
 // feels the closed-form drag and added mass across and along that axis,
 // turning with the body; its drag tangent is the rate derivative; the
-// scene's errors name the part's field.
+// scene's errors name the part's field. A part off the centre of mass:
+// its force is the energy's gradient, its tangents the derivatives, its
+// added mass that of its centre, and a float off a pin rights the body and
+// swings it at the closed-form frequency.
 
 #include <cmath>
 #include <cstdio>
@@ -20,6 +23,7 @@
 #include "convert/scene_file.h"
 #include "convert/scene_from_proto.h"
 #include "engine/model/multibody_model.h"
+#include "tests/net_force_derivatives.h"
 #include "tests/test_util.h"
 
 namespace cablesim {
@@ -29,6 +33,8 @@ constexpr double kPi = std::numbers::pi;
 constexpr double kRho = 1025;
 
 using ::testing::HasSubstr;
+using testing::CollectingSink;
+using testing::RunOk;
 using testing::SceneFromJson;
 
 // A held body (mass 500 kg) at `position`, its x axis `axis`, in a current
@@ -343,6 +349,213 @@ TEST(BodyFluidPartsTest, PartAxisOutOfThePlaneIsNamed) {
   ASSERT_FALSE(model.ok());
   EXPECT_THAT(std::string(model.status().message()),
               HasSubstr("bodies[0].hydrodynamics_parts[0].axis.z"));
+}
+
+// ---- Parts off the centre of mass (BodyHydrodynamics.center) -------------
+
+// A part's centre from the body's natural coordinates, computed here from
+// its definition r_p = r_c + c_1 e1 + c_2 e2 + c_3 e3 (the body is the
+// scene's only one: its coordinates are the first 12), and the same map of
+// the rates (its velocity).
+Eigen::Vector3d PartPoint(const Eigen::VectorXd& x, const Eigen::Vector3d& c) {
+  Eigen::Vector3d r = x.head<3>();
+  for (int k = 0; k < 3; ++k) r += c(k) * x.segment<3>(3 + 3 * k);
+  return r;
+}
+
+// A tilted body whose rod part sits off its centre of mass, piercing the
+// surface in a wave: the generalised force is minus the gradient of the
+// energy, and the stiffness the force's derivative, by central differences
+// in every unknown (step 1e-6: truncation ~1e-12, rounding ~1e-10 of the
+// largest term; tolerances 1e-6 and 1e-5 of it, as the bed's test).
+TEST(BodyFluidPartsTest, OffCentrePartForceIsTheEnergysGradientAndItsTangentTheForces) {
+  const Eigen::Vector3d c(1.5, -0.8, 2.2);
+  const std::string json = BodyJson(
+      R"({"z": -2.8})", R"({"x": 1, "y": 0.4, "z": 0.3})",
+      absl::StrFormat(R"(, "hydrodynamics_parts": [{"diameter": 0.8, "height": 3,
+           "drag_coefficient": 1.1, "added_mass": 0.9, "heave_added_mass": 0.3,
+           "center": {"x": %.17g, "y": %.17g, "z": %.17g}}])",
+                      c.x(), c.y(), c.z()),
+      false);
+  auto m = MultibodyModel::Build(SceneFromJson(json));
+  ASSERT_TRUE(m.ok()) << m.status();
+  const int n = m->dofs(), nq = m->coordinates();
+  Eigen::VectorXd z = m->initial_z(), q(nq), f = Eigen::VectorXd::Zero(n);
+  m->ToFull(z, &q);
+  // The part pierces the still level (z = 0): its buoyancy varies.
+  const double height = PartPoint(q, c).z();
+  std::printf("part centre at z = %.6g m (half height 1.5 m)\n", height);
+  ASSERT_LT(std::abs(height), 1.5);
+  ASSERT_GT(std::abs(height), 0.1);
+  const testing::NetForceDerivativeErrors e = testing::NetForceDerivatives(*m, 1e-6);
+  std::printf("force error %.3g of %.3g, stiffness error %.3g of %.3g\n", e.force, e.force_size,
+              e.matrix, e.matrix_size);
+  EXPECT_LT(e.force, 1e-6 * e.force_size);
+  EXPECT_LT(e.matrix, 1e-5 * e.matrix_size);
+  m->NetForce(q, 1.0, &f);
+  // The part's buoyancy turns the body: the force on the axes is not zero.
+  EXPECT_GT(f.segment(3, 9).lpNorm<Eigen::Infinity>(), 1e-3 * e.force_size);
+}
+
+// The added mass of a part off the centre of mass is that of its centre:
+// the body's kinetic energy with the part less the bare body's is
+// (1/2) v_p^T rho V (C_ah (I - up up^T) + C_av up up^T) v_p, v_p = rdot_c +
+// sum c_k edot_k computed here, for rates that turn and move the body (to
+// rounding, 1e-12). The part is wholly under water (V its whole volume).
+TEST(BodyFluidPartsTest, OffCentrePartAddedMassIsThatOfItsCentre) {
+  const Eigen::Vector3d c(0.7, 1.9, -1.3);
+  const double d = 0.6, length = 2.5, ca = 0.8, ca_v = 0.35;
+  auto json = [&](bool part) {
+    return BodyJson(R"({"z": -20})", R"({"x": 1, "y": -0.3, "z": 0.6})",
+                    part ? absl::StrFormat(R"(, "hydrodynamics_parts": [{"diameter": %.17g,
+                               "height": %.17g, "added_mass": %.17g, "heave_added_mass": %.17g,
+                               "center": {"x": %.17g, "y": %.17g, "z": %.17g}}])",
+                                           d, length, ca, ca_v, c.x(), c.y(), c.z())
+                         : "",
+                    false);
+  };
+  auto with = MultibodyModel::Build(SceneFromJson(json(true)));
+  auto bare = MultibodyModel::Build(SceneFromJson(json(false)));
+  ASSERT_TRUE(with.ok()) << with.status();
+  ASSERT_TRUE(bare.ok()) << bare.status();
+  const int nq = with->coordinates(), n = with->dofs();
+  Eigen::VectorXd q(nq), qd(nq), zdot(n);
+  with->ToFull(with->initial_z(), &q);
+  for (int i = 0; i < n; ++i) zdot(i) = 0.5 * std::sin(0.9 * i + 0.3);
+  with->RateToFull(zdot, &qd);
+  const Eigen::Vector3d v = PartPoint(qd, c);
+  ASSERT_GT(v.norm(), 0.1);
+  const Eigen::Matrix3d vertical = Eigen::Vector3d::UnitZ() * Eigen::Vector3d::UnitZ().transpose();
+  const double volume = kPi * d * d / 4 * length;
+  const Eigen::Matrix3d ma =
+      kRho * volume * (ca * (Eigen::Matrix3d::Identity() - vertical) + ca_v * vertical);
+  const double expected = 0.5 * v.dot(ma * v);
+  const double got = with->Energy(q, qd, 1).kinetic - bare->Energy(q, qd, 1).kinetic;
+  std::printf("added kinetic energy %.15g J, closed form %.15g J\n", got, expected);
+  EXPECT_NEAR(got, expected, 1e-12 * with->Energy(q, qd, 1).kinetic);
+  // Off the centre, the rotation alone moves the part: rates of the axes
+  // only (r_c at rest) still carry its added mass.
+  Eigen::VectorXd spin = qd;
+  spin.head<3>().setZero();
+  const Eigen::Vector3d vs = PartPoint(spin, c);
+  EXPECT_NEAR(with->Energy(q, spin, 1).kinetic - bare->Energy(q, spin, 1).kinetic,
+              0.5 * vs.dot(ma * vs), 1e-12 * with->Energy(q, spin, 1).kinetic);
+}
+
+// The drag and inertia of a part off the centre of mass, with waves and a
+// current: the damping tangent is the rate derivative (central differences,
+// as DragTangentIsTheRateDerivative).
+TEST(BodyFluidPartsTest, OffCentrePartDragTangentIsTheRateDerivative) {
+  auto model = MultibodyModel::Build(SceneFromJson(BodyJson(
+      R"({"z": -6})", R"({"x": 1, "y": 0.4, "z": 0.3})",
+      absl::StrFormat(R"(, "hydrodynamics_parts": [%s, {"diameter": 0.5, "height": 2,
+                          "drag_coefficient": 1.2, "heave_drag_coefficient": 0.8,
+                          "center": {"x": -1.2, "y": 0.9, "z": 1.6}}])",
+                      absl::StrReplaceAll(kPartB, {{R"("axis": {"y": 1, "z": 0.5}})",
+                                                    R"("axis": {"y": 1, "z": 0.5},
+                                                       "center": {"x": 2, "z": -0.5}})"}})))));
+  ASSERT_TRUE(model.ok()) << model.status();
+  ASSERT_EQ(model->body_fluid_loads().size(), 2u);
+  EXPECT_TRUE(model->body_fluid_loads()[0].has_offset());
+  double size = 0;
+  const double error = testing::DampingTangentError(*model, Eigen::VectorXd(), 1e-6, &size);
+  std::printf("tangent error %.3g of %.3g\n", error, size);
+  EXPECT_GT(size, 1);
+  EXPECT_LT(error, 1e-6 * size);
+}
+
+// A body pinned at its centre of mass to the ground, wholly under water,
+// with a buoyant float (d 1 m, 2 m, C_a 1) at L = 2 m from the pin: the
+// float's buoyancy F_b = rho g V is the only moment about the pin (the
+// weight acts at the pin). Statics from a tilt of 45 degrees bring the float
+// above the pin (to Newton's tolerance: 1e-7 m); about that equilibrium the
+// body swings as a pendulum turned upside down, omega^2 = F_b L / (J +
+// C_a rho V L^2) about each horizontal axis (its own J: 600 and 900 kg m^2;
+// the float's added mass at its centre), and freely about the vertical
+// (omega = 0). Closed forms of the small oscillation; MODAL's frequencies
+// are those of the linearised model, so they agree to rounding (1e-9,
+// relative). Without the offset's added inertia the frequencies would be 3.3
+// and 2.8 times higher; without its moment the body would not swing.
+TEST(BodyFluidPartsTest, FloatOffThePinRightsTheBodyAndSwingsAtTheClosedFormFrequency) {
+  const double g = 9.81, d = 1, h = 2, ca = 1, length = 2;
+  const double volume = kPi * d * d / 4 * h, fb = kRho * g * volume;
+  auto scene = [&](const Eigen::Vector3d& c, const std::string& analysis) {
+    return absl::StrFormat(R"({
+      "gravity": {"z": -%.17g}, "fluid": {"density": %.17g},
+      "bodies": [{"name": "b", "mass": 2000, "inertia": {"x": 600, "y": 900, "z": 500},
+                  "position": {"z": -30},
+                  "hydrodynamics_parts": [{"diameter": %.17g, "height": %.17g,
+                     "added_mass": %.17g, "heave_added_mass": 0.5,
+                     "center": {"x": %.17g, "y": %.17g, "z": %.17g}}]}],
+      "joints": [{"type": "PIN", "a": {"body": "b"}}],
+      "probes": [{"name": "float", "body": "b", "point": {"x": %.17g, "y": %.17g, "z": %.17g}}],
+      "solver": {"analysis": "%s" %s}})",
+                           g, kRho, d, h, ca, c.x(), c.y(), c.z(), c.x(), c.y(), c.z(), analysis,
+                           analysis == "MODAL" ? R"(, "modes": 3)" : "");
+  };
+  {
+    const Eigen::Vector3d tilted(length * std::sqrt(0.5), 0, length * std::sqrt(0.5));
+    CollectingSink sink;
+    RunOk(SceneFromJson(scene(tilted, "STATIC")), &sink);
+    ASSERT_FALSE(sink.frames().empty());
+    const Eigen::Vector3d r = sink.frames().back().probes[0].position_m;
+    std::printf("float at (%.3g, %.3g, %.12g) m, above the pin at z = %.12g m\n", r.x(), r.y(),
+                r.z(), -30 + length);
+    EXPECT_NEAR(r.x(), 0, 1e-7);
+    EXPECT_NEAR(r.y(), 0, 1e-7);
+    EXPECT_NEAR(r.z(), -30 + length, 1e-7);
+  }
+  CollectingSink sink;
+  const RunSummary s = RunOk(SceneFromJson(scene(Eigen::Vector3d(0, 0, length), "MODAL")), &sink);
+  ASSERT_EQ(s.frequencies_hz.size(), 3u);
+  const double added = ca * kRho * volume * length * length;
+  const double about_x = std::sqrt(fb * length / (600 + added)) / (2 * kPi);
+  const double about_y = std::sqrt(fb * length / (900 + added)) / (2 * kPi);
+  std::printf("frequencies %.12g %.12g %.12g Hz; closed form 0, %.12g, %.12g Hz\n",
+              s.frequencies_hz[0], s.frequencies_hz[1], s.frequencies_hz[2], about_y, about_x);
+  EXPECT_LT(std::abs(s.frequencies_hz[0]), 1e-6 * about_x);
+  EXPECT_NEAR(s.frequencies_hz[1] / about_y, 1, 1e-9);
+  EXPECT_NEAR(s.frequencies_hz[2] / about_x, 1, 1e-9);
+}
+
+// The same pendulum in the planar model (gravity -y, the float at (0, L)
+// in the body's frame): omega^2 = F_b L / (J_z + C_a rho V L^2).
+TEST(BodyFluidPartsTest, PlanarFloatOffThePinSwingsAtTheClosedFormFrequency) {
+  const double g = 9.81, d = 1, h = 2, ca = 1, length = 2;
+  const double volume = kPi * d * d / 4 * h, fb = kRho * g * volume;
+  CollectingSink sink;
+  const RunSummary s = RunOk(SceneFromJson(absl::StrFormat(R"({
+      "model": "PLANAR", "gravity": {"y": -%.17g}, "fluid": {"density": %.17g},
+      "bodies": [{"name": "b", "mass": 2000, "inertia": {"x": 600, "y": 900, "z": 700},
+                  "position": {"y": -30},
+                  "hydrodynamics_parts": [{"diameter": %.17g, "height": %.17g,
+                     "added_mass": %.17g, "center": {"y": %.17g}}]}],
+      "joints": [{"type": "PIN", "a": {"body": "b"}}],
+      "solver": {"analysis": "MODAL", "modes": 1}})",
+                                                           g, kRho, d, h, ca, length)),
+                             &sink);
+  ASSERT_EQ(s.frequencies_hz.size(), 1u);
+  const double expected = std::sqrt(fb * length / (700 + ca * kRho * volume * length * length)) /
+                          (2 * kPi);
+  std::printf("frequency %.12g Hz, closed form %.12g Hz\n", s.frequencies_hz[0], expected);
+  EXPECT_NEAR(s.frequencies_hz[0] / expected, 1, 1e-9);
+}
+
+TEST(BodyFluidPartsTest, CenterWithDragAreasAndOutOfThePlaneAreNamed) {
+  EXPECT_THAT(testing::SceneError(BodyJson(R"({"z": -5})", R"({"x": 1})",
+                                           R"(, "hydrodynamics_parts": [{"diameter": 1,
+                                                "height": 1, "center": {"x": 1},
+                                                "drag_area": {"x": 0.5}}])")),
+              HasSubstr("bodies[0].hydrodynamics_parts[0].center: not with drag_area"));
+  auto model = MultibodyModel::Build(SceneFromJson(R"({
+    "model": "PLANAR", "gravity": {"y": -9.81}, "fluid": {"density": 1025},
+    "bodies": [{"name": "b", "mass": 500, "inertia": {"x": 40, "y": 60, "z": 70},
+                "position": {"y": -5},
+                "hydrodynamics": {"diameter": 0.3, "height": 3, "center": {"x": 1, "z": 1}}}],
+    "solver": {"duration": 1}})"));
+  ASSERT_FALSE(model.ok());
+  EXPECT_THAT(std::string(model.status().message()),
+              HasSubstr("bodies[0].hydrodynamics.center.z"));
 }
 
 }  // namespace

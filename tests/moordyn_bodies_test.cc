@@ -659,11 +659,22 @@ TEST(MoorDynBodiesTest, RefusalsNameTheLineAndField) {
                                 "1    can       Body1      -5    0     0     5     0     0    4"}}))
                 .find("bad.dat:18: RODS Zb: a rod that is not vertical within half its length"),
             std::string::npos);
-  // The rod's cylinder off the centre of mass (the points' masses moved).
-  EXPECT_NE(Refusal(absl::StrReplaceAll(body, {{"2     Body1     -2      0       0       50",
-                                               "2     Body1     -2      0       0       0"}}))
-                .find("bad.dat:18: RODS Attachment: the displaced volume's centre lies"),
-            std::string::npos);
+  // The rod's cylinder off the centre of mass (one point's mass removed):
+  // read since 28 November 2026, the rod's cylinder centred where it is,
+  // `center` from the centre of mass in the body's frame (the world's at
+  // the start): point 1's 50 kg at world y = 2 m move the centre of mass
+  // 2 x 50 / 15,050 m along y, so the rod sits that far on the other side.
+  {
+    const v1::Scene off = Read(absl::StrReplaceAll(
+        body, {{"2     Body1     -2      0       0       50", "2     Body1     -2      0       0       0"}}));
+    ASSERT_EQ(off.bodies_size(), 1);
+    const v1::BodyHydrodynamics& h = off.bodies(0).hydrodynamics();
+    ASSERT_TRUE(h.has_center());
+    EXPECT_NEAR(h.center().y(), -2 * 50 / (1e4 + 500 * 10 + 50), 1e-12);
+    EXPECT_NEAR(h.center().x(), 0, 1e-12);
+    EXPECT_NEAR(h.center().z(), 0, 1e-12);
+    EXPECT_NEAR(off.bodies(0).position().y(), 2 * 50 / (1e4 + 500 * 10 + 50), 1e-12);
+  }
   EXPECT_NE(Refusal(absl::StrReplaceAll(body, {{"-5    0     0     5    4",
                                                "-5    0     0     5    0"}}))
                 .find("bad.dat:18: RODS NumSegs"),

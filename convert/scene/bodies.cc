@@ -51,6 +51,16 @@ absl::Status ConvertBodyFluidPart(const ConversionState& state, const std::strin
                    &plausible::kRotationalDragArea, &part->rotational_drag_area_m5}}) {
     CABLESIM_ASSIGN_OR_RETURN(*out, VectorInRange(Sub(path, name), *v, *range));
   }
+  if (h.has_center()) {
+    CABLESIM_ASSIGN_OR_RETURN(part->center_m, VectorInRange(Sub(path, "center"), h.center(),
+                                                            plausible::kCoordinate));
+    if (!part->center_m.isZero(0) &&
+        (!part->drag_area_m2.isZero(0) || !part->rotational_drag_area_m5.isZero(0))) {
+      return Invalid(Sub(path, "center"),
+                     "not with drag_area or rotational_drag_area (they act at the centre of "
+                     "mass): give the drag areas in a part of their own");
+    }
+  }
   if (h.has_axis()) {
     if (!h.along_axis())
       return Invalid(Sub(path, "axis"), "only with along_axis (the split's direction)");

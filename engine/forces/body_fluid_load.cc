@@ -21,6 +21,46 @@ BodyFluidLoad::BodyFluidLoad(const Params& p, int coord, int dim)
   up_.setZero();
   up_.head(dim) = p.up.head(dim);
   up_.normalize();
+  // T: r_p = r_c + c_1 e1 + c_2 e2 + c_3 e3 (spatial), r_c + c_x u + c_y J u
+  // (planar, J u = e_z x u = (-u_y, u_x)).
+  const Vector3d& c = p.center_body;
+  has_offset_ = dim == 2 ? (c.x() != 0 || c.y() != 0) : !c.isZero(0);
+  t_.topLeftCorner(dim, dim).setIdentity();
+  if (dim == 2) {
+    t_.block<2, 2>(0, 2) << c.x(), -c.y(), c.y(), c.x();
+  } else {
+    for (int k = 0; k < 3; ++k) t_.block<3, 3>(0, 3 + 3 * k) = c(k) * Matrix3d::Identity();
+  }
+}
+
+Vector3d BodyFluidLoad::MapPoint(const VectorXd& x) const {
+  Vector3d r = Vector3d::Zero();
+  if (!has_offset_) {
+    r.head(dim_) = x.segment(coord_, dim_);
+    return r;
+  }
+  const int n = stride();
+  for (int k = 0; k < n; ++k) r += t_.col(k) * x(coord_ + k);
+  return r;
+}
+
+BodyFluidLoad::Generalized BodyFluidLoad::Spread(const Vector3d& f) const {
+  Generalized g = Generalized::Zero();
+  g.head(stride()) = t_.leftCols(stride()).transpose() * f;
+  return g;
+}
+
+BodyFluidLoad::Generalized BodyFluidLoad::SpreadSize(double f) const {
+  Generalized g = Generalized::Zero();
+  g.head(stride()) = f * t_.leftCols(stride()).cwiseAbs().colwise().sum().transpose();
+  return g;
+}
+
+BodyFluidLoad::GeneralizedMatrix BodyFluidLoad::Spread(const Matrix3d& c) const {
+  GeneralizedMatrix g = GeneralizedMatrix::Zero();
+  const int n = stride();
+  g.topLeftCorner(n, n) = t_.leftCols(n).transpose() * c * t_.leftCols(n);
+  return g;
 }
 
 Vector3d BodyFluidLoad::Axis(const VectorXd& q) const {
@@ -46,11 +86,16 @@ double BodyFluidLoad::Submerged(double z) const {
 
 double BodyFluidLoad::Height(const VectorXd& q) const {
   double h = -p_.still_level_m;
+  if (has_offset_) {
+    const Vector3d r = MapPoint(q);
+    for (int d = 0; d < dim_; ++d) h += up_(d) * r(d);
+    return h;
+  }
   for (int d = 0; d < dim_; ++d) h += up_(d) * q(coord_ + d);
   return h;
 }
 
-Matrix3d BodyFluidLoad::AddedMass(const VectorXd& q0) const {
+BodyFluidLoad::GeneralizedMatrix BodyFluidLoad::AddedMass(const VectorXd& q0) const {
   const double v = p_.density_kg_m3 * area_ * Submerged(Height(q0));
   const Vector3d axis = Axis(q0);
   const Matrix3d vertical = axis * axis.transpose();
@@ -61,14 +106,19 @@ Matrix3d BodyFluidLoad::AddedMass(const VectorXd& q0) const {
     m.row(2).setZero();
     m.col(2).setZero();
   }
-  return m;
+  return Spread(m);
 }
 
 double BodyFluidLoad::AddHydrostatic(const VectorXd& q, double scale, VectorXd* force,
                                      Matrix3d* stiffness) const {
   const double z = Height(q);
   const double f = scale * p_.density_kg_m3 * p_.g_m_s2 * area_ * Submerged(z);
-  for (int d = 0; d < dim_; ++d) (*force)(coord_ + d) += f * up_(d);
+  if (has_offset_) {
+    const Generalized g = Spread(Vector3d(f * up_));
+    for (int k = 0; k < stride(); ++k) (*force)(coord_ + k) += g(k);
+  } else {
+    for (int d = 0; d < dim_; ++d) (*force)(coord_ + d) += f * up_(d);
+  }
   if (stiffness != nullptr && z > -p_.height_m / 2 && z < p_.height_m / 2)
     *stiffness += scale * p_.density_kg_m3 * p_.g_m_s2 * area_ * up_ * up_.transpose();
   return std::abs(f);
@@ -177,9 +227,7 @@ void BodyFluidLoad::AreaDrag(const VectorXd& q, const VectorXd& qdot, double t,
 
 Vector3d BodyFluidLoad::DynamicForce(const VectorXd& q, const VectorXd& qdot, double t,
                                      const WaveField* waves, Matrix3d* damping) const {
-  Vector3d r = Vector3d::Zero(), v = Vector3d::Zero();
-  r.head(dim_) = q.segment(coord_, dim_);
-  v.head(dim_) = qdot.segment(coord_, dim_);
+  const Vector3d r = MapPoint(q), v = MapPoint(qdot);
   const double rho = p_.density_kg_m3;
   const double z = Height(q);
   const double s = Submerged(z);
@@ -227,9 +275,21 @@ void BodyFluidForces::AddAppliedLoad(const ForceState& s, ForceOutput* out) cons
     // Its size and rounding on their own: at a floating body's draft F_s
     // cancels the weight in the same entries (MultibodyModel::NetForce).
     out->size = std::max(out->size, f);
+    if (!b.has_offset()) {
+      if (out->roundoff)
+        for (int d = 0; d < b.dim(); ++d) (*out->roundoff)(b.coord() + d) += kSumRounding * f;
+      if (out->matrix) out->map.ScatterBlock(b.coord(), k, out->scale, out->matrix);
+      continue;
+    }
+    // T^T F_s: on the axes c_k F_s, each of size up to |c_k| f.
+    const BodyFluidLoad::Generalized g = b.SpreadSize(f);
     if (out->roundoff)
-      for (int d = 0; d < b.dim(); ++d) (*out->roundoff)(b.coord() + d) += kSumRounding * f;
-    if (out->matrix) out->map.ScatterBlock(b.coord(), k, out->scale, out->matrix);
+      for (int i = 0; i < b.stride(); ++i) (*out->roundoff)(b.coord() + i) += kSumRounding * std::abs(g(i));
+    if (out->matrix) {
+      const BodyFluidLoad::GeneralizedMatrix kg = b.Spread(k);
+      out->map.ScatterRange(b.coord(), b.stride(), kg.data(), BodyFluidLoad::kMaxStride,
+                            out->scale, out->matrix);
+    }
   }
 }
 
@@ -241,12 +301,26 @@ void BodyFluidForces::AddDissipative(const ForceState& s, ForceOutput* out) cons
     Matrix3d c;
     const Vector3d force = b.DynamicForce(*s.q, *s.qdot, s.time, s.waves,
                                           out->matrix ? &c : nullptr);
-    for (int d = 0; d < dim; ++d) {
-      (*out->full)(b.coord() + d) += force(d);
-      if (out->roundoff) (*out->roundoff)(b.coord() + d) += kSumRounding * std::abs(force(d));
-    }
     out->size = std::max(out->size, force.lpNorm<Eigen::Infinity>());
-    if (out->matrix) out->map.ScatterBlock(b.coord(), c, out->scale, out->matrix);
+    if (b.has_offset()) {
+      // T^T F and T^T C T on the body's coordinates.
+      const BodyFluidLoad::Generalized g = b.Spread(force);
+      for (int k = 0; k < b.stride(); ++k) {
+        (*out->full)(b.coord() + k) += g(k);
+        if (out->roundoff) (*out->roundoff)(b.coord() + k) += kSumRounding * std::abs(g(k));
+      }
+      if (out->matrix) {
+        const BodyFluidLoad::GeneralizedMatrix cg = b.Spread(c);
+        out->map.ScatterRange(b.coord(), b.stride(), cg.data(), BodyFluidLoad::kMaxStride,
+                              out->scale, out->matrix);
+      }
+    } else {
+      for (int d = 0; d < dim; ++d) {
+        (*out->full)(b.coord() + d) += force(d);
+        if (out->roundoff) (*out->roundoff)(b.coord() + d) += kSumRounding * std::abs(force(d));
+      }
+      if (out->matrix) out->map.ScatterBlock(b.coord(), c, out->scale, out->matrix);
+    }
     if (!b.has_area_drag()) continue;
     BodyFluidLoad::Generalized area;
     BodyFluidLoad::GeneralizedMatrix area_c;
@@ -272,8 +346,10 @@ double BodyFluidForces::StoredEnergy(const ForceState& s) const {
 void BodyFluidForces::AddDissipatedPower(const ForceState& s, double* power) const {
   for (const BodyFluidLoad& b : loads_) {
     if (!b.dynamic(s.waves != nullptr)) continue;
+    // -F . v_p, v_p = T qdot_b the velocity of the part's centre.
     const Vector3d force = b.DynamicForce(*s.q, *s.qdot, s.time, s.waves, nullptr);
-    for (int d = 0; d < b.dim(); ++d) *power -= force(d) * (*s.qdot)(b.coord() + d);
+    const Vector3d v = b.MapPoint(*s.qdot);
+    for (int d = 0; d < b.dim(); ++d) *power -= force(d) * v(d);
     if (!b.has_area_drag()) continue;
     BodyFluidLoad::Generalized area;
     b.AreaDrag(*s.q, *s.qdot, s.time, s.waves, &area, nullptr);
@@ -316,6 +392,7 @@ std::unique_ptr<BodyFluidForces> MakeBodyFluidForces(const Scene& scene,
       p.current_m_s = fluid.current_m_s;
       p.drag_area = part.drag_area_m2;
       p.rotational_drag_area = part.rotational_drag_area_m5;
+      p.center_body = part.center_m;
       loads.emplace_back(p, body_coord[b], dim);
     }
   }

@@ -102,11 +102,28 @@
 // positive semi-definite. Derivatives in q (through R and f) are left out.
 //
 // Parts. A body may carry several such loads (BodySpec::hydro_parts: its
-// own volume and rods on it), each a BodyFluidLoad on the same centre of
-// mass with its own cylinder, coefficients and axis; their forces,
-// tangents, added masses (MultibodyModel sums AddedMass over them), energies
-// and damping powers add. Every part is centred at the centre of mass, so
-// none has a moment arm.
+// own volume and rods on it), each a BodyFluidLoad with its own cylinder,
+// coefficients and axis; their forces, tangents, added masses
+// (MultibodyModel sums AddedMass over them), energies and damping powers
+// add.
+//
+// Off the centre of mass (Params::center_body = c, body frame [m]). A
+// part's cylinder may be centred at r_p = r_c + R c instead of r_c. In
+// natural coordinates that point is linear in the body's coordinates q_b:
+// r_p = T q_b with T = [I, c_1 I, c_2 I, c_3 I] (spatial, q_b = [r_c, e1,
+// e2, e3]) or T = [I, c_x I + c_y J] (planar, q_b = [r_c, u], J u = e_z x
+// u). Every formula above then reads r_p and its velocity T qdot_b in place
+// of r_c and rdot_c (the height z, the flow at the point, the relative
+// velocity), and a force F at the point acts on the body as T^T F: the
+// force on r_c and its moment (R c) x F on the axes (for orthonormal axes,
+// the virtual work F . (drdot_c + sum c_k de_k)). T is constant, so the
+// tangents are T^T K T and T^T C T, the hydrostatic force stays minus the
+// gradient of U_s(up . T q_b), and the added mass T^T (rho V_ref C_a) T
+// [kg, kg m, kg m^2] is constant too: the fluid's inertia at the part's
+// centre adds rotational inertia rho V_ref C_a |c|^2 about the centre of
+// mass (to the rotational inertia of the cylinder about its own centre,
+// left out, as for a part at the centre of mass). Drag areas act at the
+// centre of mass: SceneFromProto refuses them on a part with an offset.
 //
 // Energy: F_d + F_i + F_w (and F_a, M_a) is not a potential's force; its power -F . rdot_c
 // joins the damping power (MultibodyModel::DampingPower), so energy.damped
@@ -145,6 +162,9 @@ class BodyFluidLoad {
     // Drag areas along the body's axes [m^2] and about them [m^5].
     Eigen::Vector3d drag_area = Eigen::Vector3d::Zero();
     Eigen::Vector3d rotational_drag_area = Eigen::Vector3d::Zero();
+    // The cylinder's centre in the body's frame from the centre of mass [m]
+    // (planar: its x and y). Zero: at the centre of mass.
+    Eigen::Vector3d center_body = Eigen::Vector3d::Zero();
   };
   // The body's natural coordinates per body: r_c and u (planar), r_c and
   // e1, e2, e3 (spatial).
@@ -168,22 +188,39 @@ class BodyFluidLoad {
   // The body's height above the still level [m] at full configuration q.
   double Height(const Eigen::VectorXd& q) const;
 
-  // The added-mass matrix rho V_ref C_a on the centre's D coordinates
-  // [kg], for the body at full configuration q0.
-  Eigen::Matrix3d AddedMass(const Eigen::VectorXd& q0) const;
+  // The added-mass matrix T^T (rho V_ref C_a) T on the body's stride()
+  // natural coordinates (top left; [kg] on r_c), for the body at full
+  // configuration q0. Without an offset only its D x D top left block is
+  // nonzero.
+  GeneralizedMatrix AddedMass(const Eigen::VectorXd& q0) const;
 
-  // F_s (times `scale`, the load factor) into `force` (full); its tangent
-  // scale * rho g A up up^T into `stiffness` (D x D, may be null). Returns
+  // F_s (times `scale`, the load factor) into `force` (full, as T^T F_s);
+  // its tangent at the part's centre, scale * rho g A up up^T, into
+  // `stiffness` (D x D, may be null: Spread maps it onto the body). Returns
   // |F_s|.
   double AddHydrostatic(const Eigen::VectorXd& q, double scale, Eigen::VectorXd* force,
                         Eigen::Matrix3d* stiffness) const;
   // U_s [J], times `scale`.
   double HydrostaticEnergy(const Eigen::VectorXd& q, double scale) const;
 
-  // F_d + F_i + F_w [N] at time t [s] under `waves` (null: none), and C
-  // [N s/m] into `damping` when not null.
+  // F_d + F_i + F_w [N] at the part's centre at time t [s] under `waves`
+  // (null: none), and C [N s/m] (in that point's velocity) into `damping`
+  // when not null; Spread maps both onto the body.
   Eigen::Vector3d DynamicForce(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, double t,
                                const WaveField* waves, Eigen::Matrix3d* damping) const;
+
+  // Whether the part's centre is off the centre of mass (T is not [I 0]).
+  bool has_offset() const { return has_offset_; }
+  // T x_b: the part's centre [m] from the full configuration x = q, or its
+  // velocity [m/s] from x = qdot (zero beyond dim).
+  Eigen::Vector3d MapPoint(const Eigen::VectorXd& x) const;
+  // T^T f: a force at the part's centre as a generalised force on the
+  // body's stride() coordinates (the rest zero).
+  Generalized Spread(const Eigen::Vector3d& f) const;
+  // |T|^T (f, f, f): a bound on the size of T^T F's entries for |F| <= f.
+  Generalized SpreadSize(double f) const;
+  // T^T c T: a tangent at the part's centre on the body's coordinates.
+  GeneralizedMatrix Spread(const Eigen::Matrix3d& c) const;
   // F_a and M_a as generalised forces on the body's stride() natural
   // coordinates into `force`, their tangent into `damping` when not null
   // (stride x stride, top left). Zero without drag areas.
@@ -201,6 +238,9 @@ class BodyFluidLoad {
   Params p_;
   int coord_ = 0, dim_ = 3;
   double area_ = 0;
+  bool has_offset_ = false;
+  // T (dim x stride, the rest zero).
+  Eigen::Matrix<double, 3, kMaxStride> t_ = Eigen::Matrix<double, 3, kMaxStride>::Zero();
   Eigen::Vector3d up_ = Eigen::Vector3d::UnitZ();  // zero beyond dim
 };
 

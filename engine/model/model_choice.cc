@@ -37,6 +37,7 @@ std::string OutOfPlaneField(const Scene& scene) {
           part.scene_index < 0 ? path + ".hydrodynamics"
                                : absl::StrCat(path, ".hydrodynamics_parts[", part.scene_index, "]");
       if (auto f = Z(part_path + ".axis", part.axis_body); !f.empty()) return f;
+      if (auto f = Z(part_path + ".center", part.center_m); !f.empty()) return f;
     }
   }
   auto attachment = [](const std::string& path, const Attachment& at) -> std::string {

@@ -99,9 +99,13 @@ EnergySample MultibodyModel::Energy(const VectorXd& q, const VectorXd& qdot, dou
     const BodyData& b = bodies_[i];
     double translation = 0.5 * b.mass * qdot.segment(b.coord, D).squaredNorm();
     if (b.has_added_mass) {
-      for (int i = 0; i < D; ++i)
-        for (int k = 0; k < D; ++k)
-          translation += 0.5 * b.added_mass(i, k) * qdot(b.coord + i) * qdot(b.coord + k);
+      // (1/2) qdot_b^T M_a qdot_b over the body's coordinates (only r_c's
+      // D x D block unless a fluid part is off the centre of mass).
+      const int n = body_stride_;
+      for (int i = 0; i < n; ++i)
+        for (int k = 0; k < n; ++k)
+          if (b.added_mass(i, k) != 0)
+            translation += 0.5 * b.added_mass(i, k) * qdot(b.coord + i) * qdot(b.coord + k);
     }
     en.kinetic += translation;
     double kinetic = translation;

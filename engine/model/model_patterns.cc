@@ -129,7 +129,10 @@ void ModelBuilder::EnvelopeAndMass() {
       const double diag = k < D ? b.mass : b.jbar((k - D) / D);
       m.mass_.values()[m.mass_.Slot(j, j)] += m.s_(b.coord + k) * m.s_(b.coord + k) * diag;
     }
-    if (b.has_added_mass) m.Map().ScatterBlock(b.coord, b.added_mass, 1.0, &m.mass_);
+    if (b.has_added_mass) {
+      m.Map().ScatterRange(b.coord, bs, b.added_mass.data(), BodyFluidLoad::kMaxStride, 1.0,
+                           &m.mass_);
+    }
   }
 }
 

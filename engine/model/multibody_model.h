@@ -536,11 +536,12 @@ class MultibodyModel {
     int coord = 0;  // full index of r_c
     double mass = 0;
     Eigen::Vector3d jbar = Eigen::Vector3d::Zero();  // per axis [kg m^2]
-    // The fluid's added mass on r_c (BodyFluidLoad::AddedMass, summed over
-    // the body's parts) [kg], in the mass matrix and the kinetic energy;
-    // only with has_added_mass.
+    // The fluid's added mass on the body's natural coordinates
+    // (BodyFluidLoad::AddedMass, summed over the body's parts; [kg] on r_c,
+    // the rest only for parts off the centre of mass), in the mass matrix
+    // and the kinetic energy; only with has_added_mass.
     bool has_added_mass = false;
-    Eigen::Matrix3d added_mass = Eigen::Matrix3d::Zero();
+    BodyFluidLoad::GeneralizedMatrix added_mass = BodyFluidLoad::GeneralizedMatrix::Zero();
   };
   // A flat linear form sum coeff * q[coord].
   struct ProbeTerm {

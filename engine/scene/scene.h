@@ -132,7 +132,7 @@ struct CableSpec {
 
 // One hydrodynamic part of a body (BodySpec::hydro_parts): a circular
 // cylinder of diameter and height [m] centred at the body's centre of mass
-// displaces the fluid (buoyed as a vertical one); Morison drag
+// (or at center_m from it, in the body's frame) displaces the fluid (buoyed as a vertical one); Morison drag
 // coefficients across its split axis (on d times the submerged length) and
 // along it (on the end area) [-], added-mass coefficients across and along
 // [-]. The split axis is the vertical, or with along_axis the body-frame
@@ -148,6 +148,9 @@ struct BodyFluidPart {
   // (diameter_m = height_m = 0: no buoyancy, wet wherever it is).
   Eigen::Vector3d drag_area_m2 = Eigen::Vector3d::Zero();
   Eigen::Vector3d rotational_drag_area_m5 = Eigen::Vector3d::Zero();
+  // The cylinder's centre in the body's frame from the centre of mass [m]
+  // (BodyFluidLoad's offset; zero: at the centre of mass).
+  Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
   // Where the scene gave it: -1 Body.hydrodynamics, k >= 0
   // Body.hydrodynamics_parts[k] (for naming the field).
   int scene_index = -1;
@@ -178,7 +181,7 @@ struct BodySpec {
   double contact_friction = 0;
   // Fluid loads in the scene's fluid (engine/forces/body_fluid_load.h),
   // only when has_hydrodynamics: one or more parts (BodyFluidPart), each a
-  // cylinder centred at the centre of mass whose loads add up.
+  // cylinder centred at the centre of mass or off it, whose loads add up.
   bool has_hydrodynamics = false;
   std::vector<BodyFluidPart> hydro_parts;
   // Driven by a coupling host (engine/run/coupling.h): its pose (centre of
