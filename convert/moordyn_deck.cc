@@ -1317,9 +1317,19 @@ class DeckReader {
       const double t = (lo + hi) / 2;
       (legs(t) < length ? lo : hi) = t;
     }
-    // Beyond the higher end: the rising leg would fold back; the sag.
-    if ((lo + hi) / 2 > 1) return sag;
     const Eigen3 c = corner_at((lo + hi) / 2);
+    // Beyond the higher end the rising leg folds back over the bed run: kept
+    // while the corner turns by at most 120 degrees, as the V's (a line from
+    // an anchor to a free point a little above the bed and closer than the
+    // line's length: MoorDyn's BodiesAndRods.dat, whose V would lie 46 m
+    // inside the bed); a sharper fold, the sag.
+    if ((lo + hi) / 2 > 1) {
+      const Eigen3 along{c[0] - low[0], c[1] - low[1], 0};
+      const Eigen3 up{high[0] - c[0], high[1] - c[1], high[2] - c[2]};
+      const double cos_turn = (along[0] * up[0] + along[1] * up[1]) /
+                              (Dist(along, {0, 0, 0}) * Dist(up, {0, 0, 0}));
+      if (!(cos_turn >= std::cos(2 * kPi / 3))) return sag;
+    }
     if (Dist(low, c) < 1e-9 * length || Dist(high, c) < 1e-9 * length) return {pa, pb};
     return {pa, c, pb};
   }

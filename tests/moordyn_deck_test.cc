@@ -513,6 +513,24 @@ TEST(MoorDynDeckTest, LaysDegeneratePlacements) {
   EXPECT_DOUBLE_EQ(rope.points(1).z(), -40 - 150 * 1.001 / 4);
 }
 
+// A slack line from an anchor on the bed to a free point 60 m up and 100 m
+// away, 175 m long: the corner on the bed where the two legs add up to the
+// length lies 13.5 m beyond the free point (100 u + sqrt(100^2 u^2 + 60^2)
+// = 75, u = 0.135), so the rising leg folds back by 103 degrees, which a
+// scene allows. Until 28 November 2026 such a line was laid as a V whose
+// corner lay 26 m inside the bed (MoorDyn's BodiesAndRods.dat: 46 m).
+TEST(MoorDynDeckTest, LaysALineFoldingBackOverItsBedRunOnTheBed) {
+  const v1::Scene s = Read(Edited("2     rope       3        4         150", "2     rope       3        4         175"));
+  const v1::Cable& rope = CableNamed(s, "line2");
+  ASSERT_EQ(rope.points_size(), 3);
+  const v1::Vec3& c = rope.points(1);
+  std::printf("corner (%.9g, %.9g) m\n", c.x(), c.z());
+  EXPECT_NEAR(c.z(), -100, 1e-12);
+  EXPECT_NEAR(c.x(), -300 + 100 * 1.135, 1e-9);
+  const double legs = std::hypot(c.x() + 300, c.z() + 100) + std::hypot(-200 - c.x(), -40 - c.z());
+  EXPECT_NEAR(legs, 175, 1e-9);
+}
+
 TEST(MoorDynDeckTest, RecognisesDecksByNameOrContents) {
   EXPECT_TRUE(IsMoorDynDeck("a/b/mooring.dat", ""));
   EXPECT_TRUE(IsMoorDynDeck("lines.txt", kDeck));
