@@ -666,7 +666,8 @@ TEST(MoorDynBodiesTest, RefusalsNameTheLineAndField) {
   // 2 x 50 / 15,050 m along y, so the rod sits that far on the other side.
   {
     const v1::Scene off = Read(absl::StrReplaceAll(
-        body, {{"2     Body1     -2      0       0       50", "2     Body1     -2      0       0       0"}}));
+        body, {{"2     Body1     -2      0       0       50",
+                "2     Body1     -2      0       0       0"}}));
     ASSERT_EQ(off.bodies_size(), 1);
     const v1::BodyHydrodynamics& h = off.bodies(0).hydrodynamics();
     ASSERT_TRUE(h.has_center());

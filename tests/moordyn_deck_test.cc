@@ -520,14 +520,16 @@ TEST(MoorDynDeckTest, LaysDegeneratePlacements) {
 // scene allows. Until 28 November 2026 such a line was laid as a V whose
 // corner lay 26 m inside the bed (MoorDyn's BodiesAndRods.dat: 46 m).
 TEST(MoorDynDeckTest, LaysALineFoldingBackOverItsBedRunOnTheBed) {
-  const v1::Scene s = Read(Edited("2     rope       3        4         150", "2     rope       3        4         175"));
+  const v1::Scene s = Read(
+      Edited("2     rope       3        4         150", "2     rope       3        4         175"));
   const v1::Cable& rope = CableNamed(s, "line2");
   ASSERT_EQ(rope.points_size(), 3);
   const v1::Vec3& c = rope.points(1);
   std::printf("corner (%.9g, %.9g) m\n", c.x(), c.z());
   EXPECT_NEAR(c.z(), -100, 1e-12);
   EXPECT_NEAR(c.x(), -300 + 100 * 1.135, 1e-9);
-  const double legs = std::hypot(c.x() + 300, c.z() + 100) + std::hypot(-200 - c.x(), -40 - c.z());
+  const double legs =
+      std::hypot(c.x() + 300, c.z() + 100) + std::hypot(-200 - c.x(), -40 - c.z());
   EXPECT_NEAR(legs, 175, 1e-9);
 }
 

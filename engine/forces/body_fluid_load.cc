@@ -284,7 +284,8 @@ void BodyFluidForces::AddAppliedLoad(const ForceState& s, ForceOutput* out) cons
     // T^T F_s: on the axes c_k F_s, each of size up to |c_k| f.
     const BodyFluidLoad::Generalized g = b.SpreadSize(f);
     if (out->roundoff)
-      for (int i = 0; i < b.stride(); ++i) (*out->roundoff)(b.coord() + i) += kSumRounding * std::abs(g(i));
+      for (int i = 0; i < b.stride(); ++i)
+        (*out->roundoff)(b.coord() + i) += kSumRounding * std::abs(g(i));
     if (out->matrix) {
       const BodyFluidLoad::GeneralizedMatrix kg = b.Spread(k);
       out->map.ScatterRange(b.coord(), b.stride(), kg.data(), BodyFluidLoad::kMaxStride,
