@@ -474,8 +474,8 @@ TEST(BodyFluidPartsTest, OffCentrePartDragTangentIsTheRateDerivative) {
 // the float's added mass at its centre), and freely about the vertical
 // (omega = 0). Closed forms of the small oscillation; MODAL's frequencies
 // are those of the linearised model, so they agree to rounding (1e-9,
-// relative). Without the offset's added inertia the frequencies would be 3.3
-// and 2.8 times higher; without its moment the body would not swing.
+// relative). Without the offset's added inertia the frequencies would be 3.4
+// and 2.9 times higher; without its moment the body would not swing.
 TEST(BodyFluidPartsTest, FloatOffThePinRightsTheBodyAndSwingsAtTheClosedFormFrequency) {
   const double g = 9.81, d = 1, h = 2, ca = 1, length = 2;
   const double volume = kPi * d * d / 4 * h, fb = kRho * g * volume;
