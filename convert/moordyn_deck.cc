@@ -1324,10 +1324,10 @@ class DeckReader {
     // line's length: MoorDyn's BodiesAndRods.dat, whose V would lie 46 m
     // inside the bed); a sharper fold, the sag.
     if ((lo + hi) / 2 > 1) {
-      const Eigen3 along{c[0] - low[0], c[1] - low[1], 0};
-      const Eigen3 up{high[0] - c[0], high[1] - c[1], high[2] - c[2]};
-      const double cos_turn = (along[0] * up[0] + along[1] * up[1]) /
-                              (Dist(along, {0, 0, 0}) * Dist(up, {0, 0, 0}));
+      // The bed run's direction (horizontal) against the rising leg's.
+      const double ax = c[0] - low[0], ay = c[1] - low[1];
+      const double cos_turn = (ax * (high[0] - c[0]) + ay * (high[1] - c[1])) /
+                              (std::hypot(ax, ay) * Dist(c, high));
       if (!(cos_turn >= std::cos(2 * kPi / 3))) return sag;
     }
     if (Dist(low, c) < 1e-9 * length || Dist(high, c) < 1e-9 * length) return {pa, pb};
@@ -2307,14 +2307,8 @@ class DeckReader {
           k == 0 ? body->mutable_hydrodynamics() : body->add_hydrodynamics_parts();
       if (absl::Status s = SetPart(p, own_rod, h); !s.ok()) return s;
       const Eigen::Vector3d offset = p.centre - com;
-      const double size = std::max(p.length, p.diameter);
-      if (offset.norm() > 1e-6 * size) {
-        if (own_rod) {
-          return Error(p.line, "RODS Attachment",
-                       "internal: a rod's own body off its centre");  // not reached
-        }
+      if (offset.norm() > 1e-6 * std::max(p.length, p.diameter))
         SetVec(h->mutable_center(), offset.x(), offset.y(), offset.z());
-      }
     }
     return absl::OkStatus();
   }

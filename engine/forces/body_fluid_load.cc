@@ -50,17 +50,42 @@ BodyFluidLoad::Generalized BodyFluidLoad::Spread(const Vector3d& f) const {
   return g;
 }
 
-BodyFluidLoad::Generalized BodyFluidLoad::SpreadSize(double f) const {
-  Generalized g = Generalized::Zero();
-  g.head(stride()) = f * t_.leftCols(stride()).cwiseAbs().colwise().sum().transpose();
-  return g;
-}
 
 BodyFluidLoad::GeneralizedMatrix BodyFluidLoad::Spread(const Matrix3d& c) const {
   GeneralizedMatrix g = GeneralizedMatrix::Zero();
   const int n = stride();
   g.topLeftCorner(n, n) = t_.leftCols(n).transpose() * c * t_.leftCols(n);
   return g;
+}
+
+void BodyFluidLoad::AddForce(const Vector3d& f, VectorXd* full) const {
+  if (!has_offset_) {
+    for (int d = 0; d < dim_; ++d) (*full)(coord_ + d) += f(d);
+    return;
+  }
+  const Generalized g = Spread(f);
+  for (int k = 0; k < stride(); ++k) (*full)(coord_ + k) += g(k);
+}
+
+void BodyFluidLoad::AddRounding(const Vector3d& size, VectorXd* roundoff) const {
+  if (!has_offset_) {
+    for (int d = 0; d < dim_; ++d) (*roundoff)(coord_ + d) += kSumRounding * size(d);
+    return;
+  }
+  // Entry k of T^T f sums T_dk f_d: its terms' sizes add to (|T|^T size)_k.
+  const int n = stride();
+  for (int k = 0; k < n; ++k)
+    (*roundoff)(coord_ + k) += kSumRounding * t_.col(k).cwiseAbs().dot(size);
+}
+
+void BodyFluidLoad::ScatterTangent(const Matrix3d& k, const CoordinateMap& map, double scale,
+                                   SkylineLdlt* matrix) const {
+  if (!has_offset_) {
+    map.ScatterBlock(coord_, k, scale, matrix);
+    return;
+  }
+  const GeneralizedMatrix g = Spread(k);
+  map.ScatterRange(coord_, stride(), g.data(), kMaxStride, scale, matrix);
 }
 
 Vector3d BodyFluidLoad::Axis(const VectorXd& q) const {
@@ -86,12 +111,8 @@ double BodyFluidLoad::Submerged(double z) const {
 
 double BodyFluidLoad::Height(const VectorXd& q) const {
   double h = -p_.still_level_m;
-  if (has_offset_) {
-    const Vector3d r = MapPoint(q);
-    for (int d = 0; d < dim_; ++d) h += up_(d) * r(d);
-    return h;
-  }
-  for (int d = 0; d < dim_; ++d) h += up_(d) * q(coord_ + d);
+  const Vector3d r = MapPoint(q);
+  for (int d = 0; d < dim_; ++d) h += up_(d) * r(d);
   return h;
 }
 
@@ -113,12 +134,7 @@ double BodyFluidLoad::AddHydrostatic(const VectorXd& q, double scale, VectorXd* 
                                      Matrix3d* stiffness) const {
   const double z = Height(q);
   const double f = scale * p_.density_kg_m3 * p_.g_m_s2 * area_ * Submerged(z);
-  if (has_offset_) {
-    const Generalized g = Spread(Vector3d(f * up_));
-    for (int k = 0; k < stride(); ++k) (*force)(coord_ + k) += g(k);
-  } else {
-    for (int d = 0; d < dim_; ++d) (*force)(coord_ + d) += f * up_(d);
-  }
+  AddForce(f * up_, force);
   if (stiffness != nullptr && z > -p_.height_m / 2 && z < p_.height_m / 2)
     *stiffness += scale * p_.density_kg_m3 * p_.g_m_s2 * area_ * up_ * up_.transpose();
   return std::abs(f);
@@ -275,53 +291,22 @@ void BodyFluidForces::AddAppliedLoad(const ForceState& s, ForceOutput* out) cons
     // Its size and rounding on their own: at a floating body's draft F_s
     // cancels the weight in the same entries (MultibodyModel::NetForce).
     out->size = std::max(out->size, f);
-    if (!b.has_offset()) {
-      if (out->roundoff)
-        for (int d = 0; d < b.dim(); ++d) (*out->roundoff)(b.coord() + d) += kSumRounding * f;
-      if (out->matrix) out->map.ScatterBlock(b.coord(), k, out->scale, out->matrix);
-      continue;
-    }
-    // T^T F_s: on the axes c_k F_s, each of size up to |c_k| f.
-    const BodyFluidLoad::Generalized g = b.SpreadSize(f);
-    if (out->roundoff)
-      for (int i = 0; i < b.stride(); ++i)
-        (*out->roundoff)(b.coord() + i) += kSumRounding * std::abs(g(i));
-    if (out->matrix) {
-      const BodyFluidLoad::GeneralizedMatrix kg = b.Spread(k);
-      out->map.ScatterRange(b.coord(), b.stride(), kg.data(), BodyFluidLoad::kMaxStride,
-                            out->scale, out->matrix);
-    }
+    if (out->roundoff) b.AddRounding(Vector3d::Constant(f), out->roundoff);
+    if (out->matrix) b.ScatterTangent(k, out->map, out->scale, out->matrix);
   }
 }
 
 void BodyFluidForces::AddDissipative(const ForceState& s, ForceOutput* out) const {
   const bool waves = s.waves != nullptr;
-  const int dim = out->map.dim;
   for (const BodyFluidLoad& b : loads_) {
     if (!b.dynamic(waves)) continue;
     Matrix3d c;
     const Vector3d force = b.DynamicForce(*s.q, *s.qdot, s.time, s.waves,
                                           out->matrix ? &c : nullptr);
     out->size = std::max(out->size, force.lpNorm<Eigen::Infinity>());
-    if (b.has_offset()) {
-      // T^T F and T^T C T on the body's coordinates.
-      const BodyFluidLoad::Generalized g = b.Spread(force);
-      for (int k = 0; k < b.stride(); ++k) {
-        (*out->full)(b.coord() + k) += g(k);
-        if (out->roundoff) (*out->roundoff)(b.coord() + k) += kSumRounding * std::abs(g(k));
-      }
-      if (out->matrix) {
-        const BodyFluidLoad::GeneralizedMatrix cg = b.Spread(c);
-        out->map.ScatterRange(b.coord(), b.stride(), cg.data(), BodyFluidLoad::kMaxStride,
-                              out->scale, out->matrix);
-      }
-    } else {
-      for (int d = 0; d < dim; ++d) {
-        (*out->full)(b.coord() + d) += force(d);
-        if (out->roundoff) (*out->roundoff)(b.coord() + d) += kSumRounding * std::abs(force(d));
-      }
-      if (out->matrix) out->map.ScatterBlock(b.coord(), c, out->scale, out->matrix);
-    }
+    b.AddForce(force, out->full);
+    if (out->roundoff) b.AddRounding(force.cwiseAbs(), out->roundoff);
+    if (out->matrix) b.ScatterTangent(c, out->map, out->scale, out->matrix);
     if (!b.has_area_drag()) continue;
     BodyFluidLoad::Generalized area;
     BodyFluidLoad::GeneralizedMatrix area_c;

@@ -217,10 +217,18 @@ class BodyFluidLoad {
   // T^T f: a force at the part's centre as a generalised force on the
   // body's stride() coordinates (the rest zero).
   Generalized Spread(const Eigen::Vector3d& f) const;
-  // |T|^T (f, f, f): a bound on the size of T^T F's entries for |F| <= f.
-  Generalized SpreadSize(double f) const;
   // T^T c T: a tangent at the part's centre on the body's coordinates.
   GeneralizedMatrix Spread(const Eigen::Matrix3d& c) const;
+  // The body's side of a force f [N] at the part's centre, whichever T:
+  // T^T f added to `full`; kSumRounding |T|^T `size` (the size of each
+  // term summed into f, per direction) to `roundoff`; scale T^T k T (k the
+  // D x D tangent at the centre) scattered into `matrix` through `map`.
+  // Without an offset each touches only r_c's D entries, as a force on the
+  // centre of mass does.
+  void AddForce(const Eigen::Vector3d& f, Eigen::VectorXd* full) const;
+  void AddRounding(const Eigen::Vector3d& size, Eigen::VectorXd* roundoff) const;
+  void ScatterTangent(const Eigen::Matrix3d& k, const CoordinateMap& map, double scale,
+                      SkylineLdlt* matrix) const;
   // F_a and M_a as generalised forces on the body's stride() natural
   // coordinates into `force`, their tangent into `damping` when not null
   // (stride x stride, top left). Zero without drag areas.
