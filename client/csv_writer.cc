@@ -102,22 +102,31 @@ absl::Status CsvWriter::OnFrame(const Frame& frame) {
         ", ", cable_count_, ", ", body_count_, " and ", force_count_));
     return status_;
   }
-  std::string row;
-  row.reserve(FrameRowSize(probe_count_, cable_count_, body_count_, force_count_) * 25);
-  ForEachFrameValue(frame, [&row](double value) { AppendNumber(&row, value); });
+  const size_t start = pending_.size();
+  ForEachFrameValue(frame, [this](double value) { AppendNumber(&pending_, value); });
   // The row starts with t, without the separator.
-  row.erase(0, 1);
-  row += '\n';
-  errno = 0;
-  out_->write(row.data(), static_cast<std::streamsize>(row.size()));
+  pending_.erase(start, 1);
+  pending_ += '\n';
   ++rows_;
-  if (rows_ % kRowsPerFlush == 0) out_->flush();
+  if (rows_ % kRowsPerFlush != 0) return status_;
+  WritePending();
+  out_->flush();
   return CheckStream("writing a row");
+}
+
+void CsvWriter::WritePending() {
+  errno = 0;
+  out_->write(pending_.data(), static_cast<std::streamsize>(pending_.size()));
+  pending_.clear();
 }
 
 absl::Status CsvWriter::Finish() {
   if (finished_) return status_;
   finished_ = true;
+  if (status_.ok()) {
+    WritePending();
+    CheckStream("writing a row").IgnoreError();
+  }
   errno = 0;
   out_->flush();
   CheckStream("flushing").IgnoreError();

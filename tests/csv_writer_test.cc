@@ -5,6 +5,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -79,13 +80,17 @@ TEST(CsvWriterTest, PartsAreWrittenAfterTheTotals) {
   frame.energy_parts.bodies = {{5, 6, 0, 0}};
   frame.energy_parts.loads = 7;
   ASSERT_TRUE(writer.OnFrame(frame).ok());
+  ASSERT_TRUE(writer.Finish().ok());
   const std::vector<std::string> lines = absl::StrSplit(out.str(), '\n');
   ASSERT_EQ(lines.size(), 3);
   EXPECT_EQ(lines[1],
             "0,0.10000000000000001,-0.20000000000000001,0.29999999999999999,"
             "0.40000000000000002,0.59999999999999998,9.9999999999999998e-13,0.25,1,2,3,4,5,6,7");
   // A frame without the parts of the header is refused.
-  EXPECT_FALSE(writer.OnFrame(FrameWithProbes(0.1, 0)).ok());
+  std::ostringstream other;
+  CsvWriter refusing(&other, "memory");
+  ASSERT_TRUE(refusing.OnStart(info).ok());
+  EXPECT_FALSE(refusing.OnFrame(FrameWithProbes(0.1, 0)).ok());
 }
 
 TEST(CsvWriterTest, RowsRoundTrip) {
@@ -118,7 +123,33 @@ TEST(CsvWriterTest, NonFiniteValuesAreWritten) {
   Frame frame = FrameWithProbes(1, 0);
   frame.energy.total = std::numeric_limits<double>::infinity();
   ASSERT_TRUE(writer.OnFrame(frame).ok());
+  ASSERT_TRUE(writer.Finish().ok());
   EXPECT_THAT(out.str(), HasSubstr(",inf,"));
+}
+
+// Rows are written together, kRowsPerFlush at a time (one system call per
+// batch, not per row), so a reader following the file sees them in
+// batches, and Finish writes the rest.
+TEST(CsvWriterTest, RowsAreWrittenInBatches) {
+  std::ostringstream out;
+  CsvWriter writer(&out, "memory");
+  ASSERT_TRUE(writer.OnStart(InfoWithProbes({"a"})).ok());
+  auto lines = [&out] {
+    const std::string text = out.str();
+    return std::count(text.begin(), text.end(), '\n');
+  };
+  const std::string header_only = out.str();
+  EXPECT_EQ(lines(), 1);
+  for (int i = 1; i < CsvWriter::kRowsPerFlush; ++i)
+    ASSERT_TRUE(writer.OnFrame(FrameWithProbes(i, 1)).ok());
+  EXPECT_EQ(out.str(), header_only);
+  ASSERT_TRUE(writer.OnFrame(FrameWithProbes(0, 1)).ok());
+  EXPECT_EQ(lines(), 1 + CsvWriter::kRowsPerFlush);
+  ASSERT_TRUE(writer.OnFrame(FrameWithProbes(0, 1)).ok());
+  EXPECT_EQ(lines(), 1 + CsvWriter::kRowsPerFlush);
+  ASSERT_TRUE(writer.Finish().ok());
+  EXPECT_EQ(lines(), 2 + CsvWriter::kRowsPerFlush);
+  EXPECT_EQ(writer.rows(), CsvWriter::kRowsPerFlush + 1);
 }
 
 TEST(CsvWriterTest, WrongProbeCountIsAnError) {
