@@ -74,7 +74,7 @@ TEST(EnergyGuardTest, ARiseOlderThanTheCheckedStepStopsTheRunAtItsStart) {
   EXPECT_EQ(error.find("down to h ="), std::string::npos) << error;
   // The start's strain is named (the layout is not an equilibrium).
   EXPECT_NE(error.find("solver.initial_state: STATIC"), std::string::npos) << error;
-  // The frames delivered end before the failure, each within the bound.
+  // No frame is delivered after the state where the run stopped.
   ASSERT_FALSE(sink.frames().empty());
   EXPECT_LE(sink.frames().back().t, to);
 }

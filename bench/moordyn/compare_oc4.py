@@ -52,6 +52,11 @@ MOORDYN = [
     (42, 0.00125, "LEuler", 0.01),
     (44, 0.00125, "LEuler", 0.01),
     (80, 0.0005, "RK2", 0.01),
+    # The 0.2 % class (29 November 2026, one run each): 80 segments LEuler at 0.0005 s 0.398 %,
+    # 112 at 0.00025 s 0.226 %, 120 at 0.0002 s 0.194 % (49 s of CPU); 120 at 0.00025 s and
+    # 160 at 0.0002 s stop with NaN.
+    (112, 0.00025, "LEuler", 0.01),
+    (120, 0.0002, "LEuler", 0.01),
 ]
 # cablesim settings (bench/mooring_speed_oc4.json's variants); {} = the scene as committed.
 CABLESIM = [

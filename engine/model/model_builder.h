@@ -86,8 +86,8 @@ class ModelBuilder {
   // (MeshCables, InitialCoordinates) and every 65,536 nodes or elements of
   // the steps whose cost grows with them (OrderUnknowns, BuildElements,
   // EnvelopeAndMass): a stopped step returns early, and Stopped() tells the
-  // caller to give the builder up. Measured on 2 million elements, no step
-  // between two asks takes more than 0.3 s.
+  // caller to give the builder up. Measured on 2 million elements, no stretch
+  // between two asks takes much more than 0.3 s.
   explicit ModelBuilder(const Scene& scene, std::function<bool()> should_stop = {})
       : scene_(scene), should_stop_(std::move(should_stop)) {}
 
