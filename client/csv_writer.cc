@@ -19,14 +19,17 @@ namespace {
 // format string; frames every millisecond made formatting a visible part
 // of a run's wall time.
 void AppendNumber(std::string* row, double value) {
-  char buf[32];
-  buf[0] = ',';
-  const std::to_chars_result r =
-      std::to_chars(buf + 1, buf + sizeof(buf), value, std::chars_format::general, 17);
-  row->append(buf, r.ptr);
+  row->push_back(',');
+  AppendCsvNumber(row, value);
 }
 
 }  // namespace
+
+void AppendCsvNumber(std::string* row, double value) {
+  char buf[32];  // the longest shortest form, -2.2250738585072014e-308, has 24
+  const std::to_chars_result r = std::to_chars(buf, buf + sizeof(buf), value);
+  row->append(buf, r.ptr);
+}
 
 absl::StatusOr<std::unique_ptr<std::ofstream>> OpenForWriting(const std::string& path) {
   errno = 0;

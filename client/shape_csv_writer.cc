@@ -3,7 +3,6 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
-#include "absl/strings/str_format.h"
 #include "client/csv_writer.h"
 
 namespace cablesim {
@@ -40,14 +39,23 @@ absl::Status ShapeCsvWriter::OnFrame(const Frame& frame) {
     return status_;
   }
   row_.clear();
+  // t once per frame (the same for each of its rows).
+  std::string t;
+  AppendCsvNumber(&t, frame.t);
   size_t n = 0;
   for (size_t c = 0; c < info_.cable_nodes.size(); ++c) {
     for (int k = 0; k < info_.cable_nodes[c]; ++k, ++n) {
       const Eigen::Vector3d& r = frame.nodes[n];
-      absl::StrAppendFormat(&row_, "%.17g,%d,%d,%.17g,%.17g,%.17g,%.17g", frame.t, c, k,
-                            info_.node_s[n], r.x(), r.y(), r.z());
-      if (info_.node_tension && n < frame.node_tensions.size())
-        absl::StrAppendFormat(&row_, ",%.17g", frame.node_tensions[n]);
+      absl::StrAppend(&row_, t, ",", c, ",", k, ",");
+      AppendCsvNumber(&row_, info_.node_s[n]);
+      for (int i = 0; i < 3; ++i) {
+        row_ += ',';
+        AppendCsvNumber(&row_, r(i));
+      }
+      if (info_.node_tension && n < frame.node_tensions.size()) {
+        row_ += ',';
+        AppendCsvNumber(&row_, frame.node_tensions[n]);
+      }
       row_ += '\n';
     }
   }

@@ -9,7 +9,8 @@
 // t as in the run CSV [s, or the load factor], cable the cable's index in
 // the scene, node the node's index along it (a node split where a cable
 // kinks counts once), s its arc length in the undeformed cable [m], x y z
-// its position [m] (17 significant digits). Long rather than wide: cables
+// its position [m] (numbers in the shortest form that reads back exactly:
+// AppendCsvNumber, client/csv_writer.h). Long rather than wide: cables
 // have different node counts, the header is the same for every scene, and
 // it loads directly as a table (numpy.loadtxt, pandas groupby t or cable).
 // With the scene's output.tension (ModelInfo::node_tension) each row ends
