@@ -29,6 +29,23 @@ double CableDamping::Dissipation(const ElementAt<D>& at, const ElementCoords<D>&
   return edot.dot(f);
 }
 
+template <int D>
+void CableDamping::AddMaterialForce(const ElementAt<D>& at, const ElementCoords<D>& e,
+                                    const ElementCoords<D>& edot, ElementCoords<D>* force) const {
+  const Element& p = elements_[at.index];
+  if (p.axial_s == 0 && p.bending_s == 0) return;
+  double power = 0;
+  if (at.element.AddAxialDampingForce(e, edot, p.axial_s, p.bending_s, force, &power)) return;
+  ElementMatrix<D> c = ElementMatrix<D>::Zero();
+  at.element.AddDampingMatrix(e, p.axial_s, p.bending_s, &c);
+  *force -= c * edot;
+}
+
+template void CableDamping::AddMaterialForce<2>(const ElementAt<2>&, const ElementCoords<2>&,
+                                                const ElementCoords<2>&, ElementCoords<2>*) const;
+template void CableDamping::AddMaterialForce<3>(const ElementAt<3>&, const ElementCoords<3>&,
+                                                const ElementCoords<3>&, ElementCoords<3>*) const;
+
 template double CableDamping::Dissipation<2>(const ElementAt<2>&, const ElementCoords<2>&,
                                      const ElementCoords<2>&, ElementCoords<2>*,
                                      ElementMatrix<2>*) const;

@@ -34,6 +34,15 @@ class CableDamping : public ElementDissipationTerm<CableDamping> {
   std::string_view name() const override { return "cable_damping"; }
   bool has_potential() const override { return false; }
   bool DissipatesOn(int index) const override { return elements_[index].any(); }
+  // The material (Kelvin-Voigt) part alone, -C edot with C of
+  // AddDampingMatrix (axial_s and bending_s; Rayleigh alpha left out: it
+  // acts on the mass, as a viscous medium would, not across a section),
+  // added to `force` of element at.index: what the section force of the
+  // tension outputs carries besides the elastic force
+  // (MultibodyModel::Tensions).
+  template <int D>
+  void AddMaterialForce(const ElementAt<D>& at, const ElementCoords<D>& e,
+                        const ElementCoords<D>& edot, ElementCoords<D>* force) const;
   // Removes element `index`'s axial and Rayleigh alpha damping (a winch
   // cable's, which the winch applies to the material motion instead).
   void ClearMaterialDamping(int index) {

@@ -265,6 +265,7 @@ void ModelBuilder::BuildElements() {
   // load, the seabed, the sheaves.
   if (auto damping = MakeCableDamping(std::move(damping_elements_))) {
     cable_damping_ = damping.get();
+    model_.cable_damping_ = damping.get();
     model_.element_terms_.push_back(std::move(damping));
   }
   const FreeSurface surface = Surface();

@@ -340,13 +340,22 @@ void MultibodyModel::Orientations(const VectorXd& q, const VectorXd& qdot,
 }
 
 template <int D>
-void MultibodyModel::ElementEndForces(const VectorXd& q, int k, double load_factor,
-                                      Vector3d* start, Vector3d* end, Vector3d* moment_start,
-                                      Vector3d* moment_end) const {
+void MultibodyModel::ElementEndForces(const VectorXd& q, const VectorXd* qdot, int k,
+                                      double load_factor, Vector3d* start, Vector3d* end,
+                                      Vector3d* moment_start, Vector3d* moment_end) const {
   constexpr int kN = 4 * D;
   const ElementData<D>& e = Elements<D>()[k];
   Eigen::Matrix<double, kN, 1> f = Eigen::Matrix<double, kN, 1>::Zero();  // ElasticForce adds
   e.element.ElasticForce(q.segment<kN>(e.first_coord), &f, nullptr);
+  // The material damping's force -C edot resists the stretching as the
+  // elastic force does: the ends must supply C edot besides Q_k.
+  if (qdot && cable_damping_) {
+    Eigen::Matrix<double, kN, 1> damping = Eigen::Matrix<double, kN, 1>::Zero();
+    cable_damping_->AddMaterialForce<D>(ElementAt<D>{e.element, k},
+                                        q.segment<kN>(e.first_coord),
+                                        qdot->segment<kN>(e.first_coord), &damping);
+    f -= damping;
+  }
   f -= load_factor * ElementWeight(e);
   // STATIC with a free surface: the buoyancy the element's sections lose
   // above the level is a load on it as its weight is (a line through the
@@ -377,7 +386,7 @@ void MultibodyModel::ElementEndForces(const VectorXd& q, int k, double load_fact
 }
 
 template <int D>
-double MultibodyModel::TensionOf(const VectorXd& q, int cable, double s,
+double MultibodyModel::TensionOf(const VectorXd& q, const VectorXd* qdot, int cable, double s,
                                  double load_factor) const {
   const auto& elements = Elements<D>();
   const int begin = cable_element_begin_[cable], end = cable_element_begin_[cable + 1];
@@ -387,13 +396,13 @@ double MultibodyModel::TensionOf(const VectorXd& q, int cable, double s,
   // The section force at each end of element k, averaged with the
   // neighbour's at a shared node.
   Vector3d at_start, at_end, other, unused;
-  ElementEndForces<D>(q, k, load_factor, &at_start, &at_end);
+  ElementEndForces<D>(q, qdot, k, load_factor, &at_start, &at_end);
   if (k > begin) {
-    ElementEndForces<D>(q, k - 1, load_factor, &unused, &other);
+    ElementEndForces<D>(q, qdot, k - 1, load_factor, &unused, &other);
     at_start = 0.5 * (at_start + other);
   }
   if (k + 1 < end) {
-    ElementEndForces<D>(q, k + 1, load_factor, &other, &unused);
+    ElementEndForces<D>(q, qdot, k + 1, load_factor, &other, &unused);
     at_end = 0.5 * (at_end + other);
   }
   const Vector3d force = (1 - xi) * at_start + xi * at_end;
@@ -404,8 +413,8 @@ double MultibodyModel::TensionOf(const VectorXd& q, int cable, double s,
 }
 
 template <int D>
-void MultibodyModel::CableNodeTensionsOf(const VectorXd& q, int cable, double load_factor,
-                                         double* out) const {
+void MultibodyModel::CableNodeTensionsOf(const VectorXd& q, const VectorXd* qdot, int cable,
+                                         double load_factor, double* out) const {
   const auto& elements = Elements<D>();
   const int begin = cable_element_begin_[cable], end = cable_element_begin_[cable + 1];
   Vector3d before = Vector3d::Zero(), t_before = Vector3d::Zero();
@@ -421,7 +430,7 @@ void MultibodyModel::CableNodeTensionsOf(const VectorXd& q, int cable, double lo
       constexpr int kN = 4 * D;
       const auto qe = q.segment<kN>(elements[k].first_coord);
       Vector3d at_start;
-      ElementEndForces<D>(q, k, load_factor, &at_start, &before);
+      ElementEndForces<D>(q, qdot, k, load_factor, &at_start, &before);
       force += at_start;
       Vector3d t = Vector3d::Zero();
       t.head<D>() = elements[k].element.Slope(qe, 0.0);
@@ -438,8 +447,8 @@ void MultibodyModel::CableNodeTensionsOf(const VectorXd& q, int cable, double lo
 }
 
 template <int D>
-Vector3d MultibodyModel::BendingMomentOf(const VectorXd& q, int cable, double s,
-                                         double load_factor) const {
+Vector3d MultibodyModel::BendingMomentOf(const VectorXd& q, const VectorXd* qdot, int cable,
+                                         double s, double load_factor) const {
   const auto& elements = Elements<D>();
   const int begin = cable_element_begin_[cable], end = cable_element_begin_[cable + 1];
   int k = 0;
@@ -448,42 +457,43 @@ Vector3d MultibodyModel::BendingMomentOf(const VectorXd& q, int cable, double s,
   // The moment at each end of element k (ElementEndForces), averaged with
   // the neighbour's at a shared node.
   Vector3d m_start, m_end, other, unused;
-  ElementEndForces<D>(q, k, load_factor, &unused, &unused, &m_start, &m_end);
+  ElementEndForces<D>(q, qdot, k, load_factor, &unused, &unused, &m_start, &m_end);
   if (k > begin) {
-    ElementEndForces<D>(q, k - 1, load_factor, &unused, &unused, &unused, &other);
+    ElementEndForces<D>(q, qdot, k - 1, load_factor, &unused, &unused, &unused, &other);
     m_start = 0.5 * (m_start + other);
   }
   if (k + 1 < end) {
-    ElementEndForces<D>(q, k + 1, load_factor, &unused, &unused, &other, &unused);
+    ElementEndForces<D>(q, qdot, k + 1, load_factor, &unused, &unused, &other, &unused);
     m_end = 0.5 * (m_end + other);
   }
   return (1 - xi) * m_start + xi * m_end;
 }
 
 void MultibodyModel::BendingMoments(const VectorXd& q, double load_factor,
-                                    std::vector<double>* out) const {
+                                    std::vector<double>* out, const VectorXd* qdot) const {
   out->resize(tension_probe_.size());
   for (size_t k = 0; k < tension_probe_.size(); ++k) {
     const Vector3d m =
-        dim_ == 2 ? BendingMomentOf<2>(q, tension_cable_[k], tension_s_[k], load_factor)
-                  : BendingMomentOf<3>(q, tension_cable_[k], tension_s_[k], load_factor);
+        dim_ == 2 ? BendingMomentOf<2>(q, qdot, tension_cable_[k], tension_s_[k], load_factor)
+                  : BendingMomentOf<3>(q, qdot, tension_cable_[k], tension_s_[k], load_factor);
     (*out)[k] = dim_ == 2 ? m.z() : m.norm();
   }
 }
 
 std::vector<double> MultibodyModel::CableNodeTensions(const VectorXd& q, int cable,
-                                                      double load_factor) const {
+                                                      double load_factor,
+                                                      const VectorXd* qdot) const {
   std::vector<double> out(cable_element_begin_[cable + 1] - cable_element_begin_[cable] + 1);
   if (dim_ == 2) {
-    CableNodeTensionsOf<2>(q, cable, load_factor, out.data());
+    CableNodeTensionsOf<2>(q, qdot, cable, load_factor, out.data());
   } else {
-    CableNodeTensionsOf<3>(q, cable, load_factor, out.data());
+    CableNodeTensionsOf<3>(q, qdot, cable, load_factor, out.data());
   }
   return out;
 }
 
 void MultibodyModel::Tensions(const VectorXd& q, double load_factor, std::vector<double>* probes,
-                              std::vector<double>* nodes) const {
+                              std::vector<double>* nodes, const VectorXd* qdot) const {
   // The section's axial force [N]: the force each element needs at its end
   // positions to hold its strain (its internal force's rows there) less its
   // own share of the weight (consistent load), averaged over the two
@@ -499,11 +509,14 @@ void MultibodyModel::Tensions(const VectorXd& q, double load_factor, std::vector
   // two-sided average leaves the difference of the two elements' other
   // distributed loads (inertia, drag, contact) at a node, and a cable end
   // one element's share of them (output.reactions holds a support's force
-  // exactly). Axial damping is not included.
+  // exactly). With qdot, the material damping's force joins the elastic
+  // one (the tension MoorDyn reports, T + Td of a segment, and OrcaFlex's
+  // wall tension with its axial damping term carry it too); Rayleigh
+  // alpha, which acts on the mass, does not.
   probes->resize(tension_probe_.size());
   for (size_t k = 0; k < tension_probe_.size(); ++k) {
-    (*probes)[k] = dim_ == 2 ? TensionOf<2>(q, tension_cable_[k], tension_s_[k], load_factor)
-                             : TensionOf<3>(q, tension_cable_[k], tension_s_[k], load_factor);
+    (*probes)[k] = dim_ == 2 ? TensionOf<2>(q, qdot, tension_cable_[k], tension_s_[k], load_factor)
+                             : TensionOf<3>(q, qdot, tension_cable_[k], tension_s_[k], load_factor);
   }
   if (!shape_) {
     nodes->clear();
@@ -516,15 +529,15 @@ void MultibodyModel::Tensions(const VectorXd& q, double load_factor, std::vector
     if (static_cast<size_t>(cable_nodes_[c]) != count) {
       // Not one node per element end (never so today): each node on its own.
       for (int k = 0; k < cable_nodes_[c]; ++k, ++first) {
-        (*nodes)[first] = dim_ == 2 ? TensionOf<2>(q, c, node_s_[first], load_factor)
-                                    : TensionOf<3>(q, c, node_s_[first], load_factor);
+        (*nodes)[first] = dim_ == 2 ? TensionOf<2>(q, qdot, c, node_s_[first], load_factor)
+                                    : TensionOf<3>(q, qdot, c, node_s_[first], load_factor);
       }
       continue;
     }
     if (dim_ == 2) {
-      CableNodeTensionsOf<2>(q, c, load_factor, nodes->data() + first);
+      CableNodeTensionsOf<2>(q, qdot, c, load_factor, nodes->data() + first);
     } else {
-      CableNodeTensionsOf<3>(q, c, load_factor, nodes->data() + first);
+      CableNodeTensionsOf<3>(q, qdot, c, load_factor, nodes->data() + first);
     }
     first += count;
   }

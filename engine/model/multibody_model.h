@@ -55,6 +55,7 @@
 #include "engine/forces/body_damping.h"
 #include "engine/forces/body_fluid_load.h"
 #include "engine/forces/body_seabed_contact.h"
+#include "engine/forces/cable_damping.h"
 #include "engine/forces/cable_added_mass.h"
 #include "engine/forces/force_contributor.h"
 #include "engine/forces/seabed.h"
@@ -414,22 +415,28 @@ class MultibodyModel {
   // `load_factor` (1 but in statics' load steps): the section force that
   // the elements' equations hold at the nodes (model_outputs.cc, Tensions,
   // says how and what it leaves out), its component along the tangent;
-  // compression negative. `probes` and `nodes` are resized.
+  // compression negative. `probes` and `nodes` are resized. With `qdot`
+  // (full rates; a dynamic state), the section force also carries the
+  // cables' material damping (Kelvin-Voigt: damping.axial_time and
+  // bending_time, Rayleigh beta; CableDamping::AddMaterialForce), as
+  // MoorDyn's and OrcaFlex's line tensions carry their axial damping;
+  // without it, the elastic force alone (statics, modal shapes).
   bool tension() const { return tension_; }
   void Tensions(const Eigen::VectorXd& q, double load_factor, std::vector<double>* probes,
-                std::vector<double>* nodes) const;
+                std::vector<double>* nodes, const Eigen::VectorXd* qdot = nullptr) const;
   // With output.bending_moment (bending_moment()): the bending moment [N m]
   // at every probe on a cable (ModelInfo::bending_moment_probe_names), from
   // the elements' slope rows as Tensions reads their position rows: the
   // moment u x Q_u the cable beyond the probe exerts on the cable before
   // it, averaged over the two elements at a node; planar: about z,
   // spatial: its size. `out` is resized.
+  // `qdot` as for Tensions (the bending damping's moment).
   bool bending_moment() const { return bending_moment_; }
-  void BendingMoments(const Eigen::VectorXd& q, double load_factor,
-                      std::vector<double>* out) const;
+  void BendingMoments(const Eigen::VectorXd& q, double load_factor, std::vector<double>* out,
+                      const Eigen::VectorXd* qdot = nullptr) const;
   // The same at each node of cable `cable` (its elements' ends, in order).
-  std::vector<double> CableNodeTensions(const Eigen::VectorXd& q, int cable,
-                                        double load_factor) const;
+  std::vector<double> CableNodeTensions(const Eigen::VectorXd& q, int cable, double load_factor,
+                                        const Eigen::VectorXd* qdot = nullptr) const;
   // With output.orientation (orientation()): per body 10 values
   // (Frame::body_orientation) from full q and qdot. The body's axes are its
   // natural coordinates (e1 = u, e2 = v, e3 = w, the columns of R), so
@@ -583,24 +590,26 @@ class MultibodyModel {
   void ElementEnergy(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, EnergySample* en,
                      EnergyParts* parts) const;
   // Tensions' and BendingMoments' parts: the section force at element k's
-  // two ends (its internal force's end-position rows less its weight's
-  // share) and, when asked for, the moment u x Q_u of its end-slope rows
-  // (the same force vector, computed once); the tension at (cable, s), and
-  // at every node of a cable into out.
+  // two ends (its internal force's end-position rows, with its material
+  // damping's when qdot is given, less its weight's share) and, when asked
+  // for, the moment u x Q_u of its end-slope rows (the same force vector,
+  // computed once); the tension at (cable, s), and at every node of a cable
+  // into out. `qdot` may be null (no damping term).
   template <int D>
-  void ElementEndForces(const Eigen::VectorXd& q, int k, double load_factor,
-                        Eigen::Vector3d* start, Eigen::Vector3d* end,
+  void ElementEndForces(const Eigen::VectorXd& q, const Eigen::VectorXd* qdot, int k,
+                        double load_factor, Eigen::Vector3d* start, Eigen::Vector3d* end,
                         Eigen::Vector3d* moment_start = nullptr,
                         Eigen::Vector3d* moment_end = nullptr) const;
   template <int D>
-  double TensionOf(const Eigen::VectorXd& q, int cable, double s, double load_factor) const;
+  double TensionOf(const Eigen::VectorXd& q, const Eigen::VectorXd* qdot, int cable, double s,
+                   double load_factor) const;
   // The bending moment vector at (cable, s) (model_outputs.cc).
   template <int D>
-  Eigen::Vector3d BendingMomentOf(const Eigen::VectorXd& q, int cable, double s,
-                                  double load_factor) const;
+  Eigen::Vector3d BendingMomentOf(const Eigen::VectorXd& q, const Eigen::VectorXd* qdot,
+                                  int cable, double s, double load_factor) const;
   template <int D>
-  void CableNodeTensionsOf(const Eigen::VectorXd& q, int cable, double load_factor,
-                           double* out) const;
+  void CableNodeTensionsOf(const Eigen::VectorXd& q, const Eigen::VectorXd* qdot, int cable,
+                           double load_factor, double* out) const;
   template <int D>
   Eigen::Vector3d CablePositionOf(const Eigen::VectorXd& q, int cable, double s,
                                   Eigen::Vector3d* slope) const;
@@ -697,6 +706,9 @@ class MultibodyModel {
   std::vector<char> element_dissipates_;
   bool has_element_contact_ = false;
   const CableSeabed* cable_seabed_ = nullptr;
+  // The cables' damping term (null: no cable is damped), for the material
+  // damping in the tension outputs (ElementEndForces).
+  const CableDamping* cable_damping_ = nullptr;
   // Scratch (full size) for StaticFriction (sized on first use).
   Eigen::VectorXd scratch_static_;
   Eigen::VectorXd scratch_static_roundoff_;

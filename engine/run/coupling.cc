@@ -561,8 +561,15 @@ std::vector<double> CouplingSession::NodeTensions(int c) const {
   Eigen::VectorXd q(s_->model.coordinates());
   s_->model.ToFull(stepper_ ? stepper_->z() : s_->model.initial_z(), &q);
   // The model's own tension (its axial law, its section force at the
-  // nodes: MultibodyModel::Tensions), one per node of the cable.
-  std::vector<double> tension = s_->model.CableNodeTensions(q, c, 1.0);
+  // nodes, with the material damping once the session steps:
+  // MultibodyModel::Tensions), one per node of the cable.
+  Eigen::VectorXd qdot;
+  if (stepper_) {
+    qdot.resize(s_->model.coordinates());
+    s_->model.RateToFull(stepper_->v(), &qdot);
+  }
+  std::vector<double> tension =
+      s_->model.CableNodeTensions(q, c, 1.0, stepper_ ? &qdot : nullptr);
   tension.resize(s_->info.cable_nodes[c]);
   return tension;
 }

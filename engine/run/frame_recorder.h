@@ -45,12 +45,15 @@ class FrameRecorder {
     }
     if (model_->reactions()) model_->Reactions(q_, lambda, &frame_.reactions);
     if (model_->tension()) {
-      model_->Tensions(q_, load_factor, &frame_.probe_tensions, &frame_.node_tensions);
+      // With rates, the cables' material damping is part of the tension.
+      model_->Tensions(q_, load_factor, &frame_.probe_tensions, &frame_.node_tensions,
+                       v ? &qd_ : nullptr);
     }
     if (model_->orientation()) model_->Orientations(q_, qd_, &frame_.body_orientation);
     frame_.joint_released = model_->joint_released();
     if (model_->bending_moment()) {
-      model_->BendingMoments(q_, load_factor, &frame_.probe_bending_moments);
+      model_->BendingMoments(q_, load_factor, &frame_.probe_bending_moments,
+                             v ? &qd_ : nullptr);
     }
     if (model_->shape()) model_->NodePositions(q_, &frame_.nodes);
     frame_.energy = model_->Energy(q_, qd_, load_factor, &frame_.energy_parts);
