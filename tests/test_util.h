@@ -91,6 +91,8 @@ class CollectingSink : public FrameSink {
     frames_.push_back(frame);
     return absl::OkStatus();
   }
+  // The tests of momentum read it.
+  bool wants_angular_momentum() const override { return true; }
   const ModelInfo& info() const { return info_; }
   const std::vector<Frame>& frames() const { return frames_; }
 

@@ -108,6 +108,9 @@ class StatisticsSink : public FrameSink {
 
   absl::Status OnStart(const ModelInfo& info) override;
   absl::Status OnFrame(const Frame& frame) override;
+  bool wants_angular_momentum() const override {
+    return next_ != nullptr && next_->wants_angular_momentum();
+  }
 
   // The statistics of the frames so far (the rainflow residue counted).
   RunStatistics Finish();

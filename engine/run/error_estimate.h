@@ -26,6 +26,9 @@ class ProbeRecordingSink : public FrameSink {
   absl::Status OnStart(const ModelInfo& info) override {
     return next_ ? next_->OnStart(info) : absl::OkStatus();
   }
+  bool wants_angular_momentum() const override {
+    return next_ != nullptr && next_->wants_angular_momentum();
+  }
   absl::Status OnFrame(const Frame& frame) override {
     times_.push_back(frame.t);
     for (const ProbeSample& p : frame.probes) positions_.push_back(p.position_m);

@@ -59,7 +59,8 @@ class FrameRecorder {
     frame_.energy = model_->Energy(q_, qd_, load_factor, &frame_.energy_parts);
     frame_.energy.damped = Damped(t);
     frame_.has_contact = model_->has_contact();
-    frame_.angular_momentum = model_->AngularMomentum(q_, qd_);
+    if (sink_ != nullptr && sink_->wants_angular_momentum())
+      frame_.angular_momentum = model_->AngularMomentum(q_, qd_);
     // (A joint that let go, JointRelease, leaves the model fewer rows.)
     if (phi_.size() != model_->multipliers()) phi_.setZero(model_->multipliers());
     model_->Constraints(q_, &phi_, nullptr);
