@@ -8,7 +8,118 @@
 
 #include <unsupported/Eigen/FFT>
 
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
 namespace cablesim {
+
+namespace {
+
+// sin, cos and exp of a block of arguments (At and ElevationAt, which must
+// agree to the bit, both use these). On x86-64, glibc's vector math
+// library (libmvec: the vector function ABI's variants, within 4 ulp as
+// glibc documents), 4 lanes at a time on a CPU with AVX2 and FMA, else 2
+// (SSE2, every x86-64). Measured on this project's build machine for a
+// sine and a cosine: libm's scalar pair 34 ns, the 2-lane variants 7.4 ns,
+// the 4-lane ones 2.0 ns; At's sines, cosines and exponentials took 58 %
+// of a 100-component JONSWAP buoy run with libm. Elsewhere, libm one by
+// one. Each lane's result depends on its own argument alone, so padding a
+// block's last lanes changes nothing.
+#if defined(__x86_64__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+extern "C" __m128d _ZGVbN2v_sin(__m128d);
+extern "C" __m128d _ZGVbN2v_cos(__m128d);
+extern "C" __m128d _ZGVbN2v_exp(__m128d);
+extern "C" __m256d _ZGVdN4v_sin(__m256d);
+extern "C" __m256d _ZGVdN4v_cos(__m256d);
+extern "C" __m256d _ZGVdN4v_exp(__m256d);
+
+// One libmvec function in its two widths.
+using Fn2 = __m128d (*)(__m128d);
+using Fn4 = __m256d (*)(__m256d);
+struct VectorFn {
+  Fn2 two;
+  Fn4 four;
+};
+const VectorFn kSin{_ZGVbN2v_sin, _ZGVdN4v_sin};
+const VectorFn kCos{_ZGVbN2v_cos, _ZGVdN4v_cos};
+const VectorFn kExp{_ZGVbN2v_exp, _ZGVdN4v_exp};
+
+// f of x[0..n) into y, 4 lanes at a time; the last lanes padded with 0.
+__attribute__((target("avx2,fma"))) void Apply4(Fn4 f, const double* x, int n, double* y) {
+  int i = 0;
+  for (; i + 4 <= n; i += 4) _mm256_storeu_pd(y + i, f(_mm256_loadu_pd(x + i)));
+  if (i < n) {
+    alignas(32) double in[4] = {0, 0, 0, 0}, out[4];
+    for (int j = i; j < n; ++j) in[j - i] = x[j];
+    _mm256_store_pd(out, f(_mm256_load_pd(in)));
+    for (int j = i; j < n; ++j) y[j] = out[j - i];
+  }
+}
+
+// The same, 2 lanes at a time (SSE2).
+void Apply2(Fn2 f, const double* x, int n, double* y) {
+  int i = 0;
+  for (; i + 2 <= n; i += 2) _mm_storeu_pd(y + i, f(_mm_loadu_pd(x + i)));
+  if (i < n) {
+    alignas(16) double in[2] = {x[i], 0.0}, out[2];
+    _mm_store_pd(out, f(_mm_load_pd(in)));
+    y[i] = out[0];
+  }
+}
+#pragma GCC diagnostic pop
+
+bool HasAvx2() {
+  static const bool has = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  }();
+  return has;
+}
+
+void Apply(const VectorFn& f, const double* x, int n, double* y) {
+  if (HasAvx2()) {
+    Apply4(f.four, x, n, y);
+  } else {
+    Apply2(f.two, x, n, y);
+  }
+}
+
+void SinCosBlock(const double* x, int n, double* sn, double* cs) {
+  Apply(kSin, x, n, sn);
+  Apply(kCos, x, n, cs);
+}
+void CosBlock(const double* x, int n, double* cs) { Apply(kCos, x, n, cs); }
+void ExpBlock(const double* x, int n, double* y) { Apply(kExp, x, n, y); }
+#else
+void SinCosBlock(const double* x, int n, double* sn, double* cs) {
+  for (int i = 0; i < n; ++i) {
+    sn[i] = std::sin(x[i]);
+    cs[i] = std::cos(x[i]);
+  }
+}
+void CosBlock(const double* x, int n, double* cs) {
+  for (int i = 0; i < n; ++i) cs[i] = std::cos(x[i]);
+}
+void ExpBlock(const double* x, int n, double* y) {
+  for (int i = 0; i < n; ++i) y[i] = std::exp(x[i]);
+}
+#endif
+
+// The block length: At's stack arrays hold this many components at once.
+constexpr int kBlock = 64;
+
+// The phases theta_i = k_i d_i . r - omega_i t + phi_i of the n components
+// from c on (At's and ElevationAt's, the same to the bit).
+void Phases(const WaveField::Component* c, int n, const Eigen::Vector3d& r, double t,
+            double* theta) {
+  for (int i = 0; i < n; ++i)
+    theta[i] = c[i].wavenumber_1_m * c[i].direction.dot(r) - c[i].omega_rad_s * t + c[i].phase_rad;
+}
+
+}  // namespace
 
 double WaveField::Wavenumber(double omega, double depth, double g) {
   if (!(omega > 0)) return 0;
@@ -153,19 +264,34 @@ WaveField::Kinematics WaveField::At(const Eigen::Vector3d& r, double t) const {
   const double z = std::clamp(up_.dot(r) - surface_, -depth_, 0.0);
   Eigen::Vector3d u = Eigen::Vector3d::Zero(), a = Eigen::Vector3d::Zero();
   double eta = mean_elevation_m_;
-  for (const Component& c : components_) {
-    const double k = c.wavenumber_1_m, w = c.omega_rad_s;
-    const double theta = k * c.direction.dot(r) - w * t + c.phase_rad;
-    const double cs = std::cos(theta), sn = std::sin(theta);
-    // cosh(k (z + h)) / sinh(k h) and sinh(k (z + h)) / sinh(k h) in a form
-    // that neither overflows in deep water nor loses digits.
-    const double e1 = std::exp(k * z), e2 = std::exp(-2 * k * (z + depth_)),
-                 e3 = c.depth_decay;
-    const double ch = e1 * (1 + e2) / (1 - e3), sh = e1 * (1 - e2) / (1 - e3);
-    const double aw = c.amplitude_m * w;
-    eta += c.amplitude_m * cs;
-    u += (aw * ch * cs) * c.direction + (aw * sh * sn) * up_;
-    a += (aw * w * ch * sn) * c.direction - (aw * w * sh * cs) * up_;
+  // Block by block: the phases and the exponents' arguments, then their
+  // sines, cosines and exponentials at once (SinCosBlock, ExpBlock), then
+  // the sums in the components' order.
+  double theta[kBlock], sn[kBlock], cs[kBlock], x1[kBlock], e1[kBlock], x2[kBlock], e2[kBlock];
+  const int count = static_cast<int>(components_.size());
+  for (int begin = 0; begin < count; begin += kBlock) {
+    const Component* block = components_.data() + begin;
+    const int n = std::min(kBlock, count - begin);
+    Phases(block, n, r, t, theta);
+    for (int i = 0; i < n; ++i) {
+      x1[i] = block[i].wavenumber_1_m * z;
+      x2[i] = -2 * block[i].wavenumber_1_m * (z + depth_);
+    }
+    SinCosBlock(theta, n, sn, cs);
+    ExpBlock(x1, n, e1);
+    ExpBlock(x2, n, e2);
+    for (int i = 0; i < n; ++i) {
+      const Component& c = block[i];
+      const double w = c.omega_rad_s;
+      // cosh(k (z + h)) / sinh(k h) and sinh(k (z + h)) / sinh(k h) in a
+      // form that neither overflows in deep water nor loses digits.
+      const double e3 = c.depth_decay;
+      const double ch = e1[i] * (1 + e2[i]) / (1 - e3), sh = e1[i] * (1 - e2[i]) / (1 - e3);
+      const double aw = c.amplitude_m * w;
+      eta += c.amplitude_m * cs[i];
+      u += (aw * ch * cs[i]) * c.direction + (aw * sh * sn[i]) * up_;
+      a += (aw * w * ch * sn[i]) * c.direction - (aw * w * sh * cs[i]) * up_;
+    }
   }
   out.elevation_m = ramp * eta;
   out.velocity_m_s = ramp * u;
@@ -177,10 +303,14 @@ double WaveField::ElevationAt(const Eigen::Vector3d& r, double t) const {
   double ramp;
   if (!Ramp(t, &ramp, nullptr)) return 0;
   double eta = mean_elevation_m_;
-  for (const Component& c : components_) {
-    const double theta =
-        c.wavenumber_1_m * c.direction.dot(r) - c.omega_rad_s * t + c.phase_rad;
-    eta += c.amplitude_m * std::cos(theta);
+  // The same phases and cosines as At's, so the same sum to the bit.
+  double theta[kBlock], cs[kBlock];
+  const int count = static_cast<int>(components_.size());
+  for (int begin = 0; begin < count; begin += kBlock) {
+    const int n = std::min(kBlock, count - begin);
+    Phases(components_.data() + begin, n, r, t, theta);
+    CosBlock(theta, n, cs);
+    for (int i = 0; i < n; ++i) eta += components_[begin + i].amplitude_m * cs[i];
   }
   return ramp * eta;
 }
