@@ -40,13 +40,13 @@ absl::Status ShapeCsvWriter::OnFrame(const Frame& frame) {
   }
   row_.clear();
   // t once per frame (the same for each of its rows).
-  std::string t;
-  AppendCsvNumber(&t, frame.t);
+  t_.clear();
+  AppendCsvNumber(&t_, frame.t);
   size_t n = 0;
   for (size_t c = 0; c < info_.cable_nodes.size(); ++c) {
     for (int k = 0; k < info_.cable_nodes[c]; ++k, ++n) {
       const Eigen::Vector3d& r = frame.nodes[n];
-      absl::StrAppend(&row_, t, ",", c, ",", k, ",");
+      absl::StrAppend(&row_, t_, ",", c, ",", k, ",");
       AppendCsvNumber(&row_, info_.node_s[n]);
       for (int i = 0; i < 3; ++i) {
         row_ += ',';

@@ -52,6 +52,7 @@ class ShapeCsvWriter : public FrameSink {
   absl::Status status_;
   ModelInfo info_;
   std::string row_;
+  std::string t_;  // the frame's t, formatted once per frame (reused)
 };
 
 }  // namespace cablesim

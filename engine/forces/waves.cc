@@ -79,6 +79,7 @@ bool HasAvx2() {
   return has;
 }
 
+// f of x[0..n) into y.
 void Apply(const VectorFn& f, const double* x, int n, double* y) {
   if (HasAvx2()) {
     Apply4(f.four, x, n, y);
@@ -86,25 +87,16 @@ void Apply(const VectorFn& f, const double* x, int n, double* y) {
     Apply2(f.two, x, n, y);
   }
 }
-
-void SinCosBlock(const double* x, int n, double* sn, double* cs) {
-  Apply(kSin, x, n, sn);
-  Apply(kCos, x, n, cs);
-}
-void CosBlock(const double* x, int n, double* cs) { Apply(kCos, x, n, cs); }
-void ExpBlock(const double* x, int n, double* y) { Apply(kExp, x, n, y); }
 #else
-void SinCosBlock(const double* x, int n, double* sn, double* cs) {
-  for (int i = 0; i < n; ++i) {
-    sn[i] = std::sin(x[i]);
-    cs[i] = std::cos(x[i]);
-  }
-}
-void CosBlock(const double* x, int n, double* cs) {
-  for (int i = 0; i < n; ++i) cs[i] = std::cos(x[i]);
-}
-void ExpBlock(const double* x, int n, double* y) {
-  for (int i = 0; i < n; ++i) y[i] = std::exp(x[i]);
+// libm one value at a time.
+struct VectorFn {
+  double (*one)(double);
+};
+const VectorFn kSin{[](double v) { return std::sin(v); }};
+const VectorFn kCos{[](double v) { return std::cos(v); }};
+const VectorFn kExp{[](double v) { return std::exp(v); }};
+void Apply(const VectorFn& f, const double* x, int n, double* y) {
+  for (int i = 0; i < n; ++i) y[i] = f.one(x[i]);
 }
 #endif
 
@@ -265,7 +257,7 @@ WaveField::Kinematics WaveField::At(const Eigen::Vector3d& r, double t) const {
   Eigen::Vector3d u = Eigen::Vector3d::Zero(), a = Eigen::Vector3d::Zero();
   double eta = mean_elevation_m_;
   // Block by block: the phases and the exponents' arguments, then their
-  // sines, cosines and exponentials at once (SinCosBlock, ExpBlock), then
+  // sines, cosines and exponentials at once (Apply), then
   // the sums in the components' order.
   double theta[kBlock], sn[kBlock], cs[kBlock], x1[kBlock], e1[kBlock], x2[kBlock], e2[kBlock];
   const int count = static_cast<int>(components_.size());
@@ -277,9 +269,10 @@ WaveField::Kinematics WaveField::At(const Eigen::Vector3d& r, double t) const {
       x1[i] = block[i].wavenumber_1_m * z;
       x2[i] = -2 * block[i].wavenumber_1_m * (z + depth_);
     }
-    SinCosBlock(theta, n, sn, cs);
-    ExpBlock(x1, n, e1);
-    ExpBlock(x2, n, e2);
+    Apply(kSin, theta, n, sn);
+    Apply(kCos, theta, n, cs);
+    Apply(kExp, x1, n, e1);
+    Apply(kExp, x2, n, e2);
     for (int i = 0; i < n; ++i) {
       const Component& c = block[i];
       const double w = c.omega_rad_s;
@@ -309,7 +302,7 @@ double WaveField::ElevationAt(const Eigen::Vector3d& r, double t) const {
   for (int begin = 0; begin < count; begin += kBlock) {
     const int n = std::min(kBlock, count - begin);
     Phases(components_.data() + begin, n, r, t, theta);
-    CosBlock(theta, n, cs);
+    Apply(kCos, theta, n, cs);
     for (int i = 0; i < n; ++i) eta += components_[begin + i].amplitude_m * cs[i];
   }
   return ramp * eta;
