@@ -117,6 +117,35 @@ TEST(EnergyMomentumStepperTest, FreeSpinningBodyKeepsAngularMomentumAndEnergyToR
   EXPECT_LT(de, 1e-12);
 }
 
+// Frame::angular_momentum is computed only for a sink that asks for it
+// (FrameSink::wants_angular_momentum): the free body above, spinning, run
+// once for a sink that does not ask (zeros in every frame) and once for
+// one that does (L = I omega, nonzero), with every other figure the same.
+TEST(EnergyMomentumStepperTest, AngularMomentumOnlyForASinkThatAsks) {
+  const std::string json = R"({
+    "bodies": [{"name": "b", "mass": 2, "inertia": {"x": 2, "y": 3, "z": 4}}],
+    "initial_velocity": {"angular": {"x": 0.3, "y": 0.2, "z": 1.5}},
+    "solver": {"duration": 0.1, "step": 1e-2, "output_interval": 0.05}})";
+  class NotAsking : public CollectingSink {
+   public:
+    bool wants_angular_momentum() const override { return false; }
+  };
+  NotAsking plain;
+  CollectingSink asking;
+  RunOk(SceneFromJson(json), &plain);
+  RunOk(SceneFromJson(json), &asking);
+  ASSERT_EQ(plain.frames().size(), asking.frames().size());
+  ASSERT_FALSE(plain.frames().empty());
+  // At t = 0 the body's axes are the world's: L = diag(2, 3, 4) omega.
+  EXPECT_NEAR((asking.frames().front().angular_momentum - Eigen::Vector3d(0.6, 0.6, 6.0)).norm(),
+              0, 1e-12);
+  for (size_t k = 0; k < plain.frames().size(); ++k) {
+    EXPECT_EQ(plain.frames()[k].angular_momentum, Eigen::Vector3d::Zero());
+    EXPECT_GT(asking.frames()[k].angular_momentum.norm(), 1);
+    EXPECT_EQ(plain.frames()[k].energy.total, asking.frames()[k].energy.total);
+  }
+}
+
 TEST(EnergyMomentumStepperTest, SpatialPendulumKeepsVerticalAngularMomentumToRounding) {
   // scenes/spatial-pendulum.json (spun at 4 rad/s about the vertical
   // through the pin) at h = 1e-3 for 0.5 s: gravity and the pin exert no
