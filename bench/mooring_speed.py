@@ -141,6 +141,10 @@ def main():
     ap.add_argument("--reference-cache", help="JSON file: the reference ladder's runs are read from it "
                     "when it exists and holds the same scene and ladder, else run and written to it")
     ap.add_argument("--reference-only", action="store_true", help="run the ladder (and cache it), stop")
+    ap.add_argument("--write-scene", nargs=2, metavar=("VARIANT", "FILE"),
+                    help="write the scene of one setting (a variant as JSON, e.g. "
+                    "'{\"elements\": 50, \"solver\": {\"step\": 0.2}}'; '{}' for the defaults) to FILE "
+                    "and stop: `cablesim run FILE` then times that setting alone")
     args = ap.parse_args()
     config = json.load(open(args.config))
     if args.quick:
@@ -149,6 +153,17 @@ def main():
     base = merge(json.load(open(os.path.join(ROOT, config["scene"]))), config.get("scene_patch", {}))
     for cable in base["cables"]:  # lists are replaced by scene_patch, so cables get their own
         merge(cable, config.get("cable_patch", {}))
+    if args.write_scene:
+        try:
+            variant = json.loads(args.write_scene[0])
+        except json.JSONDecodeError as e:
+            ap.error(f"--write-scene VARIANT: not JSON ({e})")
+        if not isinstance(variant, dict):
+            ap.error("--write-scene VARIANT: must be a JSON object, e.g. '{\"elements\": 50}'")
+        with open(args.write_scene[1], "w") as f:
+            json.dump(variant_scene(base, variant), f, indent=1)
+        print(f"{args.write_scene[1]}: {label(variant)}", file=sys.stderr)
+        return
     duration = float(base["solver"]["duration"])
     binary = os.path.join(args.build, "bin", "cablesim")
     repeats = int(config.get("repeats", 3))
