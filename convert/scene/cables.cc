@@ -279,10 +279,64 @@ absl::Status ConvertCable(ConversionState* state, int i, CableSpec* cable) {
     case v1::TABLE:
       cable->axial_law = AxialLaw::kTable;
       break;
+    case v1::VISCOELASTIC:
+      cable->axial_law = AxialLaw::kViscoelastic;
+      break;
     default:
       return Invalid(Sub(path, "axial_law"),
                      absl::StrCat("unknown value ", c.axial_law(),
-                                  " (must be GREEN_LAGRANGE, ENGINEERING or TABLE)"));
+                                  " (must be GREEN_LAGRANGE, ENGINEERING, TABLE or "
+                                  "VISCOELASTIC)"));
+  }
+  if (cable->axial_law == AxialLaw::kViscoelastic) {
+    const std::string vpath = Sub(path, "viscoelastic");
+    if (!c.has_viscoelastic()) return Invalid(vpath, "required with axial_law VISCOELASTIC");
+    const v1::Viscoelastic& v = c.viscoelastic();
+    const double ea = cable->youngs_modulus_pa * cable->area_m2;
+    auto stiffer = [&](const std::string& field, double value) -> absl::Status {
+      CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(vpath, field), value));
+      if (!(value > ea)) {
+        return Invalid(Sub(vpath, field),
+                       absl::StrCat("must exceed the static EA, youngs_modulus * area = ", Num(ea),
+                                    " N (got ", Num(value), "): the dynamic stiffness is the "
+                                    "stiffer one"));
+      }
+      return absl::OkStatus();
+    };
+    if (v.has_dynamic_ea()) {
+      if (v.has_dynamic_ea_base() || v.has_dynamic_ea_slope()) {
+        return Invalid(Sub(vpath, v.has_dynamic_ea_base() ? "dynamic_ea_base" : "dynamic_ea_slope"),
+                       "not with dynamic_ea (a constant dynamic stiffness or the mean-load law, "
+                       "not both)");
+      }
+      CABLESIM_RETURN_IF_ERROR(stiffer("dynamic_ea", v.dynamic_ea()));
+      cable->visco_dynamic_ea_n = v.dynamic_ea();
+    } else {
+      if (!v.has_dynamic_ea_base() || !v.has_dynamic_ea_slope()) {
+        return Invalid(Sub(vpath, v.has_dynamic_ea_base() ? "dynamic_ea_slope" : "dynamic_ea_base"),
+                       "required: give dynamic_ea, or dynamic_ea_base and dynamic_ea_slope");
+      }
+      CABLESIM_RETURN_IF_ERROR(stiffer("dynamic_ea_base", v.dynamic_ea_base()));
+      CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(vpath, "dynamic_ea_slope"), v.dynamic_ea_slope()));
+      CABLESIM_RETURN_IF_ERROR(
+          CheckNonNegative(Sub(vpath, "dynamic_ea_slope"), v.dynamic_ea_slope()));
+      cable->visco_dynamic_ea_base_n = v.dynamic_ea_base();
+      cable->visco_dynamic_ea_slope = v.dynamic_ea_slope();
+    }
+    CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(vpath, "static_damping"), v.static_damping()));
+    CABLESIM_RETURN_IF_ERROR(CheckNonNegative(Sub(vpath, "static_damping"), v.static_damping()));
+    CABLESIM_RETURN_IF_ERROR(CheckFinite(Sub(vpath, "dynamic_damping"), v.dynamic_damping()));
+    CABLESIM_RETURN_IF_ERROR(
+        CheckNonNegative(Sub(vpath, "dynamic_damping"), v.dynamic_damping()));
+    if (!(v.static_damping() + v.dynamic_damping() > 0)) {
+      return Invalid(Sub(vpath, "static_damping"),
+                     "static_damping + dynamic_damping must be > 0 (without a dashpot the two "
+                     "springs in series are one spring: use axial_law ENGINEERING)");
+    }
+    cable->visco_static_damping_ns = v.static_damping();
+    cable->visco_dynamic_damping_ns = v.dynamic_damping();
+  } else if (c.has_viscoelastic()) {
+    return Invalid(Sub(path, "viscoelastic"), "only with axial_law VISCOELASTIC");
   }
   if (cable->axial_law == AxialLaw::kTable) {
     if (!c.has_tension_table()) {
@@ -322,7 +376,9 @@ absl::Status ConvertCable(ConversionState* state, int i, CableSpec* cable) {
   if (c.has_winch()) {
     if (cable->axial_law != AxialLaw::kGreenLagrange) {
       return Invalid(Sub(path, "axial_law"),
-                     absl::StrCat(cable->axial_law == AxialLaw::kTable ? "TABLE" : "ENGINEERING",
+                     absl::StrCat(cable->axial_law == AxialLaw::kTable          ? "TABLE"
+                                  : cable->axial_law == AxialLaw::kViscoelastic ? "VISCOELASTIC"
+                                                                                : "ENGINEERING",
                                   " is not available on a cable with a winch (its line tension "
                                   "is the Green-Lagrange law's)"));
     }

@@ -204,6 +204,21 @@ absl::Status ConvertSolver(ConversionState* state) {
     }
     out.rho_infinity = s.rho_infinity();
   }
+  // A viscoelastic line's dashpots are integrated over each step of an
+  // implicit stepper (engine/elements/viscoelastic_history.h): the
+  // explicit ones would see them at the step's start only, and
+  // ENERGY_MOMENTUM's discrete gradient is for a potential.
+  if (out.analysis == Analysis::kDynamic && !out.auto_integrator &&
+      (traits.is_explicit || out.integrator == Integrator::kEnergyMomentum)) {
+    for (size_t c = 0; c < state->scene.cables.size(); ++c) {
+      if (state->scene.cables[c].axial_law != AxialLaw::kViscoelastic) continue;
+      return Invalid("solver.integrator",
+                     absl::StrCat(std::string(IntegratorName(out.integrator)),
+                                  " does not apply to cables[", c,
+                                  "], whose axial_law is VISCOELASTIC: use IMPLICIT_EULER, "
+                                  "GENERALIZED_ALPHA, HHT or AUTO"));
+    }
+  }
   out.adaptive = s.adaptive();
   out.error_estimate = s.error_estimate();
   // Steppers whose Newton matrix can be kept across iterations and steps

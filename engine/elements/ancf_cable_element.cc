@@ -152,7 +152,8 @@ typename AncfCableElement<D>::Energy AncfCableElement<D>::StrainEnergy(const Coo
       const double a = u.squaredNorm(), b = u.dot(w), c = w.squaredNorm();
       const double wl = rule_.weight[g] * length_;
       if constexpr (decltype(table_law)::value) {
-        energy.axial += wl * table_->Energy(std::sqrt(a) - 1);
+        energy.axial += wl * (visco_ ? visco_->StoredEnergy(visco_first_ + g, std::sqrt(a) - 1)
+                                     : table_->Energy(std::sqrt(a) - 1));
       } else {
         const double eps =
             axial_law_ == AxialLaw::kEngineering ? std::sqrt(a) - 1 : (a - 1) / 2;
@@ -168,13 +169,42 @@ typename AncfCableElement<D>::Energy AncfCableElement<D>::StrainEnergy(const Coo
     }
     return energy;
   };
-  return axial_law_ == AxialLaw::kTable ? loop(std::true_type{}) : loop(std::false_type{});
+  return axial_law_ == AxialLaw::kTable || axial_law_ == AxialLaw::kViscoelastic
+             ? loop(std::true_type{})
+             : loop(std::false_type{});
 }
 
-// The TABLE law's loop is instantiated in ancf_cable_element_table.cc.
+template <int D>
+void AncfCableElement<D>::AxialStrains(const Coords& e, double* out) const {
+  for (int g = 0; g < rule_.n; ++g) {
+    Point u = Point::Zero();
+    for (int k = 0; k < 4; ++k) u += d1_[g][k] * e.template segment<D>(k * D);
+    out[g] = u.norm() - 1;
+  }
+}
+
+template <int D>
+void AncfCableElement<D>::AxialStrainAndRate(const Coords& e, const Coords& edot, int g,
+                                             double* strain, double* rate) const {
+  Point u = Point::Zero(), ud = Point::Zero();
+  for (int k = 0; k < 4; ++k) {
+    u += d1_[g][k] * e.template segment<D>(k * D);
+    ud += d1_[g][k] * edot.template segment<D>(k * D);
+  }
+  const double s = u.norm();
+  *strain = s - 1;
+  *rate = s > 0 ? u.dot(ud) / s : 0.0;
+}
+
+// The TABLE and VISCOELASTIC laws' loops are instantiated in
+// ancf_cable_element_table.cc.
 extern template void AncfCableElement<2>::ElasticForceWith<AxialLaw::kTable>(
     const Coords&, Coords*, Matrix*, Coords*) const;
 extern template void AncfCableElement<3>::ElasticForceWith<AxialLaw::kTable>(
+    const Coords&, Coords*, Matrix*, Coords*) const;
+extern template void AncfCableElement<2>::ElasticForceWith<AxialLaw::kViscoelastic>(
+    const Coords&, Coords*, Matrix*, Coords*) const;
+extern template void AncfCableElement<3>::ElasticForceWith<AxialLaw::kViscoelastic>(
     const Coords&, Coords*, Matrix*, Coords*) const;
 
 template <int D>
@@ -185,6 +215,8 @@ void AncfCableElement<D>::ElasticForce(const Coords& e, Coords* force, Matrix* t
     ElasticForceWith<AxialLaw::kEngineering>(e, force, tangent, roundoff);
   else if (axial_law_ == AxialLaw::kTable)
     ElasticForceWith<AxialLaw::kTable>(e, force, tangent, roundoff);
+  else if (axial_law_ == AxialLaw::kViscoelastic)
+    ElasticForceWith<AxialLaw::kViscoelastic>(e, force, tangent, roundoff);
   else
     ElasticForceWith<AxialLaw::kGreenLagrange>(e, force, tangent, roundoff);
 }

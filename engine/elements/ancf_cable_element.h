@@ -17,7 +17,10 @@
 // EA (e + e^2/2)(1 + e) in the engineering strain e, 1.5 % stiffer at 1 %),
 // or, with AxialLaw::kTable, psi = W(e) = int_0^e T de of a tension-strain
 // table T(e) in the engineering strain (engine/elements/tension_table.h;
-// the tension along the tangent is T(e), its stiffness the table's slope).
+// the tension along the tangent is T(e), its stiffness the table's slope),
+// or, with AxialLaw::kViscoelastic, the tension T = k e + p and stiffness k
+// that engine/elements/viscoelastic_history.h gives each Gauss point for
+// the current step (its stored energy that history's).
 //
 // and, writing a = u.u, b = u.w, c = w.w,
 //
@@ -39,6 +42,7 @@
 
 #include "engine/elements/gauss_quadrature.h"
 #include "engine/elements/tension_table.h"
+#include "engine/elements/viscoelastic_history.h"
 #include "engine/scene/scene.h"
 
 namespace cablesim {
@@ -73,6 +77,18 @@ class AncfCableElement {
   // tension; ea_n stays the nominal EA that AddDampingMatrix's axial_s
   // multiplies.
   AxialLaw axial_law() const { return axial_law_; }
+  // With AxialLaw::kViscoelastic: the history whose points first_point ..
+  // first_point + gauss_points() - 1 are this element's (it must outlive
+  // the element's use; the model owns both).
+  void set_viscoelastic(const ViscoelasticHistory* history, int first_point) {
+    visco_ = history;
+    visco_first_ = first_point;
+  }
+  // The engineering strain |r'| - 1 at each Gauss point into out[g].
+  void AxialStrains(const Coords& e, double* out) const;
+  // The engineering strain and its rate u.udot / |u| at Gauss point g.
+  void AxialStrainAndRate(const Coords& e, const Coords& edot, int g, double* strain,
+                          double* rate) const;
 
   double length() const { return length_; }
   // A new undeformed length [m] (a winch cable's elements, whose length
@@ -292,6 +308,8 @@ class AncfCableElement {
   BendingModel bending_ = BendingModel::kExact;
   AxialLaw axial_law_ = AxialLaw::kGreenLagrange;
   std::shared_ptr<const TensionTable> table_;  // AxialLaw::kTable only
+  const ViscoelasticHistory* visco_ = nullptr;  // AxialLaw::kViscoelastic only
+  int visco_first_ = 0;
   GaussRule rule_;
   // Shape-function derivatives at the Gauss points: d1_[g][k] = s_k'(x),
   // d2_[g][k] = s_k''(x), derivatives in x.

@@ -4,7 +4,7 @@
 // AncfCableElement<D>::ElasticForceWith<kLaw>, the elastic force's
 // Gauss-point loop for one axial law, included by the two files that
 // instantiate it: ancf_cable_element.cc (GREEN_LAGRANGE, ENGINEERING) and
-// ancf_cable_element_table.cc (TABLE). Kept apart so that a third
+// ancf_cable_element_table.cc (TABLE, VISCOELASTIC). Kept apart so that a third
 // instantiation does not change the compiler's inlining of the other two
 // (in one file it outlined parts of the Green-Lagrange loop: +0.8 % of a
 // pendulum run's instructions, measured by callgrind).
@@ -66,6 +66,17 @@ void AncfCableElement<D>::ElasticForceWith(const Coords& e, Coords* force, Matri
         gu = f * u;
         if (tangent) huu = f * Id::Identity() + ((tk.stiffness - f) / a) * u * u.transpose();
         if (roundoff) nuu = std::abs(f) + tk.stiffness;
+      }
+    } else if constexpr (kLaw == AxialLaw::kViscoelastic) {
+      // As the table's, with T = k e + p and slope k of the step
+      // (ViscoelasticHistory).
+      const double s = std::sqrt(a);
+      if (s > 0) {
+        const ViscoelasticHistory::Coefficients& vc = visco_->coefficients(visco_first_)[g];
+        const double f = (vc.k * (s - 1) + vc.p) / s;
+        gu = f * u;
+        if (tangent) huu = f * Id::Identity() + ((vc.k - f) / a) * u * u.transpose();
+        if (roundoff) nuu = std::abs(f) + vc.k;
       }
     } else {
       const double eps = (a - 1) / 2;

@@ -10,5 +10,9 @@ template void AncfCableElement<2>::ElasticForceWith<AxialLaw::kTable>(
     const Coords&, Coords*, Matrix*, Coords*) const;
 template void AncfCableElement<3>::ElasticForceWith<AxialLaw::kTable>(
     const Coords&, Coords*, Matrix*, Coords*) const;
+template void AncfCableElement<2>::ElasticForceWith<AxialLaw::kViscoelastic>(
+    const Coords&, Coords*, Matrix*, Coords*) const;
+template void AncfCableElement<3>::ElasticForceWith<AxialLaw::kViscoelastic>(
+    const Coords&, Coords*, Matrix*, Coords*) const;
 
 }  // namespace cablesim

@@ -182,6 +182,20 @@ void ModelBuilder::BuildElementsOf(std::vector<MultibodyModel::ElementData<D>>* 
       static_assert(CableSpec::kMaxGaussPoints <= GaussRule::kMaxPoints);
       e.element =
           AncfCableElement<D>(l, ea, ei, cable.bending, cable.gauss_points, cable.axial_law, table);
+      if (cable.axial_law == AxialLaw::kViscoelastic) {
+        // The law's state per Gauss point (ViscoelasticHistory).
+        if (!model_.visco_) model_.visco_ = std::make_unique<ViscoelasticHistory>();
+        ViscoelasticHistory::Law law;
+        law.ea_static_n = ea;
+        law.ea_dynamic_n = cable.visco_dynamic_ea_n;
+        law.ea_base_n = cable.visco_dynamic_ea_base_n;
+        law.ea_slope = cable.visco_dynamic_ea_slope;
+        law.damping_static_ns = cable.visco_static_damping_ns;
+        law.damping_dynamic_ns = cable.visco_dynamic_damping_ns;
+        e.element.set_viscoelastic(model_.visco_.get(),
+                                   model_.visco_->AddElement(law, e.element.gauss_points()));
+        model_.visco_elements_.push_back(static_cast<int>(elements->size()));
+      }
       // Energy the element can hold from coordinates known to 16 eps
       // (1 + |q0|_inf): a strain of that over l, a curvature of it over l^2.
       const double strain = 16 * std::numeric_limits<double>::epsilon() * (1 + extent) / l;

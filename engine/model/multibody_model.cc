@@ -431,9 +431,81 @@ double MultibodyModel::AddedMassCorrection(const VectorXd& q, const VectorXd& zd
   return size;
 }
 
+template <int D>
+void MultibodyModel::ViscoelasticStrains(const VectorXd& z) {
+  VectorXd q(c_.size());  // once per accepted step, viscoelastic scenes only
+  ToFull(z, &q);
+  visco_strains_.resize(visco_->points());
+  double* out = visco_strains_.data();
+  for (int k : visco_elements_) {
+    const ElementData<D>& e = Elements<D>()[k];
+    e.element.AxialStrains(q.segment<4 * D>(e.first_coord), out);
+    out += e.element.gauss_points();
+  }
+}
+
+template <int D>
+double MultibodyModel::ViscoelasticPower(const VectorXd& q, const VectorXd& qdot) const {
+  double power = 0;
+  int point = 0;
+  for (int k : visco_elements_) {
+    const ElementData<D>& e = Elements<D>()[k];
+    const auto ek = q.segment<4 * D>(e.first_coord);
+    const auto edk = qdot.segment<4 * D>(e.first_coord);
+    for (int g = 0; g < e.element.gauss_points(); ++g, ++point) {
+      double strain, rate;
+      e.element.AxialStrainAndRate(ek, edk, g, &strain, &rate);
+      power += e.element.GaussLength(g) * visco_->DissipatedPower(point, strain, rate);
+    }
+  }
+  return power;
+}
+
+void MultibodyModel::StartViscoelastic(const VectorXd& z, double t) {
+  if (!visco_) return;
+  if (dim_ == 2) {
+    ViscoelasticStrains<2>(z);
+  } else {
+    ViscoelasticStrains<3>(z);
+  }
+  visco_->Start(visco_strains_, t);
+}
+
+template <int D>
+double MultibodyModel::ViscoelasticEnergyJump(const std::vector<double>& per_point) const {
+  double jump = 0;
+  int point = 0;
+  for (int k : visco_elements_) {
+    const ElementData<D>& e = Elements<D>()[k];
+    for (int g = 0; g < e.element.gauss_points(); ++g, ++point)
+      jump += e.element.GaussLength(g) * per_point[point];
+  }
+  return jump;
+}
+
+void MultibodyModel::CommitViscoelastic(const VectorXd& z, double t) {
+  if (!visco_) return;
+  if (dim_ == 2) {
+    ViscoelasticStrains<2>(z);
+  } else {
+    ViscoelasticStrains<3>(z);
+  }
+  visco_->Commit(visco_strains_, t, &visco_jump_);
+  // The mean-load law's change of stored energy with its stiffness
+  // (ViscoelasticHistory::Commit), counted as external work.
+  external_work_ +=
+      dim_ == 2 ? ViscoelasticEnergyJump<2>(visco_jump_) : ViscoelasticEnergyJump<3>(visco_jump_);
+}
+
+void MultibodyModel::RelaxViscoelastic() {
+  if (visco_) visco_->Relax();
+}
+
 double MultibodyModel::DampingPower(const VectorXd& q, const VectorXd& qdot) const {
-  if (!has_damping_) return 0;
+  if (!has_dissipated_power()) return 0;
   double power = 0;  // -Q_d . qdot
+  if (visco_) power += dim_ == 2 ? ViscoelasticPower<2>(q, qdot) : ViscoelasticPower<3>(q, qdot);
+  if (!has_damping_) return power;
   if (dim_ == 2) {
     ElementDamping<2>(q, qdot, nullptr, nullptr, 0, nullptr, &power);
   } else {
@@ -540,6 +612,7 @@ void MultibodyModel::ConstraintGamma(const VectorXd& q, const VectorXd& qdot,
 
 void MultibodyModel::SetTime(double t) {
   time_ = t;
+  if (visco_) visco_->SetTime(t);
   if (!time_dependent_) return;
   for (ConstraintFamily* f : families_) f->SetTime(t);
   for (const auto& c : contributors_) c->SetTime(t);

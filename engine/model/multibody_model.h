@@ -218,6 +218,22 @@ class MultibodyModel {
   // without drag; a current or waves may make the fluid's share negative
   // (the flow then does work on the cable). At the time of SetTime.
   double DampingPower(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot) const;
+  // Whether DampingPower can be nonzero: damping, or a viscoelastic line
+  // (whose dashpots dissipate inside its axial law, not through
+  // DampingForce).
+  bool has_dissipated_power() const { return has_damping_ || visco_ != nullptr; }
+
+  // Viscoelastic lines (AxialLaw::kViscoelastic,
+  // engine/elements/viscoelastic_history.h): the law's state at every Gauss
+  // point of their elements. Until StartViscoelastic, and after
+  // RelaxViscoelastic, the law is the relaxed T = EA e (statics, modal
+  // analysis). A dynamic run starts it at its first state (reduced z, time
+  // t) and commits every accepted step's end state; SetTime gives the
+  // elements the law of the step to that time. Nothing without such lines.
+  bool has_viscoelastic() const { return visco_ != nullptr; }
+  void StartViscoelastic(const Eigen::VectorXd& z, double t);
+  void CommitViscoelastic(const Eigen::VectorXd& z, double t);
+  void RelaxViscoelastic();
 
   // The energy [J] below which a change of the total energy is rounding:
   // sum over elements of (EA + EI / l^2) l d^2, d = 16 eps (1 + |q0|_inf) / l,
@@ -709,6 +725,18 @@ class MultibodyModel {
   // The cables' damping term (null: no cable is damped), for the material
   // damping in the tension outputs (ElementEndForces).
   const CableDamping* cable_damping_ = nullptr;
+  // The viscoelastic lines' state (null: none), and the elements (in the
+  // model's element list) whose Gauss points it holds, in its order.
+  std::unique_ptr<ViscoelasticHistory> visco_;
+  std::vector<int> visco_elements_;
+  std::vector<double> visco_strains_;  // scratch: one strain per point
+  std::vector<double> visco_jump_;     // scratch: one energy jump per point [J/m]
+  template <int D>
+  double ViscoelasticEnergyJump(const std::vector<double>& per_point) const;
+  template <int D>
+  void ViscoelasticStrains(const Eigen::VectorXd& z);
+  template <int D>
+  double ViscoelasticPower(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot) const;
   // Scratch (full size) for StaticFriction (sized on first use).
   Eigen::VectorXd scratch_static_;
   Eigen::VectorXd scratch_static_roundoff_;

@@ -18,6 +18,10 @@ std::string ImplicitNeed(const MultibodyModel& model, const Scene& scene) {
   for (int c = 0; c < static_cast<int>(scene.cables.size()); ++c)
     if (scene.cables[c].winch.enabled)
       return absl::StrFormat("cables[%d] has a winch (a mass that changes with time)", c);
+  for (int c = 0; c < static_cast<int>(scene.cables.size()); ++c)
+    if (scene.cables[c].axial_law == AxialLaw::kViscoelastic)
+      return absl::StrFormat("cables[%d] is viscoelastic (its dashpots' law is integrated over "
+                             "each implicit step)", c);
   if (scene.seabed.enabled) return "the seabed's contact stiffens the scene mid-run";
   if (!scene.sheaves.empty()) return "the sheaves' contact stiffens the scene mid-run";
   for (int b = 0; b < static_cast<int>(scene.bodies.size()); ++b)

@@ -327,7 +327,7 @@ void CouplingSession::UpdateForces() {
 }
 
 double CouplingSession::DampingPower() const {
-  if (!s_->model.has_damping() || stepper_ == nullptr) return 0;
+  if (!s_->model.has_dissipated_power() || stepper_ == nullptr) return 0;
   Eigen::VectorXd q(s_->model.coordinates()), qd(s_->model.coordinates());
   s_->model.ToFull(stepper_->z(), &q);
   s_->model.RateToFull(stepper_->v(), &qd);
@@ -415,6 +415,9 @@ absl::Status CouplingSession::Initialize(const std::vector<Eigen::Vector3d>& x,
           absl::StrCat("no static equilibrium with the host's initial positions: ", summary.error));
     }
   }
+  // Viscoelastic lines start with their dashpots at rest; each accepted
+  // step is committed in Step.
+  model.StartViscoelastic(model.initial_z(), 0);
   std::unique_ptr<Stepper> stepper = MakeStepper(&model, settings);
   std::string reason;
   if (!stepper->Initialize(&reason)) {
@@ -512,6 +515,7 @@ absl::Status CouplingSession::Step(double t_end, const std::vector<Eigen::Vector
       const double p = DampingPower();
       dissipated += 0.5 * h_try * (power + p);
       power = p;
+      s_->model.CommitViscoelastic(stepper_->z(), t);
       continue;
     }
     // A step that did not converge leaves the stepper where it was (as in

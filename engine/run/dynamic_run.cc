@@ -27,6 +27,9 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       return;
     }
   }
+  // Viscoelastic lines start from the first state with their dashpots at
+  // rest (ViscoelasticHistory); each accepted step is committed below.
+  model->StartViscoelastic(model->initial_z(), model->initial_time());
   // The stepper's settings: the scene's, with the stepper AUTO runs now.
   SolverSettings stepping = settings;
   std::unique_ptr<Stepper> stepper = MakeStepper(model, stepping);
@@ -488,6 +491,8 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
       }
       if (guarded_attempt == attempt || end_checked || checked_at_frame) guard_passed_t = t;
       rec->AdvanceDamping(t, stepper->z(), stepper->v());
+      // After the step's frames and damped work, which read the step's law.
+      model->CommitViscoelastic(stepper->z(), t);
       summary->end_time_s = t;
       if (grid_end >= 0 && t >= grid_end - 1e-9 * h_nominal) grid_end = -1;
       if (!LetGo(t)) return;

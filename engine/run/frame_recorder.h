@@ -86,7 +86,7 @@ class FrameRecorder {
   // energy.damped is the same function of time whatever the frames);
   // otherwise the power of the state in q_, qd_ at t.
   double Damped(double t) const {
-    if (!model_->has_damping()) return 0;
+    if (!model_->has_dissipated_power()) return 0;
     if (t == damped_t_) return damped_;
     if (has_end_) {
       const double h = end_t_ - damped_t_, dt = t - damped_t_;
@@ -104,7 +104,7 @@ class FrameRecorder {
   // attempt keeps the first's power), before the step's guard, its frames
   // (Damped) and AdvanceDamping.
   void EndStep(double t, const Eigen::VectorXd& z, const Eigen::VectorXd& v, long attempt) {
-    if (!model_->has_damping()) return;
+    if (!model_->has_dissipated_power()) return;
     if (has_end_ && end_attempt_ == attempt) return;
     end_attempt_ = attempt;
     model_->SetTime(t);  // the damping power of waves depends on it
@@ -119,7 +119,7 @@ class FrameRecorder {
   // Moves the start of that rule to an accepted step's end (t, z, v), with
   // the power EndStep evaluated there when it did.
   void AdvanceDamping(double t, const Eigen::VectorXd& z, const Eigen::VectorXd& v) {
-    if (!model_->has_damping()) return;
+    if (!model_->has_dissipated_power()) return;
     double power = end_power_;
     if (!has_end_) {
       model_->SetTime(t);  // the damping power of waves depends on it

@@ -28,8 +28,10 @@ enum class BendingModel { kExact, kLinear, kNone };
 // EA/2 eps^2 of the Green-Lagrange strain eps = (|r'|^2 - 1) / 2, or of the
 // engineering strain e = |r'| - 1 (tension T = EA e, as mooring decks
 // mean their EA), or a tension-strain table T(e) in the engineering strain
-// (CableSpec::tension_table_*; engine/elements/tension_table.h).
-enum class AxialLaw { kGreenLagrange, kEngineering, kTable };
+// (CableSpec::tension_table_*; engine/elements/tension_table.h), or the
+// viscoelastic law of polyester and nylon ropes: two Kelvin-Voigt elements
+// in series (CableSpec::visco_*; engine/elements/viscoelastic_history.h).
+enum class AxialLaw { kGreenLagrange, kEngineering, kTable, kViscoelastic };
 // kSlide: a body point kept on a cable, free to slide along it
 // (SlidingJoint; JointSpec::slide).
 enum class JointType { kPin, kFixed, kSlide };
@@ -89,6 +91,20 @@ struct CableSpec {
   // the axial damping time multiplies and the step checks use.
   std::vector<double> tension_table_strains;
   std::vector<double> tension_table_tensions;
+  // With AxialLaw::kViscoelastic (MoorDyn's viscoelastic line types; Hall
+  // et al., IOWTC2023-110827): in the engineering strain e, a spring
+  // EA_1 beside a dashpot BA [N s] (the slow, static part) in series with a
+  // spring EA_2 beside a dashpot BA_D [N s] (the fast, dynamic part). The
+  // static EA = EA_1 EA_2 / (EA_1 + EA_2) is youngs_modulus_pa * area_m2;
+  // the dynamic EA_2 is visco_dynamic_ea_n, or, when that is 0, the mean-
+  // load law EA_2 = visco_dynamic_ea_base_n + visco_dynamic_ea_slope *
+  // T_mean (T_mean = EA_1 e_1, the static part's tension). EA_2 > EA;
+  // BA + BA_D > 0.
+  double visco_dynamic_ea_n = 0;
+  double visco_dynamic_ea_base_n = 0;
+  double visco_dynamic_ea_slope = 0;
+  double visco_static_damping_ns = 0;
+  double visco_dynamic_damping_ns = 0;
   // Damping (MultibodyModel::DampingForce; 0: none). Kelvin-Voigt
   // retardation times [s]: axial stress E (eps + axial_damping_s deps/dt),
   // bending moment EI (kappa + bending_damping_s dkappa/dt). Rayleigh:
