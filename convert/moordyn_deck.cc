@@ -64,6 +64,11 @@ struct LineType {
   // A tension-strain table (EA given as a file): its knots, as the file
   // gives them; empty for a constant EA.
   std::vector<double> table_strains, table_tensions;
+  // A viscoelastic type (EA "EA|EA_D" or "EA|alphaMBL|beta", BA "BA|BA_D"):
+  // the dynamic stiffness (constant, or the mean-load law's base and
+  // slope) and the dynamic dashpot [N s]; ea and ba are the static ones.
+  bool visco = false;
+  double ea_dynamic = 0, ea_base = 0, ea_slope = 0, ba_dynamic = 0;
 };
 
 enum class PointKind { kFixed, kCoupled, kFree };
@@ -502,24 +507,85 @@ class DeckReader {
                                      "of %.3g Pa, outside %g to %g Pa: EA is in N",
                                      t.ea, t.diameter, e, kDeckModulusLo, kDeckModulusHi));
       }
-    } else if (absl::StrContains(w[3], "|") || absl::StartsWith(w[3], "SYROPE:")) {
+    } else if (absl::StartsWith(w[3], "SYROPE:")) {
       return Error(n, col(3),
                    absl::StrCat("\"", w[3],
-                                "\": a viscoelastic or Syrope law cannot be expressed (a constant "
-                                "EA or a tension-strain table file only)"));
+                                "\": the Syrope law (a working curve that moves with the "
+                                "largest mean tension) cannot be expressed (a constant EA, a "
+                                "tension-strain table file or a viscoelastic EA|EA_D or "
+                                "EA|alphaMBL|beta only)"));
+    } else if (absl::StrContains(w[3], "|")) {
+      // MoorDyn's viscoelastic types: static EA, then the dynamic EA_D
+      // (constant) or alphaMBL and beta (the mean-load law).
+      const std::vector<absl::string_view> parts = absl::StrSplit(w[3], '|');
+      if (parts.size() > 3) {
+        return Error(n, col(3),
+                     absl::StrCat("\"", w[3], "\": at most 3 values separated by | (EA|EA_D or "
+                                  "EA|alphaMBL|beta)"));
+      }
+      if (!absl::SimpleAtod(parts[0], &v)) {
+        return Error(n, col(3),
+                     absl::StrCat("\"", w[3], "\": a viscoelastic line's static EA must be a "
+                                  "number (a tension-strain table file under a viscoelastic law "
+                                  "cannot be expressed)"));
+      }
+      CABLESIM_ASSIGN_OR_RETURN(t.ea, Positive(n, col(3), parts[0]));
+      if (const double e = t.ea / area; e < kDeckModulusLo || e > kDeckModulusHi) {
+        return Error(n, col(3),
+                     absl::StrFormat("%g N over the area of a %g m diameter is a Young's modulus "
+                                     "of %.3g Pa, outside %g to %g Pa: EA is in N",
+                                     t.ea, t.diameter, e, kDeckModulusLo, kDeckModulusHi));
+      }
+      t.visco = true;
+      const std::string dyn = absl::StrCat(col(3), " (dynamic)");
+      if (parts.size() == 2) {
+        CABLESIM_ASSIGN_OR_RETURN(t.ea_dynamic, Positive(n, dyn, parts[1]));
+        if (!(t.ea_dynamic > t.ea)) {
+          return Error(n, dyn,
+                       absl::StrFormat("EA_D %g N must exceed the static EA %g N", t.ea_dynamic,
+                                       t.ea));
+        }
+      } else {
+        CABLESIM_ASSIGN_OR_RETURN(t.ea_base, Positive(n, dyn, parts[1]));
+        CABLESIM_ASSIGN_OR_RETURN(t.ea_slope, NonNegative(n, dyn, parts[2]));
+        if (!(t.ea_base > t.ea)) {
+          return Error(n, dyn,
+                       absl::StrFormat("alphaMBL %g N must exceed the static EA %g N (the "
+                                       "dynamic stiffness at no load)",
+                                       t.ea_base, t.ea));
+        }
+      }
     } else {
       if (absl::Status s = ReadTensionTable(n, col(3), w[3], &t); !s.ok()) return s;
     }
-    if (!absl::SimpleAtod(w[4], &v)) {
+    if (t.visco && absl::StrContains(w[4], "|")) {
+      const std::vector<absl::string_view> parts = absl::StrSplit(w[4], '|');
+      if (parts.size() > 2) {
+        return Error(n, col(4),
+                     absl::StrCat("\"", w[4], "\": at most 2 values separated by | (BA|BA_D)"));
+      }
+      CABLESIM_ASSIGN_OR_RETURN(t.ba, Number(n, col(4), parts[0]));
+      CABLESIM_ASSIGN_OR_RETURN(
+          t.ba_dynamic,
+          NonNegative(n, absl::StrCat(col(4), " (dynamic; a ratio cannot be expressed)"),
+                      parts[1]));
+    } else if (!absl::SimpleAtod(w[4], &v)) {
       return Error(n, col(4),
                    absl::StrCat("\"", w[4],
                                 "\": only one number, a damping coefficient [N s] or a negative "
                                 "damping ratio, can be expressed"));
     }
-    if (absl::StatusOr<double> r = Number(n, col(4), w[4]); r.ok()) {
+    if (absl::StrContains(w[4], "|")) {
+      // (read above)
+    } else if (absl::StatusOr<double> r = Number(n, col(4), w[4]); r.ok()) {
       t.ba = *r;
     } else {
       return r.status();
+    }
+    if (t.visco && t.ba == 0 && t.ba_dynamic == 0) {
+      return Error(n, col(4),
+                   "a viscoelastic line needs a dashpot: BA or BA_D (after a |) > 0 (without "
+                   "one its two springs are one spring of the static EA)");
     }
     if (!absl::SimpleAtod(w[5], &v)) {
       return Error(n, col(5), absl::StrCat("\"", w[5], "\": only a constant EI can be expressed"));
@@ -1469,7 +1535,9 @@ class DeckReader {
       } else {
         c->set_bending(v1::NONE);
       }
-      if (t.table_strains.empty()) {
+      if (t.visco) {
+        c->set_axial_law(v1::VISCOELASTIC);
+      } else if (t.table_strains.empty()) {
         c->set_axial_law(v1::ENGINEERING);
       } else {
         c->set_axial_law(v1::TABLE);
@@ -1483,7 +1551,21 @@ class DeckReader {
       // sqrt(EA m)); cablesim's Kelvin-Voigt time is BA / EA.
       const double ba =
           t.ba < 0 ? -t.ba * (l.length / l.segments) * std::sqrt(t.ea * t.mass_per_length) : t.ba;
-      if (ba > 0) c->mutable_damping()->set_axial_time(ba / t.ea);
+      if (t.visco) {
+        // The static dashpot BA beside EA_1 and the dynamic one beside
+        // EA_2 (a ratio BA < 0 as MoorDyn scales it, on the static EA).
+        v1::Viscoelastic* ve = c->mutable_viscoelastic();
+        if (t.ea_dynamic > 0) {
+          ve->set_dynamic_ea(t.ea_dynamic);
+        } else {
+          ve->set_dynamic_ea_base(t.ea_base);
+          ve->set_dynamic_ea_slope(t.ea_slope);
+        }
+        ve->set_static_damping(ba);
+        ve->set_dynamic_damping(t.ba_dynamic);
+      } else if (ba > 0) {
+        c->mutable_damping()->set_axial_time(ba / t.ea);
+      }
       if (rho > 0) {  // WtrDnsty 0: no fluid for the coefficients to act in
         v1::Hydrodynamics* h = c->mutable_hydrodynamics();
         h->set_normal_drag(t.cd);
@@ -1704,11 +1786,13 @@ class DeckReader {
       }
       const LineType& ta = *la.type;
       const LineType& tb = *lb.type;
-      if (ta.ea != tb.ea || !ta.table_strains.empty() || !tb.table_strains.empty()) {
+      if (ta.ea != tb.ea || !ta.table_strains.empty() || !tb.table_strains.empty() || ta.visco ||
+          tb.visco) {
         return Error(lb.line, "LINES LineType",
                      absl::StrCat("lines ", la.id, " and ", lb.id, " meet at rod ", r.id,
                                   " (of zero length) with ",
-                                  ta.table_strains.empty() && tb.table_strains.empty()
+                                  ta.visco || tb.visco ? "a viscoelastic law"
+                                  : ta.table_strains.empty() && tb.table_strains.empty()
                                       ? "different EA"
                                       : "a tension-strain table",
                                   ": the FIXED joint between them holds their stretches equal "

@@ -131,6 +131,30 @@ TEST(MoorDynDeckTest, LineTypesTranslateEveryConvention) {
   EXPECT_DOUBLE_EQ(rope.damping().axial_time(), 3.0e6 / 2.0e8);     // BA >= 0: N s
 }
 
+// MoorDyn's viscoelastic types: EA "EA|EA_D" (a constant dynamic
+// stiffness) or "EA|alphaMBL|beta" (the mean-load law), BA "BA|BA_D".
+TEST(MoorDynDeckTest, ViscoelasticTypesBecomeTheViscoelasticLaw) {
+  const v1::Scene constant = Read(Edited("2.0e8      3.0e6", "2.0e8|3.0e8  3.0e6|1.0e5"));
+  const v1::Cable& rope = CableNamed(constant, "line2");
+  EXPECT_EQ(rope.axial_law(), v1::VISCOELASTIC);
+  EXPECT_DOUBLE_EQ(rope.youngs_modulus() * rope.area(), 2.0e8);  // the static EA
+  EXPECT_DOUBLE_EQ(rope.viscoelastic().dynamic_ea(), 3.0e8);
+  EXPECT_FALSE(rope.viscoelastic().has_dynamic_ea_base());
+  EXPECT_DOUBLE_EQ(rope.viscoelastic().static_damping(), 3.0e6);
+  EXPECT_DOUBLE_EQ(rope.viscoelastic().dynamic_damping(), 1.0e5);
+  EXPECT_EQ(rope.damping().axial_time(), 0);  // BA is the law's dashpot, not Kelvin-Voigt's
+  const v1::Scene mean = Read(Edited("2.0e8      3.0e6", "2.0e8|2.2e8|0.4  3.0e6"));
+  const v1::Cable& m = CableNamed(mean, "line2");
+  EXPECT_EQ(m.axial_law(), v1::VISCOELASTIC);
+  EXPECT_FALSE(m.viscoelastic().has_dynamic_ea());
+  EXPECT_DOUBLE_EQ(m.viscoelastic().dynamic_ea_base(), 2.2e8);
+  EXPECT_DOUBLE_EQ(m.viscoelastic().dynamic_ea_slope(), 0.4);
+  EXPECT_DOUBLE_EQ(m.viscoelastic().dynamic_damping(), 0);  // no BA_D: MoorDyn's 0
+  // The scenes convert (the law's own checks pass).
+  EXPECT_TRUE(SceneFromProto(constant).ok()) << SceneFromProto(constant).status();
+  EXPECT_TRUE(SceneFromProto(mean).ok()) << SceneFromProto(mean).status();
+}
+
 TEST(MoorDynDeckTest, OptionsBecomeEnvironmentAndSeabed) {
   const v1::Scene s = Read(kDeck, "some/dir/test.dat");
   EXPECT_EQ(s.name(), "test");
@@ -356,6 +380,10 @@ TEST(MoorDynDeckTest, RefusalsNameTheLineAndField) {
        "bad.dat:21: LINES AttachB: point 9 does not exist"},
       {"1.0e9      -0.5", "chain.txt  -0.5", "bad.dat:6: LINE TYPES EA: \"chain.txt\""},
       {"1.0e9      -0.5", "1.0e9      -0.5|0.1", "bad.dat:6: LINE TYPES BA/-zeta"},
+      {"1.0e9      -0.5", "1.0e9|0.9e9  -0.5", "bad.dat:6: LINE TYPES EA (dynamic): EA_D 9e+08 N must exceed the static EA 1e+09 N"},
+      {"1.0e9      -0.5", "1.0e9|2e9  1e6|-0.1", "bad.dat:6: LINE TYPES BA/-zeta (dynamic; a ratio cannot be expressed): must be >= 0"},
+      {"1.0e9      -0.5", "1.0e9|2e9  0", "bad.dat:6: LINE TYPES BA/-zeta: a viscoelastic line needs a dashpot"},
+      {"1.0e9      -0.5", "SYROPE:s.dat|1e9|0.2  0", "bad.dat:6: LINE TYPES EA: \"SYROPE:s.dat|1e9|0.2\": the Syrope law"},
       {"100        1.0e9", "-100       1.0e9", "bad.dat:6: LINE TYPES Mass/m: must be > 0"},
       {"0.001         dtM", "0.001         dtM\n7             NotAnOption",
        "bad.dat:25: OPTIONS NotAnOption"},
