@@ -569,6 +569,11 @@ class DeckReader {
           t.ba_dynamic,
           NonNegative(n, absl::StrCat(col(4), " (dynamic; a ratio cannot be expressed)"),
                       parts[1]));
+    } else if (absl::StrContains(w[4], "|")) {
+      return Error(n, col(4),
+                   absl::StrCat("\"", w[4],
+                                "\": BA|BA_D (a dynamic dashpot) needs a viscoelastic EA "
+                                "(EA|EA_D or EA|alphaMBL|beta)"));
     } else if (!absl::SimpleAtod(w[4], &v)) {
       return Error(n, col(4),
                    absl::StrCat("\"", w[4],

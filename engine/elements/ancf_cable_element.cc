@@ -183,19 +183,6 @@ void AncfCableElement<D>::AxialStrains(const Coords& e, double* out) const {
   }
 }
 
-template <int D>
-void AncfCableElement<D>::AxialStrainAndRate(const Coords& e, const Coords& edot, int g,
-                                             double* strain, double* rate) const {
-  Point u = Point::Zero(), ud = Point::Zero();
-  for (int k = 0; k < 4; ++k) {
-    u += d1_[g][k] * e.template segment<D>(k * D);
-    ud += d1_[g][k] * edot.template segment<D>(k * D);
-  }
-  const double s = u.norm();
-  *strain = s - 1;
-  *rate = s > 0 ? u.dot(ud) / s : 0.0;
-}
-
 // The TABLE and VISCOELASTIC laws' loops are instantiated in
 // ancf_cable_element_table.cc.
 extern template void AncfCableElement<2>::ElasticForceWith<AxialLaw::kTable>(

@@ -86,9 +86,6 @@ class AncfCableElement {
   }
   // The engineering strain |r'| - 1 at each Gauss point into out[g].
   void AxialStrains(const Coords& e, double* out) const;
-  // The engineering strain and its rate u.udot / |u| at Gauss point g.
-  void AxialStrainAndRate(const Coords& e, const Coords& edot, int g, double* strain,
-                          double* rate) const;
 
   double length() const { return length_; }
   // A new undeformed length [m] (a winch cable's elements, whose length

@@ -48,7 +48,8 @@
 //
 // Before a dynamic run starts (statics, modal analysis) the law is the
 // relaxed one, T = EA e; a run starts with the dashpots at rest,
-// e_1 = EA_2 / (EA_1 + EA_2) e (the static split of the strain).
+// e_1 = EA_2 / (EA_1 + EA_2) e (the static split of the strain; under the
+// mean-load law T_m is then EA e, so EA_2 = a + beta EA e).
 //
 // Units: SI; stiffnesses EA [N], dashpots BA [N s], strains [-].
 
@@ -89,6 +90,10 @@ class ViscoelasticHistory {
   void Start(const std::vector<double>& strains, double t);
   bool started() const { return started_; }
   // Coefficients of a state at time t of the step from the committed one.
+  // Within 1e-9 of the last committed step after the committed time (a
+  // frame at it, a stepper restarted there) the last step's stay: they
+  // give the committed state's tension with its strain rate, where a
+  // step of length ~0 would divide the fast dashpot's share by ~0.
   void SetTime(double t);
   // The step to time t is accepted with `strains`: it becomes the state
   // steps start from. The coefficients stay those of the last SetTime.
@@ -100,12 +105,14 @@ class ViscoelasticHistory {
   void Commit(const std::vector<double>& strains, double t, std::vector<double>* energy_jump);
 
   // The dissipated power per unit length [W/m] at a point at strain e,
-  // with the strain rate the step's law sees, (e - e^n) / tau (de/dt
-  // `e_rate` at the committed state itself), and de_1/dt from (1): the
-  // power of the tension the law gives, so that energy.damped matches the
-  // work the supports do through it (with the rate at the step's end
-  // instead, a line pulled from rest gained energy in its first steps).
-  double DissipatedPower(int point, double e, double e_rate) const;
+  // with the strain rate the step's law sees, (e - e^n) / tau (0 at the
+  // committed state itself, tau <= 0, as the law's tension there), and
+  // de_1/dt from (1): the power of the tension the law gives, so that
+  // energy.damped matches the work the supports do through it (with the
+  // material rate at the step's end instead, a line pulled from rest
+  // gained energy in its first steps, and one started at a speed in its
+  // first).
+  double DissipatedPower(int point, double e) const;
   // Stored energy per unit length [J/m] at a point.
   double StoredEnergy(int point, double e) const;
 
@@ -127,6 +134,7 @@ class ViscoelasticHistory {
   // The committed state per point: e^n, e_1^n, and EA_1, EA_2 for the step.
   std::vector<double> e_n_, e1_n_, ea1_, ea2_;
   double t_n_ = 0;
+  double last_step_s_ = 0;  // the last committed step's length
   bool started_ = false;
 };
 

@@ -445,18 +445,15 @@ void MultibodyModel::ViscoelasticStrains(const VectorXd& z) {
 }
 
 template <int D>
-double MultibodyModel::ViscoelasticPower(const VectorXd& q, const VectorXd& qdot) const {
+double MultibodyModel::ViscoelasticPower(const VectorXd& q) const {
   double power = 0;
   int point = 0;
+  double strains[GaussRule::kMaxPoints];
   for (int k : visco_elements_) {
     const ElementData<D>& e = Elements<D>()[k];
-    const auto ek = q.segment<4 * D>(e.first_coord);
-    const auto edk = qdot.segment<4 * D>(e.first_coord);
-    for (int g = 0; g < e.element.gauss_points(); ++g, ++point) {
-      double strain, rate;
-      e.element.AxialStrainAndRate(ek, edk, g, &strain, &rate);
-      power += e.element.GaussLength(g) * visco_->DissipatedPower(point, strain, rate);
-    }
+    e.element.AxialStrains(q.segment<4 * D>(e.first_coord), strains);
+    for (int g = 0; g < e.element.gauss_points(); ++g, ++point)
+      power += e.element.GaussLength(g) * visco_->DissipatedPower(point, strains[g]);
   }
   return power;
 }
@@ -493,8 +490,19 @@ void MultibodyModel::CommitViscoelastic(const VectorXd& z, double t) {
   visco_->Commit(visco_strains_, t, &visco_jump_);
   // The mean-load law's change of stored energy with its stiffness
   // (ViscoelasticHistory::Commit), counted as external work.
-  external_work_ +=
+  const double jump =
       dim_ == 2 ? ViscoelasticEnergyJump<2>(visco_jump_) : ViscoelasticEnergyJump<3>(visco_jump_);
+  external_work_ += jump;
+  visco_work_ += jump;
+}
+
+bool MultibodyModel::AdoptViscoelastic(const MultibodyModel& old) {
+  if (!visco_ || !old.visco_ || visco_->points() != old.visco_->points() ||
+      visco_elements_ != old.visco_elements_)
+    return false;
+  *visco_ = *old.visco_;  // the contents: the elements point at visco_
+  visco_work_ = old.visco_work_;
+  return true;
 }
 
 void MultibodyModel::RelaxViscoelastic() {
@@ -504,7 +512,7 @@ void MultibodyModel::RelaxViscoelastic() {
 double MultibodyModel::DampingPower(const VectorXd& q, const VectorXd& qdot) const {
   if (!has_dissipated_power()) return 0;
   double power = 0;  // -Q_d . qdot
-  if (visco_) power += dim_ == 2 ? ViscoelasticPower<2>(q, qdot) : ViscoelasticPower<3>(q, qdot);
+  if (visco_) power += dim_ == 2 ? ViscoelasticPower<2>(q) : ViscoelasticPower<3>(q);
   if (!has_damping_) return power;
   if (dim_ == 2) {
     ElementDamping<2>(q, qdot, nullptr, nullptr, 0, nullptr, &power);

@@ -234,6 +234,13 @@ class MultibodyModel {
   void StartViscoelastic(const Eigen::VectorXd& z, double t);
   void CommitViscoelastic(const Eigen::VectorXd& z, double t);
   void RelaxViscoelastic();
+  // The mean-load law's changes of stored energy at its stiffness updates
+  // [J] (ViscoelasticHistory::Commit), which external_work() includes.
+  double viscoelastic_work() const { return visco_work_; }
+  // Takes over `old`'s viscoelastic state and its share of the external
+  // work (a model rebuilt when a joint lets go, whose elements and Gauss
+  // points are old's); false when the two do not match point for point.
+  bool AdoptViscoelastic(const MultibodyModel& old);
 
   // The energy [J] below which a change of the total energy is rounding:
   // sum over elements of (EA + EI / l^2) l d^2, d = 16 eps (1 + |q0|_inf) / l,
@@ -731,12 +738,13 @@ class MultibodyModel {
   std::vector<int> visco_elements_;
   std::vector<double> visco_strains_;  // scratch: one strain per point
   std::vector<double> visco_jump_;     // scratch: one energy jump per point [J/m]
+  double visco_work_ = 0;              // viscoelastic_work()
   template <int D>
   double ViscoelasticEnergyJump(const std::vector<double>& per_point) const;
   template <int D>
   void ViscoelasticStrains(const Eigen::VectorXd& z);
   template <int D>
-  double ViscoelasticPower(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot) const;
+  double ViscoelasticPower(const Eigen::VectorXd& q) const;
   // Scratch (full size) for StaticFriction (sized on first use).
   Eigen::VectorXd scratch_static_;
   Eigen::VectorXd scratch_static_roundoff_;

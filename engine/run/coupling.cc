@@ -345,8 +345,9 @@ double CouplingSession::energy() const {
   EnergyParts parts;
   EnergySample e = s_->model.Energy(q, qd, 1.0, &parts);
   // (No external work is summed in a session: potential is gravity's and
-  // the constant loads'.)
-  double total = e.total + s_->model.external_work();
+  // the constant loads'; but the viscoelastic lines' stiffness updates
+  // are, and stay: they are the lines' own.)
+  double total = e.total + s_->model.external_work() - s_->model.viscoelastic_work();
   for (const Body& b : bodies_) total -= parts.bodies[b.body].kinetic + parts.bodies[b.body].gravity;
   return total;
 }
@@ -406,6 +407,7 @@ absl::Status CouplingSession::Initialize(const std::vector<Eigen::Vector3d>& x,
     }
   }
   model.SetTime(0);
+  model.RelaxViscoelastic();  // (statics take the static EA, also on a retry)
   if (!statics) model.SetInitialState(model.initial_z());
   if (statics) {
     RunSummary summary;

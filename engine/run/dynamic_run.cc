@@ -29,6 +29,17 @@ void RunDynamic(MultibodyModel* model, const SolverSettings& settings, const Run
   }
   // Viscoelastic lines start from the first state with their dashpots at
   // rest (ViscoelasticHistory); each accepted step is committed below.
+  // Their dashpots are integrated over implicit steps only (scenes are
+  // refused otherwise, naming solver.integrator; this guards callers that
+  // build settings by hand).
+  if (model->has_viscoelastic() && (TraitsOf(settings.integrator).is_explicit ||
+                                    settings.integrator == Integrator::kEnergyMomentum)) {
+    Fail(summary, 0,
+         absl::StrFormat("%s does not apply to a scene with viscoelastic cables (use "
+                         "IMPLICIT_EULER, GENERALIZED_ALPHA or HHT)",
+                         IntegratorName(settings.integrator)));
+    return;
+  }
   model->StartViscoelastic(model->initial_z(), model->initial_time());
   // The stepper's settings: the scene's, with the stepper AUTO runs now.
   SolverSettings stepping = settings;

@@ -89,10 +89,16 @@ absl::StatusOr<bool> JointRelease::LetGo(MultibodyModel* model, double t, double
         "joints[%d] let go at t = %.9g s, but the model without it could not be built: %s",
         events->back().joint, t, built.status().message()));
   }
+  // The viscoelastic lines' state goes on in the new model (the mesh is
+  // the same: a released joint only drops its rows), or restarts at rest
+  // if it cannot.
+  MultibodyModel old = std::move(*model);
   *model = std::move(*built);
   model->set_stop_poll(poll);
   model->SetTime(t);
   model->SetInitialState(model->Reduce(q_), model->Reduce(qdot_), work, t);
+  if (old.has_viscoelastic() && !model->AdoptViscoelastic(old))
+    model->StartViscoelastic(model->initial_z(), t);
   rebuilt_ = true;
   return true;
 }

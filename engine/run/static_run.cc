@@ -12,7 +12,9 @@ void RunStatic(MultibodyModel* model, const SolverSettings& settings, const RunC
                FrameRecorder* rec, RunSummary* summary) {
   StaticSolver solver(model, settings);
   // Statics is the equilibrium at t = 0: moving supports at their start,
-  // time-varying loads at their value there (scaled by the load factor).
+  // time-varying loads at their value there (scaled by the load factor);
+  // viscoelastic lines at their static EA.
+  model->RelaxViscoelastic();
   model->SetTime(0);
   ExternalWork external_work(model);
   auto on_increment = [&](const Eigen::VectorXd& z0, const Eigen::VectorXd& z1, double alpha) {
@@ -37,6 +39,7 @@ bool StartFromEquilibrium(MultibodyModel* model, const SolverSettings& settings,
   SolverSettings statics = settings;
   statics.analysis = Analysis::kStatic;
   statics.newton_tolerance = std::min(settings.newton_tolerance, 1e-12);
+  model->RelaxViscoelastic();  // viscoelastic lines at their static EA
   StaticSolver solver(model, statics);
   RunSummary path;
   const bool ok = FollowLoadPath(&solver, statics, control, &path,
