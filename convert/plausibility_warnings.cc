@@ -136,7 +136,13 @@ std::vector<std::string> PlausibilityWarnings(const v1::Scene& proto, const Scen
           path, size_field));
     }
     if (fixed_dynamic_step && ea > 0) {
-      const double period = 2 * kPi * std::sqrt((payload + cable_mass / 3) * length / ea);
+      // A viscoelastic line bounces on its dynamic stiffness EA_2 (at least
+      // the mean-load law's at no load), stiffer than the static EA.
+      double ea_bounce = ea;
+      if (cable.axial_law == AxialLaw::kViscoelastic)
+        ea_bounce = std::max(ea, cable.visco_dynamic_ea_n > 0 ? cable.visco_dynamic_ea_n
+                                                               : cable.visco_dynamic_ea_base_n);
+      const double period = 2 * kPi * std::sqrt((payload + cable_mass / 3) * length / ea_bounce);
       if (period < shortest_period) {
         shortest_period = period;
         shortest_what = absl::StrFormat("the axial bounce of %s with %.3g kg of payload",

@@ -30,6 +30,7 @@
 #include <gtest/gtest.h>
 
 #include "absl/strings/str_format.h"
+#include "convert/plausibility_warnings.h"
 #include "engine/elements/viscoelastic_history.h"
 #include "engine/run/simulation.h"
 #include "test_util.h"
@@ -205,6 +206,19 @@ TEST(ViscoelasticLineTest, StepCoefficientsRelaxToTheStaticLaw) {
   const double e1 = ea2 / (ea1 + ea2) * 1e-3;
   const auto s = ViscoelasticHistory::StepCoefficients(law, ea1, ea2, 1e-3, e1, 1e-7);
   EXPECT_NEAR(s.k * 1e-3 + s.p, kEa * 1e-3, 1e-9 * kEa * 1e-3);
+}
+
+// The fixed-step warning measures a viscoelastic line's axial bounce on its
+// dynamic stiffness: the bar's is 2.09 ms with EA_2 = 3 EA (3.63 ms with
+// the static EA), so a 3 ms step is warned about.
+TEST(ViscoelasticLineTest, StepWarningUsesTheDynamicStiffness) {
+  const std::string json = Bar(R"({"dynamic_ea": 23561.9, "static_damping": 1e4})", 0.003);
+  const absl::StatusOr<v1::Scene> proto = ParseSceneJson(json);
+  ASSERT_TRUE(proto.ok()) << proto.status();
+  const std::vector<std::string> warnings = PlausibilityWarnings(*proto, SceneFromJson(json));
+  EXPECT_THAT(warnings, ::testing::Contains(HasSubstr(
+                            "solver.step: 0.003 s is above the shortest period the scene's "
+                            "cables resolve, 0.00209 s")));
 }
 
 TEST(ViscoelasticLineTest, RefusalsNameTheField) {
