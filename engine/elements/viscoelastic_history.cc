@@ -83,12 +83,12 @@ void ViscoelasticHistory::Relax() {
 }
 
 void ViscoelasticHistory::Start(const std::vector<double>& strains, double t) {
-  for (int i = 0; i < points(); ++i) e_n_[i] = strains[i];
   t_n_ = t;
   last_step_s_ = 0;
   started_ = true;
   for (int i = 0; i < points(); ++i) {
     const Law& law = laws_[point_law_[i]];
+    e_n_[i] = strains[i];
     // At rest the slow part carries the whole tension, T_m = EA e: the
     // mean-load law's EA_2 in closed form (DynamicStiffness of the split
     // below returns it; an iteration from the unloaded split did not

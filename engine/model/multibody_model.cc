@@ -460,11 +460,7 @@ double MultibodyModel::ViscoelasticPower(const VectorXd& q) const {
 
 void MultibodyModel::StartViscoelastic(const VectorXd& z, double t) {
   if (!visco_) return;
-  if (dim_ == 2) {
-    ViscoelasticStrains<2>(z);
-  } else {
-    ViscoelasticStrains<3>(z);
-  }
+  dim_ == 2 ? ViscoelasticStrains<2>(z) : ViscoelasticStrains<3>(z);
   visco_->Start(visco_strains_, t);
 }
 
@@ -482,11 +478,7 @@ double MultibodyModel::ViscoelasticEnergyJump(const std::vector<double>& per_poi
 
 void MultibodyModel::CommitViscoelastic(const VectorXd& z, double t) {
   if (!visco_) return;
-  if (dim_ == 2) {
-    ViscoelasticStrains<2>(z);
-  } else {
-    ViscoelasticStrains<3>(z);
-  }
+  dim_ == 2 ? ViscoelasticStrains<2>(z) : ViscoelasticStrains<3>(z);
   visco_->Commit(visco_strains_, t, &visco_jump_);
   // The mean-load law's change of stored energy with its stiffness
   // (ViscoelasticHistory::Commit), counted as external work.
